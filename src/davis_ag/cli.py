@@ -1,0 +1,41 @@
+"""The ``davis-ag`` command line: one sub-command per module in :mod:`davis_ag.commands`."""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from davis_ag import __version__
+from davis_ag.errors import UserError
+
+# Each name is a module of davis_ag.commands defining ``register(subparsers)``; the registered
+# parser's ``func`` default takes the parsed arguments and returns an exit code.
+COMMANDS = ["generate"]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """Build the top-level parser with every sub-command registered."""
+    parser = argparse.ArgumentParser(prog="davis-ag", description=__doc__)
+    parser.add_argument("--version", action="version", version=f"davis-ag {__version__}")
+    subparsers = parser.add_subparsers(dest="command", required=True)
+    for name in COMMANDS:
+        importlib.import_module(f"davis_ag.commands.{name}").register(subparsers)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line; a :class:`UserError` becomes one line on stderr and exit code 2."""
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except UserError as error:
+        print(f"davis-ag {args.command}: error: {error}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"davis-ag {args.command}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,1 @@
+"""One module per ``davis-ag`` sub-command; each defines ``register(subparsers)``."""
