@@ -1,0 +1,43 @@
+"""``davis-ag train``: train the paper's A2C agent on a dataset's train split."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``train`` sub-command."""
+    parser = subparsers.add_parser(
+        "train",
+        help="train an A2C agent for target visibility maximisation",
+        description="Train Stable-Baselines3 A2C (CnnPolicy, the paper's NatureCNN, SB3 default "
+                    "hyperparameters) on the train split of the TVM environment and save a .zip.",
+    )
+    parser.add_argument("--dataset", required=True, metavar="DIR", help="dataset root")
+    parser.add_argument("--scenario", required=True, choices=["sp", "mp"],
+                        help="single plant (tau=3) or multi plant (tau=5)")
+    parser.add_argument("--crop", default=None, help="train on one crop only (default: all)")
+    parser.add_argument("--timesteps", type=int, default=300_000, metavar="N",
+                        help="environment steps (default: 300000, as in the paper)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of SB3 and the environments")
+    parser.add_argument("--n-envs", type=int, default=8, help="parallel environments (default: 8)")
+    parser.add_argument("--arch", choices=["nature", "pooled"], default="nature",
+                        help="network: nature (the paper's, default) or pooled (fast smoke tests)")
+    parser.add_argument("--device", default="auto", help="torch device (default: auto)")
+    parser.add_argument("--cache-dir", default=None, metavar="DIR",
+                        help="observation cache folder (default: DIR/.davis_ag_cache)")
+    parser.add_argument("--out", required=True, metavar="MODEL.zip", help="where to save the model")
+    parser.add_argument("--verbose", type=int, default=1, help="SB3 verbosity (default: 1)")
+    parser.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Train and save; prints the model's path."""
+    from davis_ag.agents import train_a2c
+
+    path = train_a2c(args.dataset, args.scenario, total_timesteps=args.timesteps, seed=args.seed,
+                     out_path=args.out, n_envs=args.n_envs, crop=args.crop,
+                     cache_dir=args.cache_dir, arch=args.arch, device=args.device,
+                     verbose=args.verbose)
+    print(f"saved {path}")
+    return 0

@@ -1,0 +1,42 @@
+"""``davis-ag validate DIR``: check a dataset and list every problem, one line each."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from davis_ag.errors import UserError
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``validate`` sub-command."""
+    parser = subparsers.add_parser(
+        "validate",
+        help="check a dataset: schema, files, pointers, boxes against masks",
+        description="Check a DAVIS-Ag dataset (ours or the original download): every annotations.json "
+                    "entry, image and mask, every pointer and every box against its mask. Prints one "
+                    "'path: reason' line per problem and a summary; exits 0 when sound, 1 otherwise.",
+    )
+    parser.add_argument("dir", metavar="DIR", help="dataset root, group folder (e.g. Single-Strawberry) "
+                                                   "or scene folder")
+    parser.add_argument("--quick", action="store_true",
+                        help="skip pixel checks (image and mask sizes, boxes against masks)")
+    parser.add_argument("--box-tolerance", type=int, default=None, metavar="PX",
+                        help="pixels a box edge may differ from its mask's extent (default: 0 for scenes "
+                             "with scene.json, 1 for the original download)")
+    parser.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Validate ``args.dir``; 0 when sound, 1 when a problem was found."""
+    from tqdm import tqdm
+
+    from davis_ag.validate import validate_dataset
+
+    if args.box_tolerance is not None and args.box_tolerance < 0:
+        raise UserError(f"--box-tolerance must be 0 or more, got {args.box_tolerance}")
+    # tqdm.write keeps the problem lines from tearing the progress bar on stderr.
+    report = validate_dataset(args.dir, quick=args.quick, box_tolerance=args.box_tolerance,
+                              on_problem=lambda p: tqdm.write(str(p), file=sys.stdout), progress=True)
+    print(report.summary())
+    return 0 if report.ok else 1

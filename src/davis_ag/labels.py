@@ -1,0 +1,121 @@
+"""Fruit labels of one view from the renderer's primitive-id image: masks, boxes, visibility.
+
+Box convention (the published one): ``[xmin, ymin, width, height, fruit_id, 0]`` where xmin, ymin
+is the fruit's leftmost column and topmost row and width, height its inclusive pixel extent.
+The segmentation image holds, per pixel, the id of the fruit seen there if that fruit has a box
+in this view, else 255.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from davis_ag.render import Camera
+from davis_ag.view_grid import Viewpoint
+
+NO_FRUIT = 255
+#: Fruit ids are uint8 values below NO_FRUIT, so a scene holds at most this many fruit.
+MAX_FRUIT = NO_FRUIT
+
+
+@dataclass(frozen=True)
+class ViewLabels:
+    """Labels of one view.
+
+    Attributes:
+        segmentation: (height, width) uint8, fruit id per pixel, 255 where no labelled fruit.
+        boxes: Published boxes ``[xmin, ymin, width, height, fruit_id, 0]``, sorted by fruit id.
+        visible_pixels: Visible pixels of each boxed fruit.
+    """
+
+    segmentation: np.ndarray
+    boxes: list[list[int]]
+    visible_pixels: dict[int, int]
+
+
+def fruit_lookup(fruit_primitives: dict[int, np.ndarray], uuid_count: int) -> np.ndarray:
+    """Table from primitive-id pixel value (UUID + 1, 0 = nothing) to fruit id, 255 for non-fruit.
+
+    Args:
+        fruit_primitives: Primitive UUIDs of each fruit id.
+        uuid_count: One more than the largest UUID in the scene.
+    """
+    table = np.full(uuid_count + 1, NO_FRUIT, dtype=np.uint8)
+    for fruit_id, uuids in fruit_primitives.items():
+        table[np.asarray(uuids, dtype=np.int64) + 1] = fruit_id
+    return table
+
+
+def label_view(primitive_ids: np.ndarray, lookup: np.ndarray, min_pixels: int) -> ViewLabels:
+    """Boxes and segmentation of the fruit seen in a view.
+
+    Args:
+        primitive_ids: The renderer's id image (UUID + 1 per pixel, 0 = nothing).
+        lookup: :func:`fruit_lookup` of the scene.
+        min_pixels: Visible pixels a fruit needs for a box (section III-C).
+    """
+    fruit_map = lookup[np.minimum(primitive_ids, len(lookup) - 1)]
+    flat = np.flatnonzero(fruit_map != NO_FRUIT)
+    ids = fruit_map.ravel()[flat]
+    counts = np.bincount(ids, minlength=NO_FRUIT)
+    kept = np.flatnonzero(counts >= min_pixels)
+    width = fruit_map.shape[1]
+    rows, cols = np.divmod(flat, width)
+    boxes: list[list[int]] = []
+    for fruit_id in kept:
+        mine = ids == fruit_id
+        r, c = rows[mine], cols[mine]
+        x0, y0 = int(c.min()), int(r.min())
+        boxes.append([x0, y0, int(c.max()) - x0 + 1, int(r.max()) - y0 + 1, int(fruit_id), 0])
+    keep = np.zeros(NO_FRUIT + 1, dtype=bool)
+    keep[kept] = True
+    segmentation = np.where(keep[fruit_map], fruit_map, NO_FRUIT).astype(np.uint8)
+    return ViewLabels(segmentation, boxes, {int(f): int(counts[f]) for f in kept})
+
+
+def silhouette_pixels(camera: Camera, view: Viewpoint, polygons: list[np.ndarray]) -> int:
+    """Pixels a fruit would cover in the image with nothing in front of it.
+
+    The fruit's primitives are projected with the pinhole model and filled (OpenCV, 1/16-pixel
+    precision); the count is taken within the image frame, like the visible pixels.
+
+    Args:
+        camera: The camera.
+        view: The pose.
+        polygons: The fruit's primitives, grouped by vertex count: arrays of (n, k, 3).
+    """
+    projected = []
+    for group in polygons:
+        uv, depth = camera.project(view, group)
+        in_front = (depth > 0.01).all(axis=1)
+        if in_front.any():
+            projected.append(uv[in_front])
+    if not projected:
+        return 0
+    lo = np.floor(np.min([p.reshape(-1, 2).min(axis=0) for p in projected], axis=0)).astype(int)
+    hi = np.ceil(np.max([p.reshape(-1, 2).max(axis=0) for p in projected], axis=0)).astype(int)
+    lo = np.maximum(lo, 0)
+    hi = np.minimum(hi, (camera.width, camera.height))
+    if (hi <= lo).any():
+        return 0
+    canvas = np.zeros((hi[1] - lo[1], hi[0] - lo[0]), dtype=np.uint8)
+    shift = 4
+    # OpenCV puts integer coordinates at pixel centres; ours put them at pixel corners.
+    for group in projected:
+        points = np.round((group - lo - 0.5) * (1 << shift)).astype(np.int32)
+        cv2.fillPoly(canvas, list(points), 1, lineType=cv2.LINE_8, shift=shift)
+    return int(np.count_nonzero(canvas))
+
+
+def visible_fractions(
+    camera: Camera, view: Viewpoint, labels: ViewLabels, fruit_polygons: dict[int, list[np.ndarray]]
+) -> dict[int, float]:
+    """Visible pixels over unoccluded pixels for every boxed fruit, rounded to 4 digits."""
+    fractions = {}
+    for fruit_id, visible in labels.visible_pixels.items():
+        whole = silhouette_pixels(camera, view, fruit_polygons[fruit_id])
+        fractions[fruit_id] = round(min(1.0, visible / max(whole, visible, 1)), 4)
+    return fractions

@@ -1,0 +1,394 @@
+"""Grow the plants of a scene with pyhelios3d's PlantArchitecture and measure what was built.
+
+Phenotypes follow Table 1 of the paper, varied per plant (section III-A). The library models do
+not expose height, fruit radius or leaf length directly, so each plant is built, measured, its
+shoot parameters corrected by the ratio of target to measured value, and rebuilt from the same
+seed, until the measurement is within ``TOLERANCE`` of the target (at most ``MAX_BUILDS`` builds).
+
+What is measured (metres):
+
+- height: top of the plant above the ground (strawberry, tomato); for the vine, the trunk height.
+- fruit radius: per fruit, half the mean extent of its vertices along their principal axes;
+  for the vine, the radius of single berries (a cluster is one fruit object, split into berries
+  by mesh connectivity). The plant's value is the median over fruit.
+- leaf length: per leaf (every blade on one petiole: three leaflets for strawberry, seven for
+  tomato, one for the vine), the extent of its blades along their principal axis; the plant's
+  value is the median over leaves. Helios numbers a leaf's blades consecutively, so a leaf is a
+  run of consecutive blade object ids, at most ``blades_per_leaf`` long.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import copy
+import math
+import os
+import sys
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from davis_ag.config import PHENOTYPE_SPREAD, CropSpec
+from davis_ag.errors import UserError
+
+#: Helios maps seeds 0, 1, 2**31 - 1 and 2**32 - 1 to the same plant: stay inside this range.
+HELIOS_SEED_RANGE = (2, 2**31 - 2)
+#: Relative error at which a built phenotype counts as on target.
+TOLERANCE = 0.03
+MAX_BUILDS = 4
+
+
+@dataclass(frozen=True)
+class Phenotype:
+    """Plant height (vine: trunk height), fruit (vine: berry) radius and leaf length, in metres."""
+
+    plant_height: float
+    fruit_radius: float
+    leaf_length: float
+
+
+@dataclass
+class GrownPlant:
+    """One plant as built in the Helios context.
+
+    Attributes:
+        index: Position of the plant in the scene, 0-based.
+        seed: The Helios seed it was grown from (after any regrowth).
+        position: Stem position (x, y), m.
+        target: The phenotype asked for.
+        measured: The phenotype measured on the built geometry.
+        fruit_objects: Helios object ids of its fruit (a grape cluster is one object).
+        uuids: Every primitive of the plant.
+        builds: Builds it took, regrowths for too few fruit included.
+    """
+
+    index: int
+    seed: int
+    position: tuple[float, float]
+    target: Phenotype
+    measured: Phenotype
+    fruit_objects: list[int]
+    uuids: list[int] = field(repr=False)
+    builds: int
+
+    def summary(self) -> dict:
+        """JSON-ready description for scene.json."""
+        return {
+            "index": self.index,
+            "seed": self.seed,
+            "position": list(self.position),
+            "phenotype_target": asdict(self.target),
+            "phenotype_measured": asdict(self.measured),
+            "fruit_count": len(self.fruit_objects),
+            "builds": self.builds,
+        }
+
+
+def require_native_helios() -> None:
+    """Fail loudly when pyhelios would silently fall back to its mock mode.
+
+    Raises:
+        UserError: when the native Helios library (and with it system libGL/libEGL) is missing.
+    """
+    try:
+        from pyhelios.plugins import get_library_info
+    except ImportError as error:  # pragma: no cover - depends on the machine
+        raise UserError(f"pyhelios3d is not installed ({error}): run 'make demo' or pip install pyhelios3d") from None
+    info = get_library_info()
+    if info.get("is_mock", True):
+        raise UserError(
+            "pyhelios3d runs in mock mode: its native library did not load "
+            f"({info.get('library_path')}); install the system GL libraries (Debian: apt-get install libgl1 libegl1)"
+        )
+
+
+@contextlib.contextmanager
+def quiet_stdout():
+    """Silence native prints (growth progress bars) by redirecting file descriptor 1."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    with open(os.devnull, "w") as devnull:
+        os.dup2(devnull.fileno(), 1)
+    try:
+        yield
+    finally:
+        sys.stdout.flush()
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
+def helios_seed(rng: np.random.Generator) -> int:
+    """Draw a seed Helios treats as distinct from every other."""
+    low, high = HELIOS_SEED_RANGE
+    return int(rng.integers(low, high + 1))
+
+
+def sample_phenotype(crop: CropSpec, rng: np.random.Generator) -> Phenotype:
+    """Draw a target phenotype uniformly within the paper's spread around Table 1."""
+
+    def vary(nominal: float, spread: float) -> float:
+        return float(nominal * (1.0 + rng.uniform(-spread, spread)))
+
+    return Phenotype(
+        plant_height=vary(crop.plant_height, PHENOTYPE_SPREAD["plant_height"]),
+        fruit_radius=vary(crop.fruit_radius, PHENOTYPE_SPREAD["fruit_radius"]),
+        leaf_length=vary(crop.leaf_length, PHENOTYPE_SPREAD["leaf_length"]),
+    )
+
+
+# ---------------------------------------------------------------------------------------------
+# Geometry measurement
+
+
+def primitive_vertices(context, uuids: list[int]) -> list[np.ndarray]:
+    """Vertices of each primitive, as (n, 3) arrays, fetched in one native call."""
+    if not uuids:
+        return []
+    flat, offsets = context.getPrimitiveVertices(list(uuids))
+    flat = np.asarray(flat, dtype=np.float64).reshape(-1, 3)
+    bounds = list(np.asarray(offsets, dtype=np.int64) // 3) + [len(flat)]
+    return [flat[bounds[i]:bounds[i + 1]] for i in range(len(uuids))]
+
+
+def object_vertices(context, object_id: int) -> np.ndarray:
+    """All vertices of a Helios object, (n, 3)."""
+    parts = primitive_vertices(context, context.getObjectPrimitiveUUIDs(object_id))
+    return np.concatenate(parts) if parts else np.zeros((0, 3))
+
+
+def principal_extents(points: np.ndarray) -> np.ndarray:
+    """Extents of a point set along its principal axes, largest first."""
+    centred = points - points.mean(axis=0)
+    _, _, axes = np.linalg.svd(centred, full_matrices=False)
+    projected = centred @ axes.T
+    return np.sort(projected.max(axis=0) - projected.min(axis=0))[::-1]
+
+
+def fruit_radius(points: np.ndarray) -> float:
+    """Half the mean principal extent: the radius for a sphere, a mean radius for a cone."""
+    return float(principal_extents(points).mean() / 2.0)
+
+
+def berry_radii(context, object_id: int) -> np.ndarray:
+    """Radii of the single berries of a grape cluster, split by mesh connectivity."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    triangles = primitive_vertices(context, context.getObjectPrimitiveUUIDs(object_id))
+    if not triangles:
+        return np.zeros(0)
+    corners = np.concatenate(triangles)
+    # Berries share no vertices with each other, triangles of one berry do.
+    _, vertex_ids = np.unique(np.round(corners, 7), axis=0, return_inverse=True)
+    vertex_ids = vertex_ids.ravel()
+    sizes = np.array([len(t) for t in triangles])
+    starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+    rows = np.repeat(vertex_ids[starts], sizes)
+    count = int(vertex_ids.max()) + 1
+    graph = coo_matrix((np.ones(len(rows)), (rows, vertex_ids)), shape=(count, count))
+    _, labels = connected_components(graph, directed=False)
+    berry_of_corner = labels[vertex_ids]
+    radii = []
+    for berry in np.unique(berry_of_corner):
+        points = corners[berry_of_corner == berry]
+        if len(points) >= 12:  # skip stray stem pieces
+            radii.append(np.linalg.norm(points - points.mean(axis=0), axis=1).mean())
+    return np.asarray(radii)
+
+
+def leaf_length(points: np.ndarray) -> float:
+    """Extent of a leaf blade along its principal axis."""
+    return float(principal_extents(points)[0])
+
+
+def leaf_groups(blade_ids: list[int], blades_per_leaf: int) -> list[list[int]]:
+    """Group blade object ids into leaves: runs of consecutive ids, cut every ``blades_per_leaf``."""
+    groups: list[list[int]] = []
+    for blade in sorted(blade_ids):
+        if groups and blade == groups[-1][-1] + 1 and len(groups[-1]) < blades_per_leaf:
+            groups[-1].append(blade)
+        else:
+            groups.append([blade])
+    return groups
+
+
+def measure_plant(
+    context,
+    plant_architecture,
+    plant_id: int,
+    crop: CropSpec,
+    blades_per_leaf: int,
+    trunk_top: float | None = None,
+) -> Phenotype:
+    """Measure height, fruit radius and leaf length of a built plant (see the module docstring)."""
+    fruit_ids = plant_architecture.getPlantFruitObjectIDs(plant_id)
+    if crop.name == "vine":
+        radii = np.concatenate([berry_radii(context, f) for f in fruit_ids]) if fruit_ids else np.zeros(0)
+    else:
+        radii = np.array([fruit_radius(object_vertices(context, f)) for f in fruit_ids])
+    blades = plant_architecture.getPlantLeafObjectIDs(plant_id)
+    lengths = np.array([
+        leaf_length(np.concatenate([object_vertices(context, b) for b in group]))
+        for group in leaf_groups(blades, blades_per_leaf)
+    ])
+    if trunk_top is not None:
+        height = trunk_top
+    else:
+        parts = primitive_vertices(context, plant_architecture.getAllPlantUUIDs(plant_id))
+        height = float(max(p[:, 2].max() for p in parts))
+    return Phenotype(
+        plant_height=height,
+        fruit_radius=float(np.median(radii)) if len(radii) else math.nan,
+        leaf_length=float(np.median(lengths)) if len(lengths) else math.nan,
+    )
+
+
+def relative_error(measured: Phenotype, target: Phenotype) -> dict[str, float]:
+    """Relative error of each measured trait; NaN traits (no fruit) count as infinitely wrong."""
+    errors = {}
+    for name, want in asdict(target).items():
+        got = getattr(measured, name)
+        errors[name] = math.inf if not math.isfinite(got) else abs(got / want - 1.0)
+    return errors
+
+
+def scale_parameter(spec: dict, factor: float) -> None:
+    """Scale a PlantArchitecture RandomParameter spec ``{'distribution', 'parameters'}`` in place."""
+    if spec["distribution"] in ("constant", "uniform"):
+        spec["parameters"] = [float(v) * factor for v in spec["parameters"]]
+    elif spec["distribution"] == "normal":  # mean and standard deviation both scale
+        spec["parameters"] = [float(v) * factor for v in spec["parameters"]]
+    else:
+        raise ValueError(f"cannot scale a {spec['distribution']} parameter")
+
+
+def scaled_shoot_parameters(defaults: dict, crop: CropSpec, knobs: dict[str, float]) -> dict:
+    """Shoot parameters with the height, fruit and leaf knobs applied.
+
+    Args:
+        defaults: The library's parameters of one shoot type.
+        crop: Which parameter drives the height.
+        knobs: Multiplicative factors ``plant_height``, ``fruit_radius``, ``leaf_length``.
+
+    Returns:
+        A modified deep copy.
+    """
+    params = copy.deepcopy(defaults)
+    phytomer = params["phytomer_parameters"]
+    scale_parameter(phytomer["inflorescence"]["fruit_prototype_scale"], knobs["fruit_radius"])
+    scale_parameter(phytomer["leaf"]["prototype_scale"], knobs["leaf_length"])
+    if crop.name == "strawberry":
+        # A strawberry's height is its petioles (the stem barely grows).
+        scale_parameter(phytomer["petiole"]["length"], knobs["plant_height"])
+    elif crop.name == "tomato":
+        scale_parameter(params["internode_length_max"], knobs["plant_height"])
+    return params
+
+
+# ---------------------------------------------------------------------------------------------
+# Growing
+
+
+def _lift_to_ground(context, plant_architecture, plant_id: int) -> None:
+    """Raise a plant whose drooping fruit would hang below the soil, as if on a small mound."""
+    from pyhelios.types import vec3
+
+    uuids = plant_architecture.getAllPlantUUIDs(plant_id)
+    lowest = min(float(p[:, 2].min()) for p in primitive_vertices(context, uuids))
+    if lowest >= 0.0:
+        return
+    shift = vec3(0.0, 0.0, -lowest + 0.002)
+    # Helios moves the primitives of a compound object only through the object itself.
+    objects = list(plant_architecture.getAllPlantObjectIDs(plant_id))
+    in_objects = set(context.getObjectPrimitiveUUIDs(objects)) if objects else set()
+    loose = [u for u in uuids if u not in in_objects]
+    if objects:
+        context.translateObject(objects, shift)
+    if loose:
+        context.translatePrimitive(loose, shift)
+
+
+#: Measured height ~ a + b * knob for the library models (fitted on a few seeds), used only for
+#: the first build's guess; later builds correct it by the secant through the last two builds.
+HEIGHT_MODEL = {"strawberry": (0.32, 0.173), "tomato": (0.505, 0.68)}
+#: Fruit radius and leaf length of the library models as built, for the first build's guess.
+DEFAULT_SIZES = {"strawberry": (0.047, 0.25), "tomato": (0.020, 0.155)}
+
+
+def _next_height_knob(history: list[tuple[float, float]], target: float) -> float:
+    """Secant step through the last two (knob, height) builds; a ratio step after the first."""
+    (k1, h1) = history[-1]
+    if len(history) == 1 or abs(history[-2][1] - h1) < 1e-6:
+        return k1 * target / h1
+    (k0, h0) = history[-2]
+    slope = (h1 - h0) / (k1 - k0) if k1 != k0 else h1 / k1
+    return max(0.2, k1 + (target - h1) / slope) if slope > 0 else k1 * target / h1
+
+
+def grow_library_plant(
+    context,
+    plant_architecture,
+    shoot_defaults: dict[str, dict],
+    crop: CropSpec,
+    index: int,
+    position: tuple[float, float],
+    target: Phenotype,
+    seed: int,
+) -> GrownPlant:
+    """Grow a strawberry or tomato from the PlantArchitecture library to a target phenotype.
+
+    Args:
+        context: The scene's Helios Context.
+        plant_architecture: Its PlantArchitecture, with ``crop.helios_model`` loaded.
+        shoot_defaults: The library's parameters of every shoot type, read before any change.
+        crop: The crop.
+        index: The plant's index in the scene.
+        position: Stem position (x, y), m.
+        target: The phenotype to reach.
+        seed: Helios seed; a plant with fewer than ``crop.min_fruit`` fruit is regrown from the
+            next seed.
+
+    Returns:
+        The grown plant, left in the context.
+    """
+    from pyhelios.types import vec3
+
+    first_shoot = next(iter(shoot_defaults.values()))
+    blades_per_leaf = int(first_shoot["phytomer_parameters"]["leaf"]["leaves_per_petiole"]["parameters"][0])
+    builds = 0
+    while True:
+        intercept, slope = HEIGHT_MODEL[crop.name]
+        knobs = {
+            "plant_height": max(0.2, (target.plant_height - intercept) / slope),
+            "fruit_radius": target.fruit_radius / DEFAULT_SIZES[crop.name][0],
+            "leaf_length": target.leaf_length / DEFAULT_SIZES[crop.name][1],
+        }
+        history: list[tuple[float, float]] = []
+        for attempt in range(MAX_BUILDS):
+            for label, defaults in shoot_defaults.items():
+                plant_architecture.defineShootType(label, scaled_shoot_parameters(defaults, crop, knobs))
+            context.seedRandomGenerator(seed)
+            with quiet_stdout():
+                plant_id = plant_architecture.buildPlantInstanceFromLibrary(
+                    vec3(position[0], position[1], 0.0), crop.age_days
+                )
+            builds += 1
+            fruit = plant_architecture.getPlantFruitObjectIDs(plant_id)
+            if len(fruit) < crop.min_fruit:
+                break
+            _lift_to_ground(context, plant_architecture, plant_id)
+            measured = measure_plant(context, plant_architecture, plant_id, crop, blades_per_leaf)
+            errors = relative_error(measured, target)
+            if max(errors.values()) <= TOLERANCE or attempt == MAX_BUILDS - 1:
+                return GrownPlant(index, seed, position, target, measured, list(fruit),
+                                  list(plant_architecture.getAllPlantUUIDs(plant_id)), builds)
+            history.append((knobs["plant_height"], measured.plant_height))
+            knobs["plant_height"] = _next_height_knob(history, target.plant_height)
+            # Fruit and leaf size are proportional to their prototype scales.
+            for name in ("fruit_radius", "leaf_length"):
+                knobs[name] *= getattr(target, name) / getattr(measured, name)
+            plant_architecture.deletePlantInstance(plant_id)
+        plant_architecture.deletePlantInstance(plant_id)
+        seed = seed + 1 if seed < HELIOS_SEED_RANGE[1] else HELIOS_SEED_RANGE[0]
+        if builds > 40:
+            raise UserError(f"{crop.name}: no plant with {crop.min_fruit}+ fruit after {builds} builds")

@@ -1,0 +1,182 @@
+"""Draw views of a Helios scene: colour and primitive-id images straight from native buffers.
+
+The camera is an ideal pinhole. Helios' field of view is vertical; pixel (column u, row v) covers
+[u, u+1) x [v, v+1) with row 0 at the top, so a point at camera coordinates (right, up, forward)
+lands at u = cx + fx * right / forward, v = cy - fy * up / forward with cx = width / 2,
+cy = height / 2 (measured against rendered spheres to within half a pixel).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from davis_ag.view_grid import Viewpoint
+
+#: Vertical field of view of every camera, degrees (horizontal follows from the aspect ratio).
+DEFAULT_VFOV = 45.0
+
+
+@dataclass(frozen=True)
+class Camera:
+    """Image size and field of view of the pinhole camera.
+
+    Attributes:
+        width, height: Image size in pixels.
+        vfov: Vertical field of view, degrees.
+    """
+
+    width: int = 1280
+    height: int = 720
+    vfov: float = DEFAULT_VFOV
+
+    @property
+    def fy(self) -> float:
+        """Focal length in pixels (square pixels, so also fx)."""
+        return (self.height / 2) / math.tan(math.radians(self.vfov) / 2)
+
+    @property
+    def hfov(self) -> float:
+        """Horizontal field of view, degrees."""
+        return math.degrees(2 * math.atan((self.width / 2) / self.fy))
+
+    def intrinsics(self) -> dict:
+        """JSON-ready intrinsics, in the OpenCV convention (pixel centres at +0.5)."""
+        return {
+            "model": "pinhole",
+            "width": self.width,
+            "height": self.height,
+            "fx": self.fy,
+            "fy": self.fy,
+            "cx": self.width / 2,
+            "cy": self.height / 2,
+            "vfov_deg": self.vfov,
+            "hfov_deg": self.hfov,
+            "distortion": [0.0, 0.0, 0.0, 0.0, 0.0],
+        }
+
+    def project(self, view: Viewpoint, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Project world points into a view.
+
+        Args:
+            view: The camera pose.
+            points: World points, (..., 3).
+
+        Returns:
+            Pixel coordinates (..., 2) as (u, v) and depth along the optical axis (...).
+        """
+        forward = np.asarray(view.look_at(1.0)) - np.asarray(view.position)
+        forward /= np.linalg.norm(forward)
+        right = np.cross(forward, (0.0, 0.0, 1.0))
+        right /= np.linalg.norm(right)
+        up = np.cross(right, forward)
+        offset = np.asarray(points, dtype=np.float64) - np.asarray(view.position)
+        depth = offset @ forward
+        safe = np.where(depth > 1e-6, depth, 1e-6)
+        u = self.width / 2 + self.fy * (offset @ right) / safe
+        v = self.height / 2 - self.fy * (offset @ up) / safe
+        return np.stack([u, v], axis=-1), depth
+
+
+@dataclass(frozen=True)
+class Lighting:
+    """Sun and sky of a scene.
+
+    Attributes:
+        sun_elevation, sun_azimuth: Direction towards the sun, degrees (azimuth from +x, CCW).
+        sky_texture: Equirectangular sky image shipped with Helios, or None for its default.
+    """
+
+    sun_elevation: float
+    sun_azimuth: float
+    sky_texture: str | None = None
+
+    @property
+    def direction(self) -> tuple[float, float, float]:
+        """Unit vector towards the sun."""
+        el, az = math.radians(self.sun_elevation), math.radians(self.sun_azimuth)
+        return (math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el))
+
+
+class HeliosRenderer:
+    """A headless Helios Visualizer holding one scene's geometry.
+
+    Args:
+        context: The Helios Context with the scene.
+        camera: Image size and field of view.
+        lighting: Sun direction and sky.
+        antialiasing: Multisamples of the colour image (ids are always exact).
+    """
+
+    def __init__(self, context, camera: Camera, lighting: Lighting, antialiasing: int = 4) -> None:
+        from pyhelios import Visualizer
+        from pyhelios.types import vec3
+
+        from davis_ag.plants import quiet_stdout
+
+        self.camera = camera
+        self._vec3 = vec3
+        with quiet_stdout():
+            self._vis = Visualizer(camera.width, camera.height, antialiasing_samples=antialiasing, headless=True)
+        self._vis.hideWatermark()
+        self._vis.hideNavigationGizmo()
+        self._vis.disableMessages()
+        self._vis.setCameraFieldOfView(camera.vfov)
+        self._vis.setLightingModel("phong_shadowed")
+        self._vis.setLightDirection(vec3(*lighting.direction))
+        self._vis.setBackgroundSkyTexture(lighting.sky_texture)
+        self._vis.buildContextGeometry(context)
+
+    def set_view(self, view: Viewpoint) -> None:
+        """Place the camera at a viewpoint."""
+        self._vis.setCameraPosition(self._vec3(*view.position), self._vec3(*view.look_at(1.0)))
+
+    def draw_colour(self) -> np.ndarray:
+        """Draw the colour image of the current view, (height, width, 3) uint8, row 0 at the top."""
+        from pyhelios.plugins import helios_lib
+
+        self._vis.plotOnce(False)
+        width, height, size = ctypes.c_uint(), ctypes.c_uint(), ctypes.c_uint()
+        pointer = helios_lib.getWindowPixelsRGB_sized(
+            self._vis.visualizer, ctypes.byref(width), ctypes.byref(height), ctypes.byref(size)
+        )
+        self._check(pointer, size.value)
+        # The native buffer is bottom row first, one uint32 per channel.
+        pixels = np.ctypeslib.as_array(pointer, shape=(size.value,)).reshape(height.value, width.value, 3)
+        return pixels[::-1].astype(np.uint8)
+
+    def draw_primitive_ids(self) -> np.ndarray:
+        """Draw which primitive each pixel sees: UUID + 1, 0 for none, (height, width) uint32."""
+        from pyhelios.plugins import helios_lib
+
+        width, height, size = ctypes.c_uint(), ctypes.c_uint(), ctypes.c_uint()
+        pointer = helios_lib.visualizerGetPixelUUIDs(
+            self._vis.visualizer, ctypes.byref(width), ctypes.byref(height), ctypes.byref(size)
+        )
+        self._check(pointer, size.value)
+        return np.ctypeslib.as_array(pointer, shape=(size.value,)).reshape(height.value, width.value).copy()
+
+    def render(self, view: Viewpoint) -> tuple[np.ndarray, np.ndarray]:
+        """Colour image and primitive ids of one view."""
+        self.set_view(view)
+        return self.draw_colour(), self.draw_primitive_ids()
+
+    def close(self) -> None:
+        """Release the Visualizer and its GL context."""
+        vis, self._vis = self._vis, None
+        if vis is not None:
+            del vis
+
+    def _check(self, pointer, size: int) -> None:
+        expected = self.camera.width * self.camera.height
+        if not pointer or size not in (expected, 3 * expected):
+            raise RuntimeError(f"Helios returned {size} values for a {self.camera.width}x{self.camera.height} view")
+
+    def __enter__(self) -> "HeliosRenderer":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
