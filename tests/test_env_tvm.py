@@ -199,3 +199,20 @@ def test_speed(sp_root: Path) -> None:
     env = TVMEnv(sp_root, "sp", split="all")
     rate = benchmark_steps(env, 5000)
     assert rate >= 5000, f"{rate:.0f} steps/s"
+
+
+def test_fallback_split_is_seeded_70_30() -> None:
+    from davis_ag.env.splits import fallback_split
+
+    ids = [f"Single-Tomato/{i:03d}" for i in range(10)]
+    split = fallback_split(list(reversed(ids)))
+    assert split == fallback_split(ids)  # order of discovery does not matter
+    assert len(split["train"]) == 7 and len(split["test"]) == 3
+    assert sorted(split["train"] + split["test"]) == ids
+    assert fallback_split(ids[:2])["test"] and fallback_split(ids[:1])["train"] == ids[:1]
+
+
+def test_stable_baselines3_accepts_the_env(sp_root: Path) -> None:
+    from stable_baselines3.common.env_checker import check_env as sb3_check_env
+
+    sb3_check_env(TVMEnv(sp_root, "sp", split="all"), warn=True)

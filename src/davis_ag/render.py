@@ -129,6 +129,8 @@ class HeliosRenderer:
         self._vis.setLightDirection(vec3(*lighting.direction))
         self._vis.setBackgroundSkyTexture(lighting.sky_texture)
         self._vis.buildContextGeometry(context)
+        # The very first frame is drawn before the shadow map exists; draw one to throw away.
+        self._vis.plotOnce(False)
 
     def set_view(self, view: Viewpoint) -> None:
         """Place the camera at a viewpoint."""
@@ -136,9 +138,13 @@ class HeliosRenderer:
 
     def draw_colour(self) -> np.ndarray:
         """Draw the colour image of the current view, (height, width, 3) uint8, row 0 at the top."""
+        self._vis.plotOnce(False)
+        return self.read_colour()
+
+    def read_colour(self) -> np.ndarray:
+        """The colour image last drawn, without drawing again."""
         from pyhelios.plugins import helios_lib
 
-        self._vis.plotOnce(False)
         width, height, size = ctypes.c_uint(), ctypes.c_uint(), ctypes.c_uint()
         pointer = helios_lib.getWindowPixelsRGB_sized(
             self._vis.visualizer, ctypes.byref(width), ctypes.byref(height), ctypes.byref(size)
@@ -149,7 +155,11 @@ class HeliosRenderer:
         return pixels[::-1].astype(np.uint8)
 
     def draw_primitive_ids(self) -> np.ndarray:
-        """Draw which primitive each pixel sees: UUID + 1, 0 for none, (height, width) uint32."""
+        """Draw which primitive each pixel sees: UUID + 1, 0 for none, (height, width) uint32.
+
+        Helios draws the colour frame first as part of this call, so :meth:`read_colour` then
+        returns the colour image of the same view with no second draw.
+        """
         from pyhelios.plugins import helios_lib
 
         width, height, size = ctypes.c_uint(), ctypes.c_uint(), ctypes.c_uint()
@@ -160,9 +170,10 @@ class HeliosRenderer:
         return np.ctypeslib.as_array(pointer, shape=(size.value,)).reshape(height.value, width.value).copy()
 
     def render(self, view: Viewpoint) -> tuple[np.ndarray, np.ndarray]:
-        """Colour image and primitive ids of one view."""
+        """Colour image and primitive ids of one view, from a single draw of each pass."""
         self.set_view(view)
-        return self.draw_colour(), self.draw_primitive_ids()
+        primitive_ids = self.draw_primitive_ids()
+        return self.read_colour(), primitive_ids
 
     def close(self) -> None:
         """Release the Visualizer and its GL context."""

@@ -3,9 +3,10 @@
 An episode (section V-C):
 
 - ``reset`` draws, from ``self.np_random`` only, a scene of the split, then a view of it, then a
-  target fruit boxed in that view with OER < 0.4 (and, as in section III-C, at least the crop's
-  ``min_fruit_pixels`` visible pixels, scaled by image area relative to 1280x720 so that small
-  test images keep their fruit). Each level is uniform, so every scene is equally likely.
+  target fruit boxed in that view with OER < 0.4 and at least ``min_fruit_pixels`` visible
+  pixels (section III-C): scene.json's value where the scene has one (what its boxes were made
+  with), else the crop's, scaled by image area relative to 1280x720. Each level is uniform, so
+  every scene is equally likely. The (scene, view, fruit) start list is built once.
 - The observation is the view resized to 224x224 plus a fourth channel that is 255 inside the
   target's box and 0 elsewhere (section IV-C uses 1; 255 keeps one uint8 image space, which
   Stable-Baselines3 scales by 1/255 anyway).
@@ -21,6 +22,10 @@ An episode (section V-C):
   follows, so a learner must not bootstrap past it (``truncated`` would make SB3 add
   ``gamma * V(last obs)``). ``truncated`` is always False.
 - Reward: ``max(OER_end - OER_0, 0) ** 2`` on the last step, 0 before.
+- ``info``: ``oer_0``, ``oer_t`` (current), ``path`` (view names: the start, then one per move,
+  repeated where a move was refused; ``done`` adds none), ``target_fruit`` (instance id),
+  ``scene`` (id) and ``steps``.
+- Exact planners read the dynamics through :meth:`TVMEnv.move_table`, not the image.
 """
 
 from __future__ import annotations
