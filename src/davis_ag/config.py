@@ -81,7 +81,7 @@ CROPS: dict[str, CropSpec] = {
         name="vine", title="Vine", plant_height=0.70, fruit_radius=0.0075,
         leaf_length=0.18, altitudes=(0.50, 0.75, 1.00), min_fruit_pixels=700,
         exclusion_radius=1.00, mp_plants=3, mp_spacing=2.00, min_fruit=4,
-        helios_model="grapevine_VSP", age_days=0.0,
+        helios_model="grapevine_VSP", age_days=95.0,
     ),
 }
 

@@ -25,6 +25,7 @@ import math
 import os
 import sys
 from dataclasses import asdict, dataclass, field
+from typing import Callable
 
 import numpy as np
 
@@ -325,6 +326,83 @@ def _next_height_knob(history: list[tuple[float, float]], target: float) -> floa
     return max(0.2, k1 + (target - h1) / slope) if slope > 0 else k1 * target / h1
 
 
+def in_table_range(measured: Phenotype, crop: CropSpec, slack: float = 0.0) -> bool:
+    """Whether every measured trait lies within Table 1's value +- the paper's spread (+ slack)."""
+    nominal = {"plant_height": crop.plant_height, "fruit_radius": crop.fruit_radius, "leaf_length": crop.leaf_length}
+    return all(
+        abs(getattr(measured, name) / value - 1.0) <= PHENOTYPE_SPREAD[name] + slack
+        for name, value in nominal.items()
+    )
+
+
+#: Builds a plant from knobs and a seed; returns its id and, for the vine, its trunk's top.
+BuildPlant = Callable[[dict, int], "tuple[int, float | None]"]
+
+
+def grow_to_target(
+    context,
+    plant_architecture,
+    crop: CropSpec,
+    index: int,
+    position: tuple[float, float],
+    target: Phenotype,
+    seed: int,
+    build: BuildPlant,
+    first_knobs: dict[str, float],
+    blades_per_leaf: int,
+) -> GrownPlant:
+    """Build, measure, correct and rebuild a plant until it matches its target phenotype.
+
+    Args:
+        context: The scene's Helios Context.
+        plant_architecture: Its PlantArchitecture, with the crop's model loaded.
+        crop: The crop.
+        index: The plant's index in the scene.
+        position: Stem position (x, y), m.
+        target: The phenotype to reach.
+        seed: Helios seed. A plant with fewer than ``crop.min_fruit`` fruit, or one still
+            outside Table 1's range after ``MAX_BUILDS`` builds, is regrown from the next seed.
+        build: Makes the plant from knobs (factors on the library's height, fruit and leaf
+            parameters) and a seed.
+        first_knobs: The knobs of the first build.
+        blades_per_leaf: Leaf blades on one petiole, to measure whole leaves.
+
+    Returns:
+        The grown plant, left in the context.
+    """
+    builds = 0
+    while True:
+        knobs = dict(first_knobs)
+        history: list[tuple[float, float]] = []
+        for attempt in range(MAX_BUILDS):
+            plant_id, trunk_top = build(knobs, seed)
+            builds += 1
+            fruit = plant_architecture.getPlantFruitObjectIDs(plant_id)
+            if len(fruit) < crop.min_fruit:
+                plant_architecture.deletePlantInstance(plant_id)
+                break
+            measured = measure_plant(context, plant_architecture, plant_id, crop, blades_per_leaf, trunk_top)
+            on_target = max(relative_error(measured, target).values()) <= TOLERANCE
+            if on_target or (attempt == MAX_BUILDS - 1 and in_table_range(measured, crop)):
+                return GrownPlant(index, seed, position, target, measured, list(fruit),
+                                  list(plant_architecture.getAllPlantUUIDs(plant_id)), builds)
+            history.append((knobs["plant_height"], measured.plant_height))
+            knobs["plant_height"] = _next_height_knob(history, target.plant_height)
+            # Fruit and leaf size are proportional to their prototype scales.
+            for name in ("fruit_radius", "leaf_length"):
+                knobs[name] *= getattr(target, name) / getattr(measured, name)
+            plant_architecture.deletePlantInstance(plant_id)
+        seed = seed + 1 if seed < HELIOS_SEED_RANGE[1] else HELIOS_SEED_RANGE[0]
+        if builds > 40:
+            raise UserError(f"{crop.name}: no plant with {crop.min_fruit}+ fruit on target after {builds} builds")
+
+
+def blades_per_leaf(shoot_defaults: dict[str, dict]) -> int:
+    """Leaf blades per petiole of a model's shoots."""
+    first_shoot = next(iter(shoot_defaults.values()))
+    return int(first_shoot["phytomer_parameters"]["leaf"]["leaves_per_petiole"]["parameters"][0])
+
+
 def grow_library_plant(
     context,
     plant_architecture,
@@ -341,54 +419,28 @@ def grow_library_plant(
         context: The scene's Helios Context.
         plant_architecture: Its PlantArchitecture, with ``crop.helios_model`` loaded.
         shoot_defaults: The library's parameters of every shoot type, read before any change.
-        crop: The crop.
-        index: The plant's index in the scene.
-        position: Stem position (x, y), m.
-        target: The phenotype to reach.
-        seed: Helios seed; a plant with fewer than ``crop.min_fruit`` fruit is regrown from the
-            next seed.
+        crop, index, position, target, seed: As for :func:`grow_to_target`.
 
     Returns:
         The grown plant, left in the context.
     """
     from pyhelios.types import vec3
 
-    first_shoot = next(iter(shoot_defaults.values()))
-    blades_per_leaf = int(first_shoot["phytomer_parameters"]["leaf"]["leaves_per_petiole"]["parameters"][0])
-    builds = 0
-    while True:
-        intercept, slope = HEIGHT_MODEL[crop.name]
-        knobs = {
-            "plant_height": max(0.2, (target.plant_height - intercept) / slope),
-            "fruit_radius": target.fruit_radius / DEFAULT_SIZES[crop.name][0],
-            "leaf_length": target.leaf_length / DEFAULT_SIZES[crop.name][1],
-        }
-        history: list[tuple[float, float]] = []
-        for attempt in range(MAX_BUILDS):
-            for label, defaults in shoot_defaults.items():
-                plant_architecture.defineShootType(label, scaled_shoot_parameters(defaults, crop, knobs))
-            context.seedRandomGenerator(seed)
-            with quiet_stdout():
-                plant_id = plant_architecture.buildPlantInstanceFromLibrary(
-                    vec3(position[0], position[1], 0.0), crop.age_days
-                )
-            builds += 1
-            fruit = plant_architecture.getPlantFruitObjectIDs(plant_id)
-            if len(fruit) < crop.min_fruit:
-                break
-            _lift_to_ground(context, plant_architecture, plant_id)
-            measured = measure_plant(context, plant_architecture, plant_id, crop, blades_per_leaf)
-            errors = relative_error(measured, target)
-            if max(errors.values()) <= TOLERANCE or attempt == MAX_BUILDS - 1:
-                return GrownPlant(index, seed, position, target, measured, list(fruit),
-                                  list(plant_architecture.getAllPlantUUIDs(plant_id)), builds)
-            history.append((knobs["plant_height"], measured.plant_height))
-            knobs["plant_height"] = _next_height_knob(history, target.plant_height)
-            # Fruit and leaf size are proportional to their prototype scales.
-            for name in ("fruit_radius", "leaf_length"):
-                knobs[name] *= getattr(target, name) / getattr(measured, name)
-            plant_architecture.deletePlantInstance(plant_id)
-        plant_architecture.deletePlantInstance(plant_id)
-        seed = seed + 1 if seed < HELIOS_SEED_RANGE[1] else HELIOS_SEED_RANGE[0]
-        if builds > 40:
-            raise UserError(f"{crop.name}: no plant with {crop.min_fruit}+ fruit after {builds} builds")
+    def build(knobs: dict, seed: int) -> tuple[int, None]:
+        for label, defaults in shoot_defaults.items():
+            plant_architecture.defineShootType(label, scaled_shoot_parameters(defaults, crop, knobs))
+        context.seedRandomGenerator(seed)
+        with quiet_stdout():
+            plant_id = plant_architecture.buildPlantInstanceFromLibrary(
+                vec3(position[0], position[1], 0.0), crop.age_days)
+        _lift_to_ground(context, plant_architecture, plant_id)
+        return plant_id, None
+
+    intercept, slope = HEIGHT_MODEL[crop.name]
+    first_knobs = {
+        "plant_height": max(0.2, (target.plant_height - intercept) / slope),
+        "fruit_radius": target.fruit_radius / DEFAULT_SIZES[crop.name][0],
+        "leaf_length": target.leaf_length / DEFAULT_SIZES[crop.name][1],
+    }
+    return grow_to_target(context, plant_architecture, crop, index, position, target, seed, build,
+                          first_knobs, blades_per_leaf(shoot_defaults))
