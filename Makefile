@@ -1,0 +1,35 @@
+# davis-ag: every target sets itself up; the virtual environment is made on first use.
+PYTHON ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+STAMP := $(VENV)/.installed-$(shell cat pyproject.toml | cksum | cut -d' ' -f1)
+OUT ?= out
+
+.PHONY: setup demo test bench reproduce clean
+
+setup: $(STAMP)
+
+# torch first, pinned: 2.13.0 is a CPU build already on this machine's disk, where an open
+# range would download a multi-GB CUDA build.
+$(STAMP): pyproject.toml
+	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install -q --upgrade pip
+	$(BIN)/python -m pip install -q torch==2.13.0
+	$(BIN)/python -m pip install -q -e ".[test,ray]"
+	rm -f $(VENV)/.installed-*
+	touch $@
+
+demo: $(STAMP)
+	$(BIN)/davis-ag demo --out $(OUT)/demo
+
+test: $(STAMP)
+	$(BIN)/python -m pytest -q
+
+bench: $(STAMP)
+	$(BIN)/python -m davis_ag.bench --out $(OUT)/bench.json
+
+reproduce: $(STAMP)
+	$(BIN)/davis-ag reproduce --out $(OUT)/reproduce --results docs/results.md
+
+clean:
+	rm -rf $(OUT) .pytest_cache
