@@ -42,6 +42,8 @@ class CropSpec:
         altitudes: The three camera altitudes, low to high (Table 1), m.
         min_fruit_pixels: Visible pixels a fruit needs to get a box (section III-C).
         exclusion_radius: Cameras closer than this to a plant's centre are not placed, m.
+        centre_height: Height of the plant's centre, which single-plant cameras aim at and
+            exclusion is measured from: half the plant, or the middle of the vine's canopy, m.
         mp_plants: Plants in the multi-plant row.
         mp_spacing: Distance between neighbouring plants in the multi-plant row, m.
         min_fruit: A plant with fewer fruit is regrown from the next seed.
@@ -57,6 +59,7 @@ class CropSpec:
     altitudes: tuple[float, float, float]
     min_fruit_pixels: int
     exclusion_radius: float
+    centre_height: float
     mp_plants: int
     mp_spacing: float
     min_fruit: int
@@ -68,19 +71,19 @@ CROPS: dict[str, CropSpec] = {
     "strawberry": CropSpec(
         name="strawberry", title="Strawberry", plant_height=0.40, fruit_radius=0.025,
         leaf_length=0.10, altitudes=(0.25, 0.40, 0.55), min_fruit_pixels=210,
-        exclusion_radius=0.75, mp_plants=5, mp_spacing=0.30, min_fruit=4,
+        exclusion_radius=0.75, centre_height=0.20, mp_plants=5, mp_spacing=0.30, min_fruit=4,
         helios_model="strawberry", age_days=90.0,
     ),
     "tomato": CropSpec(
         name="tomato", title="Tomato", plant_height=1.00, fruit_radius=0.030,
         leaf_length=0.20, altitudes=(0.70, 1.10, 1.50), min_fruit_pixels=240,
-        exclusion_radius=1.00, mp_plants=3, mp_spacing=0.60, min_fruit=4,
+        exclusion_radius=1.00, centre_height=0.50, mp_plants=3, mp_spacing=0.60, min_fruit=4,
         helios_model="tomato", age_days=100.0,
     ),
     "vine": CropSpec(
         name="vine", title="Vine", plant_height=0.70, fruit_radius=0.0075,
         leaf_length=0.18, altitudes=(0.50, 0.75, 1.00), min_fruit_pixels=700,
-        exclusion_radius=1.00, mp_plants=3, mp_spacing=2.00, min_fruit=4,
+        exclusion_radius=1.00, centre_height=1.00, mp_plants=3, mp_spacing=2.00, min_fruit=4,
         helios_model="grapevine_VSP", age_days=95.0,
     ),
 }
@@ -182,5 +185,5 @@ def plant_positions(scenario: ScenarioSpec, crop: CropSpec) -> list[tuple[float,
 
 
 def plant_centres(scenario: ScenarioSpec, crop: CropSpec) -> list[tuple[float, float, float]]:
-    """Nominal plant centres (stem at half the Table 1 height): what cameras keep away from."""
-    return [(x, y, crop.plant_height / 2) for x, y in plant_positions(scenario, crop)]
+    """Nominal plant centres: what cameras aim at and keep away from."""
+    return [(x, y, crop.centre_height) for x, y in plant_positions(scenario, crop)]

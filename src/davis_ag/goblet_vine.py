@@ -23,6 +23,7 @@ from davis_ag.plants import (
     GrownPlant,
     Phenotype,
     blades_per_leaf,
+    fruit_body_uuids,
     grow_to_target,
     quiet_stdout,
     scaled_shoot_parameters,
@@ -31,6 +32,8 @@ from davis_ag.plants import (
 TRUNK_NODES = 7
 ARM_NODES = 3
 ARM_COUNT = (4, 6)
+#: Colour of ripe dark grapes (linear RGB), varied by +-15 % per cluster.
+BERRY_COLOUR = (0.26, 0.12, 0.30)
 #: Berry radius and leaf length of the library's grapevine shoots as built, for the first guess.
 DEFAULT_SIZES = (0.0085, 0.16)
 
@@ -107,5 +110,14 @@ def grow_goblet_vine(
         "fruit_radius": target.fruit_radius / DEFAULT_SIZES[0],
         "leaf_length": target.leaf_length / DEFAULT_SIZES[1],
     }
-    return grow_to_target(context, plant_architecture, crop, index, position, target, seed, build,
+    vine = grow_to_target(context, plant_architecture, crop, index, position, target, seed, build,
                           first_knobs, blades_per_leaf(shoot_defaults))
+    # The library's berries are near black (0.05, 0.08, 0.1) and render as silhouettes.
+    from pyhelios.types import RGBcolor
+
+    rng = np.random.default_rng(vine.seed)
+    for cluster in vine.fruit_objects:
+        shade = rng.uniform(0.85, 1.15)
+        colour = RGBcolor(*(min(1.0, c * shade) for c in BERRY_COLOUR))
+        context.setPrimitiveColor(fruit_body_uuids(context, cluster), colour)
+    return vine

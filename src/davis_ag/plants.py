@@ -8,9 +8,10 @@ seed, until the measurement is within ``TOLERANCE`` of the target (at most ``MAX
 What is measured (metres):
 
 - height: top of the plant above the ground (strawberry, tomato); for the vine, the trunk height.
-- fruit radius: per fruit, half the mean extent of its vertices along their principal axes;
-  for the vine, the radius of single berries (a cluster is one fruit object, split into berries
-  by mesh connectivity). The plant's value is the median over fruit.
+- fruit radius: per fruit, half the mean extent of its body's vertices along their principal
+  axes (the body: the fruit object without its green calyx and stalk); for the vine, the radius
+  of single berries (a cluster is one fruit object, split into berries by mesh connectivity).
+  The plant's value is the median over fruit.
 - leaf length: per leaf (every blade on one petiole: three leaflets for strawberry, seven for
   tomato, one for the vine), the extent of its blades along their principal axis; the plant's
   value is the median over leaves. Helios numbers a leaf's blades consecutively, so a leaf is a
@@ -151,6 +152,22 @@ def primitive_vertices(context, uuids: list[int]) -> list[np.ndarray]:
     return [flat[bounds[i]:bounds[i + 1]] for i in range(len(uuids))]
 
 
+def fruit_body_uuids(context, object_id: int) -> list[int]:
+    """The fruit itself: Helios builds the green calyx and stalk into fruit objects; drop them.
+
+    Fruit bodies are textured (strawberry) or coloured red or dark blue (tomato, grape berries);
+    calyx, stalk and rachis are untextured green.
+    """
+    uuids = list(context.getObjectPrimitiveUUIDs(object_id))
+    if not uuids:
+        return uuids
+    textured = np.array([bool(t) for t in context.getPrimitiveTextureFile(uuids)])
+    colours = np.asarray(context.getPrimitiveColor(uuids), dtype=float).reshape(-1, 3)
+    green = (colours[:, 1] > colours[:, 0]) & (colours[:, 1] >= colours[:, 2])
+    body = [u for u, keep in zip(uuids, textured | ~green) if keep]
+    return body or uuids
+
+
 def object_vertices(context, object_id: int) -> np.ndarray:
     """All vertices of a Helios object, (n, 3)."""
     parts = primitive_vertices(context, context.getObjectPrimitiveUUIDs(object_id))
@@ -175,7 +192,7 @@ def berry_radii(context, object_id: int) -> np.ndarray:
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
-    triangles = primitive_vertices(context, context.getObjectPrimitiveUUIDs(object_id))
+    triangles = primitive_vertices(context, fruit_body_uuids(context, object_id))
     if not triangles:
         return np.zeros(0)
     corners = np.concatenate(triangles)
@@ -189,12 +206,12 @@ def berry_radii(context, object_id: int) -> np.ndarray:
     graph = coo_matrix((np.ones(len(rows)), (rows, vertex_ids)), shape=(count, count))
     _, labels = connected_components(graph, directed=False)
     berry_of_corner = labels[vertex_ids]
-    radii = []
-    for berry in np.unique(berry_of_corner):
-        points = corners[berry_of_corner == berry]
-        if len(points) >= 12:  # skip stray stem pieces
-            radii.append(np.linalg.norm(points - points.mean(axis=0), axis=1).mean())
-    return np.asarray(radii)
+    corner_count = np.bincount(berry_of_corner).astype(float)
+    centres = np.stack([np.bincount(berry_of_corner, weights=corners[:, axis]) for axis in range(3)], axis=1)
+    centres /= corner_count[:, None]
+    spread = np.linalg.norm(corners - centres[berry_of_corner], axis=1)
+    radii = np.bincount(berry_of_corner, weights=spread) / corner_count
+    return radii[corner_count >= 12]  # stray stem pieces are not berries
 
 
 def leaf_length(points: np.ndarray) -> float:
@@ -226,7 +243,10 @@ def measure_plant(
     if crop.name == "vine":
         radii = np.concatenate([berry_radii(context, f) for f in fruit_ids]) if fruit_ids else np.zeros(0)
     else:
-        radii = np.array([fruit_radius(object_vertices(context, f)) for f in fruit_ids])
+        radii = np.array([
+            fruit_radius(np.concatenate(primitive_vertices(context, fruit_body_uuids(context, f))))
+            for f in fruit_ids
+        ])
     blades = plant_architecture.getPlantLeafObjectIDs(plant_id)
     lengths = np.array([
         leaf_length(np.concatenate([object_vertices(context, b) for b in group]))
@@ -313,7 +333,7 @@ def _lift_to_ground(context, plant_architecture, plant_id: int) -> None:
 #: the first build's guess; later builds correct it by the secant through the last two builds.
 HEIGHT_MODEL = {"strawberry": (0.32, 0.173), "tomato": (0.505, 0.68)}
 #: Fruit radius and leaf length of the library models as built, for the first build's guess.
-DEFAULT_SIZES = {"strawberry": (0.047, 0.25), "tomato": (0.020, 0.155)}
+DEFAULT_SIZES = {"strawberry": (0.029, 0.23), "tomato": (0.016, 0.205)}
 
 
 def _next_height_knob(history: list[tuple[float, float]], target: float) -> float:

@@ -16,6 +16,7 @@ from davis_ag.errors import UserError
 from davis_ag.labels import MAX_FRUIT
 from davis_ag.plants import (
     GrownPlant,
+    fruit_body_uuids,
     grow_library_plant,
     helios_seed,
     primitive_vertices,
@@ -27,6 +28,9 @@ from davis_ag.render import Lighting
 
 #: Side of the square soil tile under every scene, m: wide enough to reach the horizon's haze.
 GROUND_SIZE = 60.0
+#: Side of the finely textured soil around the grid and the size of one of its patches, m.
+NEAR_SIZE = 12.0
+NEAR_PATCH = 0.12
 
 
 @dataclass
@@ -36,7 +40,7 @@ class Fruit:
     Attributes:
         id: Scene-wide id, 0..254: the value in segmentation images and boxes.
         plant: Index of the plant bearing it.
-        uuids: Its Helios primitives.
+        uuids: Its Helios primitives: the fruit body, without calyx and stalk.
         polygons: Its primitives' vertices grouped by vertex count, arrays (n, k, 3).
         center: Centre of its bounding box (x, y, z), m.
         size: Extent of its bounding box (dx, dy, dz), m.
@@ -89,21 +93,24 @@ def helios_texture(name: str) -> str:
 
 
 def add_ground(context) -> None:
-    """A flat square of textured soil at z = 0."""
+    """Textured soil at z = 0: fine patches under the grid, one coarse tile out to the horizon.
+
+    Helios keeps textures at a low resolution, so a texture stretched over metres turns into a
+    checkerboard of blocks; one texture per ``NEAR_PATCH`` patch keeps the soil's grain.
+    """
     from pyhelios.types import int2, vec2, vec3
 
+    texture = helios_texture("dirt.jpg")
+    patches = int(round(NEAR_SIZE / NEAR_PATCH))
+    context.addTileObject(center=vec3(0.0, 0.0, 0.0), size=vec2(NEAR_SIZE, NEAR_SIZE),
+                          subdiv=int2(patches, patches), texturefile=texture)
     repeats = int(GROUND_SIZE / 1.5)
-    context.addTileObject(
-        center=vec3(0.0, 0.0, 0.0),
-        size=vec2(GROUND_SIZE, GROUND_SIZE),
-        subdiv=int2(1, 1),
-        texturefile=helios_texture("dirt.jpg"),
-        texture_repeat=int2(repeats, repeats),
-    )
+    context.addTileObject(center=vec3(0.0, 0.0, -0.002), size=vec2(GROUND_SIZE, GROUND_SIZE),
+                          subdiv=int2(1, 1), texturefile=texture, texture_repeat=int2(repeats, repeats))
 
 
 def _fruit(context, fruit_id: int, plant: int, object_id: int) -> Fruit:
-    uuids = np.asarray(context.getObjectPrimitiveUUIDs(object_id), dtype=np.int64)
+    uuids = np.asarray(fruit_body_uuids(context, object_id), dtype=np.int64)
     parts = primitive_vertices(context, list(uuids))
     by_count: dict[int, list[np.ndarray]] = {}
     for part in parts:
@@ -158,4 +165,4 @@ def build_scene(scenario: ScenarioSpec, crop: CropSpec, rng: np.random.Generator
                 raise UserError(f"a {crop.name} scene grew more than {MAX_FRUIT} fruit, the most uint8 ids can label")
             fruits.append(_fruit(context, len(fruits), plant.index, object_id))
     lighting = Lighting(sun_elevation=float(rng.uniform(35.0, 75.0)), sun_azimuth=float(rng.uniform(0.0, 360.0)))
-    return SceneModel(context, plants, fruits, lighting, aim_height=crop.plant_height / 2)
+    return SceneModel(context, plants, fruits, lighting, aim_height=crop.centre_height)

@@ -7,7 +7,8 @@ Conventions (also in the README):
 - Grid: the scenario's extent is tiled with square cells of ``step`` metres, centred on the
   origin; a camera position is a cell centre, so no camera stands on a stem. A camera closer
   than the crop's exclusion radius to any plant, measured in 3-D from the camera to the plant's
-  centre (its stem at half the plant's Table 1 height), is not placed; so the exclusion zone
+  centre (its stem at the crop's ``centre_height``: half the plant, or the middle of the vine's
+  canopy), is not placed; so the exclusion zone
   shrinks with altitude, and ``up``/``down`` can point to "" too.
 - Yaw: degrees counter-clockwise from +x; pitch: degrees above the horizon (negative looks down).
 - Single plant: the camera always aims at ``(0, 0, aim_height)``; forward, backward, right and

@@ -1,0 +1,71 @@
+"""``davis-ag preview``: render a few views of one scene, with fruit boxes drawn, without a dataset.
+
+It grows the same scene ``generate`` would (same dataset seed and index give the same plants,
+sun and slip) and draws the chosen views, so a researcher can look before rendering hundreds.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import numpy as np
+from PIL import Image, ImageDraw
+
+from davis_ag.commands.generate import image_size
+from davis_ag.config import crop_spec, plant_centres, scenario_spec
+from davis_ag.errors import UserError
+from davis_ag.generate import SceneRequest
+from davis_ag.labels import fruit_lookup, label_view, visible_fractions
+from davis_ag.render import Camera, HeliosRenderer
+from davis_ag.scene import build_scene
+from davis_ag.view_grid import build_view_grid
+
+
+def register(subparsers) -> None:
+    parser = subparsers.add_parser("preview", help="render a few views of one scene with boxes drawn",
+                                   description=__doc__)
+    parser.add_argument("--crop", default="strawberry", help="strawberry, tomato or vine")
+    parser.add_argument("--scenario", default="sp", help="sp or mp")
+    parser.add_argument("--seed", type=int, default=0, help="dataset seed (default 0)")
+    parser.add_argument("--index", type=int, default=0, help="scene index (default 0)")
+    parser.add_argument("--views", default="1", help="comma-separated view numbers (default 1)")
+    parser.add_argument("--size", type=image_size, default=(1280, 720), help="image size (default 1280x720)")
+    parser.add_argument("--out", type=Path, required=True, help="folder for the pictures")
+    parser.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    crop, scenario = crop_spec(args.crop), scenario_spec(args.scenario)
+    try:
+        numbers = [int(v) for v in args.views.split(",")]
+    except ValueError:
+        raise UserError(f"--views {args.views!r} is not a list of view numbers like 1,40,200") from None
+    if args.out.exists() and not args.out.is_dir():
+        raise UserError(f"{args.out} is a file: choose a folder for --out")
+    request = SceneRequest(scenario, crop, args.index, args.seed, Camera(*args.size))
+    rng = np.random.default_rng(request.seed)
+    model = build_scene(scenario, crop, rng)
+    grid = build_view_grid(scenario, crop, plant_centres(scenario, crop), model.aim_height, rng)
+    bad = [n for n in numbers if not 1 <= n <= len(grid.viewpoints)]
+    if bad:
+        raise UserError(f"view {bad[0]} does not exist: this scene has views 1..{len(grid.viewpoints)}")
+    lookup = fruit_lookup({f.id: f.uuids for f in model.fruits}, model.uuid_count)
+    polygons = {f.id: f.polygons for f in model.fruits}
+    args.out.mkdir(parents=True, exist_ok=True)
+    with HeliosRenderer(model.context, request.camera, model.lighting) as renderer:
+        for number in numbers:
+            view = grid.viewpoints[number - 1]
+            colour, primitive_ids = renderer.render(view)
+            labels = label_view(primitive_ids, lookup, request.min_fruit_pixels)
+            fractions = visible_fractions(request.camera, view, labels, polygons)
+            stem = f"{crop.name}-{scenario.name}-{args.index:03d}-{number:04d}"
+            Image.fromarray(colour).save(args.out / f"{stem}.jpeg", quality=95)
+            boxed = Image.fromarray(colour)
+            draw = ImageDraw.Draw(boxed)
+            for x, y, w, h, fruit_id, _ in labels.boxes:
+                draw.rectangle([x, y, x + w - 1, y + h - 1], outline=(255, 220, 0), width=2)
+                draw.text((x, max(0, y - 12)), f"{fruit_id}: {fractions[fruit_id]:.2f}", fill=(255, 220, 0))
+            boxed.save(args.out / f"{stem}-boxes.jpeg", quality=90)
+            print(f"{args.out / stem}.jpeg: {len(labels.boxes)} fruit boxed, pose {view.pose}")
+    return 0
