@@ -11,12 +11,22 @@ from davis_ag.errors import UserError
 
 # Each name is a module of davis_ag.commands defining ``register(subparsers)``; the registered
 # parser's ``func`` default takes the parsed arguments and returns an exit code.
-COMMANDS = ["generate", "validate", "train", "evaluate", "preview"]
+COMMANDS = ["generate", "validate", "train", "evaluate", "preview", "demo", "reproduce"]
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """Reports bad arguments as one line on stderr, exit status 2, like a :class:`UserError`.
+
+    Sub-command parsers are made of the same class (argparse's default).
+    """
+
+    def error(self, message: str):  # type: ignore[override]
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
 def build_parser() -> argparse.ArgumentParser:
     """Build the top-level parser with every sub-command registered."""
-    parser = argparse.ArgumentParser(prog="davis-ag", description=__doc__)
+    parser = OneLineParser(prog="davis-ag", description=__doc__)
     parser.add_argument("--version", action="version", version=f"davis-ag {__version__}")
     subparsers = parser.add_subparsers(dest="command", required=True)
     for name in COMMANDS:

@@ -402,8 +402,10 @@ def grow_to_target(
                 plant_architecture.deletePlantInstance(plant_id)
                 break
             measured = measure_plant(context, plant_architecture, plant_id, crop, blades_per_leaf, trunk_top)
-            on_target = max(relative_error(measured, target).values()) <= TOLERANCE
-            if on_target or (attempt == MAX_BUILDS - 1 and in_table_range(measured, crop)):
+            # A target near the edge of the range plus the tolerance could leave it: require both.
+            in_range = in_table_range(measured, crop)
+            on_target = max(relative_error(measured, target).values()) <= TOLERANCE and in_range
+            if on_target or (attempt == MAX_BUILDS - 1 and in_range):
                 return GrownPlant(index, seed, position, target, measured, list(fruit),
                                   list(plant_architecture.getAllPlantUUIDs(plant_id)), builds)
             history.append((knobs["plant_height"], measured.plant_height))
