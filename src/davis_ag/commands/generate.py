@@ -1,17 +1,24 @@
-"""``davis-ag generate``: render scenes into a dataset folder in the published layout."""
+"""``davis-ag generate``: render scenes into a dataset folder in the published layout.
+
+Either one group from the flags (``--crop tomato --scenario sp --scenes 5``) or a whole dataset
+from a config file or preset (``--config paper``). A run killed at any point finishes the dataset
+when started again with the same command; finished scenes are skipped.
+"""
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import re
 from pathlib import Path
 
-from tqdm import tqdm
-
-from davis_ag.config import crop_spec, scenario_spec
+from davis_ag.dataset_config import load_dataset_config, single_group_config
 from davis_ag.errors import UserError
-from davis_ag.generate import SceneRequest, check_output_root, check_scene_slot, generate_scene
 from davis_ag.render import Camera
+from davis_ag.runner import DEFAULT_MAX_RETRIES, RunOptions, default_workers, run_dataset
+
+#: Flags that describe the one group of a config-less run.
+GROUP_FLAGS = ("crop", "scenario", "scenes", "first")
 
 
 def image_size(text: str) -> tuple[int, int]:
@@ -29,43 +36,69 @@ def count(text: str) -> int:
     return int(text)
 
 
+def whole(text: str) -> int:
+    """Parse a whole number from 0."""
+    if not text.isdigit():
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number from 0")
+    return int(text)
+
+
 def register(subparsers) -> None:
     parser = subparsers.add_parser("generate", help="render DAVIS-Ag scenes with Helios",
-                                   description=__doc__)
-    parser.add_argument("--crop", default="strawberry", help="strawberry, tomato or vine")
-    parser.add_argument("--scenario", default="sp", help="sp (single plant) or mp (multi plant)")
-    parser.add_argument("--scenes", type=count, default=1, help="how many scenes (default 1)")
-    parser.add_argument("--first", type=int, default=0, help="index of the first scene (default 0)")
-    parser.add_argument("--seed", type=int, default=0, help="dataset seed (default 0)")
-    parser.add_argument("--size", type=image_size, default=(1280, 720), help="image size (default 1280x720)")
+                                   description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--config", help="dataset config: a preset (paper, mini) or a YAML file")
+    parser.add_argument("--crop", help="strawberry, tomato or vine (default strawberry; not with --config)")
+    parser.add_argument("--scenario", help="sp (single plant) or mp (multi plant) (default sp)")
+    parser.add_argument("--scenes", type=count, help="how many scenes (default 1)")
+    parser.add_argument("--first", type=int, help="index of the first scene (default 0)")
+    parser.add_argument("--seed", type=int, help="dataset seed (default 0, or the config's)")
+    parser.add_argument("--size", type=image_size, help="image size (default 1280x720, or the config's)")
     parser.add_argument("--out", type=Path, required=True, help="dataset folder")
+    parser.add_argument("--only", action="append", metavar="SCENE",
+                        help="make only this scene or group, e.g. Single-Strawberry/003 (repeatable, or "
+                             "comma-separated)")
+    parser.add_argument("--workers", type=count,
+                        help=f"scene processes on this machine, each drawing with one Mesa thread (default: "
+                             f"one per core as memory allows, {default_workers()} here; 1 draws in this process "
+                             "with every core)")
+    parser.add_argument("--executor", choices=("local", "ray"), default="local",
+                        help="local processes (default) or one Ray task per scene on a cluster")
+    parser.add_argument("--address", help="Ray cluster address: auto (on a cluster machine) or ray://HEAD:10001")
+    parser.add_argument("--cpus-per-scene", type=count, default=1,
+                        help="Ray: CPUs (and Mesa threads) each scene task reserves (default 1)")
+    parser.add_argument("--max-retries", type=whole, default=DEFAULT_MAX_RETRIES,
+                        help=f"tries again for a scene whose worker died (default {DEFAULT_MAX_RETRIES})")
+    parser.add_argument("--quiet", action="store_true", help="no progress bars")
     parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    crop, scenario = crop_spec(args.crop), scenario_spec(args.scenario)
-    if args.first < 0 or args.first + args.scenes > 1000:
-        raise UserError(f"scene indices {args.first}..{args.first + args.scenes - 1} do not fit 000..999")
-    if args.seed < 0:
-        raise UserError(f"--seed {args.seed} is negative: use a whole number from 0")
-    check_output_root(args.out)
-    camera = Camera(*args.size)
-    requests = [SceneRequest(scenario, crop, args.first + i, args.seed, camera) for i in range(args.scenes)]
-    todo = [r for r in requests if not check_scene_slot(args.out, r)]
-    if len(todo) < len(requests):
-        print(f"{len(requests) - len(todo)} of {len(requests)} scenes already complete in {args.out}: skipped")
-    with tqdm(total=len(todo), desc="scenes", unit="scene", position=0) as scenes_bar, \
-         tqdm(desc="views", unit="view", position=1, leave=False) as views_bar:
-        for request in todo:
-            views_bar.reset()
-            views_bar.set_description(f"views {request.folder}")
-
-            def on_view(done: int, total: int) -> None:
-                views_bar.total = total
-                views_bar.update(1)
-
-            scene_dir, stats = generate_scene(request, args.out, on_view)
-            scenes_bar.update(1)
-            tqdm.write(f"{scene_dir}: {stats['views']} views, grown in {stats['grow_s']:.1f} s, "
-                       f"{stats['views_s'] / stats['views']:.3f} s per view")
+    given = [f"--{flag}" for flag in GROUP_FLAGS if getattr(args, flag) is not None]
+    if args.config:
+        if given:
+            raise UserError(f"{', '.join(given)} cannot be combined with --config: the config lists the "
+                            "groups; use --only to pick scenes of it")
+        config = load_dataset_config(args.config)
+        if args.seed is not None or args.size is not None:
+            if args.seed is not None and args.seed < 0:
+                raise UserError(f"--seed {args.seed} is negative: use a whole number from 0")
+            config = dataclasses.replace(config, seed=config.seed if args.seed is None else args.seed,
+                             camera=config.camera if args.size is None else Camera(*args.size))
+    else:
+        config = single_group_config(args.scenario or "sp", args.crop or "strawberry", args.scenes or 1,
+                                     0 if args.first is None else args.first, args.seed or 0,
+                                     args.size or (1280, 720))
+    if args.executor != "ray" and args.address:
+        raise UserError("--address is for --executor ray")
+    if args.executor == "ray" and args.workers is not None:
+        raise UserError("--workers is for the local executor: Ray runs one task per scene on the cluster "
+                        "(see --cpus-per-scene)")
+    only = [item for value in args.only or [] for item in value.split(",") if item.strip()]
+    requests = config.requests(only)
+    options = RunOptions(workers=args.workers or default_workers(), executor=args.executor, address=args.address,
+                         cpus_per_scene=args.cpus_per_scene, max_retries=args.max_retries,
+                         progress=not args.quiet)
+    report = run_dataset(requests, args.out, options)
+    splits = f"; {report.splits.name} written" if report.splits else ""
+    print(f"{report.root}: {len(report.made)} scenes made, {len(report.skipped)} already complete{splits}")
     return 0
