@@ -52,7 +52,7 @@ class ReproduceConfig:
 #: ``paper-scale``: Table 3's scene counts at 1280x720 and 300K A2C steps (days on such a machine).
 CONFIGS: dict[str, ReproduceConfig] = {
     "small": ReproduceConfig("small", (640, 360), sp_scenes=3, mp_scenes=2, mp_extent=(3.0, 2.0),
-                             sp_timesteps=80_000, mp_timesteps=40_000),
+                             sp_timesteps=30_000, mp_timesteps=15_000),
     "paper-scale": ReproduceConfig("paper-scale", (1280, 720), sp_scenes=86, mp_scenes=44,
                                    mp_extent=None, sp_timesteps=300_000, mp_timesteps=300_000),
 }
