@@ -216,3 +216,17 @@ def test_mock_pyhelios_is_a_clear_error(monkeypatch: pytest.MonkeyPatch) -> None
         require_native_helios()
     with pytest.raises(UserError, match="mock mode"):
         build_scene(SCENARIO, CROPS["strawberry"], np.random.default_rng(0))
+
+
+def test_generate_command_refuses_mock_helios_before_any_scene(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import pyhelios.plugins
+
+    monkeypatch.setattr(pyhelios.plugins, "get_library_info",
+                        lambda: {"is_mock": True, "library_path": None})
+    out = tmp_path / "data"
+    code = cli.main(["generate", "--scenes", "1", "--out", str(out), "--workers", "1"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "mock mode" in err[0]
+    assert not out.exists()

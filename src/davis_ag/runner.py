@@ -36,6 +36,7 @@ from tqdm import tqdm
 from davis_ag.config import CropSpec, ScenarioSpec, parse_group_name
 from davis_ag.dataset_files import DATASET_FILE, SPLITS_FILE, dataset_settings, reconcile_settings, write_splits
 from davis_ag.errors import UserError
+from davis_ag.plants import require_native_helios
 from davis_ag.generate import (
     ROOT_EXTRAS,
     SceneRequest,
@@ -235,6 +236,8 @@ def run_dataset(requests: Sequence[SceneRequest], root: Path, options: RunOption
     if not requests:
         raise UserError("no scenes to make")
     options = options or RunOptions()
+    if options.executor != "ray":  # Ray's drivers draw nothing; its workers check for themselves
+        require_native_helios()  # before any scene, not as each scene's failure
     root = Path(root).expanduser().absolute()
     _precheck(root)
     root.mkdir(parents=True, exist_ok=True)
