@@ -25,8 +25,8 @@ from davis_ag.plants import (
     blades_per_leaf,
     fruit_body_uuids,
     grow_to_target,
+    prepare_build,
     quiet_stdout,
-    scaled_shoot_parameters,
 )
 
 TRUNK_NODES = 7
@@ -77,9 +77,7 @@ def grow_goblet_vine(
     from pyhelios.types import AxisRotation, vec3
 
     def build(knobs: dict, seed: int) -> tuple[int, float]:
-        for label, defaults in shoot_defaults.items():
-            plant_architecture.defineShootType(label, scaled_shoot_parameters(defaults, crop, knobs))
-        context.seedRandomGenerator(seed)
+        prepare_build(context, plant_architecture, shoot_defaults, crop, knobs, seed)
         rng = np.random.default_rng(seed)  # the vine's own layout draws
         plant_id = plant_architecture.addPlantInstance(vec3(position[0], position[1], 0.0), 0.0)
         internode = knobs["plant_height"] * crop.plant_height / TRUNK_NODES

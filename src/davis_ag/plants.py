@@ -425,6 +425,14 @@ def blades_per_leaf(shoot_defaults: dict[str, dict]) -> int:
     return int(first_shoot["phytomer_parameters"]["leaf"]["leaves_per_petiole"]["parameters"][0])
 
 
+def prepare_build(context, plant_architecture, shoot_defaults: dict[str, dict], crop: CropSpec,
+                  knobs: dict[str, float], seed: int) -> None:
+    """Redefine every shoot type with the knobs applied and seed Helios, before a build."""
+    for label, defaults in shoot_defaults.items():
+        plant_architecture.defineShootType(label, scaled_shoot_parameters(defaults, crop, knobs))
+    context.seedRandomGenerator(seed)
+
+
 def grow_library_plant(
     context,
     plant_architecture,
@@ -449,9 +457,7 @@ def grow_library_plant(
     from pyhelios.types import vec3
 
     def build(knobs: dict, seed: int) -> tuple[int, None]:
-        for label, defaults in shoot_defaults.items():
-            plant_architecture.defineShootType(label, scaled_shoot_parameters(defaults, crop, knobs))
-        context.seedRandomGenerator(seed)
+        prepare_build(context, plant_architecture, shoot_defaults, crop, knobs, seed)
         with quiet_stdout():
             plant_id = plant_architecture.buildPlantInstanceFromLibrary(
                 vec3(position[0], position[1], 0.0), crop.age_days)
