@@ -44,6 +44,9 @@ def test_demo_renders_validates_benchmarks_and_reports(tmp_path: Path,
                     crop=crop) == 0
     again = capsys.readouterr()
     assert "already complete" in again.out + again.err
+    # ... but never one drawn at another size.
+    with pytest.raises(UserError, match="96x54"):
+        run_demo(out, scenes=1, size=(128, 72), episodes=2, sessions=1, scenario=scenario, crop=crop)
 
 
 @pytest.mark.parametrize("text", ["abc", "10x10", "640", "0x360"])

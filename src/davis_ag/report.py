@@ -134,8 +134,9 @@ def draw_oer_histogram(oers: np.ndarray, out_path: str | Path, title: str = "") 
 
 
 def _busiest_view(scene: Scene) -> Any:
-    """The view with the most boxes (the first such), for the mask figure."""
-    return max(scene.views.values(), key=lambda v: len(v.boxes))
+    """The view with the most boxes, the largest total box area among those: for the mask figure."""
+    return max(scene.views.values(),
+               key=lambda v: (len(v.boxes), sum(b.width * b.height for b in v.boxes)))
 
 
 def _table(header: list[str], rows: list[list[Any]]) -> str:

@@ -31,8 +31,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help="output folder (DIR/dataset, DIR/report/index.html)")
     parser.add_argument("--scenes", type=int, default=2,
                         help="SP strawberry scenes (default 2: one train, one test scene)")
-    parser.add_argument("--size", type=_size, default="640x360",
-                        help="image size WIDTHxHEIGHT (default 640x360)")
+    parser.add_argument("--size", type=_size, default="1280x720",
+                        help="image size WIDTHxHEIGHT (default 1280x720, the paper's)")
     parser.add_argument("--seed", type=int, default=0, help="dataset and evaluation seed (default 0)")
     parser.add_argument("--episodes", type=int, default=200, help="episodes per session (default 200)")
     parser.add_argument("--sessions", type=int, default=3, help="evaluation sessions (default 3)")

@@ -48,7 +48,7 @@ class ReproduceConfig:
     seed: int = 0
 
 
-#: ``small``: about an hour on a 2-core CPU machine (see docs/results.md for what it measured).
+#: ``small``: 43 min of stages measured on a 2-core CPU machine without GPU (docs/results.md).
 #: ``paper-scale``: Table 3's scene counts at 1280x720 and 300K A2C steps (days on such a machine).
 CONFIGS: dict[str, ReproduceConfig] = {
     "small": ReproduceConfig("small", (640, 360), sp_scenes=3, mp_scenes=2, mp_extent=(3.0, 2.0),
@@ -79,7 +79,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--results", type=Path, default=Path("docs/results.md"), metavar="MD",
                         help="Markdown results file (default: docs/results.md)")
     parser.add_argument("--config", choices=list(CONFIGS), default="small",
-                        help="small (about an hour on 2 CPU cores, default) or paper-scale")
+                        help="small (43 min measured on 2 CPU cores, default) or paper-scale")
     parser.add_argument("--sp-scenes", type=int, default=None, help="override the SP scene count")
     parser.add_argument("--mp-scenes", type=int, default=None, help="override the MP scene count")
     parser.add_argument("--sp-timesteps", type=int, default=None, help="override SP A2C steps")
@@ -316,6 +316,14 @@ def _notes(config: ReproduceConfig, state: dict[str, Any], out: Path | None) -> 
             else:
                 notes.append(f"{key}: evaluated on the test split, {len(scenes)} scene(s): "
                              f"{', '.join(scenes)} (70/30 split by scene, seeded).")
+    for scenario, result in state.get("results", {}).items():
+        lengths = {n: p.get("length", {}).get("mean") for n, p in result["policies"].items()}
+        if lengths.get("LRD") is not None and lengths.get("LRD") == lengths.get("UDD"):
+            notes.append(f"{scenario.upper()}: LRD and UDD have the same episode lengths because every "
+                         "policy plays the same seeded episodes with the same agent seeds, and both "
+                         "draw `done` with probability 1/3 at each step (common random numbers).")
+    notes.append("Stage times are wall times; a resumed run keeps each scene's own time. Other "
+                 "work may share the machine, so rates (e.g. A2C steps/s) can vary between stages.")
     notes.append("Oracle is not in the paper: it plays the best reachable final OER within tau "
                  "steps from the environment's tables, an upper bound for any policy.")
     notes.append("Episode starts follow section V-C: a boxed target with OER < 0.4 and at least the "
