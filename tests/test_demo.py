@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import argparse
+
 from dataclasses import replace
 from pathlib import Path
 
@@ -9,7 +11,8 @@ import pytest
 
 from davis_ag import cli
 from davis_ag.config import crop_spec, scenario_spec
-from davis_ag.demo import parse_size, run_demo
+from davis_ag.commands.generate import image_size
+from davis_ag.demo import run_demo
 from davis_ag.errors import UserError
 
 
@@ -50,13 +53,13 @@ def test_demo_renders_validates_benchmarks_and_reports(tmp_path: Path,
 
 
 @pytest.mark.parametrize("text", ["abc", "10x10", "640", "0x360"])
-def test_bad_sizes_are_user_errors(text: str) -> None:
-    with pytest.raises(UserError, match="image size"):
-        parse_size(text)
+def test_bad_sizes_are_refused(text: str) -> None:
+    with pytest.raises(argparse.ArgumentTypeError, match="image size"):
+        image_size(text)
 
 
 def test_good_size_parses() -> None:
-    assert parse_size("640x360") == (640, 360)
+    assert image_size("640x360") == (640, 360)
 
 
 @pytest.mark.parametrize("kwargs", [{"scenes": 0}, {"episodes": 0}, {"sessions": 0}, {"seed": -1}])

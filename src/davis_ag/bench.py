@@ -38,6 +38,7 @@ import numpy as np
 
 from davis_ag.config import CROPS, SCENARIOS, plant_centres
 from davis_ag.dataset_config import load_dataset_config
+from davis_ag.errors import UserError
 from davis_ag.generate import SceneRequest, generate_scene
 from davis_ag.render import Camera, HeliosRenderer
 from davis_ag.runner import count_views
@@ -190,6 +191,27 @@ def projection(per_view: dict[str, float], overhead: dict[str, float]) -> dict:
                            f"machine make {POOL_GAIN}x the views of one process (measured, docs/performance.md)"}
 
 
+def env_speed(dataset: Path, steps: int = 20_000) -> dict:
+    """Steps per second of the TVM environment on the scene just drawn (cache built first).
+
+    Returns:
+        Steps per second through ``gymnasium.make`` and the target, or the reason it could not
+        run (a scene of few views may hold no eligible start).
+    """
+    import gymnasium
+
+    from davis_ag.env import TVM_ID, benchmark_steps
+
+    try:
+        env = gymnasium.make(TVM_ID, dataset=str(dataset), scenario="sp", split="all")
+    except UserError as error:
+        return {"skipped": str(error)}
+    env.reset(seed=SEED)
+    rate = benchmark_steps(env, steps, seed=SEED)
+    env.close()
+    return {"steps_per_second": round(rate), "steps": steps, "target_min": 5000}
+
+
 def run(out: Path, crops: list[str], profile: bool) -> dict:
     """Run every measurement; return the JSON report."""
     load_start = os.getloadavg()
@@ -218,6 +240,7 @@ def run(out: Path, crops: list[str], profile: bool) -> dict:
                             "cpu_documented_over_ours": documented.cpu / ours.cpu,
                             "cpu_ours_over_floor": ours.cpu / floor.cpu, "targets": TARGETS}
         report["views_per_second"] = {"strawberry": 1 / ours.wall}
+        report["env_steps_per_second"] = env_speed(root / "ours")
         for name in crops:
             crop = CROPS[name]
             timed, stats, rest = time_ours(SceneRequest(OTHER_GRID, crop, 0, SEED, CAMERA), root / name)
@@ -254,6 +277,9 @@ def table(report: dict) -> str:
                  f"{TARGETS['documented_over_ours_min']}), ours/floor {ratios['ours_over_floor']:.2f} "
                  f"(target <= {TARGETS['ours_over_floor_max']})")
     lines.append("views/s (ours): " + ", ".join(f"{k} {v:.2f}" for k, v in report["views_per_second"].items()))
+    env = report.get("env_steps_per_second", {})
+    if "steps_per_second" in env:
+        lines.append(f"TVM environment: {env['steps_per_second']} steps/s (target >= {env['target_min']})")
     p = report["paper_projection"]
     lines.append(f"paper preset: {p['images']} images in {p['scenes']} scenes: {p['hours_one_machine']} h on one "
                  f"machine like this ({p['hours_one_machine_one_process']} h in one process), "

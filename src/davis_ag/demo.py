@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import json
 import os
-import re
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -31,24 +30,6 @@ from davis_ag.render import Camera
 BASELINES: tuple[str, ...] = ("LRD", "UDD", "Rand", "Oracle")
 #: Default image size of the demo: the paper's (2 scenes took 5.6 min in all on 2 CPU cores).
 DEMO_SIZE: tuple[int, int] = (1280, 720)
-
-
-def parse_size(text: str) -> tuple[int, int]:
-    """Parse an image size like ``640x360``.
-
-    Args:
-        text: ``WIDTHxHEIGHT``.
-
-    Returns:
-        ``(width, height)``.
-
-    Raises:
-        UserError: when it is not two whole numbers of at least 16 joined by ``x``.
-    """
-    match = re.fullmatch(r"\s*(\d+)\s*[xX]\s*(\d+)\s*", text)
-    if not match or min(int(match[1]), int(match[2])) < 16:
-        raise UserError(f"--size {text!r} is not an image size like 640x360 (16 pixels at least)")
-    return int(match[1]), int(match[2])
 
 
 @dataclass

@@ -10,16 +10,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-
-def _size(text: str) -> tuple[int, int]:
-    """Argparse type for ``WIDTHxHEIGHT``."""
-    from davis_ag.demo import parse_size
-    from davis_ag.errors import UserError
-
-    try:
-        return parse_size(text)
-    except UserError as error:
-        raise argparse.ArgumentTypeError(str(error)) from None
+from davis_ag.commands.generate import image_size
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -31,7 +22,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help="output folder (DIR/dataset, DIR/report/index.html)")
     parser.add_argument("--scenes", type=int, default=2,
                         help="SP strawberry scenes (default 2: one train, one test scene)")
-    parser.add_argument("--size", type=_size, default="1280x720",
+    parser.add_argument("--size", type=image_size, default="1280x720",
                         help="image size WIDTHxHEIGHT (default 1280x720, the paper's)")
     parser.add_argument("--seed", type=int, default=0, help="dataset and evaluation seed (default 0)")
     parser.add_argument("--episodes", type=int, default=200, help="episodes per session (default 200)")
