@@ -11,7 +11,7 @@ import pytest
 
 from davis_ag import cli
 from davis_ag.config import crop_spec, scenario_spec
-from davis_ag.commands.generate import image_size
+from davis_ag.commands.arguments import image_size
 from davis_ag.demo import run_demo
 from davis_ag.errors import UserError
 
@@ -23,8 +23,8 @@ def _tiny_specs() -> tuple:
     return scenario, crop
 
 
-def test_demo_renders_validates_benchmarks_and_reports(tmp_path: Path,
-                                                       capsys: pytest.CaptureFixture[str]) -> None:
+def test_demo_renders_validates_benchmarks_and_reports(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                       monkeypatch: pytest.MonkeyPatch) -> None:
     from davis_ag.plants import require_native_helios
 
     try:
@@ -32,8 +32,10 @@ def test_demo_renders_validates_benchmarks_and_reports(tmp_path: Path,
     except UserError as error:
         pytest.skip(str(error))
     scenario, crop = _tiny_specs()
+    # A relative output folder from another working directory, as `make demo` passes it.
+    monkeypatch.chdir(tmp_path)
     out = tmp_path / "demo"
-    code = run_demo(out, scenes=1, size=(96, 54), episodes=5, sessions=2, scenario=scenario, crop=crop)
+    code = run_demo(Path("demo"), scenes=1, size=(96, 54), episodes=5, sessions=2, scenario=scenario, crop=crop)
     printed = capsys.readouterr().out
     assert code == 0
     assert "sound" in printed

@@ -215,3 +215,19 @@ def test_ray_executor_makes_the_same_dataset(reference: Path, tiny_config: Path,
     finally:
         ray.shutdown()
     assert digest(root) == digest(reference)
+
+
+def test_generate_with_a_relative_out_from_another_folder(reference: Path, tiny_config: Path, tmp_path: Path,
+                                                          monkeypatch: pytest.MonkeyPatch) -> None:
+    """As a newcomer runs it: a relative --out, from a folder that is neither the repo nor /tmp's root.
+
+    pyhelios moves the process's working directory while it builds and closes a Visualizer; a
+    relative path used after that once sent the last images into pyhelios's own folders.
+    """
+    elsewhere = tmp_path / "somewhere" / "else"
+    elsewhere.mkdir(parents=True)
+    monkeypatch.chdir(elsewhere)
+    for _ in range(2):  # the race lost 2 runs in 3: more than one try to make it show
+        shutil.rmtree(elsewhere / "data", ignore_errors=True)
+        assert main(["generate", "--config", str(tiny_config), "--out", "data", "--workers", "1", "--quiet"]) == 0
+        assert digest(elsewhere / "data") == digest(reference)

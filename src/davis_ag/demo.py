@@ -268,6 +268,7 @@ def run_demo(out: Path, scenes: int = 2, size: tuple[int, int] = DEMO_SIZE, seed
         raise UserError("--episodes and --sessions must be at least 1")
     if seed < 0:
         raise UserError(f"--seed {seed} is negative: use a whole number from 0")
+    out = Path(out).expanduser().absolute()  # Helios moves the working directory as it works
     scenario = scenario or scenario_spec("sp")
     crop = crop or crop_spec("strawberry")
     if out.exists() and not out.is_dir():

@@ -107,6 +107,7 @@ def generate_scene(
     Returns:
         The scene folder and timing statistics.
     """
+    root = Path(root).absolute()  # Helios moves the working directory while it builds and closes
     started = time.perf_counter()
     rng = np.random.default_rng(request.seed)
     model = build_scene(request.scenario, request.crop, rng)
@@ -131,6 +132,7 @@ def generate_scene(
                 visible[view.image_name] = {str(k): v for k, v in fractions.items()}
                 if on_view:
                     on_view(view.index + 1, len(grid.viewpoints))
+            writer.wait()  # every image written before the Visualizer's teardown moves the cwd
         drawn = time.perf_counter()
         metadata = scene_metadata(request, model, grid, visible)
         metadata["timing_s"] = {"grow": round(grown - started, 3), "draw_and_label": round(drawn - grown, 3)}

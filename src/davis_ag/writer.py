@@ -46,7 +46,10 @@ class SceneWriter:
     """
 
     def __init__(self, scene_dir: Path) -> None:
-        self.scene_dir = Path(scene_dir)
+        # Absolute from the start: pyhelios changes the process's working directory while a
+        # Visualizer or PlantArchitecture is built or destroyed, and our encoder threads may
+        # still be writing then.
+        self.scene_dir = Path(scene_dir).absolute()
         self.tmp_dir = partial_dir(self.scene_dir)
         if self.tmp_dir.exists():  # left by a run that crashed mid-scene
             shutil.rmtree(self.tmp_dir)
@@ -77,6 +80,10 @@ class SceneWriter:
     def _drain(self, keep: int = 0) -> None:
         while len(self._pending) > keep:
             self._pending.pop(0).result()
+
+    def wait(self) -> None:
+        """Block until every queued image is on disk (call before a renderer is closed)."""
+        self._drain()
 
     def finish(self, scene_metadata: dict) -> Path:
         """Write annotations.json and scene.json, then move the scene into place.

@@ -8,9 +8,10 @@ benchmarks LRD, UDD, Rand and the Oracle on the test split (Table 4 style) and w
 from __future__ import annotations
 
 import argparse
+
+from davis_ag.commands import arguments
 from pathlib import Path
 
-from davis_ag.commands.generate import image_size
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -18,11 +19,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "demo", help="generate a small dataset, validate it, run the baselines, write a report",
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--out", type=Path, required=True, metavar="DIR",
+    parser.add_argument("--out", type=arguments.path, required=True, metavar="DIR",
                         help="output folder (DIR/dataset, DIR/report/index.html)")
     parser.add_argument("--scenes", type=int, default=2,
                         help="SP strawberry scenes (default 2: one train, one test scene)")
-    parser.add_argument("--size", type=image_size, default="1280x720",
+    parser.add_argument("--size", type=arguments.image_size, default="1280x720",
                         help="image size WIDTHxHEIGHT (default 1280x720, the paper's)")
     parser.add_argument("--seed", type=int, default=0, help="dataset and evaluation seed (default 0)")
     parser.add_argument("--episodes", type=int, default=200, help="episodes per session (default 200)")

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from davis_ag.commands import arguments
 from davis_ag.errors import UserError
 
 
@@ -17,13 +18,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "episodes, fixed seeds), print a Table 4 style summary, write it as JSON and "
                     "a PNG bar chart.",
     )
-    parser.add_argument("--dataset", required=True, metavar="DIR", help="dataset root")
+    parser.add_argument("--dataset", type=arguments.path, required=True, metavar="DIR", help="dataset root")
     parser.add_argument("--scenario", required=True, choices=["sp", "mp"],
                         help="single plant (tau=3) or multi plant (tau=5)")
     parser.add_argument("--crop", default=None, help="evaluate on one crop only (default: all)")
     parser.add_argument("--split", default="test", choices=["train", "test", "all"],
                         help="scenes to evaluate on (default: test)")
-    parser.add_argument("--model", default=None, metavar="MODEL.zip",
+    parser.add_argument("--model", type=arguments.path, default=None, metavar="MODEL.zip",
                         help="trained A2C model; adds the A2C column")
     parser.add_argument("--policies", default="LRD,UDD,Rand,Oracle",
                         help="comma-separated baselines (default: LRD,UDD,Rand,Oracle)")
@@ -32,10 +33,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--episodes", type=int, default=200, help="episodes per session (200)")
     parser.add_argument("--sessions", type=int, default=3, help="sessions (3)")
     parser.add_argument("--seed", type=int, default=0, help="base seed of the episodes (0)")
-    parser.add_argument("--cache-dir", default=None, metavar="DIR",
+    parser.add_argument("--cache-dir", type=arguments.path, default=None, metavar="DIR",
                         help="observation cache folder (default: DIR/.davis_ag_cache)")
-    parser.add_argument("--out", required=True, metavar="RESULTS.json", help="results file")
-    parser.add_argument("--plot", default=None, metavar="PNG",
+    parser.add_argument("--out", type=arguments.path, required=True, metavar="RESULTS.json", help="results file")
+    parser.add_argument("--plot", type=arguments.path, default=None, metavar="PNG",
                         help="bar chart (default: the --out path with .png)")
     parser.set_defaults(func=run)
 

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import re
 from pathlib import Path
 
+from davis_ag.commands import arguments
 from davis_ag.dataset_config import load_dataset_config, single_group_config
 from davis_ag.errors import UserError
 from davis_ag.render import Camera
@@ -21,27 +21,6 @@ from davis_ag.runner import DEFAULT_MAX_RETRIES, RunOptions, default_workers, ru
 GROUP_FLAGS = ("crop", "scenario", "scenes", "first")
 
 
-def image_size(text: str) -> tuple[int, int]:
-    """Parse ``WIDTHxHEIGHT``."""
-    match = re.fullmatch(r"(\d+)x(\d+)", text.strip())
-    if not match or min(int(match[1]), int(match[2])) < 16:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an image size like 1280x720 (16 pixels at least)")
-    return int(match[1]), int(match[2])
-
-
-def count(text: str) -> int:
-    """Parse a positive count."""
-    if not text.isdigit() or int(text) < 1:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a positive whole number")
-    return int(text)
-
-
-def whole(text: str) -> int:
-    """Parse a whole number from 0."""
-    if not text.isdigit():
-        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number from 0")
-    return int(text)
-
 
 def register(subparsers) -> None:
     parser = subparsers.add_parser("generate", help="render DAVIS-Ag scenes with Helios",
@@ -49,24 +28,24 @@ def register(subparsers) -> None:
     parser.add_argument("--config", help="dataset config: a preset (paper, mini) or a YAML file")
     parser.add_argument("--crop", help="strawberry, tomato or vine (default strawberry; not with --config)")
     parser.add_argument("--scenario", help="sp (single plant) or mp (multi plant) (default sp)")
-    parser.add_argument("--scenes", type=count, help="how many scenes (default 1)")
+    parser.add_argument("--scenes", type=arguments.count, help="how many scenes (default 1)")
     parser.add_argument("--first", type=int, help="index of the first scene (default 0)")
     parser.add_argument("--seed", type=int, help="dataset seed (default 0, or the config's)")
-    parser.add_argument("--size", type=image_size, help="image size (default 1280x720, or the config's)")
-    parser.add_argument("--out", type=Path, required=True, help="dataset folder")
+    parser.add_argument("--size", type=arguments.image_size, help="image size (default 1280x720, or the config's)")
+    parser.add_argument("--out", type=arguments.path, required=True, help="dataset folder")
     parser.add_argument("--only", action="append", metavar="SCENE",
                         help="make only this scene or group, e.g. Single-Strawberry/003 (repeatable, or "
                              "comma-separated)")
-    parser.add_argument("--workers", type=count,
+    parser.add_argument("--workers", type=arguments.count,
                         help=f"scene processes on this machine, each drawing with one Mesa thread (default: "
                              f"one per core as memory allows, {default_workers()} here; 1 draws in this process "
                              "with every core)")
     parser.add_argument("--executor", choices=("local", "ray"), default="local",
                         help="local processes (default) or one Ray task per scene on a cluster")
     parser.add_argument("--address", help="Ray cluster address: auto (on a cluster machine) or ray://HEAD:10001")
-    parser.add_argument("--cpus-per-scene", type=count, default=1,
+    parser.add_argument("--cpus-per-scene", type=arguments.count, default=1,
                         help="Ray: CPUs (and Mesa threads) each scene task reserves (default 1)")
-    parser.add_argument("--max-retries", type=whole, default=DEFAULT_MAX_RETRIES,
+    parser.add_argument("--max-retries", type=arguments.whole, default=DEFAULT_MAX_RETRIES,
                         help=f"tries again for a scene whose worker died (default {DEFAULT_MAX_RETRIES})")
     parser.add_argument("--quiet", action="store_true", help="no progress bars")
     parser.set_defaults(func=run)

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 from PIL import Image, ImageDraw
 
-from davis_ag.commands.generate import image_size
+from davis_ag.commands import arguments
 from davis_ag.config import crop_spec, plant_centres, scenario_spec
 from davis_ag.errors import UserError
 from davis_ag.generate import SceneRequest
@@ -30,8 +30,8 @@ def register(subparsers) -> None:
     parser.add_argument("--seed", type=int, default=0, help="dataset seed (default 0)")
     parser.add_argument("--index", type=int, default=0, help="scene index (default 0)")
     parser.add_argument("--views", default="1", help="comma-separated view numbers (default 1)")
-    parser.add_argument("--size", type=image_size, default=(1280, 720), help="image size (default 1280x720)")
-    parser.add_argument("--out", type=Path, required=True, help="folder for the pictures")
+    parser.add_argument("--size", type=arguments.image_size, default=(1280, 720), help="image size (default 1280x720)")
+    parser.add_argument("--out", type=arguments.path, required=True, help="folder for the pictures")
     parser.set_defaults(func=run)
 
 

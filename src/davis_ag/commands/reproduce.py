@@ -17,6 +17,7 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
+from davis_ag.commands import arguments
 from davis_ag.errors import UserError
 
 
@@ -75,8 +76,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "reproduce", help="reproduce Table 4: generate, train A2C, benchmark, write results.md",
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--out", type=Path, required=True, metavar="DIR", help="work folder")
-    parser.add_argument("--results", type=Path, default=Path("docs/results.md"), metavar="MD",
+    parser.add_argument("--out", type=arguments.path, required=True, metavar="DIR", help="work folder")
+    parser.add_argument("--results", type=arguments.path, default="docs/results.md", metavar="MD",
                         help="Markdown results file (default: docs/results.md)")
     parser.add_argument("--config", choices=list(CONFIGS), default="small",
                         help="small (43 min measured on 2 CPU cores, default) or paper-scale")

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from davis_ag.commands import arguments
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``train`` sub-command."""
@@ -13,7 +15,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Train Stable-Baselines3 A2C (CnnPolicy, the paper's NatureCNN, SB3 default "
                     "hyperparameters) on the train split of the TVM environment and save a .zip.",
     )
-    parser.add_argument("--dataset", required=True, metavar="DIR", help="dataset root")
+    parser.add_argument("--dataset", type=arguments.path, required=True, metavar="DIR", help="dataset root")
     parser.add_argument("--scenario", required=True, choices=["sp", "mp"],
                         help="single plant (tau=3) or multi plant (tau=5)")
     parser.add_argument("--crop", default=None, help="train on one crop only (default: all)")
@@ -24,9 +26,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--arch", choices=["nature", "pooled"], default="nature",
                         help="network: nature (the paper's, default) or pooled (fast smoke tests)")
     parser.add_argument("--device", default="auto", help="torch device (default: auto)")
-    parser.add_argument("--cache-dir", default=None, metavar="DIR",
+    parser.add_argument("--cache-dir", type=arguments.path, default=None, metavar="DIR",
                         help="observation cache folder (default: DIR/.davis_ag_cache)")
-    parser.add_argument("--out", required=True, metavar="MODEL.zip", help="where to save the model")
+    parser.add_argument("--out", type=arguments.path, required=True, metavar="MODEL.zip", help="where to save the model")
     parser.add_argument("--verbose", type=int, default=1, help="SB3 verbosity (default: 1)")
     parser.set_defaults(func=run)
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from davis_ag.commands import arguments
 from davis_ag.errors import UserError
 
 
@@ -17,7 +18,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "entry, image and mask, every pointer and every box against its mask. Prints one "
                     "'path: reason' line per problem and a summary; exits 0 when sound, 1 otherwise.",
     )
-    parser.add_argument("dir", metavar="DIR", help="dataset root, group folder (e.g. Single-Strawberry) "
+    parser.add_argument("dir", type=arguments.path, metavar="DIR", help="dataset root, group folder (e.g. Single-Strawberry) "
                                                    "or scene folder")
     parser.add_argument("--quick", action="store_true",
                         help="skip pixel checks (image and mask sizes, boxes against masks)")
