@@ -1,6 +1,6 @@
 """Write tiny but fully consistent DAVIS-Ag datasets for tests (no renderer, no Helios).
 
-The grid and pointers come from the real :func:`davis_ag.view_grid.build_view_grid` on a shrunk
+The grid and pointers come from the real :func:`davis_ag.scene.view_grid.build_view_grid` on a shrunk
 scenario, so an environment built on them sees the true action graph. The "renderer" is a
 pinhole camera with a z-buffer over flat discs (fruits) and axis-aligned rectangles (leaves)
 placed in 3-D around each plant: parallax moves leaves across fruits between views, so the
@@ -28,9 +28,9 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
-from davis_ag import config
-from davis_ag.config import CropSpec, ScenarioSpec
-from davis_ag.view_grid import Viewpoint, build_view_grid
+from davis_ag.scene import specs as config
+from davis_ag.scene.specs import CropSpec, ScenarioSpec
+from davis_ag.scene.view_grid import Viewpoint, build_view_grid
 
 #: Visible pixels a fruit needs for a box at these tiny sizes (the real threshold is per crop).
 TINY_MIN_FRUIT_PIXELS = 4

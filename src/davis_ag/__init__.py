@@ -2,4 +2,4 @@
 
 __version__ = "0.1.0"
 
-from davis_ag import env as _env  # noqa: E402,F401 - registers davis_ag/TVM-v0
+from davis_ag import benchmark as _benchmark  # noqa: E402,F401 - registers davis_ag/TVM-v0

@@ -4,7 +4,7 @@ against drawing alone, and what the paper-scale dataset would take.
 All in one process, on one single-plant strawberry scene at 1280x720 and a fixed set of its views
 (the scene's own grid, thinned: every 0.5 m at the middle altitude):
 
-- ours: the real generate path (:func:`davis_ag.generate.generate_scene`: draw, labels, visible
+- ours: the real generate path (:func:`davis_ag.generate.one_scene.generate_scene`: draw, labels, visible
   fractions, JPEG, PNG, annotations, atomic publish), seconds per view from the first view done
   to the scene published, so the writes still queued at the end are paid for;
 - documented: the same views drawn by pyhelios as its documentation shows: ``printWindow`` to a
@@ -36,14 +36,15 @@ from typing import Callable
 
 import numpy as np
 
-from davis_ag.config import CROPS, SCENARIOS, plant_centres
-from davis_ag.dataset_config import load_dataset_config
 from davis_ag.errors import UserError
-from davis_ag.generate import SceneRequest, generate_scene
-from davis_ag.render import Camera, HeliosRenderer
-from davis_ag.runner import count_views
-from davis_ag.scene import build_scene
-from davis_ag.view_grid import build_view_grid
+from davis_ag.generate.one_scene import SceneRequest, generate_scene
+from davis_ag.generate.run_config import load_dataset_config
+from davis_ag.generate.run_progress import count_views
+from davis_ag.render.helios import HeliosRenderer
+from davis_ag.scene.build import build_scene
+from davis_ag.scene.camera import Camera
+from davis_ag.scene.specs import CROPS, SCENARIOS, plant_centres
+from davis_ag.scene.view_grid import build_view_grid
 
 SEED = 0
 CAMERA = Camera(1280, 720)
@@ -200,7 +201,7 @@ def env_speed(dataset: Path, steps: int = 20_000) -> dict:
     """
     import gymnasium
 
-    from davis_ag.env import TVM_ID, benchmark_steps
+    from davis_ag.benchmark import TVM_ID, benchmark_steps
 
     try:
         env = gymnasium.make(TVM_ID, dataset=str(dataset), scenario="sp", split="all")

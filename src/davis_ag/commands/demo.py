@@ -10,8 +10,6 @@ from __future__ import annotations
 import argparse
 
 from davis_ag.commands import arguments
-from pathlib import Path
-
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -33,7 +31,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run the demo; 0 on success, 1 when the generated dataset failed validation."""
-    from davis_ag.demo import run_demo
+    from davis_ag.workflows.demo import run_demo
 
     return run_demo(args.out, scenes=args.scenes, size=args.size, seed=args.seed,
                     episodes=args.episodes, sessions=args.sessions)

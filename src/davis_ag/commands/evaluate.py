@@ -43,9 +43,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Evaluate, print the table, write JSON and PNG."""
-    from davis_ag.agents import build_agents
-    from davis_ag.env import TVMEnv
-    from davis_ag.evaluation import evaluate_agents, format_table, plot_results, write_json
+    from davis_ag.benchmark import TVMEnv
+    from davis_ag.benchmark.agents import build_agents
+    from davis_ag.benchmark.evaluation import evaluate_agents, format_table, plot_results, write_json
 
     if args.episodes < 1 or args.sessions < 1:
         raise UserError("--episodes and --sessions must be at least 1")

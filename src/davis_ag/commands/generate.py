@@ -9,13 +9,13 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-from pathlib import Path
 
 from davis_ag.commands import arguments
-from davis_ag.dataset_config import load_dataset_config, single_group_config
 from davis_ag.errors import UserError
-from davis_ag.render import Camera
-from davis_ag.runner import DEFAULT_MAX_RETRIES, RunOptions, default_workers, run_dataset
+from davis_ag.generate.run_config import load_dataset_config, single_group_config
+from davis_ag.generate.run_progress import DEFAULT_MAX_RETRIES, RunOptions, default_workers
+from davis_ag.generate.runner import run_dataset
+from davis_ag.scene.camera import Camera
 
 #: Flags that describe the one group of a config-less run.
 GROUP_FLAGS = ("crop", "scenario", "scenes", "first")

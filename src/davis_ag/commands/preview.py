@@ -7,19 +7,19 @@ sun and slip) and draws the chosen views, so a researcher can look before render
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 import numpy as np
 from PIL import Image, ImageDraw
 
 from davis_ag.commands import arguments
-from davis_ag.config import crop_spec, plant_centres, scenario_spec
 from davis_ag.errors import UserError
-from davis_ag.generate import SceneRequest
-from davis_ag.labels import fruit_lookup, label_view, visible_fractions
-from davis_ag.render import Camera, HeliosRenderer
-from davis_ag.scene import build_scene
-from davis_ag.view_grid import build_view_grid
+from davis_ag.generate.one_scene import SceneRequest
+from davis_ag.labels.fruit_labels import fruit_lookup, label_view, visible_fractions
+from davis_ag.render.helios import HeliosRenderer
+from davis_ag.scene.build import build_scene
+from davis_ag.scene.camera import Camera
+from davis_ag.scene.specs import crop_spec, plant_centres, scenario_spec
+from davis_ag.scene.view_grid import build_view_grid
 
 
 def register(subparsers) -> None:

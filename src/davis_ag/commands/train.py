@@ -35,7 +35,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Train and save; prints the model's path."""
-    from davis_ag.agents import train_a2c
+    from davis_ag.benchmark.agents import train_a2c
 
     path = train_a2c(args.dataset, args.scenario, total_timesteps=args.timesteps, seed=args.seed,
                      out_path=args.out, n_envs=args.n_envs, crop=args.crop,

@@ -32,7 +32,7 @@ def run(args: argparse.Namespace) -> int:
     """Validate ``args.dir``; 0 when sound, 1 when a problem was found."""
     from tqdm import tqdm
 
-    from davis_ag.validate import validate_dataset
+    from davis_ag.data.validate import validate_dataset
 
     if args.box_tolerance is not None and args.box_tolerance < 0:
         raise UserError(f"--box-tolerance must be 0 or more, got {args.box_tolerance}")

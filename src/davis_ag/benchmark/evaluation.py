@@ -1,0 +1,187 @@
+"""Benchmark policies as in section V-C and Table 4.
+
+Protocol: the test split; ``sessions`` (3) sessions of ``episodes`` (200) episodes. Episode
+``e`` of session ``s`` resets the environment with a seed drawn from
+``numpy.random.SeedSequence([seed, s])``, so every policy plays exactly the same episodes
+(same scene, view and target); an agent's own randomness is seeded from
+``SeedSequence([seed, s, 1])`` so that it never mirrors the environment's draws. Per policy
+and session the mean final OER (``OER_tau``), cumulative reward and episode length are taken;
+the table reports their mean and standard deviation (population, ``ddof=0``) over sessions.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from davis_ag.atomic_files import write_json_atomic
+from davis_ag.benchmark import TVMEnv
+from davis_ag.benchmark.agents import Agent
+
+#: Table 4's metrics: key in the results, row label.
+METRICS: dict[str, str] = {"oer_tau": "OER_tau", "reward": "Cum. Reward", "length": "Ep. Length"}
+
+
+def episode_seeds(seed: int, session: int, episodes: int) -> tuple[list[int], list[int]]:
+    """Reset seeds and agent seeds of one session.
+
+    Args:
+        seed: The evaluation's base seed.
+        session: Session index.
+        episodes: Episodes in the session.
+
+    Returns:
+        ``(reset_seeds, agent_seeds)``, one each per episode.
+    """
+    env_seeds = np.random.SeedSequence([seed, session]).generate_state(episodes)
+    agent_seeds = np.random.SeedSequence([seed, session, 1]).generate_state(episodes)
+    return [int(s) for s in env_seeds], [int(s) for s in agent_seeds]
+
+
+def run_episode(env: TVMEnv, agent: Agent, reset_seed: int,
+                agent_seed: int | None = None) -> dict[str, Any]:
+    """Play one episode.
+
+    Args:
+        env: The environment (a :class:`TVMEnv`, wrapped or not).
+        agent: The policy.
+        reset_seed: Seed of ``env.reset``; fixes the scene, view and target.
+        agent_seed: Seed of the agent's own randomness.
+
+    Returns:
+        ``{"oer_0", "oer_tau", "reward", "length", "scene", "target_fruit", "path",
+        "actions"}``.
+    """
+    obs, info = env.reset(seed=reset_seed)
+    agent.reset(agent_seed)
+    total, actions = 0.0, []
+    while True:
+        action = agent.act(obs, env)
+        actions.append(action)
+        obs, reward, terminated, truncated, info = env.step(action)
+        total += float(reward)
+        if terminated or truncated:
+            break
+    return {"oer_0": info["oer_0"], "oer_tau": info["oer_t"], "reward": total,
+            "length": len(actions), "scene": info["scene"], "target_fruit": info["target_fruit"],
+            "path": info["path"], "actions": actions}
+
+
+def evaluate_agents(env: TVMEnv, agents: list[Agent], episodes: int = 200, sessions: int = 3,
+                    seed: int = 0, keep_episodes: bool = False) -> dict[str, Any]:
+    """Run every agent on the same episodes and summarise as Table 4.
+
+    Args:
+        env: The (test split) environment.
+        agents: The policies; their ``name`` labels the results.
+        episodes: Episodes per session (200 in the paper).
+        sessions: Sessions (3 in the paper).
+        seed: Base seed of the episode draw.
+        keep_episodes: Also return every episode's record (large).
+
+    Returns:
+        ``{"protocol": {...}, "policies": {name: {metric: {"mean", "std", "sessions"}}}}``
+        with metrics ``oer_tau``, ``reward``, ``length`` and ``oer_0``, plus ``"episodes"``
+        per policy when ``keep_episodes``.
+    """
+    inner = env.unwrapped if hasattr(env, "unwrapped") else env
+    results: dict[str, Any] = {
+        "protocol": {"scenario": inner.scenario, "split": inner.split, "tau": inner.tau,
+                     "episodes": episodes, "sessions": sessions, "seed": seed,
+                     "scenes": [s.id for s in inner.scenes], "dataset": str(inner.dataset.root)},
+        "policies": {},
+    }
+    for agent in agents:
+        per_session: dict[str, list[float]] = {k: [] for k in (*METRICS, "oer_0")}
+        records = []
+        for session in range(sessions):
+            env_seeds, agent_seeds = episode_seeds(seed, session, episodes)
+            runs = [run_episode(env, agent, r, a) for r, a in zip(env_seeds, agent_seeds)]
+            for key in per_session:
+                per_session[key].append(float(np.mean([run[key] for run in runs])))
+            records.extend({"session": session, **run} for run in runs)
+        summary: dict[str, Any] = {
+            key: {"mean": float(np.mean(values)), "std": float(np.std(values)),
+                  "sessions": values}
+            for key, values in per_session.items()}
+        if keep_episodes:
+            summary["episodes"] = records
+        results["policies"][agent.name] = summary
+    return results
+
+
+def _number(value: float) -> str:
+    """Table 4 style: three decimals, no leading zero below 1 (``.433``)."""
+    text = f"{value:.3f}"
+    return text[1:] if text.startswith("0.") else text.replace("-0.", "-.")
+
+
+def format_table(results: dict[str, Any]) -> str:
+    """Plain-text Table 4: one row per metric, one column per policy, ``mean ±std``.
+
+    Args:
+        results: What :func:`evaluate_agents` returned.
+
+    Returns:
+        The table, lines joined by newlines.
+    """
+    protocol, policies = results["protocol"], results["policies"]
+    names = list(policies)
+    label = f"{protocol['scenario'].upper()} ({protocol['split']})"
+    cells = [[label, "Metric", *names]]
+    for key, title in METRICS.items():
+        row = ["", title]
+        for name in names:
+            stat = policies[name][key]
+            row.append(f"{_number(stat['mean'])} ±{_number(stat['std'])}")
+        cells.append(row)
+    widths = [max(len(row[i]) for row in cells) for i in range(len(cells[0]))]
+    lines = ["  ".join(c.ljust(w) for c, w in zip(row, widths)).rstrip() for row in cells]
+    lines.insert(1, "-" * len(lines[0]))
+    lines.append(f"mean ±std over {protocol['sessions']} sessions of {protocol['episodes']} "
+                 f"episodes, tau={protocol['tau']}")
+    return "\n".join(lines)
+
+
+def write_json(results: dict[str, Any], path: str | os.PathLike[str]) -> Path:
+    """Write the results as indented JSON (atomically: temp file then rename)."""
+    return write_json_atomic(path, results, indent=2)
+
+
+def plot_results(results: dict[str, Any], path: str | os.PathLike[str]) -> Path:
+    """Bar chart of the three Table 4 metrics per policy, with the std over sessions as error
+    bars, saved as PNG.
+
+    Args:
+        results: What :func:`evaluate_agents` returned.
+        path: The PNG to write.
+
+    Returns:
+        ``path``.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")  # files only: no display on servers
+    import matplotlib.pyplot as plt
+
+    policies = results["policies"]
+    names = list(policies)
+    fig, axes = plt.subplots(1, len(METRICS), figsize=(4 * len(METRICS), 3.2))
+    for ax, (key, title) in zip(axes, METRICS.items()):
+        means = [policies[n][key]["mean"] for n in names]
+        stds = [policies[n][key]["std"] for n in names]
+        ax.bar(names, means, yerr=stds, capsize=4, color=[f"C{i}" for i in range(len(names))])
+        ax.set_title(title)
+        ax.tick_params(axis="x", labelrotation=30)
+    protocol = results["protocol"]
+    fig.suptitle(f"{protocol['scenario'].upper()} {protocol['split']}: {protocol['sessions']} x "
+                 f"{protocol['episodes']} episodes")
+    fig.tight_layout()
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=120)
+    plt.close(fig)
+    return out

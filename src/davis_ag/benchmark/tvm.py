@@ -1,0 +1,321 @@
+"""Target visibility maximisation (TVM, section IV-A) as a Gymnasium environment.
+
+An episode (section V-C):
+
+- ``reset`` draws, from ``self.np_random`` only, a scene of the split, then a view of it, then a
+  target fruit boxed in that view with OER < 0.4 and at least ``min_fruit_pixels`` visible
+  pixels (section III-C): scene.json's value where the scene has one (what its boxes were made
+  with), else the crop's, scaled by image area relative to 1280x720. Each level is uniform, so
+  every scene is equally likely. The (scene, view, fruit) start list is built once.
+- The observation is the view resized to 224x224 plus a fourth channel that is 255 inside the
+  target's box and 0 elsewhere (section IV-C uses 1; 255 keeps one uint8 image space, which
+  Stable-Baselines3 scales by 1/255 anyway).
+- The box, and so the OER, is always the target's box as annotated in the *current* view (the
+  instance id is stable across a scene's views).
+- Actions: the scenario's moves in :data:`davis_ag.scene.specs` order, then ``done``: SP forward,
+  backward, left, right, up, down, done (7); MP adds rotate_cw, rotate_ccw before done (9).
+- A move that points to "" or to a view where the target has no box leaves the agent where it
+  is (section V-C); it still costs a step.
+- Every action, ``done`` included, is a step; the episode ends after ``tau`` steps (3 SP, 5 MP)
+  or on ``done``, so the episode length is the paper's "Ep. Length" (1 when ``done`` comes
+  first). Both endings are ``terminated=True``: the reward is the final one and nothing
+  follows, so a learner must not bootstrap past it (``truncated`` would make SB3 add
+  ``gamma * V(last obs)``). ``truncated`` is always False.
+- Reward: ``max(OER_end - OER_0, 0) ** 2`` on the last step, 0 before.
+- ``info``: ``oer_0``, ``oer_t`` (current), ``path`` (view names: the start, then one per move,
+  repeated where a move was refused; ``done`` adds none), ``target_fruit`` (instance id),
+  ``scene`` (id) and ``steps``.
+- Exact planners read the dynamics through :meth:`TVMEnv.move_table`, not the image.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from davis_ag.benchmark.cache import OBS_SIZE, SceneCache, load_scene_cache
+from davis_ag.benchmark.splits import scene_crop, select_scenes
+from davis_ag.errors import UserError
+from davis_ag.scene.specs import ALL_ACTIONS, crop_spec, scenario_spec
+
+#: Section V-C: an episode starts on a target with OER below this.
+MAX_START_OER = 0.4
+#: Image area that the crops' ``min_fruit_pixels`` (section III-C) refer to.
+REFERENCE_PIXELS = 1280 * 720
+
+
+@dataclass
+class _Starts:
+    """One scene's eligible starts, as compressed rows: views, then boxes per view."""
+
+    views: np.ndarray  # (n,) view indices with at least one eligible target
+    offsets: np.ndarray  # (n + 1,) into boxes
+    boxes: np.ndarray  # rows of the scene's box tables
+
+
+def as_dataset(dataset: Any) -> Any:
+    """Accept an opened dataset or a path to one."""
+    if hasattr(dataset, "scenes") and hasattr(dataset, "root"):
+        return dataset
+    from davis_ag.data.reader import open_dataset
+
+    return open_dataset(Path(os.fspath(dataset)))
+
+
+class TVMEnv(gym.Env[np.ndarray, np.int64]):
+    """DAVIS-Ag target visibility maximisation; see the module docstring for the rules."""
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 2}
+
+    def __init__(self, dataset: Any, scenario: str = "sp", split: str = "train",
+                 crop: str | None = None, cache_dir: str | os.PathLike[str] | None = None,
+                 max_start_oer: float = MAX_START_OER, tau: int | None = None,
+                 render_mode: str | None = None) -> None:
+        """Open the scenes of one scenario and split, building their caches if needed.
+
+        Args:
+            dataset: A dataset root (path) or an opened ``davis_ag.data.reader.Dataset``; passing
+                the opened one lets several environments share one parse.
+            scenario: ``sp`` or ``mp``.
+            split: ``train``, ``test`` or ``all`` (see :mod:`davis_ag.benchmark.splits`).
+            crop: Keep one crop only; ``None`` keeps all crops of the scenario.
+            cache_dir: Base folder of the observation caches (default under the dataset root).
+            max_start_oer: A target must start with an OER below this (0.4 in the paper).
+            tau: Steps per episode; default the scenario's (3 SP, 5 MP).
+            render_mode: ``None`` or ``"rgb_array"``.
+
+        Raises:
+            UserError: when the path is not a dataset, the split has no scene, or no scene has
+                an eligible start.
+        """
+        spec = scenario_spec(scenario)
+        if render_mode not in (None, "rgb_array"):
+            raise UserError(f"unknown render_mode {render_mode!r}: use None or 'rgb_array'")
+        self.render_mode = render_mode
+        self.dataset = as_dataset(dataset)
+        self.scenario = spec.name
+        self.split = split
+        self.tau = int(tau if tau is not None else spec.tau)
+        if self.tau < 1:
+            raise UserError(f"tau must be at least 1, got {self.tau}")
+        #: Action names by index: the scenario's moves, then ``done``.
+        self.action_names: tuple[str, ...] = tuple(spec.actions) + ("done",)
+        self.done_action = len(self.action_names) - 1
+        # Column of each move in the cache's pointer table (which follows ALL_ACTIONS).
+        self._columns = [ALL_ACTIONS.index(a) for a in spec.actions]
+        self.action_space = spaces.Discrete(len(self.action_names))
+        self.observation_space = spaces.Box(0, 255, (OBS_SIZE, OBS_SIZE, 4), dtype=np.uint8)
+
+        self.scenes = select_scenes(self.dataset, spec.name, split, crop)
+        self.caches: list[SceneCache] = [
+            load_scene_cache(s, self.dataset.root, cache_dir) for s in self.scenes]
+        self._starts: list[tuple[int, _Starts]] = []
+        for index, (scene, cache) in enumerate(zip(self.scenes, self.caches)):
+            starts = self._eligible(cache, self._min_pixels(scene, cache), max_start_oer)
+            if len(starts.views):
+                self._starts.append((index, starts))
+        if not self._starts:
+            raise UserError(
+                f"no eligible start in the {split} split of {self.dataset.root} "
+                f"({len(self.scenes)} {spec.name} scenes): no boxed fruit has OER < "
+                f"{max_start_oer} and enough visible pixels; use another split or dataset")
+        self._scene = self._view = self._box = self._fruit = self._t = -1
+        self._oer_0 = 0.0
+        self._path: list[str] = []
+        self._over = True
+
+    @staticmethod
+    def _min_pixels(scene: Any, cache: SceneCache) -> float:
+        """Visible pixels a start target needs: scene.json's threshold if the scene has one
+        (what its boxes were made with), else the crop's, scaled to the image area."""
+        metadata = scene.metadata
+        if metadata and isinstance(metadata.get("min_fruit_pixels"), (int, float)):
+            return float(metadata["min_fruit_pixels"])
+        crop = scene_crop(scene)
+        if crop is None:
+            return 0.0
+        area = cache.image_size[0] * cache.image_size[1]
+        return crop_spec(crop).min_fruit_pixels * area / REFERENCE_PIXELS
+
+    @staticmethod
+    def _eligible(cache: SceneCache, min_pixels: float, max_oer: float) -> _Starts:
+        """Boxes a scene's episodes may start from (OER and visible-pixel filters)."""
+        ok = (cache.box_oer < max_oer) & (cache.box_pixels >= min_pixels)
+        boxes = np.flatnonzero(ok).astype(np.int32)
+        # Rows were written view by view, so a stable sort by view keeps each view's boxes
+        # together in annotation order.
+        boxes = boxes[np.argsort(cache.box_view[boxes], kind="stable")]
+        views, counts = np.unique(cache.box_view[boxes], return_counts=True)
+        offsets = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+        return _Starts(views=views.astype(np.int32), offsets=offsets, boxes=boxes)
+
+    # ----------------------------------------------------------------------------- episode
+
+    def reset(self, *, seed: int | None = None,
+              options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
+        """Start an episode.
+
+        Args:
+            seed: Reseeds ``self.np_random``, the only source of randomness.
+            options: ``{"start": (scene_id, view_name, fruit_id)}`` forces a start (any boxed
+                fruit, eligible or not); used by tests and hand-made cases.
+
+        Returns:
+            The first observation and the info dict (see :meth:`_info`).
+        """
+        super().reset(seed=seed)
+        if options and "start" in options:
+            self._force_start(*options["start"])
+        else:
+            rng = self.np_random
+            scene, starts = self._starts[int(rng.integers(len(self._starts)))]
+            k = int(rng.integers(len(starts.views)))
+            lo, hi = int(starts.offsets[k]), int(starts.offsets[k + 1])
+            box = int(starts.boxes[lo + int(rng.integers(hi - lo))])
+            self._scene, self._box = scene, box
+        cache = self.caches[self._scene]
+        self._view = int(cache.box_view[self._box])
+        self._fruit = int(cache.box_fruit[self._box])
+        self._t = 0
+        self._oer_0 = float(cache.box_oer[self._box])
+        self._path = [cache.view_names[self._view]]
+        self._over = False
+        return self._observation(), self._info()
+
+    def _force_start(self, scene_id: str, view_name: str, fruit_id: int) -> None:
+        """Point the episode at a given scene, view and fruit (``options["start"]``)."""
+        ids = [s.id for s in self.scenes]
+        if scene_id not in ids:
+            raise UserError(f"start scene {scene_id!r} is not in the {self.split} split")
+        cache = self.caches[ids.index(scene_id)]
+        if view_name not in cache.view_names:
+            raise UserError(f"start view {view_name!r} is not in scene {scene_id}")
+        view = cache.view_names.index(view_name)
+        column = np.flatnonzero(cache.fruit_ids == int(fruit_id))
+        box = int(cache.box_index[view, column[0]]) if len(column) else -1
+        if box < 0:
+            raise UserError(f"fruit {fruit_id} has no box in {scene_id}/{view_name}")
+        self._scene, self._box = ids.index(scene_id), box
+
+    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        """Apply one action.
+
+        Args:
+            action: An integer index into :attr:`action_names`.
+
+        Returns:
+            ``(observation, reward, terminated, truncated, info)``.
+
+        Raises:
+            UserError: for an action outside the action space, or a step after the end.
+        """
+        a = self._action_index(action)
+        if self._over:
+            raise UserError("the episode is over (or never started): call reset() first")
+        self._t += 1
+        if a != self.done_action:
+            self._view, self._box = self._move(self._view, a)
+            self._path.append(self.caches[self._scene].view_names[self._view])
+        terminated = a == self.done_action or self._t >= self.tau
+        reward = 0.0
+        if terminated:
+            self._over = True
+            reward = self.reward(self._oer_0, self.oer)
+        return self._observation(), reward, terminated, False, self._info()
+
+    def _action_index(self, action: Any) -> int:
+        """Validate an action (Python or NumPy integer, or a one-element integer array)."""
+        if isinstance(action, np.ndarray) and action.size == 1:
+            action = action.reshape(()).item() if action.dtype.kind in "iu" else action
+        if isinstance(action, (int, np.integer)) and not isinstance(action, bool):
+            if 0 <= int(action) < len(self.action_names):
+                return int(action)
+        raise UserError(f"invalid action {action!r}: expected an integer in "
+                        f"0..{len(self.action_names) - 1} ({', '.join(self.action_names)})")
+
+    def _move(self, view: int, action: int) -> tuple[int, int]:
+        """Where a move leads for the current target: ``(view, box row)``; refused: stays."""
+        cache = self.caches[self._scene]
+        nxt = int(cache.pointers[view, self._columns[action]])
+        if nxt >= 0:
+            box = int(cache.box_index[nxt, self._fruit])
+            if box >= 0:
+                return nxt, box
+        return view, int(cache.box_index[view, self._fruit])
+
+    @staticmethod
+    def reward(oer_0: float, oer_end: float) -> float:
+        """Section IV-C: ``max(OER_end - OER_0, 0) ** 2``."""
+        return float(max(oer_end - oer_0, 0.0) ** 2)
+
+    # ----------------------------------------------------------------------------- state
+
+    @property
+    def oer(self) -> float:
+        """The target's OER in the current view."""
+        return float(self.caches[self._scene].box_oer[self._box])
+
+    @property
+    def steps_taken(self) -> int:
+        """Steps of the current episode so far (``done`` included)."""
+        return self._t
+
+    @property
+    def current_view(self) -> int:
+        """Index of the current view in the current scene's cache."""
+        return self._view
+
+    @property
+    def scene_id(self) -> str:
+        """Id of the current episode's scene."""
+        return self.scenes[self._scene].id
+
+    def move_table(self) -> tuple[np.ndarray, np.ndarray]:
+        """The current target's dynamics, for exact planners such as the Oracle agent.
+
+        Returns:
+            ``next_view``: ``(n_views, n_moves)`` int32, the view each move (actions
+            ``0..done_action-1``) leads to from each view, with refused moves staying put;
+            and ``oer``: ``(n_views,)`` float32, the target's OER per view, NaN where it has
+            no box (such views are never entered).
+        """
+        cache = self.caches[self._scene]
+        nxt = cache.pointers[:, self._columns]
+        here = np.arange(cache.n_views, dtype=np.int32)[:, None]
+        boxes = cache.box_index[:, self._fruit]
+        valid = (nxt >= 0) & (boxes[np.maximum(nxt, 0)] >= 0)
+        oer = np.where(boxes >= 0, cache.box_oer[np.maximum(boxes, 0)], np.nan)
+        return np.where(valid, nxt, here).astype(np.int32), oer.astype(np.float32)
+
+    def _observation(self) -> np.ndarray:
+        """The current view (224x224 RGB) with the target's box as a fourth 0/255 channel."""
+        cache = self.caches[self._scene]
+        # The cache's fourth channel is all zeros: one contiguous copy, then the box.
+        obs = np.array(cache.images[self._view])
+        x0, y0, x1, y1 = cache.box_scaled[self._box].tolist()
+        obs[y0:y1 + 1, x0:x1 + 1, 3] = 255
+        return obs
+
+    def _info(self) -> dict[str, Any]:
+        """Episode facts: start and current OER, views visited, target, scene, steps."""
+        return {"oer_0": self._oer_0, "oer_t": self.oer, "path": list(self._path),
+                "target_fruit": int(self.caches[self._scene].fruit_ids[self._fruit]),
+                "scene": self.scenes[self._scene].id, "steps": self._t}
+
+    def render(self) -> np.ndarray | None:
+        """``rgb_array``: the 224x224 view with the target's box outlined in red."""
+        if self.render_mode != "rgb_array" or self._scene < 0:
+            return None
+        cache = self.caches[self._scene]
+        frame = np.array(cache.images[self._view, :, :, :3])
+        x0, y0, x1, y1 = cache.box_scaled[self._box].tolist()
+        red = np.array([255, 0, 0], dtype=np.uint8)
+        frame[y0, x0:x1 + 1] = frame[y1, x0:x1 + 1] = red
+        frame[y0:y1 + 1, x0] = frame[y0:y1 + 1, x1] = red
+        return frame

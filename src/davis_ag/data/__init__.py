@@ -1,0 +1,2 @@
+"""Stage 5, reading: the published DAVIS-Ag layout (ours and the original download), its schema and
+validation."""

@@ -1,0 +1,378 @@
+"""Read a DAVIS-Ag dataset: what we generate and the original download alike.
+
+Annotations are read when a scene's views are first asked for, pixels when an image or mask
+is. The original README leaves some details open, so the reader accepts image names with or
+without ".jpeg" (keys and pointer values), a missing pointer key as an invalid move, float box
+values, a missing pose, a missing ``_seg.png`` and unknown keys. Anything it cannot make sense
+of raises :class:`~davis_ag.errors.UserError` naming the file and the entry.
+
+The pure parsers and box helpers live in :mod:`davis_ag.data.annotation_schema` and are re-exported
+here, so ``from davis_ag.data.reader import Box, exposure_rate`` works.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from davis_ag.data.annotation_schema import (
+    NO_FRUIT,
+    Box,
+    ViewRecord,
+    boxes_from_mask,
+    exposure_rate,
+    normalise_view_name,
+    parse_box,
+    parse_entry,
+    parse_pose,
+)
+from davis_ag.errors import UserError
+from davis_ag.scene import specs as config
+
+__all__ = [
+    "ANNOTATIONS", "NO_FRUIT", "SCENE_METADATA", "SPLITS", "Box", "Dataset", "NotFoundError", "Scene",
+    "View", "ViewRecord", "boxes_from_mask", "exposure_rate", "normalise_view_name", "open_dataset",
+    "parse_box", "parse_entry", "parse_pose", "read_json",
+]
+
+ANNOTATIONS = "annotations.json"
+SCENE_METADATA = "scene.json"
+SPLITS = "splits.json"
+
+
+class NotFoundError(UserError, KeyError):
+    """A scene or view that is not in the dataset; also a ``KeyError`` for ``dict``-minded callers."""
+
+    def __str__(self) -> str:  # KeyError would quote the message
+        return str(self.args[0]) if self.args else ""
+
+
+def read_json(path: Path, what: str) -> Any:
+    """Load a JSON file, turning every failure into one :class:`UserError` line."""
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as error:
+        raise UserError(f"{path}: cannot read {what} ({error.strerror or error}); check the file") from None
+    except UnicodeDecodeError:
+        raise UserError(f"{path}: {what} is not UTF-8 text; re-download or regenerate it") from None
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as error:
+        raise UserError(f"{path}: {what} is not valid JSON (line {error.lineno} column {error.colno}: "
+                        f"{error.msg}); re-download or regenerate it") from None
+
+
+def _view_order(name: str) -> tuple[int, str]:
+    stem = name.removesuffix(".jpeg")
+    return (int(stem), name) if stem.isdigit() else (1 << 62, name)
+
+
+@dataclass(eq=False)
+class View:
+    """One camera view of a scene: its annotation and lazy access to its pixels.
+
+    Attributes:
+        name: Image name, e.g. ``"0001.jpeg"``.
+        scene: The scene it belongs to.
+        pose: ``(x, y, z, yaw_deg, pitch_deg)``, or ``None`` where the annotation has none.
+        boxes: Fruit boxes, in file order.
+        pointers: Every action of the scene to the image name it leads to, "" where invalid.
+    """
+
+    name: str
+    scene: Scene = field(repr=False)
+    pose: tuple[float, ...] | None
+    boxes: tuple[Box, ...]
+    pointers: dict[str, str]
+
+    @property
+    def image_path(self) -> Path:
+        """Where the RGB image is (``images/0001.jpeg``)."""
+        return self.scene.path / "images" / self.name
+
+    @property
+    def mask_path(self) -> Path:
+        """Where the instance mask is (``images/0001_seg.png``), whether or not it exists."""
+        return self.scene.path / "images" / f"{self.name.removesuffix('.jpeg')}_seg.png"
+
+    def next(self, action: str) -> View | None:
+        """The view an action leads to.
+
+        Args:
+            action: One of :data:`davis_ag.scene.specs.ALL_ACTIONS`.
+
+        Returns:
+            The target view, or ``None`` where the move is invalid (or the scene lacks the action).
+
+        Raises:
+            UserError: for an unknown action or a pointer that names no view of the scene.
+        """
+        if action not in config.ALL_ACTIONS:
+            raise UserError(f"unknown action {action!r}: choose one of {', '.join(config.ALL_ACTIONS)}")
+        target = self.pointers.get(action, "")
+        if not target:
+            return None
+        found = self.scene.views.get(target)
+        if found is None:
+            raise UserError(f"{self.scene.path / ANNOTATIONS}: {self.name}: {action} points to {target}, "
+                            "which is not a view of this scene; run `davis-ag validate` on it")
+        return found
+
+    def box(self, fruit_id: int) -> Box | None:
+        """The box of a fruit in this view, or ``None`` where the fruit has none."""
+        return next((b for b in self.boxes if b.fruit_id == fruit_id), None)
+
+    def image(self) -> np.ndarray:
+        """Decode the image.
+
+        Returns:
+            ``H x W x 3`` uint8 RGB array.
+
+        Raises:
+            UserError: when the file is missing or unreadable.
+        """
+        return _load_pixels(self.image_path, "RGB")
+
+    def mask(self) -> np.ndarray | None:
+        """Decode the instance mask.
+
+        Returns:
+            ``H x W`` uint8 array (fruit id per pixel, 255 for none), or ``None`` without a mask file.
+
+        Raises:
+            UserError: when the file exists but cannot be read.
+        """
+        if not self.mask_path.is_file():
+            return None
+        return _load_pixels(self.mask_path, None)
+
+
+def _load_pixels(path: Path, mode: str | None) -> np.ndarray:
+    from PIL import Image, UnidentifiedImageError
+
+    try:
+        with Image.open(path) as im:
+            if mode:
+                im = im.convert(mode)
+            pixels = np.asarray(im)
+    except FileNotFoundError:
+        raise UserError(f"{path}: image file missing; re-download or regenerate the scene") from None
+    except (OSError, UnidentifiedImageError, ValueError) as error:
+        raise UserError(f"{path}: cannot decode ({error}); re-download or regenerate the scene") from None
+    if mode is None:
+        # A mask saved as RGB still carries the id in every channel; keep one.
+        if pixels.ndim == 3:
+            pixels = pixels[..., 0]
+        pixels = pixels.astype(np.uint8, copy=False)
+    return pixels
+
+
+@dataclass(eq=False)
+class Scene:
+    """One scene folder (``<group>/<NNN>``); its annotations load on first use.
+
+    Attributes:
+        path: The scene folder.
+        group: Its group folder's name, e.g. ``Single-Strawberry``.
+    """
+
+    path: Path
+    group: str
+
+    @property
+    def id(self) -> str:
+        """``"<group>/<scene>"``, e.g. ``"Single-Strawberry/000"``."""
+        return f"{self.group}/{self.path.name}"
+
+    @cached_property
+    def _specs(self) -> tuple[config.ScenarioSpec, config.CropSpec] | None:
+        return config.parse_group_name(self.group)
+
+    @property
+    def scenario(self) -> str | None:
+        """``"sp"`` or ``"mp"`` from the group name; ``None`` for an unknown group name."""
+        return self._specs[0].name if self._specs else None
+
+    @property
+    def crop(self) -> str | None:
+        """``"strawberry"``, ``"tomato"`` or ``"vine"``; ``None`` for an unknown group name."""
+        return self._specs[1].name if self._specs else None
+
+    @property
+    def annotations_path(self) -> Path:
+        """The scene's annotations.json."""
+        return self.path / ANNOTATIONS
+
+    def raw_annotations(self) -> dict[str, Any]:
+        """The annotations.json object as stored (for validators and converters).
+
+        Raises:
+            UserError: when it is unreadable, not JSON or not a JSON object.
+        """
+        raw = read_json(self.annotations_path, "annotations")
+        if not isinstance(raw, dict):
+            raise UserError(f"{self.annotations_path}: must hold a JSON object keyed by image name, "
+                            f"got {type(raw).__name__}; re-download or regenerate the scene")
+        return raw
+
+    @cached_property
+    def views(self) -> dict[str, View]:
+        """Every view, name to :class:`View`, in image order.
+
+        Raises:
+            UserError: naming the file and entry, when an entry cannot be read.
+        """
+        records = []
+        for key, entry in self.raw_annotations().items():
+            try:
+                records.append(parse_entry(key, entry))
+            except ValueError as error:
+                raise UserError(f"{self.annotations_path}: entry {key!r}: {error}; "
+                                "run `davis-ag validate` for every problem") from None
+        records.sort(key=lambda r: _view_order(r.name))
+        present = {a for r in records for a in r.pointers}
+        actions = tuple(a for a in config.ALL_ACTIONS if a in present)
+        if not actions:
+            actions = self._specs[0].actions if self._specs else config.SP_ACTIONS
+        self._actions = actions
+        return {r.name: View(r.name, self, r.pose, r.boxes, {a: r.pointers.get(a, "") for a in actions})
+                for r in records}
+
+    @property
+    def actions(self) -> tuple[str, ...]:
+        """The pointer keys the scene's views carry, in :data:`davis_ag.scene.specs.ALL_ACTIONS` order."""
+        _ = self.views
+        return self._actions
+
+    def view(self, name: str | int) -> View:
+        """Look a view up by ``"0001"``, ``"0001.jpeg"`` or 1-based number ``1``.
+
+        Raises:
+            NotFoundError: when the scene has no such view.
+        """
+        try:
+            key = normalise_view_name(name)
+        except ValueError as error:
+            raise NotFoundError(f"scene {self.id}: {error}") from None
+        if key not in self.views:
+            names = list(self.views)
+            span = f"{names[0]} .. {names[-1]}" if names else "none"
+            raise NotFoundError(f"scene {self.id} has no view {name!r} (its views: {span})")
+        return self.views[key]
+
+    @cached_property
+    def metadata(self) -> dict[str, Any] | None:
+        """Our scene.json as a plain dict (seed, camera, plants, fruits, visible_fraction...).
+
+        Returns:
+            ``None`` where the scene has none (the original download never has).
+
+        Raises:
+            UserError: when scene.json exists but is not a JSON object.
+        """
+        path = self.path / SCENE_METADATA
+        if not path.is_file():
+            return None
+        data = read_json(path, "scene metadata")
+        if not isinstance(data, dict):
+            raise UserError(f"{path}: must hold a JSON object, got {type(data).__name__}; regenerate the scene")
+        return data
+
+    def __len__(self) -> int:
+        return len(self.views)
+
+    def __iter__(self) -> Iterator[View]:
+        return iter(self.views.values())
+
+    def __repr__(self) -> str:
+        return f"Scene({self.id!r}, path={str(self.path)!r})"
+
+
+@dataclass(eq=False)
+class Dataset:
+    """The scenes found under one path.
+
+    Attributes:
+        root: The dataset root (the folder holding group folders), also when a group or scene
+            folder was opened.
+        scenes: The scenes under the opened path, sorted by id.
+    """
+
+    root: Path
+    scenes: list[Scene]
+
+    def scene(self, scene_id: str) -> Scene:
+        """Look a scene up by id, e.g. ``"Single-Strawberry/000"``.
+
+        Raises:
+            NotFoundError: when no scene has that id.
+        """
+        for scene in self.scenes:
+            if scene.id == scene_id.strip("/").replace("\\", "/"):
+                return scene
+        known = ", ".join(s.id for s in self.scenes[:3]) + (" ..." if len(self.scenes) > 3 else "")
+        raise NotFoundError(f"{self.root}: no scene {scene_id!r} (scenes: {known or 'none'})")
+
+    @cached_property
+    def splits(self) -> dict[str, Any] | None:
+        """Our splits.json (``{"seed", "train": [ids], "test": [ids]}``), or ``None`` without one.
+
+        Raises:
+            UserError: when the file exists but is not a JSON object.
+        """
+        path = self.root / SPLITS
+        if not path.is_file():
+            return None
+        data = read_json(path, "splits")
+        if not isinstance(data, dict):
+            raise UserError(f"{path}: must hold a JSON object with train and test lists; fix or delete it")
+        return data
+
+    def __len__(self) -> int:
+        return len(self.scenes)
+
+    def __iter__(self) -> Iterator[Scene]:
+        return iter(self.scenes)
+
+
+def _scene_dirs(folder: Path) -> list[Path]:
+    return sorted(p for p in folder.iterdir() if p.is_dir() and (p / ANNOTATIONS).is_file())
+
+
+def open_dataset(path: str | Path) -> Dataset:
+    """Open a dataset root, a group folder (``Single-Strawberry``) or a single scene folder.
+
+    Args:
+        path: The folder.
+
+    Returns:
+        The :class:`Dataset`; nothing but folder names is read yet.
+
+    Raises:
+        UserError: when the path does not exist or holds no DAVIS-Ag scene.
+    """
+    path = Path(path).expanduser().absolute()
+    if not path.exists():
+        raise UserError(f"{path}: no such folder; give the dataset root, a group folder or a scene folder")
+    if not path.is_dir():
+        raise UserError(f"{path}: is a file; give the folder that holds it")
+    if (path / ANNOTATIONS).is_file():
+        root, scenes = path.parent.parent, [Scene(path, path.parent.name)]
+    elif scene_dirs := _scene_dirs(path):
+        root, scenes = path.parent, [Scene(p, path.name) for p in scene_dirs]
+    else:
+        scenes = [Scene(s, g.name) for g in sorted(path.iterdir()) if g.is_dir() for s in _scene_dirs(g)]
+        root = path
+        if not scenes:
+            raise UserError(
+                f"{path}: not a DAVIS-Ag dataset: no {ANNOTATIONS} in it, in its sub-folders or theirs; "
+                f"give the root that holds e.g. Single-Strawberry/000/{ANNOTATIONS}, a group folder "
+                "or a scene folder")
+    scenes.sort(key=lambda s: s.id)
+    return Dataset(root, scenes)

@@ -1,0 +1,352 @@
+"""Check that a DAVIS-Ag dataset is sound: schema, files, pointers, boxes against masks.
+
+Every problem found is reported (one ``path: reason`` each) rather than stopping at the first,
+so one run lists everything a re-download or regeneration has to fix. What the reader
+tolerates in the original download (names without ".jpeg", float boxes, missing pose or
+pointer keys, unknown keys) is not a problem; a missing image or mask is.
+
+Box against mask: our writer makes each box exactly the inclusive pixel extent of its fruit's
+mask, so scenes with a scene.json (ours) are held to that. The original README does not say
+whether its width is ``xmax - xmin`` or ``xmax - xmin + 1``, so other scenes get one pixel of
+slack on each edge unless told otherwise.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+from collections import Counter
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from davis_ag.data.reader import (
+    ANNOTATIONS,
+    NO_FRUIT,
+    SCENE_METADATA,
+    SPLITS,
+    Box,
+    Dataset,
+    Scene,
+    ViewRecord,
+    boxes_from_mask,
+    normalise_view_name,
+    open_dataset,
+    parse_entry,
+)
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One thing wrong, and the file it is in."""
+
+    path: Path
+    reason: str
+
+    def __str__(self) -> str:
+        return f"{_display(self.path)}: {self.reason}"
+
+
+def _display(path: Path) -> str:
+    # Relative to the working directory when inside it: shorter and what the user typed.
+    try:
+        return os.path.relpath(path) if Path(path).is_relative_to(Path.cwd()) else str(path)
+    except (ValueError, OSError):  # another drive on Windows, or a deleted working directory
+        return str(path)
+
+
+@dataclass
+class Report:
+    """What a validation run looked at and found."""
+
+    scenes: int = 0
+    views: int = 0
+    boxes: int = 0
+    problems: list[Problem] = field(default_factory=list)
+
+    @property
+    def ok(self) -> bool:
+        """True when no problem was found."""
+        return not self.problems
+
+    def summary(self) -> str:
+        """One line: the counts and the verdict."""
+        verdict = "sound" if self.ok else _plural(len(self.problems), "problem")
+        counts = ", ".join(_plural(n, what) for n, what in
+                           ((self.scenes, "scene"), (self.views, "view"), (self.boxes, "box")))
+        return f"checked {counts}: {verdict}"
+
+
+def _plural(n: int, word: str) -> str:
+    return f"{n} {word}" + ("" if n == 1 else "es" if word.endswith("x") else "s")
+
+
+def _read_json(path: Path) -> tuple[object, str | None]:
+    try:
+        return json.loads(path.read_text(encoding="utf-8")), None
+    except json.JSONDecodeError as error:
+        return None, f"not valid JSON (line {error.lineno} column {error.colno}: {error.msg})"
+    except (OSError, UnicodeDecodeError) as error:
+        return None, f"cannot read ({error})"
+
+
+def validate_scene(scene: Scene, quick: bool = False, box_tolerance: int | None = None,
+                   report: Report | None = None, on_problem: Callable[[Problem], None] | None = None,
+                   ) -> Report:
+    """Check one scene folder.
+
+    Args:
+        scene: The scene.
+        quick: Skip everything that decodes pixels (image and mask sizes, boxes against masks).
+        box_tolerance: Pixels a box edge may differ from its mask's extent; ``None`` picks 0 for
+            our scenes (with scene.json) and 1 for others.
+        report: Add to this report instead of a new one.
+        on_problem: Called with each problem as it is found (to print while the run goes on).
+
+    Returns:
+        The report.
+    """
+    report = report if report is not None else Report()
+    report.scenes += 1
+
+    def flag(path: Path, reason: str) -> None:
+        problem = Problem(path, reason)
+        report.problems.append(problem)
+        if on_problem:
+            on_problem(problem)
+
+    ann_path = scene.path / ANNOTATIONS
+    raw, error = _read_json(ann_path)
+    if error is None and (not isinstance(raw, dict) or not raw):
+        error = "must be a non-empty JSON object keyed by image name"
+    if error is not None or not isinstance(raw, dict):
+        flag(ann_path, error or "unreadable")
+        return report
+
+    metadata = None
+    if (scene.path / SCENE_METADATA).is_file():
+        metadata, error = _read_json(scene.path / SCENE_METADATA)
+        if error or not isinstance(metadata, dict):
+            flag(scene.path / SCENE_METADATA, error or "must hold a JSON object")
+            metadata = None
+    tolerance = box_tolerance if box_tolerance is not None else (0 if metadata is not None else 1)
+
+    records: dict[str, ViewRecord] = {}
+    # Names of every entry, readable or not, so a broken entry does not also orphan its files.
+    names = {_name_or_key(key) for key in raw}
+    for key, entry in raw.items():
+        try:
+            record = parse_entry(key, entry)
+        except ValueError as error:
+            flag(ann_path, f"entry {key!r}: {error}")
+            continue
+        if record.name in records:
+            flag(ann_path, f"entry {key!r}: names the same image as another entry")
+        records[record.name] = record
+    report.views += len(raw)
+
+    images = scene.path / "images"
+    for record in records.values():
+        for action, target in record.pointers.items():
+            if target and target not in names:
+                flag(ann_path, f"{record.name}: {action} points to {target}, which is not a view of this scene")
+        report.boxes += len(record.boxes)
+        for problem in _box_schema_problems(record):
+            flag(ann_path, problem)
+        image, mask = images / record.name, images / f"{record.name.removesuffix('.jpeg')}_seg.png"
+        has_image, has_mask = image.is_file(), mask.is_file()
+        if not has_image:
+            flag(image, f"missing: annotations.json has an entry {record.name} for it")
+        if not has_mask:
+            flag(mask, f"missing: the instance mask of {record.name}")
+        if quick:
+            size = _camera_size(metadata)
+            if size:
+                for problem in _boxes_inside(record, size):
+                    flag(ann_path, problem)
+        elif has_image:
+            for path, problem in _pixel_problems(record, ann_path, image, mask if has_mask else None,
+                                                 metadata, tolerance):
+                flag(path, problem)
+
+    if images.is_dir():
+        for path in sorted(images.iterdir()):
+            stem = path.name.removesuffix("_seg.png") if path.name.endswith("_seg.png") else path.stem
+            if path.suffix.lower() in (".jpeg", ".jpg", ".png") and f"{stem}.jpeg" not in names:
+                flag(path, "has no entry in annotations.json")
+    return report
+
+
+def _name_or_key(key: str) -> str:
+    try:
+        return normalise_view_name(key)
+    except ValueError:
+        return key
+
+
+def _box_schema_problems(record: ViewRecord) -> list[str]:
+    problems = []
+    seen: set[int] = set()
+    for box in record.boxes:
+        where = f"{record.name}: box {box.to_list()[:5]}"
+        if box.width < 1 or box.height < 1:
+            problems.append(f"{where} has no area")
+        if box.xmin < 0 or box.ymin < 0:
+            problems.append(f"{where} starts outside the image")
+        if not 0 <= box.fruit_id < NO_FRUIT:
+            problems.append(f"{where}: fruit id must be 0..254 to fit the uint8 mask")
+        if box.fruit_id in seen:
+            problems.append(f"{where}: fruit {box.fruit_id} has two boxes in this view")
+        seen.add(box.fruit_id)
+    return problems
+
+
+def _camera_size(metadata: dict | None) -> tuple[int, int] | None:
+    camera = (metadata or {}).get("camera")
+    if isinstance(camera, dict) and isinstance(camera.get("width"), int) and isinstance(camera.get("height"), int):
+        return camera["width"], camera["height"]
+    return None
+
+
+def _boxes_inside(record: ViewRecord, size: tuple[int, int]) -> list[str]:
+    width, height = size
+    return [f"{record.name}: box {b.to_list()[:5]} reaches past the {width}x{height} image"
+            for b in record.boxes if b.xmax >= width or b.ymax >= height]
+
+
+def _pixel_problems(record: ViewRecord, ann_path: Path, image: Path, mask_path: Path | None,
+                    metadata: dict | None, tolerance: int) -> list[tuple[Path, str]]:
+    import numpy as np
+    from PIL import Image
+
+    problems: list[tuple[Path, str]] = []
+    try:
+        with Image.open(image) as im:
+            size, mode = im.size, im.mode
+            # Decoding at 1/8 scale still reads every byte, so truncation shows, at a fraction of the cost.
+            im.draft("RGB", (max(1, size[0] // 8), max(1, size[1] // 8)))
+            im.load()
+    except Exception as error:  # Pillow raises many types for a damaged file
+        return [(image, f"cannot decode ({error})")]
+    if mode != "RGB":
+        problems.append((image, f"must be RGB, got mode {mode}"))
+    expected = _camera_size(metadata)
+    if expected and size != expected:
+        problems.append((image, f"is {size[0]}x{size[1]} but scene.json's camera says {expected[0]}x{expected[1]}"))
+    problems += [(ann_path, p) for p in _boxes_inside(record, size)]
+    if mask_path is None:
+        return problems
+    try:
+        with Image.open(mask_path) as im:
+            mask_mode = im.mode
+            mask = np.asarray(im)
+    except Exception as error:
+        return problems + [(mask_path, f"cannot decode ({error})")]
+    if mask_mode not in ("L", "P") or mask.dtype != np.uint8 or mask.ndim != 2:
+        return problems + [(mask_path, f"must be a uint8 single-channel PNG, got mode {mask_mode}")]
+    if mask.shape[::-1] != size:
+        return problems + [(mask_path, f"is {mask.shape[1]}x{mask.shape[0]} but its image is {size[0]}x{size[1]}")]
+    extents = boxes_from_mask(mask)
+    boxes = {b.fruit_id: b for b in record.boxes}
+    for fid in sorted(set(extents) - set(boxes)):
+        problems.append((mask_path, f"holds fruit {fid}, which has no box in {record.name}"))
+    for fid, box in boxes.items():
+        if fid not in extents:
+            problems.append((mask_path, f"has no pixels of fruit {fid}, which has a box in {record.name}"))
+        elif not _close(box, extents[fid], tolerance):
+            m = extents[fid]
+            problems.append((mask_path, f"{record.name}: box of fruit {fid} is {box.to_list()[:4]} but its mask "
+                                        f"pixels span {[m.xmin, m.ymin, m.width, m.height]} (x, y, width, height)"))
+    return problems
+
+
+def _close(box: Box, extent: Box, tolerance: int) -> bool:
+    edges = zip((box.xmin, box.ymin, box.xmax, box.ymax), (extent.xmin, extent.ymin, extent.xmax, extent.ymax))
+    return all(abs(a - b) <= tolerance for a, b in edges)
+
+
+def _check_splits(dataset: Dataset, whole: bool) -> list[Problem]:
+    path = dataset.root / SPLITS
+    if not path.is_file():
+        return []
+    data, error = _read_json(path)
+    if error:
+        return [Problem(path, error)]
+    if not isinstance(data, dict):
+        return [Problem(path, "must hold a JSON object with train and test lists")]
+    problems = []
+    known = {scene.id for scene in dataset.scenes}
+    lists = {}
+    for name in ("train", "test"):
+        ids = data.get(name)
+        if not isinstance(ids, list) or not all(isinstance(i, str) for i in ids):
+            problems.append(Problem(path, f"{name!r} must be a list of scene ids like \"Single-Strawberry/000\""))
+            continue
+        lists[name] = set(ids)
+        # Only scenes under the opened path are known; a group or scene opened alone sees a subset.
+        if whole:
+            problems += [Problem(path, f"{name} lists {i}, which is not a scene here") for i in ids if i not in known]
+    if len(lists) == 2 and (both := sorted(lists["train"] & lists["test"])):
+        problems.append(Problem(path, f"{len(both)} scene(s) in both train and test, e.g. {both[0]}"))
+    return problems
+
+
+def _check_counts(dataset: Dataset, counts: dict[str, int]) -> list[Problem]:
+    """Scenes of a group share one grid, so a scene with another view count lost or gained images."""
+    problems = []
+    by_group: dict[str, list[Scene]] = {}
+    for scene in dataset.scenes:
+        if scene.id in counts:
+            by_group.setdefault(scene.group, []).append(scene)
+    for group, scenes in by_group.items():
+        common, votes = Counter(counts[s.id] for s in scenes).most_common(1)[0]
+        if votes * 2 <= len(scenes):
+            continue
+        problems += [Problem(s.path / ANNOTATIONS, f"has {counts[s.id]} views but {votes} of the "
+                             f"{len(scenes)} scenes of {group} have {common}")
+                     for s in scenes if counts[s.id] != common]
+    return problems
+
+
+def validate_dataset(path: str | Path, quick: bool = False, box_tolerance: int | None = None,
+                     on_problem: Callable[[Problem], None] | None = None, progress: bool = False) -> Report:
+    """Check every scene under a dataset root, group folder or scene folder.
+
+    Args:
+        path: What to check.
+        quick: Skip pixel checks.
+        box_tolerance: See :func:`validate_scene`.
+        on_problem: Called with each problem as it is found.
+        progress: Show a tqdm bar on stderr (when it is a terminal and there are several scenes).
+
+    Returns:
+        The :class:`Report`.
+
+    Raises:
+        UserError: when the path is not a DAVIS-Ag dataset at all.
+    """
+    from tqdm import tqdm
+
+    dataset = open_dataset(path)
+    report = Report()
+    counts: dict[str, int] = {}
+
+    def emit(problem: Problem) -> None:
+        report.problems.append(problem)
+        if on_problem:
+            on_problem(problem)
+
+    whole = Path(path).expanduser().absolute() == dataset.root
+    for problem in _check_splits(dataset, whole):
+        emit(problem)
+    bar = tqdm(dataset.scenes, desc="validate", unit="scene", file=sys.stderr,
+               disable=None if progress and len(dataset.scenes) > 1 else True)
+    for scene in bar:
+        before = report.views
+        validate_scene(scene, quick, box_tolerance, report, on_problem)
+        if report.views > before:  # an unreadable annotations.json is reported already
+            counts[scene.id] = report.views - before
+    for problem in _check_counts(dataset, counts):
+        emit(problem)
+    return report

@@ -1,0 +1,228 @@
+"""Generate DAVIS-Ag scenes: grow, lay out the grid, draw every view, label it and write it.
+
+Seeds: a dataset seed, the scenario, the crop and the scene's index determine the scene's seed
+(:func:`scene_seed`), so any one scene can be regenerated alone; the scene seed drives every
+random choice of that scene (phenotypes, Helios seeds, sun, slip) and is saved in scene.json.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import platform
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from davis_ag import __version__
+from davis_ag.errors import UserError
+from davis_ag.generate.scene_writer import SceneWriter, partial_dir
+from davis_ag.labels.fruit_labels import fruit_lookup, label_view, visible_fractions
+from davis_ag.render.helios import HeliosRenderer
+from davis_ag.scene.build import build_scene
+from davis_ag.scene.camera import Camera
+from davis_ag.scene.specs import CROPS, SCENARIOS, CropSpec, ScenarioSpec, group_name, plant_centres
+from davis_ag.scene.view_grid import build_view_grid
+
+SCENE_FORMAT = "davis-ag-scene/1"
+
+CONVENTIONS = {
+    "units": {"length": "m", "angle": "deg"},
+    "world_frame": "x east, y north, z up; ground at z = 0; single plant at the origin, "
+                   "multi-plant row along x centred on the origin",
+    "pose": "[x, y, z, yaw, pitch]: camera position after slip; yaw counter-clockwise from +x; "
+            "pitch above the horizon (negative looks down)",
+    "box": "[xmin, ymin, width, height, fruit_id, 0]: inclusive pixel extent, row 0 at the top",
+    "segmentation": "uint8 fruit_id per pixel for fruit with a box in the view, 255 elsewhere",
+    "actions_sp": "forward +y, backward -y, right +x, left -x (world-fixed), up/down between altitudes",
+    "actions_mp": "forward along the grid axis nearest the heading, backward opposite, left 90 deg "
+                  "counter-clockwise of forward, right clockwise; rotate_ccw +30 deg, rotate_cw -30 deg",
+    "visible_fraction": "visible pixels of a fruit over the pixels it would cover with nothing in front",
+}
+
+
+@dataclass(frozen=True)
+class SceneRequest:
+    """Which scene to make.
+
+    Attributes:
+        scenario, crop: What kind of scene.
+        index: Scene number within its group (folder ``NNN``).
+        dataset_seed: The dataset's seed.
+        camera: Image size and field of view.
+    """
+
+    scenario: ScenarioSpec
+    crop: CropSpec
+    index: int
+    dataset_seed: int
+    camera: Camera = Camera()
+
+    @property
+    def seed(self) -> int:
+        """This scene's own seed."""
+        return scene_seed(self.dataset_seed, self.scenario, self.crop, self.index)
+
+    @property
+    def min_fruit_pixels(self) -> int:
+        """The crop's box threshold, defined at 1280x720 and scaled with the image area."""
+        scale = self.camera.width * self.camera.height / (1280 * 720)
+        return max(1, round(self.crop.min_fruit_pixels * scale))
+
+    @property
+    def folder(self) -> str:
+        """Path of the scene folder below the dataset root."""
+        return f"{group_name(self.scenario, self.crop)}/{self.index:03d}"
+
+
+def scene_seed(dataset_seed: int, scenario: ScenarioSpec, crop: CropSpec, index: int) -> int:
+    """Derive a scene's seed from the dataset seed; independent streams for every scene."""
+    keys = [dataset_seed, list(SCENARIOS).index(scenario.name), list(CROPS).index(crop.name), index]
+    return int(np.random.SeedSequence(keys).generate_state(1, dtype=np.uint32)[0])
+
+
+def read_scene_seed(scene_dir: Path) -> int | None:
+    """The seed a finished scene was made with, or None when it carries no scene.json of ours."""
+    try:
+        with open(scene_dir / "scene.json") as handle:
+            return int(json.load(handle)["seed"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+
+
+def generate_scene(
+    request: SceneRequest,
+    root: Path,
+    on_view: Callable[[int, int], None] | None = None,
+) -> tuple[Path, dict]:
+    """Make one scene and write it atomically under ``root``.
+
+    Args:
+        request: What to make.
+        root: The dataset root.
+        on_view: Called with (views done, views in all) after every view, for progress bars.
+
+    Returns:
+        The scene folder and timing statistics.
+    """
+    root = Path(root).absolute()  # Helios moves the working directory while it builds and closes
+    started = time.perf_counter()
+    rng = np.random.default_rng(request.seed)
+    model = build_scene(request.scenario, request.crop, rng)
+    grown = time.perf_counter()
+    grid = build_view_grid(request.scenario, request.crop, plant_centres(request.scenario, request.crop),
+                           model.aim_height, rng)
+    lookup = fruit_lookup({f.id: f.uuids for f in model.fruits}, model.uuid_count)
+    polygons = {f.id: f.polygons for f in model.fruits}
+    camera = request.camera
+    scene_dir = root / request.folder
+    writer = SceneWriter(scene_dir)
+    visible: dict[str, dict[str, float]] = {}
+    try:
+        with HeliosRenderer(model.context, camera, model.lighting) as renderer:
+            for view in grid.viewpoints:
+                colour, primitive_ids = renderer.render(view)
+                labels = label_view(primitive_ids, lookup, request.min_fruit_pixels)
+                fractions = visible_fractions(camera, view, labels, polygons)
+                entry = {"bounding_boxes": labels.boxes, "pose": [round(v, 5) for v in view.pose]}
+                entry.update(grid.pointers(view.index))
+                writer.add_view(view.image_name, colour, labels.segmentation, entry)
+                visible[view.image_name] = {str(k): v for k, v in fractions.items()}
+                if on_view:
+                    on_view(view.index + 1, len(grid.viewpoints))
+            writer.wait()  # every image written before the Visualizer's teardown moves the cwd
+        drawn = time.perf_counter()
+        metadata = scene_metadata(request, model, grid, visible)
+        metadata["timing_s"] = {"grow": round(grown - started, 3), "draw_and_label": round(drawn - grown, 3)}
+        writer.finish(metadata)
+    except BaseException:
+        writer.abort()
+        raise
+    stats = {"views": len(grid.viewpoints), "grow_s": grown - started, "views_s": drawn - grown,
+             "total_s": time.perf_counter() - started}
+    return scene_dir, stats
+
+
+def scene_metadata(request: SceneRequest, model, grid, visible: dict) -> dict:
+    """Our scene.json: everything the published annotations leave out."""
+    import pyhelios
+
+    return {
+        "format": SCENE_FORMAT,
+        "generator": {"name": "davis-ag", "version": __version__, "pyhelios3d": pyhelios.__version__,
+                      "python": platform.python_version()},
+        "seed": request.seed,
+        "dataset_seed": request.dataset_seed,
+        "scenario": request.scenario.name,
+        "crop": request.crop.name,
+        "scene": request.folder,
+        "conventions": CONVENTIONS,
+        "camera": request.camera.intrinsics(),
+        "lighting": {"model": "phong_shadowed", "sun_elevation_deg": model.lighting.sun_elevation,
+                     "sun_azimuth_deg": model.lighting.sun_azimuth, "sun_direction": model.lighting.direction},
+        "grid": {"extent_m": list(request.scenario.extent), "step_m": request.scenario.step,
+                 "altitudes_m": [request.crop.altitudes[i] for i in request.scenario.altitude_levels],
+                 "headings": request.scenario.headings, "exclusion_radius_m": request.crop.exclusion_radius,
+                 "aim_height_m": model.aim_height, "views": len(grid.viewpoints)},
+        "min_fruit_pixels": request.min_fruit_pixels,
+        "plants": [plant.summary() for plant in model.plants],
+        "fruits": [fruit.summary() for fruit in model.fruits],
+        "views": {v.image_name: {"grid": [v.ix, v.iy, v.level, v.heading], "nominal": list(v.nominal)}
+                  for v in grid.viewpoints},
+        "visible_fraction": visible,
+    }
+
+
+# ---------------------------------------------------------------------------------------------
+# Output folder checks
+
+#: Names a dataset root may hold besides group folders.
+ROOT_EXTRAS = {"splits.json", "dataset.json", ".davis_ag_cache", ".davis_ag.lock", "reports"}
+
+
+def check_output_root(root: Path) -> None:
+    """Refuse an output folder we could damage or cannot write.
+
+    Raises:
+        UserError: when ``root`` is a file, holds something that is not a DAVIS-Ag dataset, or
+            cannot be written.
+    """
+    from davis_ag.scene.specs import parse_group_name
+
+    if root.exists() and not root.is_dir():
+        raise UserError(f"{root} is a file, not a folder: choose another --out")
+    if root.is_dir():
+        strangers = [p.name for p in root.iterdir()
+                     if p.name not in ROOT_EXTRAS and not (p.is_dir() and parse_group_name(p.name))]
+        if strangers:
+            raise UserError(f"{root} holds other things ({', '.join(sorted(strangers)[:3])}): "
+                            "choose an empty or DAVIS-Ag folder for --out")
+    parent = root if root.exists() else next((p for p in root.parents if p.exists()), Path("/"))
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise UserError(f"cannot write to {parent}: choose a writable --out")
+
+
+def check_scene_slot(root: Path, request: SceneRequest) -> bool:
+    """Whether a scene is already complete (True: skip it); clear stale partial folders.
+
+    Raises:
+        UserError: when a finished scene was made with a different seed: it is never replaced.
+    """
+    scene_dir = root / request.folder
+    if scene_dir.exists():
+        seed = read_scene_seed(scene_dir)
+        if seed != request.seed:
+            raise UserError(f"{scene_dir} already holds a scene made with other settings (seed {seed}, "
+                            f"not {request.seed}): use another --out or --seed, or move it away")
+        return True
+    return False
+
+
+def remove_stale_partial(root: Path, request: SceneRequest) -> None:
+    """Drop what a crashed run left of a scene."""
+    import shutil
+
+    shutil.rmtree(partial_dir(root / request.folder), ignore_errors=True)

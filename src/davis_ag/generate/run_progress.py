@@ -1,0 +1,155 @@
+"""What a dataset run reports as it goes: its options, its outcome, progress bars and failures.
+
+Shared by the runner and its executors (local pool, Ray), which receive these objects from the
+runner and never import it.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import traceback
+from dataclasses import dataclass, field
+from functools import lru_cache
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+from tqdm import tqdm
+
+from davis_ag.errors import UserError
+from davis_ag.generate.one_scene import SceneRequest
+from davis_ag.scene.specs import CropSpec, ScenarioSpec
+from davis_ag.scene.view_grid import build_view_grid
+
+#: Memory one scene process may need at most (a multi-plant vine scene), bytes.
+WORKER_MEMORY = 3 * 2**30
+#: How often a scene whose worker process died is tried again.
+DEFAULT_MAX_RETRIES = 2
+
+
+def default_workers() -> int:
+    """Scene processes for this machine: one per core, as far as memory allows.
+
+    Measured on 2 cores (docs/performance.md): two processes drawing with one Mesa thread each
+    made 1.90 views/s, one process with two Mesa threads 1.61 (llvmpipe's threads leave part of
+    each frame serial), and plant growth, single-threaded, only overlaps across processes.
+    """
+    cores = os.cpu_count() or 1
+    try:
+        memory = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError):
+        return cores
+    return max(1, min(cores, memory // WORKER_MEMORY))
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """How to run the scenes.
+
+    Attributes:
+        workers: Local scene processes; 1 draws in this process.
+        executor: ``local`` (this machine) or ``ray`` (an existing Ray cluster).
+        address: Ray cluster address (``auto``, ``ray://head:10001``); None starts or finds one.
+        cpus_per_scene: Ray only: CPUs each scene task reserves, also its Mesa thread count.
+        max_retries: Tries after the first for a scene whose worker process died.
+        progress: Show progress bars and one line per finished scene.
+    """
+
+    workers: int = field(default_factory=lambda: default_workers())
+    executor: str = "local"
+    address: str | None = None
+    cpus_per_scene: int = 1
+    max_retries: int = DEFAULT_MAX_RETRIES
+    progress: bool = True
+
+
+@dataclass
+class RunReport:
+    """What a run did.
+
+    Attributes:
+        root: The dataset folder.
+        made: Scene ids made by this run.
+        skipped: Scene ids that were already complete.
+        failed: Scene id to error message.
+        splits: splits.json, when written.
+    """
+
+    root: Path
+    made: list[str] = field(default_factory=list)
+    skipped: list[str] = field(default_factory=list)
+    failed: dict[str, str] = field(default_factory=dict)
+    splits: Path | None = None
+
+
+# ---------------------------------------------------------------------------------------------
+# Progress
+
+
+@lru_cache(maxsize=None)
+def count_views(scenario: ScenarioSpec, crop: CropSpec) -> int:
+    """Views of every scene of a scenario and crop (exclusion uses the nominal grid, not slip)."""
+    from davis_ag.scene.specs import plant_centres
+
+    grid = build_view_grid(scenario, crop, plant_centres(scenario, crop), crop.plant_height / 2,
+                           np.random.default_rng(0))
+    return len(grid.viewpoints)
+
+
+class Progress:
+    """A scenes bar and a views bar (with the time left), fed by events from any executor.
+
+    Events are tuples ``("start", scene_id)`` and ``("view", scene_id, done, total)``.
+
+    Args:
+        todo: The scenes to make.
+        enabled: False hides the bars and the per-scene lines.
+    """
+
+    def __init__(self, todo: Sequence[SceneRequest], enabled: bool) -> None:
+        self.enabled = enabled
+        total_views = sum(count_views(r.scenario, r.crop) for r in todo)
+        disable = None if enabled else True  # None: no bars when stderr is not a terminal
+        self.scenes = tqdm(total=len(todo), desc="scenes", unit="scene", position=0, disable=disable,
+                           dynamic_ncols=True)
+        # The time left comes from this bar: views are the unit of work, scenes vary tenfold.
+        self.views = tqdm(total=total_views, desc="views", unit="view", position=1, disable=disable,
+                          dynamic_ncols=True, smoothing=0.05)
+        self._counted: dict[str, int] = {}
+
+    def event(self, event: tuple) -> None:
+        """Apply one event."""
+        kind, scene = event[0], event[1]
+        if kind == "start":  # a scene (re)starts: views a dead try counted no longer count
+            self.views.update(-self._counted.pop(scene, 0))
+            self._counted[scene] = 0
+        elif kind == "view":
+            done = int(event[2])
+            self.views.update(done - self._counted.get(scene, 0))
+            self._counted[scene] = done
+
+    def finished(self, request: SceneRequest, stats: dict) -> None:
+        """A scene is complete."""
+        self.scenes.update(1)
+        self.write(f"{request.folder}: {stats['views']} views, grown in {stats['grow_s']:.1f} s, "
+                   f"{stats['views_s'] / max(stats['views'], 1):.3f} s per view")
+
+    def write(self, line: str, always: bool = False) -> None:
+        """A line above the bars (``always``: even when progress is off)."""
+        if self.enabled or always:
+            tqdm.write(line, file=sys.stderr)
+
+    def close(self) -> None:
+        """Remove the bars."""
+        self.views.close()
+        self.scenes.close()
+
+
+def record_failure(report: RunReport, progress: Progress, request: SceneRequest, error: BaseException) -> None:
+    """Note a failed scene; a traceback is shown for anything but a UserError (a bug, not bad input)."""
+    message = str(error) if isinstance(error, UserError) else f"{type(error).__name__}: {error}"
+    report.failed[request.folder] = message
+    if not isinstance(error, UserError):
+        progress.write("".join(traceback.format_exception(error)).rstrip(), always=True)
+    progress.write(f"{request.folder}: failed: {message}", always=True)

@@ -1,0 +1,178 @@
+"""A scene: plants grown in a Helios Context on textured soil, with its fruit numbered.
+
+This is the scene description the renderer draws and the writer saves; every random choice is
+drawn from the generator handed in.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from davis_ag.errors import UserError
+from davis_ag.scene.lighting import Lighting
+from davis_ag.scene.plants import (
+    GrownPlant,
+    fruit_body_uuids,
+    grow_library_plant,
+    helios_seed,
+    primitive_vertices,
+    quiet_stdout,
+    require_native_helios,
+    sample_phenotype,
+)
+from davis_ag.scene.specs import MAX_FRUIT, CropSpec, ScenarioSpec, plant_positions
+
+#: Side of the square soil tile under every scene, m: wide enough to reach the horizon's haze.
+GROUND_SIZE = 60.0
+#: Side of the finely textured soil around the grid and the size of one of its patches, m.
+NEAR_SIZE = 12.0
+NEAR_PATCH = 0.12
+#: Size of one texture repeat on the far soil, m.
+FAR_REPEAT = 1.5
+
+
+@dataclass
+class Fruit:
+    """One fruit (a grape cluster for the vine) with its scene-wide id.
+
+    Attributes:
+        id: Scene-wide id, 0..254: the value in segmentation images and boxes.
+        plant: Index of the plant bearing it.
+        uuids: Its Helios primitives: the fruit body, without calyx and stalk.
+        polygons: Its primitives' vertices grouped by vertex count, arrays (n, k, 3).
+        center: Centre of its bounding box (x, y, z), m.
+        size: Extent of its bounding box (dx, dy, dz), m.
+    """
+
+    id: int
+    plant: int
+    uuids: np.ndarray
+    polygons: list[np.ndarray] = field(repr=False)
+    center: tuple[float, float, float]
+    size: tuple[float, float, float]
+
+    def summary(self) -> dict:
+        """JSON-ready description for scene.json."""
+        return {"id": self.id, "plant": self.plant, "center": list(self.center), "size": list(self.size)}
+
+
+@dataclass
+class SceneModel:
+    """Everything that is drawn.
+
+    Attributes:
+        context: The Helios Context.
+        plants: The grown plants.
+        fruits: Every fruit, by id.
+        lighting: Sun and sky.
+        aim_height: Height single-plant cameras aim at, m.
+    """
+
+    context: object
+    plants: list[GrownPlant]
+    fruits: list[Fruit]
+    lighting: Lighting
+    aim_height: float
+
+    @property
+    def uuid_count(self) -> int:
+        """One more than the largest primitive UUID."""
+        return int(max(self.context.getAllUUIDs())) + 1
+
+
+def helios_texture(name: str) -> str:
+    """Path of a texture shipped with pyhelios3d's Visualizer plug-in."""
+    import pyhelios
+
+    path = Path(pyhelios.__file__).parent / "assets/build/plugins/visualizer/textures" / name
+    if not path.exists():
+        raise UserError(f"pyhelios3d lacks its texture {path}: reinstall pyhelios3d")
+    return str(path)
+
+
+def add_ground(context) -> None:
+    """Textured soil at z = 0: fine patches under the grid, a coarse ring out to the horizon.
+
+    Helios keeps textures at a low resolution, so a texture stretched over metres turns into a
+    checkerboard of blocks; one texture per ``NEAR_PATCH`` patch keeps the soil's grain. The far
+    field is a ring around the patches rather than one tile beneath them, which Helios would fill
+    a second time in every frame and in every shadow map (20 % of a view's time).
+    """
+    from pyhelios.types import int2, vec2, vec3
+
+    texture = helios_texture("dirt.jpg")
+    patches = int(round(NEAR_SIZE / NEAR_PATCH))
+    context.addTileObject(center=vec3(0.0, 0.0, 0.0), size=vec2(NEAR_SIZE, NEAR_SIZE),
+                          subdiv=int2(patches, patches), texturefile=texture)
+    band = (GROUND_SIZE - NEAR_SIZE) / 2
+    offset = (NEAR_SIZE + band) / 2
+    strips = [  # (centre x, centre y, size x, size y): north, south, east, west
+        (0.0, offset, GROUND_SIZE, band), (0.0, -offset, GROUND_SIZE, band),
+        (offset, 0.0, band, NEAR_SIZE), (-offset, 0.0, band, NEAR_SIZE),
+    ]
+    for x, y, width, depth in strips:
+        repeats = int2(max(1, round(width / FAR_REPEAT)), max(1, round(depth / FAR_REPEAT)))
+        context.addTileObject(center=vec3(x, y, 0.0), size=vec2(width, depth), subdiv=int2(1, 1),
+                              texturefile=texture, texture_repeat=repeats)
+
+
+def _fruit(context, fruit_id: int, plant: int, object_id: int) -> Fruit:
+    uuids = np.asarray(fruit_body_uuids(context, object_id), dtype=np.int64)
+    parts = primitive_vertices(context, list(uuids))
+    by_count: dict[int, list[np.ndarray]] = {}
+    for part in parts:
+        by_count.setdefault(len(part), []).append(part)
+    polygons = [np.stack(group).astype(np.float64) for group in by_count.values()]
+    points = np.concatenate(parts)
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    return Fruit(fruit_id, plant, uuids, polygons,
+                 tuple(float(v) for v in (lo + hi) / 2), tuple(float(v) for v in hi - lo))
+
+
+def build_scene(scenario: ScenarioSpec, crop: CropSpec, rng: np.random.Generator) -> SceneModel:
+    """Grow a scene's plants on soil, choose the sun and number the fruit.
+
+    Args:
+        scenario: Single or multi plant.
+        crop: The crop.
+        rng: The scene's only source of randomness.
+
+    Returns:
+        The :class:`SceneModel`.
+    """
+    require_native_helios()
+    from pyhelios import Context, PlantArchitecture
+
+    context = Context()
+    plant_architecture = PlantArchitecture(context)
+    plant_architecture.disableMessages()
+    plants: list[GrownPlant] = []
+    with quiet_stdout():
+        if crop.name == "vine":
+            from davis_ag.scene.goblet_vine import grow_goblet_vine, load_vine_model
+
+            shoot_defaults = load_vine_model(plant_architecture)
+        else:
+            plant_architecture.loadPlantModelFromLibrary(crop.helios_model)
+            shoot_defaults = {
+                label: plant_architecture.getCurrentShootParameters(label)
+                for label in plant_architecture.listShootTypeLabels()
+            }
+    for index, position in enumerate(plant_positions(scenario, crop)):
+        target = sample_phenotype(crop, rng)
+        seed = helios_seed(rng)
+        grow = grow_goblet_vine if crop.name == "vine" else grow_library_plant
+        plants.append(grow(context, plant_architecture, shoot_defaults, crop, index, position, target, seed))
+    add_ground(context)
+
+    fruits: list[Fruit] = []
+    for plant in plants:
+        for object_id in plant.fruit_objects:
+            if len(fruits) >= MAX_FRUIT:
+                raise UserError(f"a {crop.name} scene grew more than {MAX_FRUIT} fruit, the most uint8 ids can label")
+            fruits.append(_fruit(context, len(fruits), plant.index, object_id))
+    lighting = Lighting(sun_elevation=float(rng.uniform(35.0, 75.0)), sun_azimuth=float(rng.uniform(0.0, 360.0)))
+    return SceneModel(context, plants, fruits, lighting, aim_height=crop.centre_height)

@@ -1,0 +1,194 @@
+"""What a DAVIS-Ag scene is made of: the paper's crop (Table 1) and scenario (Table 2) settings.
+
+Everything here is plain data. Lengths are metres, angles degrees.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from davis_ag.errors import UserError
+
+#: Actions of the single-plant scenario, in the order the environment numbers them.
+SP_ACTIONS: tuple[str, ...] = ("forward", "backward", "left", "right", "up", "down")
+#: Multi-plant adds the two rotations of 30 degrees.
+MP_ACTIONS: tuple[str, ...] = SP_ACTIONS + ("rotate_cw", "rotate_ccw")
+#: Every pointer key an annotations.json entry may carry.
+ALL_ACTIONS: tuple[str, ...] = MP_ACTIONS
+
+#: Each action's inverse: applying both (when both are valid) returns to the start.
+INVERSE_ACTION: dict[str, str] = {
+    "forward": "backward",
+    "backward": "forward",
+    "left": "right",
+    "right": "left",
+    "up": "down",
+    "down": "up",
+    "rotate_cw": "rotate_ccw",
+    "rotate_ccw": "rotate_cw",
+}
+
+
+@dataclass(frozen=True)
+class CropSpec:
+    """One crop's Table 1 defaults and the settings that follow from them.
+
+    Attributes:
+        name: Short name used on the command line (``strawberry``, ``tomato``, ``vine``).
+        title: Capitalised name in published folder names (``Strawberry``...).
+        plant_height: Plant height, or trunk height for the vine (Table 1), m.
+        fruit_radius: Fruit radius, or single-berry radius for the vine (Table 1), m.
+        leaf_length: Leaf length (Table 1), m.
+        altitudes: The three camera altitudes, low to high (Table 1), m.
+        min_fruit_pixels: Visible pixels a fruit needs to get a box (section III-C).
+        exclusion_radius: Cameras closer than this to a plant's centre are not placed, m.
+        centre_height: Height of the plant's centre, which single-plant cameras aim at and
+            exclusion is measured from: half the plant, or the middle of the vine's canopy, m.
+        mp_plants: Plants in the multi-plant row.
+        mp_spacing: Distance between neighbouring plants in the multi-plant row, m.
+        min_fruit: A plant with fewer fruit is regrown from the next seed.
+        helios_model: The pyhelios3d PlantArchitecture model the plant starts from.
+        age_days: Age the plant is grown to: old enough to bear fruit.
+    """
+
+    name: str
+    title: str
+    plant_height: float
+    fruit_radius: float
+    leaf_length: float
+    altitudes: tuple[float, float, float]
+    min_fruit_pixels: int
+    exclusion_radius: float
+    centre_height: float
+    mp_plants: int
+    mp_spacing: float
+    min_fruit: int
+    helios_model: str
+    age_days: float
+
+
+CROPS: dict[str, CropSpec] = {
+    "strawberry": CropSpec(
+        name="strawberry", title="Strawberry", plant_height=0.40, fruit_radius=0.025,
+        leaf_length=0.10, altitudes=(0.25, 0.40, 0.55), min_fruit_pixels=210,
+        exclusion_radius=0.75, centre_height=0.20, mp_plants=5, mp_spacing=0.30, min_fruit=4,
+        helios_model="strawberry", age_days=90.0,
+    ),
+    "tomato": CropSpec(
+        name="tomato", title="Tomato", plant_height=1.00, fruit_radius=0.030,
+        leaf_length=0.20, altitudes=(0.70, 1.10, 1.50), min_fruit_pixels=240,
+        exclusion_radius=1.00, centre_height=0.50, mp_plants=3, mp_spacing=0.60, min_fruit=4,
+        helios_model="tomato", age_days=100.0,
+    ),
+    "vine": CropSpec(
+        name="vine", title="Vine", plant_height=0.70, fruit_radius=0.0075,
+        leaf_length=0.18, altitudes=(0.50, 0.75, 1.00), min_fruit_pixels=700,
+        exclusion_radius=1.00, centre_height=1.00, mp_plants=3, mp_spacing=2.00, min_fruit=4,
+        helios_model="grapevine_VSP", age_days=95.0,
+    ),
+}
+
+#: Relative spread of the phenotype around Table 1, uniform (section III-A).
+PHENOTYPE_SPREAD: dict[str, float] = {"plant_height": 0.15, "fruit_radius": 0.20, "leaf_length": 0.20}
+
+
+@dataclass(frozen=True)
+class ScenarioSpec:
+    """One scenario's Table 2 settings.
+
+    Attributes:
+        name: ``sp`` (single plant) or ``mp`` (multi plant).
+        title: Prefix of published folder names (``Single``, ``Multi``).
+        extent: Grid size along x and y, m.
+        step: Distance between neighbouring grid positions, m.
+        altitude_levels: Which of the crop's three altitudes are used (indices, low to high).
+        headings: Camera headings per position (1 means: always aimed at the plant).
+        actions: The pointer keys every view carries.
+        tau: Steps per episode in the benchmark (section V-C).
+    """
+
+    name: str
+    title: str
+    extent: tuple[float, float]
+    step: float
+    altitude_levels: tuple[int, ...]
+    headings: int
+    actions: tuple[str, ...]
+    tau: int
+
+
+SCENARIOS: dict[str, ScenarioSpec] = {
+    "sp": ScenarioSpec(
+        name="sp", title="Single", extent=(3.0, 3.0), step=0.25, altitude_levels=(0, 1, 2),
+        headings=1, actions=SP_ACTIONS, tau=3,
+    ),
+    "mp": ScenarioSpec(
+        name="mp", title="Multi", extent=(7.0, 3.0), step=0.50, altitude_levels=(0, 2),
+        headings=12, actions=MP_ACTIONS, tau=5,
+    ),
+}
+
+#: Standard deviation of the Gaussian "slip" added to each camera x and y (section III-B), m.
+SLIP_SIGMA = 0.025
+
+#: Value of a segmentation pixel that shows no fruit (the published layout's uint8 masks).
+NO_FRUIT = 255
+#: Fruit ids are uint8 values below NO_FRUIT, so a scene holds at most this many fruit.
+MAX_FRUIT = NO_FRUIT
+
+
+def crop_spec(name: str) -> CropSpec:
+    """Look a crop up by name.
+
+    Args:
+        name: ``strawberry``, ``tomato`` or ``vine`` (``grape`` and ``goblet`` are accepted too).
+
+    Returns:
+        Its :class:`CropSpec`.
+
+    Raises:
+        UserError: for any other name.
+    """
+    key = {"grape": "vine", "goblet": "vine", "goblet_vine": "vine"}.get(name.lower(), name.lower())
+    if key not in CROPS:
+        raise UserError(f"unknown crop {name!r}: choose one of {', '.join(CROPS)}")
+    return CROPS[key]
+
+
+def scenario_spec(name: str) -> ScenarioSpec:
+    """Look a scenario up by name (``sp``/``single`` or ``mp``/``multi``).
+
+    Raises:
+        UserError: for any other name.
+    """
+    key = {"single": "sp", "multi": "mp"}.get(name.lower(), name.lower())
+    if key not in SCENARIOS:
+        raise UserError(f"unknown scenario {name!r}: choose sp (single plant) or mp (multi plant)")
+    return SCENARIOS[key]
+
+
+def group_name(scenario: ScenarioSpec, crop: CropSpec) -> str:
+    """The published folder name of a scenario and crop, e.g. ``Single-Strawberry``."""
+    return f"{scenario.title}-{crop.title}"
+
+
+def parse_group_name(name: str) -> tuple[ScenarioSpec, CropSpec] | None:
+    """Invert :func:`group_name`; ``None`` for a folder that is not a DAVIS-Ag group."""
+    scenario_title, _, crop_title = name.partition("-")
+    scenarios = {s.title: s for s in SCENARIOS.values()}
+    crops = {c.title: c for c in CROPS.values()}
+    if scenario_title in scenarios and crop_title in crops:
+        return scenarios[scenario_title], crops[crop_title]
+    return None
+
+
+def plant_positions(scenario: ScenarioSpec, crop: CropSpec) -> list[tuple[float, float]]:
+    """Stem positions (x, y): the origin for a single plant, else a row along x centred on it."""
+    count = 1 if scenario.name == "sp" else crop.mp_plants
+    offset = (count - 1) / 2
+    return [((i - offset) * crop.mp_spacing, 0.0) for i in range(count)]
+
+
+def plant_centres(scenario: ScenarioSpec, crop: CropSpec) -> list[tuple[float, float, float]]:
+    """Nominal plant centres: what cameras aim at and keep away from."""
+    return [(x, y, crop.centre_height) for x, y in plant_positions(scenario, crop)]

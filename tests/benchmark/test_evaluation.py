@@ -1,0 +1,138 @@
+"""The section V-C protocol, the Table 4 summary, its files, and the train/evaluate commands."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from layout_factory import write_tiny_dataset
+
+from davis_ag.benchmark import TVMEnv
+from davis_ag.benchmark.agents import build_agents
+from davis_ag.benchmark.evaluation import (
+    episode_seeds,
+    evaluate_agents,
+    format_table,
+    plot_results,
+    run_episode,
+    write_json,
+)
+from davis_ag.commands import evaluate as evaluate_command
+from davis_ag.commands import train as train_command
+from davis_ag.errors import UserError
+
+
+@pytest.fixture(scope="module")
+def sp_root(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return write_tiny_dataset(tmp_path_factory.mktemp("sp"), "sp", "strawberry", scenes=2)
+
+
+def _parser() -> argparse.ArgumentParser:
+    # Only our commands: the CLI's other sub-commands are not needed (nor maybe present) here.
+    parser = argparse.ArgumentParser(prog="davis-ag")
+    sub = parser.add_subparsers(dest="command", required=True)
+    train_command.register(sub)
+    evaluate_command.register(sub)
+    return parser
+
+
+def test_episode_seeds_are_fixed_and_distinct() -> None:
+    a, b = episode_seeds(0, 0, 200), episode_seeds(0, 0, 200)
+    assert a == b and len(set(a[0])) == 200
+    assert episode_seeds(0, 1, 200)[0] != a[0]  # sessions differ
+    assert set(a[0]).isdisjoint(a[1])  # the agent never mirrors the environment's stream
+
+
+def test_protocol_and_summary(sp_root: Path) -> None:
+    env = TVMEnv(sp_root, "sp", "test")
+    agents = build_agents(["LRD", "UDD", "Rand", "Oracle"])
+    results = evaluate_agents(env, agents, episodes=30, sessions=3, seed=5, keep_episodes=True)
+    assert results["protocol"]["scenes"] == ["Single-Strawberry/001"]  # the test split only
+    policies = results["policies"]
+    assert list(policies) == ["LRD", "UDD", "Rand", "Oracle"]
+    for name, summary in policies.items():
+        episodes = summary["episodes"]
+        assert len(episodes) == 90
+        for metric in ("oer_tau", "reward", "length"):
+            sessions = [np.mean([e[metric] for e in episodes if e["session"] == s])
+                        for s in range(3)]
+            assert summary[metric]["sessions"] == pytest.approx(sessions)
+            assert summary[metric]["mean"] == pytest.approx(np.mean(sessions))
+            assert summary[metric]["std"] == pytest.approx(np.std(sessions))
+        for e in episodes:
+            assert 1 <= e["length"] <= 3
+            assert e["reward"] == pytest.approx(max(e["oer_tau"] - e["oer_0"], 0) ** 2)
+    starts = {name: [(e["scene"], e["path"][0], e["target_fruit"]) for e in s["episodes"]]
+              for name, s in policies.items()}
+    assert all(v == starts["LRD"] for v in starts.values())  # same episodes for every policy
+    again = evaluate_agents(env, build_agents(["Rand"]), episodes=30, sessions=3, seed=5)
+    assert again["policies"]["Rand"]["reward"] == {
+        k: v for k, v in policies["Rand"]["reward"].items()}  # reproducible
+
+
+def test_episode_length_counts_done(sp_root: Path) -> None:
+    env = TVMEnv(sp_root, "sp", "all")
+    run = run_episode(env, build_agents(["LRD"])[0], 0, 0)
+    assert run["length"] == len(run["actions"])
+    assert run["actions"][-1] == env.done_action or run["length"] == env.tau
+
+
+def test_table_json_and_plot(sp_root: Path, tmp_path: Path) -> None:
+    env = TVMEnv(sp_root, "sp", "test")
+    results = evaluate_agents(env, build_agents(["LRD", "Rand"]), episodes=10, sessions=2)
+    table = format_table(results)
+    lines = table.splitlines()
+    assert "LRD" in lines[0] and "Rand" in lines[0]
+    assert [line.split()[0] for line in lines[2:5]] == ["OER_tau", "Cum.", "Ep."]
+    assert "±" in lines[2]
+    out = write_json(results, tmp_path / "r" / "results.json")
+    assert json.loads(out.read_text())["policies"].keys() == {"LRD", "Rand"}
+    png = plot_results(results, tmp_path / "r" / "results.png")
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_commands(sp_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    import torch
+
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)  # tiny tensors on shared cores: see test_agents
+    try:
+        model = tmp_path / "model.zip"
+        args = _parser().parse_args(
+            ["train", "--dataset", str(sp_root), "--scenario", "sp", "--timesteps", "40",
+             "--n-envs", "2", "--arch", "pooled", "--device", "cpu", "--verbose", "0",
+             "--out", str(model)])
+        assert args.func(args) == 0 and model.is_file()
+        out = tmp_path / "results.json"
+        args = _parser().parse_args(
+            ["evaluate", "--dataset", str(sp_root), "--scenario", "sp", "--model", str(model),
+             "--episodes", "5", "--sessions", "2", "--out", str(out)])
+        assert args.func(args) == 0
+    finally:
+        torch.set_num_threads(threads)
+    printed = capsys.readouterr().out
+    assert "A2C" in printed and "Oracle" in printed and "OER_tau" in printed
+    assert set(json.loads(out.read_text())["policies"]) == {"LRD", "UDD", "Rand", "Oracle", "A2C"}
+    assert out.with_suffix(".png").is_file()
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--policies", "LRD,Greedy"], "unknown policy"),
+    (["--episodes", "0"], "at least 1"),
+    (["--model", "/nonexistent.zip"], "no such model"),
+])
+def test_evaluate_bad_input(sp_root: Path, tmp_path: Path, argv: list[str], message: str) -> None:
+    args = _parser().parse_args(["evaluate", "--dataset", str(sp_root), "--scenario", "sp",
+                                 "--out", str(tmp_path / "r.json"), *argv])
+    with pytest.raises(UserError, match=message):
+        args.func(args)
+
+
+def test_not_a_dataset(tmp_path: Path) -> None:
+    args = _parser().parse_args(["evaluate", "--dataset", str(tmp_path), "--scenario", "sp",
+                                 "--out", str(tmp_path / "r.json")])
+    with pytest.raises(UserError, match="not a DAVIS-Ag dataset"):
+        args.func(args)

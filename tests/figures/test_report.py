@@ -1,0 +1,88 @@
+"""The report's figures and HTML, drawn from the tiny dataset factory (no Helios)."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+from layout_factory import write_tiny_dataset
+
+from davis_ag.data.reader import open_dataset
+from davis_ag.errors import UserError
+from davis_ag.figures.report import draw_oer_histogram, draw_view_grid, phenotype_rows, write_report
+from davis_ag.workflows.demo import Timer, run_baselines
+
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.fixture(scope="module")
+def tiny_root(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Two SP strawberry scenes (one train, one test) and one MP scene."""
+    root = tmp_path_factory.mktemp("tiny")
+    write_tiny_dataset(root, "sp", "strawberry", scenes=2)
+    write_tiny_dataset(root, "mp", "strawberry", scenes=1)
+    return root
+
+
+def _is_png(path: Path) -> bool:
+    return path.is_file() and path.read_bytes()[:8] == PNG_MAGIC
+
+
+def test_report_writes_pngs_and_links_resolve(tiny_root: Path, tmp_path: Path) -> None:
+    results = run_baselines(tiny_root, "sp", "strawberry", "test", episodes=4, sessions=2)
+    timer = Timer()
+    with timer.stage("generate"):
+        pass
+    out = tmp_path / "report"
+    index = write_report(tiny_root, out, results=results, validation="checked 3 scenes: sound",
+                         timer=timer, generated=[{"scene": "Single-Strawberry/000", "skipped": True}])
+    assert index == out / "index.html"
+    text = index.read_text()
+    links = re.findall(r"(?:src|href)='([^']+)'", text)
+    images = [link for link in links if link.endswith(".png")]
+    assert {"contact_sheet.png", "mask.png", "oer.png", "baselines.png", "grid_000.png"} <= set(images)
+    for link in images:
+        assert not link.startswith("/"), "links must be relative"
+        assert _is_png(out / link), link
+    assert "OER_tau" in text and "sound" in text
+    assert all((out / link).is_file() for link in links)
+
+
+def test_view_grid_one_panel_per_altitude(tiny_root: Path, tmp_path: Path) -> None:
+    for scene in open_dataset(tiny_root).scenes:
+        path = draw_view_grid(scene, tmp_path / f"{scene.id.replace('/', '_')}.png")
+        assert _is_png(path)
+
+
+def test_oer_histogram_handles_empty_and_values(tmp_path: Path) -> None:
+    assert _is_png(draw_oer_histogram(np.zeros(0), tmp_path / "empty.png"))
+    assert _is_png(draw_oer_histogram(np.array([0.1, 0.5, 0.9]), tmp_path / "some.png"))
+
+
+def test_phenotypes_without_scene_json_give_no_rows(tiny_root: Path) -> None:
+    header, rows = phenotype_rows(open_dataset(tiny_root).scenes)
+    assert header[:3] == ["scene", "plant", "fruit"]
+    assert all(len(row) == len(header) for row in rows)
+
+
+def test_report_of_a_folder_without_a_dataset_is_a_user_error(tmp_path: Path) -> None:
+    with pytest.raises(UserError) as error:
+        write_report(tmp_path, tmp_path / "report")
+    assert "\n" not in str(error.value)
+
+
+def test_results_markdown_puts_ours_beside_the_paper(tmp_path: Path) -> None:
+    from davis_ag.commands.reproduce import CONFIGS, write_results_md
+
+    stat = {"mean": 0.5, "std": 0.01}
+    state = {"results": {"sp": {"protocol": {"split": "test", "tau": 3, "sessions": 3, "episodes": 200,
+                                             "scenes": ["Single-Strawberry/002"]},
+                                "policies": {name: {"oer_tau": stat, "reward": stat, "length": stat}
+                                             for name in ("LRD", "UDD", "Rand", "Oracle", "A2C")}}},
+             "stages": {"sp-strawberry: generate": {"seconds": 12.0, "note": "1 scene"}}}
+    text = write_results_md(tmp_path / "results.md", CONFIGS["small"], state, tmp_path).read_text()
+    assert "| A2C | .500 ± .010 | .520 |" in text
+    assert "## MP vine" in text and "Not run" in text
+    assert "CPU cores" in text and "| total | 12 | |" in text

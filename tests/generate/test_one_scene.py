@@ -1,0 +1,232 @@
+"""Generating a scene end to end (tiny images, a reduced grid) and the generate command's refusals."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from davis_ag import cli
+from davis_ag.data.reader import open_dataset
+from davis_ag.data.validate import validate_dataset
+from davis_ag.errors import UserError
+from davis_ag.generate.one_scene import ROOT_EXTRAS, SceneRequest, generate_scene
+from davis_ag.scene.camera import Camera
+from davis_ag.scene.plants import Phenotype, in_table_range, require_native_helios
+from davis_ag.scene.specs import CROPS, SCENARIOS, SP_ACTIONS
+
+#: Single-plant strawberry on a 3 m x 1 m grid with 50 cm steps at two altitudes: 16 views, four
+#: columns of two on either side of the plant, so every kind of move is valid somewhere and
+#: blocked somewhere (grid edge or exclusion zone).
+SCENARIO = replace(SCENARIOS["sp"], extent=(3.0, 1.0), step=0.5, altitude_levels=(0, 1))
+CAMERA = Camera(96, 54)
+REQUEST = SceneRequest(SCENARIO, CROPS["strawberry"], index=0, dataset_seed=0, camera=CAMERA)
+VIEWS = 16
+
+
+@pytest.fixture(scope="module")
+def generated(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path, dict]:
+    """The dataset root, the scene folder and the timing statistics of one generated scene."""
+    root = tmp_path_factory.mktemp("dataset")
+    calls: list[tuple[int, int]] = []
+    scene_dir, stats = generate_scene(REQUEST, root, on_view=lambda done, total: calls.append((done, total)))
+    assert calls == [(i, VIEWS) for i in range(1, VIEWS + 1)]
+    return root, scene_dir, stats
+
+
+def test_generated_scene_is_a_sound_dataset(generated: tuple[Path, Path, dict]) -> None:
+    root, scene_dir, stats = generated
+    assert scene_dir == root / "Single-Strawberry" / "000"
+    assert stats["views"] == VIEWS
+    # Published atomically: the scene folder and nothing half-written beside it.
+    assert sorted(p.name for p in scene_dir.parent.iterdir()) == ["000"]
+    assert sorted(p.name for p in scene_dir.iterdir()) == ["annotations.json", "images", "scene.json"]
+    names = [f"{i:04d}.jpeg" for i in range(1, VIEWS + 1)]
+    assert sorted(p.name for p in (scene_dir / "images").iterdir()) == sorted(
+        names + [n.replace(".jpeg", "_seg.png") for n in names])
+
+    report = validate_dataset(root)
+    assert report.ok, [str(p) for p in report.problems]
+    assert report.summary().endswith(": sound") and (report.scenes, report.views) == (1, VIEWS)
+
+    dataset = open_dataset(root)
+    (scene,) = dataset.scenes
+    assert (scene.scenario, scene.crop, len(scene)) == ("sp", "strawberry", VIEWS)
+    view = scene.view("0001.jpeg")
+    assert view.image().shape == (CAMERA.height, CAMERA.width, 3)
+    assert view.mask().shape == (CAMERA.height, CAMERA.width)
+
+
+def test_annotations_follow_the_published_layout(generated: tuple[Path, Path, dict]) -> None:
+    _, scene_dir, _ = generated
+    annotations = json.loads((scene_dir / "annotations.json").read_text())
+    assert list(annotations) == [f"{i:04d}.jpeg" for i in range(1, VIEWS + 1)]
+    boxes = 0
+    for action in SP_ACTIONS:
+        assert {entry[action] == "" for entry in annotations.values()} == {True, False}, action
+    for name, entry in annotations.items():
+        assert set(entry) == {"bounding_boxes", "pose", *SP_ACTIONS}
+        assert len(entry["pose"]) == 5
+        for action in SP_ACTIONS:
+            assert entry[action] == "" or entry[action] in annotations
+        mask = np.asarray(Image.open(scene_dir / "images" / name.replace(".jpeg", "_seg.png")))
+        assert mask.dtype == np.uint8 and mask.shape == (CAMERA.height, CAMERA.width)
+        boxed = {box[4] for box in entry["bounding_boxes"]}
+        assert set(np.unique(mask)) <= boxed | {255}
+        for x, y, w, h, fruit_id, zero in entry["bounding_boxes"]:
+            rows, cols = np.nonzero(mask == fruit_id)
+            assert [x, y, x + w - 1, y + h - 1, zero] == [cols.min(), rows.min(), cols.max(), rows.max(), 0]
+        boxes += len(boxed)
+    assert boxes > 0  # the plant's fruit are seen
+
+
+def test_scene_json_records_what_the_annotations_leave_out(generated: tuple[Path, Path, dict]) -> None:
+    _, scene_dir, _ = generated
+    meta = json.loads((scene_dir / "scene.json").read_text())
+    annotations = json.loads((scene_dir / "annotations.json").read_text())
+    assert meta["seed"] == REQUEST.seed and meta["dataset_seed"] == 0
+    assert (meta["scenario"], meta["crop"], meta["scene"]) == ("sp", "strawberry", "Single-Strawberry/000")
+    assert meta["camera"] == CAMERA.intrinsics()
+    assert meta["grid"]["views"] == VIEWS and meta["grid"]["altitudes_m"] == [0.25, 0.40]
+    assert meta["min_fruit_pixels"] == REQUEST.min_fruit_pixels
+
+    crop = CROPS["strawberry"]
+    (plant,) = meta["plants"]
+    # Table 1 +- the paper's spread, up to the tolerance the plant is grown to (plants.TOLERANCE).
+    assert in_table_range(Phenotype(**plant["phenotype_measured"]), crop, slack=0.04)
+    assert plant["fruit_count"] >= crop.min_fruit
+    fruits = meta["fruits"]
+    assert [f["id"] for f in fruits] == list(range(len(fruits))) and len(fruits) == plant["fruit_count"]
+    for fruit in fruits:
+        assert len(fruit["center"]) == 3 and len(fruit["size"]) == 3
+        assert 0 < fruit["center"][2] < plant["phenotype_measured"]["plant_height"]
+        assert max(fruit["size"]) < 4 * crop.fruit_radius
+
+    assert list(meta["visible_fraction"]) == list(annotations)
+    for name, fractions in meta["visible_fraction"].items():
+        assert set(fractions) == {str(box[4]) for box in annotations[name]["bounding_boxes"]}
+        assert all(0 < value <= 1 for value in fractions.values())
+
+
+def test_the_same_request_gives_the_same_scene(generated: tuple[Path, Path, dict], tmp_path: Path) -> None:
+    _, first, _ = generated
+    second, _ = generate_scene(REQUEST, tmp_path)
+    assert (first / "annotations.json").read_bytes() == (second / "annotations.json").read_bytes()
+    meta = [json.loads((d / "scene.json").read_text()) for d in (first, second)]
+    for m in meta:
+        del m["timing_s"]
+    assert meta[0] == meta[1]
+    for mask in sorted((first / "images").glob("*_seg.png")):
+        assert mask.read_bytes() == (second / "images" / mask.name).read_bytes(), mask.name
+    # Colour images come from the same draws too (Mesa's software rasteriser is deterministic).
+    for image in sorted((first / "images").glob("*.jpeg")):
+        assert image.read_bytes() == (second / "images" / image.name).read_bytes(), image.name
+
+
+# ---------------------------------------------------------------------------------------------
+# The command line
+
+
+@pytest.fixture(autouse=True)
+def only_generate(monkeypatch: pytest.MonkeyPatch) -> None:
+    # Other sub-commands may be mid-development; these tests exercise generate alone.
+    assert "generate" in cli.COMMANDS
+    monkeypatch.setattr(cli, "COMMANDS", ["generate"])
+
+
+def refused(capsys: pytest.CaptureFixture[str], *args: str) -> str:
+    """Run ``davis-ag generate`` expecting a refusal: exit status 2, one line on stderr, returned."""
+    try:
+        code = cli.main(["generate", *args])
+    except SystemExit as exit_:  # argparse's own refusals
+        code = exit_.code
+    out, err = capsys.readouterr()
+    assert code == 2, (out, err)
+    assert "Traceback" not in out + err
+    lines = err.splitlines()
+    assert len(lines) == 1, err
+    return lines[0]
+
+
+def snapshot(folder: Path) -> dict[str, bytes | None]:
+    return {str(p.relative_to(folder)): p.read_bytes() if p.is_file() else None for p in sorted(folder.rglob("*"))}
+
+
+def test_unknown_crop_and_scenario_are_refused(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    assert "banana" in refused(capsys, "--crop", "banana", "--out", str(tmp_path / "ds"))
+    assert "sideways" in refused(capsys, "--scenario", "sideways", "--out", str(tmp_path / "ds"))
+    assert not (tmp_path / "ds").exists()
+
+
+@pytest.mark.parametrize("args", [
+    ["--scenes", "0"], ["--scenes", "-3"], ["--scenes", "two"],
+    ["--size", "garbage"], ["--size", "1280x"], ["--size", "8x8"],
+    ["--seed", "-1"], ["--first", "999", "--scenes", "2"],
+])
+def test_bad_numbers_are_refused(args: list[str], capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    line = refused(capsys, *args, "--out", str(tmp_path / "ds"))
+    assert line.startswith("davis-ag generate: ")
+    assert not (tmp_path / "ds").exists()
+
+
+def test_an_out_that_is_a_file_is_refused(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    out = tmp_path / "notes.txt"
+    out.write_text("mine")
+    assert "is a file" in refused(capsys, "--out", str(out), "--size", "96x54")
+    assert out.read_text() == "mine"
+
+
+def test_an_out_holding_other_things_is_left_alone(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    out = tmp_path / "home"
+    (out / "photos").mkdir(parents=True)
+    (out / "photos" / "cat.jpeg").write_bytes(b"\xff\xd8 not really")
+    (out / "todo.txt").write_text("buy soil")
+    before = snapshot(out)
+    assert "holds other things" in refused(capsys, "--out", str(out), "--size", "96x54")
+    assert snapshot(out) == before
+
+
+def test_a_scene_made_with_another_seed_is_not_overwritten(
+    generated: tuple[Path, Path, dict], capsys: pytest.CaptureFixture[str], tmp_path: Path,
+) -> None:
+    _, scene_dir, _ = generated
+    root = tmp_path / "ds"
+    shutil.copytree(scene_dir, root / "Single-Strawberry" / "000")
+    before = snapshot(root / "Single-Strawberry")
+    # Our scene was made with dataset seed 0; seed 1 would make another scene 000.
+    line = refused(capsys, "--out", str(root), "--seed", "1", "--size", "96x54")
+    assert "already holds a scene made with other settings" in line
+    assert snapshot(root / "Single-Strawberry") == before
+    assert {p.name for p in root.iterdir()} <= {"Single-Strawberry", *ROOT_EXTRAS}
+
+
+def test_mock_pyhelios_is_a_clear_error(monkeypatch: pytest.MonkeyPatch) -> None:
+    import pyhelios.plugins
+
+    from davis_ag.scene.build import build_scene
+
+    # Without its native library (no system libGL/libEGL) pyhelios would silently run as a mock.
+    monkeypatch.setattr(pyhelios.plugins, "get_library_info", lambda: {"is_mock": True, "library_path": None})
+    with pytest.raises(UserError, match="mock mode.*libgl1"):
+        require_native_helios()
+    with pytest.raises(UserError, match="mock mode"):
+        build_scene(SCENARIO, CROPS["strawberry"], np.random.default_rng(0))
+
+
+def test_generate_command_refuses_mock_helios_before_any_scene(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import pyhelios.plugins
+
+    monkeypatch.setattr(pyhelios.plugins, "get_library_info",
+                        lambda: {"is_mock": True, "library_path": None})
+    out = tmp_path / "data"
+    code = cli.main(["generate", "--scenes", "1", "--out", str(out), "--workers", "1"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "mock mode" in err[0]
+    assert not out.exists()

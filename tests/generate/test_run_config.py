@@ -1,0 +1,111 @@
+"""Dataset config files and presets: what they describe and how bad ones are reported."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from davis_ag.errors import UserError
+from davis_ag.generate.one_scene import scene_seed
+from davis_ag.generate.run_config import load_dataset_config, parse_dataset_config, preset_names, single_group_config
+from davis_ag.scene.specs import CROPS, SCENARIOS
+
+#: Table 3 of the paper: scenes per group.
+TABLE_3 = {"Single-Strawberry": 86, "Single-Tomato": 130, "Single-Vine": 182,
+           "Multi-Strawberry": 77, "Multi-Tomato": 113, "Multi-Vine": 44}
+
+
+def test_presets_ship_with_the_package() -> None:
+    assert {"paper", "mini"} <= set(preset_names())
+
+
+def test_paper_preset_has_table_3_counts() -> None:
+    config = load_dataset_config("paper")
+    assert {g.name: g.scenes for g in config.groups} == TABLE_3
+    assert (config.camera.width, config.camera.height) == (1280, 720)
+    requests = config.requests()
+    assert len(requests) == sum(TABLE_3.values())
+    assert len({r.seed for r in requests}) == len(requests)  # every scene its own seed
+    # The paper preset uses the paper's grids unchanged.
+    assert all(g.scenario.step in (0.25, 0.5) for g in config.groups)
+
+
+def test_mini_preset_is_small() -> None:
+    config = load_dataset_config("mini")
+    assert len(config.requests()) <= 3
+    assert config.camera.width * config.camera.height <= 640 * 360
+
+
+def test_config_file_with_grid_override(tmp_path: Path) -> None:
+    path = tmp_path / "small.yaml"
+    path.write_text("seed: 7\nimage_size: [320, 180]\ngrid: {step: 0.5}\ngroups:\n"
+                    "  - {scenario: single, crop: tomato, scenes: 2, first: 3}\n"
+                    "  - {scenario: mp, crop: grape, scenes: 1, grid: {altitude_levels: [0], headings: 4}}\n")
+    config = load_dataset_config(path)
+    assert config.name == "small" and config.seed == 7
+    assert [r.folder for r in config.requests()] == ["Single-Tomato/003", "Single-Tomato/004", "Multi-Vine/000"]
+    sp, mp = config.groups
+    assert sp.scenario.step == 0.5 and sp.scenario.extent == (3.0, 3.0)
+    assert mp.scenario.step == 0.5 and mp.scenario.altitude_levels == (0,) and mp.scenario.headings == 4
+    # Seeds depend on names and indices only, not on the grid.
+    assert config.requests()[0].seed == scene_seed(7, SCENARIOS["sp"], CROPS["tomato"], 3)
+
+
+def test_only_picks_scenes_and_groups() -> None:
+    config = load_dataset_config("paper")
+    picked = config.requests(["single-strawberry/3", "Multi-Vine"])
+    assert picked[0].folder == "Single-Strawberry/003"
+    assert [r.folder for r in picked[1:]] == [f"Multi-Vine/{i:03d}" for i in range(44)]
+    full = {r.folder: r.seed for r in config.requests()}
+    assert picked[0].seed == full["Single-Strawberry/003"]  # the same scene as in the full run
+    with pytest.raises(UserError, match="not a scene or group"):
+        config.requests(["Single-Strawberry/086"])
+
+
+@pytest.mark.parametrize(("text", "message"), [
+    ("groups: [", "not valid YAML at line"),
+    ("- 1\n- 2\n", "must be a mapping"),
+    ("seed: 1\n", "groups: must be a non-empty list"),
+    ("sed: 1\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "sed: unknown key"),
+    ("seed: -1\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "seed: must be from 0"),
+    ("seed: 1.5\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "seed: must be a whole number"),
+    ("image_size: 1280\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "image_size: must be WIDTHxHEIGHT"),
+    ("image_size: 8x8\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "image_size: 8x8 is too small"),
+    ("groups: [{scenario: sp, crop: banana, scenes: 1}]\n", "groups[0].crop: unknown crop 'banana'"),
+    ("groups: [{scenario: xp, crop: tomato, scenes: 1}]\n", "groups[0].scenario: unknown scenario"),
+    ("groups: [{scenario: sp, crop: tomato}]\n", "groups[0].scenes: missing"),
+    ("groups: [{scenario: sp, crop: tomato, scenes: 0}]\n", "groups[0].scenes: must be from 1"),
+    ("groups: [{scenario: sp, crop: tomato, scenes: 'many'}]\n", "groups[0].scenes: must be a whole number"),
+    ("groups: [{scenario: sp, crop: tomato, scenes: 5, first: 998}]\n", "do not fit 000..999"),
+    ("groups: [{scenario: sp, crop: tomato, scenes: 1, sceens: 2}]\n", "groups[0].sceens: unknown key"),
+    ("groups:\n - {scenario: sp, crop: tomato, scenes: 1}\n - {scenario: single, crop: tomato, scenes: 2}\n",
+     "groups[1]: Single-Tomato is already groups[0]"),
+    ("grid: {step: 0}\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "grid.step: must be a positive number"),
+    ("grid: {stepp: 1}\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "grid.stepp: unknown key"),
+    ("groups: [{scenario: sp, crop: tomato, scenes: 1, grid: {altitude_levels: [2, 0]}}]\n",
+     "groups[0].grid.altitude_levels: must list distinct levels"),
+    ("groups: [{scenario: sp, crop: tomato, scenes: 1, grid: {headings: 4}}]\n", "only 1"),
+    ("groups: [{scenario: mp, crop: tomato, scenes: 1, grid: {headings: 8}}]\n", "does not work for multi plant"),
+    ("groups: [{scenario: sp, crop: tomato, scenes: 1, grid: {extent: [1, 1], step: 2}}]\n", "no position fits"),
+])
+def test_bad_configs_name_file_key_and_problem(text: str, message: str) -> None:
+    with pytest.raises(UserError) as caught:
+        parse_dataset_config(text, "bad.yaml")
+    assert str(caught.value).startswith("bad.yaml: ")
+    assert message in str(caught.value)
+    assert "\n" not in str(caught.value)
+
+
+def test_missing_config_lists_presets(tmp_path: Path) -> None:
+    with pytest.raises(UserError, match="no config file 'papr' and no preset of that name.*mini"):
+        load_dataset_config("papr")
+    with pytest.raises(UserError, match="is a folder"):
+        load_dataset_config(tmp_path)
+
+
+def test_single_group_from_flags() -> None:
+    config = single_group_config("mp", "vine", 2, 5, 3, (640, 360))
+    assert [r.folder for r in config.requests()] == ["Multi-Vine/005", "Multi-Vine/006"]
+    with pytest.raises(UserError, match="do not fit"):
+        single_group_config("sp", "tomato", 2, 999, 0, (640, 360))
