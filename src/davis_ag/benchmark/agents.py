@@ -17,10 +17,9 @@ from typing import Any, Protocol
 import gymnasium as gym
 import numpy as np
 import torch
-from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
-from torch import nn
 
 from davis_ag.benchmark import TVMEnv
+from davis_ag.benchmark.networks import ARCHITECTURES, PooledFeatures, PaperCNN  # noqa: F401 - re-exported
 from davis_ag.errors import UserError
 
 #: Section IV-B action sets by agent name. Rand uses every action of the environment, which in
@@ -160,41 +159,6 @@ class OracleAgent:
         return self._plan[t] if t < len(self._plan) else inner.done_action
 
 
-class PooledFeatures(BaseFeaturesExtractor):
-    """A small feature extractor for quick runs and tests: 8x average pooling, one conv.
-
-    NatureCNN (the paper's network) costs ~90 M multiply-adds per 224x224 observation; this
-    one costs well under 1 M, so a few thousand A2C steps take seconds on a CPU. Not for
-    results: the paper's numbers need ``arch="nature"``.
-    """
-
-    def __init__(self, observation_space: gym.spaces.Box, features_dim: int = 64) -> None:
-        """Args:
-            observation_space: Channels-first image space (SB3 transposes ours).
-            features_dim: Size of the feature vector.
-        """
-        super().__init__(observation_space, features_dim)
-        self.cnn = nn.Sequential(
-            nn.AvgPool2d(8), nn.Conv2d(observation_space.shape[0], 16, 3, stride=2), nn.ReLU(),
-            nn.Flatten())
-        with torch.no_grad():
-            n = self.cnn(torch.zeros(1, *observation_space.shape)).shape[1]
-        self.head = nn.Sequential(nn.Linear(n, features_dim), nn.ReLU())
-
-    def forward(self, observations: torch.Tensor) -> torch.Tensor:
-        """Features of a batch of (already 0-1 scaled) observations."""
-        return self.head(self.cnn(observations))
-
-
-#: Network choices of :func:`train_a2c`: SB3 ``policy_kwargs`` by name.
-ARCHITECTURES: dict[str, dict[str, Any]] = {
-    # CnnPolicy's default NatureCNN is the paper's network: convs (8,4), (4,2), (3,1), then 512
-    # features, with separate linear action and value heads.
-    "nature": {},
-    "pooled": {"features_extractor_class": PooledFeatures},
-}
-
-
 def make_vec_tvm(dataset: Any, scenario: str, n_envs: int, seed: int, split: str = "train",
                  crop: str | None = None, cache_dir: str | os.PathLike[str] | None = None) -> Any:
     """``n_envs`` TVM environments in one SB3 ``DummyVecEnv`` (each wrapped in ``Monitor``).
@@ -225,7 +189,7 @@ def make_vec_tvm(dataset: Any, scenario: str, n_envs: int, seed: int, split: str
 def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed: int = 0,
               out_path: str | os.PathLike[str] = "a2c.zip", n_envs: int = 8,
               crop: str | None = None, cache_dir: str | os.PathLike[str] | None = None,
-              arch: str = "nature", device: str = "auto", verbose: int = 0,
+              arch: str = "paper", device: str = "auto", verbose: int = 0,
               callback: Any = None) -> Path:
     """Train the paper's A2C agent on the train split and save it.
 
@@ -244,7 +208,8 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
         n_envs: Parallel environments per update.
         crop: Train on one crop only (the paper: strawberry for SP, vine for MP).
         cache_dir: Observation cache folder (default under the dataset root).
-        arch: ``nature`` (the paper's NatureCNN) or ``pooled`` (fast, for smoke tests).
+        arch: ``paper`` (section V-B's network, default), ``nature`` (SB3's NatureCNN) or
+            ``pooled`` (fast, for smoke tests); see :mod:`davis_ag.benchmark.networks`.
         device: Torch device for SB3 (``auto``, ``cpu``, ``cuda``).
         verbose: SB3 verbosity.
         callback: Optional SB3 callback.

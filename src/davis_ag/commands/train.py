@@ -12,7 +12,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "train",
         help="train an A2C agent for target visibility maximisation",
-        description="Train Stable-Baselines3 A2C (CnnPolicy, the paper's NatureCNN, SB3 default "
+        description="Train Stable-Baselines3 A2C (CnnPolicy with the paper's network, SB3 default "
                     "hyperparameters) on the train split of the TVM environment and save a .zip.",
     )
     parser.add_argument("--dataset", type=arguments.path, required=True, metavar="DIR", help="dataset root")
@@ -23,8 +23,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help="environment steps (default: 300000, as in the paper)")
     parser.add_argument("--seed", type=int, default=0, help="seed of SB3 and the environments")
     parser.add_argument("--n-envs", type=int, default=8, help="parallel environments (default: 8)")
-    parser.add_argument("--arch", choices=["nature", "pooled"], default="nature",
-                        help="network: nature (the paper's, default) or pooled (fast smoke tests)")
+    parser.add_argument("--arch", choices=["paper", "nature", "pooled"], default="paper",
+                        help="network: paper (section V-B, default), nature (SB3's NatureCNN) or pooled "
+                             "(fast smoke tests)")
     parser.add_argument("--device", default="auto", help="torch device (default: auto)")
     parser.add_argument("--cache-dir", type=arguments.path, default=None, metavar="DIR",
                         help="observation cache folder (default: DIR/.davis_ag_cache)")
