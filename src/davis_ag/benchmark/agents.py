@@ -19,7 +19,7 @@ import numpy as np
 import torch
 
 from davis_ag.benchmark import TVMEnv
-from davis_ag.benchmark.networks import ARCHITECTURES, PooledFeatures, PaperCNN  # noqa: F401 - re-exported
+from davis_ag.benchmark.networks import ARCHITECTURES, PaperCNN, PooledFeatures  # noqa: F401 - re-exported
 from davis_ag.errors import UserError
 
 #: Section IV-B action sets by agent name. Rand uses every action of the environment, which in
