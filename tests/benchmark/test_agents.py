@@ -17,9 +17,9 @@ from davis_ag.benchmark.agents import (
     build_agents,
     heuristic,
     oracle_plan,
-    train_a2c,
 )
 from davis_ag.benchmark.evaluation import evaluate_agents, run_episode
+from davis_ag.benchmark.training import train_a2c
 from davis_ag.errors import UserError
 
 

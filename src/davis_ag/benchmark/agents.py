@@ -19,7 +19,6 @@ import numpy as np
 import torch
 
 from davis_ag.benchmark import TVMEnv
-from davis_ag.benchmark.networks import ARCHITECTURES, PaperCNN, PooledFeatures  # noqa: F401 - re-exported
 from davis_ag.errors import UserError
 
 #: Section IV-B action sets by agent name. Rand uses every action of the environment, which in
@@ -157,84 +156,6 @@ class OracleAgent:
             self._plan = oracle_plan(next_view, oer, inner.current_view, inner.tau)
         t = inner.steps_taken
         return self._plan[t] if t < len(self._plan) else inner.done_action
-
-
-def make_vec_tvm(dataset: Any, scenario: str, n_envs: int, seed: int, split: str = "train",
-                 crop: str | None = None, cache_dir: str | os.PathLike[str] | None = None) -> Any:
-    """``n_envs`` TVM environments in one SB3 ``DummyVecEnv`` (each wrapped in ``Monitor``).
-
-    The environment is fast (tens of thousands of steps/s), so subprocesses would only add
-    pickling; the network is the cost. The dataset is opened once and shared.
-
-    Args:
-        dataset: Dataset root or opened dataset.
-        scenario: ``sp`` or ``mp``.
-        n_envs: Number of environments.
-        seed: Environment ``i`` is seeded with ``seed + i``.
-        split, crop, cache_dir: As for :class:`davis_ag.benchmark.TVMEnv`.
-
-    Returns:
-        The vectorised environment.
-    """
-    from stable_baselines3.common.env_util import make_vec_env
-
-    from davis_ag.benchmark.tvm import as_dataset
-
-    opened = as_dataset(dataset)
-    kwargs = {"dataset": opened, "scenario": scenario, "split": split, "crop": crop,
-              "cache_dir": cache_dir}
-    return make_vec_env(TVMEnv, n_envs=n_envs, seed=seed, env_kwargs=kwargs)
-
-
-def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed: int = 0,
-              out_path: str | os.PathLike[str] = "a2c.zip", n_envs: int = 8,
-              crop: str | None = None, cache_dir: str | os.PathLike[str] | None = None,
-              arch: str = "paper", device: str = "auto", verbose: int = 0,
-              callback: Any = None) -> Path:
-    """Train the paper's A2C agent on the train split and save it.
-
-    Hyperparameters are Stable-Baselines3's A2C defaults (the paper gives none): learning rate
-    7e-4, ``n_steps=5`` per environment and update, ``gamma=0.99``, ``gae_lambda=1``,
-    ``ent_coef=0``, ``vf_coef=0.5``, ``max_grad_norm=0.5``, RMSprop (alpha 0.99, eps 1e-5);
-    CnnPolicy scales the uint8 observation by 1/255. ``n_envs`` (8) is ours; the paper's
-    300K timesteps count environment steps over all environments.
-
-    Args:
-        dataset: Dataset root or opened dataset.
-        scenario: ``sp`` or ``mp``.
-        total_timesteps: Environment steps to train for (300K in section VI).
-        seed: Seeds SB3 (network init, action sampling) and the environments.
-        out_path: Where to save the model (``.zip`` is added by SB3 if missing).
-        n_envs: Parallel environments per update.
-        crop: Train on one crop only (the paper: strawberry for SP, vine for MP).
-        cache_dir: Observation cache folder (default under the dataset root).
-        arch: ``paper`` (section V-B's network, default), ``nature`` (SB3's NatureCNN) or
-            ``pooled`` (fast, for smoke tests); see :mod:`davis_ag.benchmark.networks`.
-        device: Torch device for SB3 (``auto``, ``cpu``, ``cuda``).
-        verbose: SB3 verbosity.
-        callback: Optional SB3 callback.
-
-    Returns:
-        The saved model's path.
-
-    Raises:
-        UserError: for a bad dataset, scenario, split or architecture.
-    """
-    from stable_baselines3 import A2C
-
-    if arch not in ARCHITECTURES:
-        raise UserError(f"unknown network {arch!r}: choose one of {', '.join(ARCHITECTURES)}")
-    if total_timesteps < 1 or n_envs < 1:
-        raise UserError("--timesteps and --n-envs must be positive")
-    env = make_vec_tvm(dataset, scenario, n_envs, seed, "train", crop, cache_dir)
-    model = A2C("CnnPolicy", env, seed=seed, device=device, verbose=verbose,
-                policy_kwargs=dict(ARCHITECTURES[arch]))
-    model.learn(total_timesteps=total_timesteps, callback=callback)
-    out = Path(out_path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    model.save(out)
-    env.close()
-    return out if out.suffix == ".zip" else out.with_name(out.name + ".zip")
 
 
 class A2CAgent:

@@ -30,17 +30,20 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--cache-dir", type=arguments.path, default=None, metavar="DIR",
                         help="observation cache folder (default: DIR/.davis_ag_cache)")
     parser.add_argument("--out", type=arguments.path, required=True, metavar="MODEL.zip", help="where to save the model")
+    parser.add_argument("--checkpoint-every", type=arguments.whole, default=10_000, metavar="N",
+                        help="save a checkpoint beside --out every N steps (0: never); running the same "
+                             "command again resumes from it (default: 10000)")
     parser.add_argument("--verbose", type=int, default=1, help="SB3 verbosity (default: 1)")
     parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     """Train and save; prints the model's path."""
-    from davis_ag.benchmark.agents import train_a2c
+    from davis_ag.benchmark.training import train_a2c
 
     path = train_a2c(args.dataset, args.scenario, total_timesteps=args.timesteps, seed=args.seed,
                      out_path=args.out, n_envs=args.n_envs, crop=args.crop,
                      cache_dir=args.cache_dir, arch=args.arch, device=args.device,
-                     verbose=args.verbose)
+                     verbose=args.verbose, checkpoint_every=args.checkpoint_every)
     print(f"saved {path}")
     return 0

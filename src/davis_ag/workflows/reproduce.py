@@ -90,8 +90,8 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
     Returns:
         0 on success, 1 when a dataset failed validation.
     """
-    from davis_ag.benchmark.agents import train_a2c
     from davis_ag.benchmark.evaluation import format_table, plot_results, write_json
+    from davis_ag.benchmark.training import train_a2c
     from davis_ag.data.validate import validate_dataset
     from davis_ag.generate.one_scene import SceneRequest
     from davis_ag.scene.camera import Camera
@@ -153,7 +153,7 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
         timesteps = config.sp_timesteps if scenario_name == "sp" else config.mp_timesteps
         stamp = out / "models" / f"a2c_{key}.json"
         if not model.is_file() or load_state(stamp).get("timesteps") != timesteps:
-            print(f"training A2C (NatureCNN) on {key} train split for {timesteps} steps", flush=True)
+            print(f"training A2C (the paper's network) on {key} train split for {timesteps} steps", flush=True)
             start = time.perf_counter()
             train_a2c(root, scenario_name, total_timesteps=timesteps, seed=config.seed,
                       out_path=model, n_envs=config.n_envs, crop=crop_name, device="cpu",
@@ -257,7 +257,7 @@ def _notes(config: ReproduceConfig, state: dict[str, Any], out: Path | None) -> 
             rate = steps / seconds
             notes.append(f"A2C on {key} trained for {steps:,} environment steps, "
                          f"{steps / 300_000:.1%} of the paper's 300K: {rate:.1f} steps/s with "
-                         f"NatureCNN on this CPU (cache build included), so 300K would take about "
+                         f"the paper's network on this CPU (cache build included), so 300K would take about "
                          f"{300_000 / rate / 3600:.1f} h per scenario here. The A2C column is "
                          "therefore an under-trained agent, not the paper's.")
         result = state.get("results", {}).get(scenario)
@@ -313,8 +313,8 @@ def write_results_md(path: Path, config: ReproduceConfig, state: dict[str, Any],
         f"- **Configuration** `{config.name}`: {config.sp_scenes} SP strawberry scene(s) (Table 2 "
         f"grid, 352 views each) and {config.mp_scenes} MP vine scene(s) (grid {mp_grid}, 0.5 m "
         f"step, 12 headings, 2 altitudes) at {config.size[0]}x{config.size[1]}, dataset seed "
-        f"{config.seed}; box thresholds scaled by image area; A2C (SB3 defaults, CnnPolicy = "
-        f"NatureCNN, {config.n_envs} environments) for {config.sp_timesteps:,} (SP) and "
+        f"{config.seed}; box thresholds scaled by image area; A2C (SB3 defaults, the paper's "
+        f"network of section V-B, {config.n_envs} environments) for {config.sp_timesteps:,} (SP) and "
         f"{config.mp_timesteps:,} (MP) environment steps; evaluation {config.sessions} sessions x "
         f"{config.episodes} episodes, seed {config.seed}, A2C deterministic.",
         "- **Paper**: 86 SP strawberry and 44 MP vine scenes at 1280x720 (Table 3), A2C for 300K "

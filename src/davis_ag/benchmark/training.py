@@ -1,0 +1,172 @@
+"""Train the paper's A2C agent (section IV-C) with Stable-Baselines3, checkpointed and resumable.
+
+A 300K-step run on a CPU takes hours, so training saves a checkpoint every few thousand steps
+(model, optimiser state and step count in SB3's zip, beside a small JSON of the run's settings)
+and a run started again with the same settings continues from the last checkpoint instead of
+from scratch. What a resumed run does not restore: the environments' episodes in flight (they
+start anew) and the random streams, so a resumed run is a valid continuation, not bit-identical
+to an uninterrupted one.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+from stable_baselines3.common.callbacks import BaseCallback
+
+from davis_ag.atomic_files import atomic_output, write_json_atomic
+from davis_ag.benchmark import TVMEnv
+from davis_ag.benchmark.networks import ARCHITECTURES
+from davis_ag.errors import UserError
+
+#: Steps between checkpoints by default: about a minute of training on a 2-core CPU.
+CHECKPOINT_EVERY = 10_000
+
+
+def make_vec_tvm(dataset: Any, scenario: str, n_envs: int, seed: int, split: str = "train",
+                 crop: str | None = None, cache_dir: str | os.PathLike[str] | None = None) -> Any:
+    """``n_envs`` TVM environments in one SB3 ``DummyVecEnv`` (each wrapped in ``Monitor``).
+
+    The environment is fast (tens of thousands of steps/s), so subprocesses would only add
+    pickling; the network is the cost. The dataset is opened once and shared.
+
+    Args:
+        dataset: Dataset root or opened dataset.
+        scenario: ``sp`` or ``mp``.
+        n_envs: Number of environments.
+        seed: Environment ``i`` is seeded with ``seed + i``.
+        split, crop, cache_dir: As for :class:`davis_ag.benchmark.TVMEnv`.
+
+    Returns:
+        The vectorised environment.
+    """
+    from stable_baselines3.common.env_util import make_vec_env
+
+    from davis_ag.benchmark.tvm import as_dataset
+
+    opened = as_dataset(dataset)
+    kwargs = {"dataset": opened, "scenario": scenario, "split": split, "crop": crop,
+              "cache_dir": cache_dir}
+    return make_vec_env(TVMEnv, n_envs=n_envs, seed=seed, env_kwargs=kwargs)
+
+
+def model_path(out_path: str | os.PathLike[str]) -> Path:
+    """The ``.zip`` SB3 writes for ``out_path``."""
+    out = Path(out_path)
+    return out if out.suffix == ".zip" else out.with_name(out.name + ".zip")
+
+
+def checkpoint_paths(out_path: str | os.PathLike[str]) -> tuple[Path, Path]:
+    """The checkpoint model and its settings file for a training run saving to ``out_path``."""
+    final = model_path(out_path)
+    stem = final.with_suffix("")
+    return stem.with_name(stem.name + ".checkpoint.zip"), stem.with_name(stem.name + ".checkpoint.json")
+
+
+def save_model(model: Any, path: Path) -> None:
+    """Save an SB3 model atomically (a kill mid-save leaves the previous file)."""
+    with atomic_output(path, "wb") as handle:
+        model.save(handle)
+
+
+class _Checkpoint(BaseCallback):
+    """Saves the model and the run's settings every ``every`` environment steps."""
+
+    def __init__(self, every: int, model_file: Path, settings_file: Path, settings: dict[str, Any]) -> None:
+        super().__init__()
+        self.every, self.model_file, self.settings_file, self.settings = every, model_file, settings_file, settings
+        self._last = 0
+
+    def _on_training_start(self) -> None:
+        self._last = self.model.num_timesteps
+
+    def _on_step(self) -> bool:
+        if self.model.num_timesteps - self._last >= self.every:
+            self._last = self.model.num_timesteps
+            save_model(self.model, self.model_file)
+            write_json_atomic(self.settings_file, {**self.settings, "timesteps_done": self._last})
+        return True
+
+
+def _resumable(settings_file: Path, model_file: Path, settings: dict[str, Any]) -> int | None:
+    """Steps done by a checkpoint of a run with the same settings, else None."""
+    try:
+        saved = json.loads(settings_file.read_text())
+    except (OSError, ValueError):
+        return None
+    if not model_file.is_file() or not isinstance(saved, dict):
+        return None
+    done = saved.pop("timesteps_done", None)
+    return int(done) if saved == settings and isinstance(done, int) else None
+
+
+def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed: int = 0,
+              out_path: str | os.PathLike[str] = "a2c.zip", n_envs: int = 8,
+              crop: str | None = None, cache_dir: str | os.PathLike[str] | None = None,
+              arch: str = "paper", device: str = "auto", verbose: int = 0,
+              callback: Any = None, checkpoint_every: int = CHECKPOINT_EVERY) -> Path:
+    """Train the paper's A2C agent on the train split and save it; resume a killed run.
+
+    Hyperparameters are Stable-Baselines3's A2C defaults (the paper gives none): learning rate
+    7e-4, ``n_steps=5`` per environment and update, ``gamma=0.99``, ``gae_lambda=1``,
+    ``ent_coef=0``, ``vf_coef=0.5``, ``max_grad_norm=0.5``, RMSprop (alpha 0.99, eps 1e-5);
+    CnnPolicy scales the uint8 observation by 1/255. ``n_envs`` (8) is ours; the paper's
+    300K timesteps count environment steps over all environments.
+
+    Args:
+        dataset: Dataset root or opened dataset.
+        scenario: ``sp`` or ``mp``.
+        total_timesteps: Environment steps to train for (300K in section VI).
+        seed: Seeds SB3 (network init, action sampling) and the environments.
+        out_path: Where to save the model (``.zip`` is added if missing).
+        n_envs: Parallel environments per update.
+        crop: Train on one crop only (the paper: strawberry for SP, vine for MP).
+        cache_dir: Observation cache folder (default under the dataset root).
+        arch: ``paper`` (section V-B's network, default), ``nature`` (SB3's NatureCNN) or
+            ``pooled`` (fast, for smoke tests); see :mod:`davis_ag.benchmark.networks`.
+        device: Torch device for SB3 (``auto``, ``cpu``, ``cuda``).
+        verbose: SB3 verbosity.
+        callback: Optional SB3 callback.
+        checkpoint_every: Environment steps between checkpoints (0: none). A checkpoint of a run
+            with the same settings beside ``out_path`` is resumed; it is removed once the final
+            model is saved.
+
+    Returns:
+        The saved model's path.
+
+    Raises:
+        UserError: for a bad dataset, scenario, split or architecture.
+    """
+    from stable_baselines3 import A2C
+
+    if arch not in ARCHITECTURES:
+        raise UserError(f"unknown network {arch!r}: choose one of {', '.join(ARCHITECTURES)}")
+    if total_timesteps < 1 or n_envs < 1 or checkpoint_every < 0:
+        raise UserError("--timesteps and --n-envs must be positive, --checkpoint-every from 0")
+    final = model_path(out_path)
+    model_file, settings_file = checkpoint_paths(final)
+    settings = {"dataset": str(getattr(dataset, "root", dataset)), "scenario": scenario, "crop": crop,
+                "seed": seed, "n_envs": n_envs, "arch": arch, "algorithm": "A2C"}
+    env = make_vec_tvm(dataset, scenario, n_envs, seed, "train", crop, cache_dir)
+    done = _resumable(settings_file, model_file, settings)
+    if done is not None:
+        model = A2C.load(model_file, env=env, device=device)
+        print(f"resuming {final.name} from its checkpoint at {done} of {total_timesteps} steps", flush=True)
+    else:
+        model = A2C("CnnPolicy", env, seed=seed, device=device, verbose=verbose,
+                    policy_kwargs=dict(ARCHITECTURES[arch]))
+        done = 0
+    callbacks = [c for c in (callback,) if c is not None]
+    if checkpoint_every:
+        callbacks.append(_Checkpoint(checkpoint_every, model_file, settings_file, settings))
+    if total_timesteps > done:
+        model.learn(total_timesteps=total_timesteps - done, callback=callbacks or None,
+                    reset_num_timesteps=done == 0)
+    save_model(model, final)
+    env.close()
+    model_file.unlink(missing_ok=True)
+    settings_file.unlink(missing_ok=True)
+    return final

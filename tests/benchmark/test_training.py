@@ -1,0 +1,69 @@
+"""A2C training checkpoints and resumes: a run killed midway continues where it stopped."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from layout_factory import write_tiny_dataset
+from stable_baselines3 import A2C
+from stable_baselines3.common.callbacks import BaseCallback
+
+from davis_ag.benchmark.training import checkpoint_paths, train_a2c
+
+
+class _Kill(BaseCallback):
+    """Stands in for a kill: stops the process's training with an exception after ``at`` steps."""
+
+    def __init__(self, at: int) -> None:
+        super().__init__()
+        self.at = at
+
+    def _on_step(self) -> bool:
+        if self.model.num_timesteps >= self.at:
+            raise KeyboardInterrupt
+        return True
+
+
+@pytest.fixture()
+def one_thread() -> None:
+    import torch
+
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)  # tiny tensors: a spinning thread pool is slower on a busy machine
+    yield
+    torch.set_num_threads(threads)
+
+
+def test_a_killed_run_resumes_from_its_checkpoint(tmp_path: Path, one_thread: None,
+                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2)
+    out = tmp_path / "models" / "a2c"
+    kwargs = dict(total_timesteps=240, seed=1, out_path=out, n_envs=2, arch="pooled", device="cpu",
+                  checkpoint_every=40)
+    with pytest.raises(KeyboardInterrupt):
+        train_a2c(root, "sp", callback=_Kill(130), **kwargs)
+    model_file, settings_file = checkpoint_paths(out)
+    saved = json.loads(settings_file.read_text())
+    assert 80 <= saved["timesteps_done"] <= 130 and model_file.is_file()
+    assert not (tmp_path / "models" / "a2c.zip").exists()  # no final model from a killed run
+
+    path = train_a2c(root, "sp", **kwargs)
+    assert f"at {saved['timesteps_done']} of 240 steps" in capsys.readouterr().out
+    assert path == tmp_path / "models" / "a2c.zip"
+    assert A2C.load(path, device="cpu").num_timesteps == 240  # no step trained twice or skipped
+    assert not model_file.exists() and not settings_file.exists()
+
+
+def test_other_settings_never_resume_a_checkpoint(tmp_path: Path, one_thread: None,
+                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2)
+    out = tmp_path / "a2c.zip"
+    with pytest.raises(KeyboardInterrupt):
+        train_a2c(root, "sp", total_timesteps=200, seed=1, out_path=out, n_envs=2, arch="pooled",
+                  device="cpu", checkpoint_every=20, callback=_Kill(60))
+    path = train_a2c(root, "sp", total_timesteps=100, seed=2, out_path=out, n_envs=2, arch="pooled",
+                     device="cpu", checkpoint_every=20)
+    assert "resuming" not in capsys.readouterr().out
+    assert A2C.load(path, device="cpu").num_timesteps == 100
