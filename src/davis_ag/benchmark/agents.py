@@ -20,6 +20,7 @@ import torch
 from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 from torch import nn
 
+from davis_ag.atomic_files import atomic_output, prove_writable_file, write_or_rescue
 from davis_ag.benchmark import TVMEnv
 from davis_ag.errors import UserError
 
@@ -261,15 +262,37 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
         raise UserError(f"unknown network {arch!r}: choose one of {', '.join(ARCHITECTURES)}")
     if total_timesteps < 1 or n_envs < 1:
         raise UserError("--timesteps and --n-envs must be positive")
+    if not 0 <= seed < 2**32:
+        raise UserError(f"--seed {seed}: use a whole number from 0 to {2**32 - 1}")
+    check_device(device)
+    out = Path(out_path).expanduser().absolute()
+    out = out if out.suffix == ".zip" else out.with_name(out.name + ".zip")  # as SB3 names it
+    prove_writable_file(out)  # before hours of training, not after
     env = make_vec_tvm(dataset, scenario, n_envs, seed, "train", crop, cache_dir)
     model = A2C("CnnPolicy", env, seed=seed, device=device, verbose=verbose,
                 policy_kwargs=dict(ARCHITECTURES[arch]))
     model.learn(total_timesteps=total_timesteps, callback=callback)
-    out = Path(out_path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    model.save(out)
     env.close()
-    return out if out.suffix == ".zip" else out.with_name(out.name + ".zip")
+
+    def save(path: Path) -> None:
+        with atomic_output(path) as handle:
+            model.save(handle)
+
+    return write_or_rescue(out, save, "the trained model")
+
+
+def check_device(device: str) -> None:
+    """Refuse a torch device name torch does not know, before any work.
+
+    Raises:
+        UserError: naming the device and the choices.
+    """
+    if device == "auto":
+        return
+    try:
+        torch.device(device)
+    except (RuntimeError, ValueError, TypeError):
+        raise UserError(f"--device {device!r} is not a torch device: use auto, cpu or cuda") from None
 
 
 class A2CAgent:
@@ -305,16 +328,31 @@ class A2CAgent:
         if seed is not None and not self.deterministic:
             torch.manual_seed(seed)
 
+    def check(self, env: gym.Env) -> None:
+        """Refuse an environment the model was not trained for, before any episode.
+
+        Raises:
+            UserError: when the model was trained for another action or observation space
+                (e.g. an SP model on MP: 7 actions against 9).
+        """
+        inner = tvm(env)
+        n = inner.action_space.n
+        if getattr(self.model.action_space, "n", n) != n:
+            raise UserError(f"the model has {self.model.action_space.n} actions, the {inner.scenario} "
+                            f"environment {n}: use a model trained on the same scenario")
+        shape = getattr(self.model.observation_space, "shape", None)
+        # SB3 stores image spaces channels-first.
+        if shape is not None and sorted(shape) != sorted(inner.observation_space.shape):
+            raise UserError(f"the model takes observations of shape {shape}, the environment gives "
+                            f"{inner.observation_space.shape}: use a model trained by davis-ag train")
+
     def act(self, obs: np.ndarray, env: gym.Env) -> int:
         """The model's action for ``obs``.
 
         Raises:
             UserError: when the model was trained for another action space (e.g. SP vs MP).
         """
-        n = tvm(env).action_space.n
-        if getattr(self.model.action_space, "n", n) != n:
-            raise UserError(f"the model has {self.model.action_space.n} actions, the "
-                            f"environment {n}: use a model trained on the same scenario")
+        self.check(env)
         action, _ = self.model.predict(obs, deterministic=self.deterministic)
         return int(action)
 

@@ -29,8 +29,8 @@ def register(subparsers) -> None:
     parser.add_argument("--crop", help="strawberry, tomato or vine (default strawberry; not with --config)")
     parser.add_argument("--scenario", help="sp (single plant) or mp (multi plant) (default sp)")
     parser.add_argument("--scenes", type=arguments.count, help="how many scenes (default 1)")
-    parser.add_argument("--first", type=int, help="index of the first scene (default 0)")
-    parser.add_argument("--seed", type=int, help="dataset seed (default 0, or the config's)")
+    parser.add_argument("--first", type=arguments.whole, help="index of the first scene (default 0)")
+    parser.add_argument("--seed", type=arguments.seed, help="dataset seed (default 0, or the config's)")
     parser.add_argument("--size", type=arguments.image_size, help="image size (default 1280x720, or the config's)")
     parser.add_argument("--out", type=arguments.path, required=True, help="dataset folder")
     parser.add_argument("--only", action="append", metavar="SCENE",
@@ -59,8 +59,6 @@ def run(args: argparse.Namespace) -> int:
                             "groups; use --only to pick scenes of it")
         config = load_dataset_config(args.config)
         if args.seed is not None or args.size is not None:
-            if args.seed is not None and args.seed < 0:
-                raise UserError(f"--seed {args.seed} is negative: use a whole number from 0")
             config = dataclasses.replace(config, seed=config.seed if args.seed is None else args.seed,
                              camera=config.camera if args.size is None else Camera(*args.size))
     else:
@@ -72,6 +70,7 @@ def run(args: argparse.Namespace) -> int:
     if args.executor == "ray" and args.workers is not None:
         raise UserError("--workers is for the local executor: Ray runs one task per scene on the cluster "
                         "(see --cpus-per-scene)")
+    arguments.prove_writable_folder(args.out)
     only = [item for value in args.only or [] for item in value.split(",") if item.strip()]
     requests = config.requests(only)
     options = RunOptions(workers=args.workers or default_workers(), executor=args.executor, address=args.address,

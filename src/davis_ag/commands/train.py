@@ -19,24 +19,29 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--scenario", required=True, choices=["sp", "mp"],
                         help="single plant (tau=3) or multi plant (tau=5)")
     parser.add_argument("--crop", default=None, help="train on one crop only (default: all)")
-    parser.add_argument("--timesteps", type=int, default=300_000, metavar="N",
+    parser.add_argument("--timesteps", type=arguments.bounded(1, 10**9), default=300_000, metavar="N",
                         help="environment steps (default: 300000, as in the paper)")
-    parser.add_argument("--seed", type=int, default=0, help="seed of SB3 and the environments")
-    parser.add_argument("--n-envs", type=int, default=8, help="parallel environments (default: 8)")
+    parser.add_argument("--seed", type=arguments.seed, default=0, help="seed of SB3 and the environments")
+    parser.add_argument("--n-envs", type=arguments.bounded(1, 256), default=8,
+                        help="parallel environments (default: 8)")
     parser.add_argument("--arch", choices=["nature", "pooled"], default="nature",
                         help="network: nature (the paper's, default) or pooled (fast smoke tests)")
     parser.add_argument("--device", default="auto", help="torch device (default: auto)")
     parser.add_argument("--cache-dir", type=arguments.path, default=None, metavar="DIR",
                         help="observation cache folder (default: DIR/.davis_ag_cache)")
     parser.add_argument("--out", type=arguments.path, required=True, metavar="MODEL.zip", help="where to save the model")
-    parser.add_argument("--verbose", type=int, default=1, help="SB3 verbosity (default: 1)")
+    parser.add_argument("--verbose", type=int, choices=(0, 1, 2), default=1, help="SB3 verbosity (default: 1)")
     parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     """Train and save; prints the model's path."""
-    from davis_ag.benchmark.agents import train_a2c
+    from davis_ag.benchmark.agents import check_device, train_a2c
 
+    check_device(args.device)
+    arguments.prove_writable_file(args.out)
+    if args.cache_dir is not None:
+        arguments.prove_writable_folder(args.cache_dir, "--cache-dir")
     path = train_a2c(args.dataset, args.scenario, total_timesteps=args.timesteps, seed=args.seed,
                      out_path=args.out, n_envs=args.n_envs, crop=args.crop,
                      cache_dir=args.cache_dir, arch=args.arch, device=args.device,

@@ -184,4 +184,5 @@ def _run_here(todo: Sequence[SceneRequest], root: Path, progress: Progress, repo
             record_failure(report, progress, request, error)
             continue
         report.made.append(request.folder)
+        report.stats[request.folder] = stats
         progress.finished(request, stats)
