@@ -15,7 +15,7 @@ import os
 from pathlib import Path
 
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 from layout_factory import write_tiny_dataset
 
@@ -131,6 +131,7 @@ def test_no_traceback_and_nothing_outside_the_output_changes(command: str, data:
     except SystemExit as exit_:  # argparse: a bad value (2) or --help (0)
         code = int(exit_.code or 0)
     printed, err = capsys.readouterr()
+    event(f"exit {code}")  # --hypothesis-show-statistics shows how often each outcome came up
     assert "Traceback" not in printed + err, argv
     assert code in (0, 1, 2), (argv, code, err)
     if code == 2:

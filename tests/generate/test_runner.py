@@ -232,3 +232,32 @@ def test_generate_with_a_relative_out_from_another_folder(reference: Path, tiny_
         shutil.rmtree(elsewhere / "data", ignore_errors=True)
         assert main(["generate", "--config", str(tiny_config), "--out", "data", "--workers", "1", "--quiet"]) == 0
         assert digest(elsewhere / "data") == digest(reference)
+
+
+def test_a_full_disk_midway_leaves_no_half_scene_and_the_next_run_redoes_it(
+        reference: Path, tiny_config: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    import errno
+    import itertools
+
+    from PIL import Image
+
+    save, calls = Image.Image.save, itertools.count()
+
+    def filling(self: Image.Image, *args: Any, **kwargs: Any) -> None:
+        if next(calls) == 2:  # the disk fills up at the third image, mid-way through the views
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        save(self, *args, **kwargs)
+
+    monkeypatch.setattr(Image.Image, "save", filling)
+    root = tmp_path / "data"
+    requests = load_dataset_config(tiny_config).requests(["Single-Strawberry/000"])
+    with pytest.raises(UserError, match="1 of 1 scenes failed .*No space left on device.*run the same command again"):
+        run_dataset(requests, root, RunOptions(workers=1, progress=False))
+    assert not list((root / "Single-Strawberry").iterdir())  # no half scene, visible or hidden
+    assert not (root / "splits.json").exists()
+
+    monkeypatch.undo()  # space again
+    report = run_dataset(requests, root, RunOptions(workers=1, progress=False))
+    assert report.made == ["Single-Strawberry/000"]
+    scene = {k: v for k, v in digest(root).items() if k.startswith("Single-Strawberry/000/")}
+    assert scene == {k: v for k, v in digest(reference).items() if k.startswith("Single-Strawberry/000/")}
