@@ -71,6 +71,10 @@ def write_json_atomic(path: str | os.PathLike[str], data: Any, indent: int = 1) 
 # Proving an output path writable, and keeping a result whose final write failed
 
 
+#: Name prefix of the short-lived file that proves a folder writable (others must ignore it).
+PROBE_PREFIX = ".davis_ag-write-test-"
+
+
 def _nearest_existing(path: Path) -> Path:
     """``path`` or its nearest ancestor that exists."""
     for candidate in (path, *path.parents):
@@ -85,7 +89,7 @@ def _try_create_file_in(folder: Path) -> str | None:
     ``os.access`` cannot answer this: as root it says yes to ``/proc`` and to read-only mounts.
     """
     try:
-        handle, name = tempfile.mkstemp(prefix=".davis_ag-write-test-", dir=folder)
+        handle, name = tempfile.mkstemp(prefix=PROBE_PREFIX, dir=folder)
     except OSError as error:
         return error.strerror or type(error).__name__
     os.close(handle)

@@ -17,7 +17,7 @@ from typing import Callable
 import numpy as np
 
 from davis_ag import __version__
-from davis_ag.atomic_files import prove_writable_folder
+from davis_ag.atomic_files import PROBE_PREFIX, prove_writable_folder
 from davis_ag.errors import UserError
 from davis_ag.generate.scene_writer import SceneWriter, partial_dir
 from davis_ag.labels.fruit_labels import fruit_lookup, label_view, visible_fractions
@@ -206,7 +206,8 @@ def check_output_root(root: Path) -> None:
         raise UserError(f"{root} is a file, not a folder: choose another --out")
     if root.is_dir():
         strangers = [p.name for p in root.iterdir()
-                     if p.name not in ROOT_EXTRAS and not (p.is_dir() and parse_group_name(p.name))]
+                     if p.name not in ROOT_EXTRAS and not p.name.startswith(PROBE_PREFIX)
+                     and not (p.is_dir() and parse_group_name(p.name))]
         if strangers:
             raise UserError(f"{root} holds other things ({', '.join(sorted(strangers)[:3])}): "
                             "choose an empty or DAVIS-Ag folder for --out")
