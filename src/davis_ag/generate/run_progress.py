@@ -124,6 +124,7 @@ class Progress:
         self._total_views = total_views
         self._done_views = 0
         self._started = self._last_line = time.monotonic()
+        self._finished = 0
         disable = None if enabled else True  # None: no bars when stderr is not a terminal
         self.scenes = tqdm(total=len(todo), desc="scenes", unit="scene", position=0, disable=disable,
                            dynamic_ncols=True)
@@ -153,13 +154,16 @@ class Progress:
         now = time.monotonic()
         self._last_line = now
         done, total = self._done_views, max(self._total_views, 1)
-        left = (now - self._started) * (total - done) / done if done > 0 else float("nan")
-        eta = f"{left / 60:.0f} min left" if left == left else "time left unknown"
+        # Until a scene is finished the rate misses the plant growth of later scenes (or is all
+        # growth): no estimate rather than a wild one.
+        left = (now - self._started) * (total - done) / done if done > 0 and self._finished else None
+        eta = f"{left / 60:.0f} min left" if left is not None else "time left known after the first scene"
         self.write(f"{done} of {total} views ({100 * done / total:.0f} %), {eta}")
 
     def finished(self, request: SceneRequest, stats: dict) -> None:
         """A scene is complete."""
         self.scenes.update(1)
+        self._finished += 1
         self.write(f"{request.folder}: {stats['views']} views, grown in {stats['grow_s']:.1f} s, "
                    f"{stats['views_s'] / max(stats['views'], 1):.3f} s per view")
 
