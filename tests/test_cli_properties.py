@@ -108,7 +108,15 @@ def pools_for(command: str, out: str) -> tuple[list[str], dict[str, st.SearchStr
     raise AssertionError(command)
 
 
-@pytest.mark.parametrize("command", ["generate", "demo", "reproduce", "preview", "train", "evaluate", "validate"])
+#: The commands the property drives; a new command must be added here (and to pools_for).
+COVERED = ("generate", "demo", "reproduce", "preview", "train", "evaluate", "validate")
+
+
+def test_every_command_is_covered() -> None:
+    assert sorted(cli.COMMANDS) == sorted(COVERED), "add the new command's options to pools_for"
+
+
+@pytest.mark.parametrize("command", COVERED)
 @settings(max_examples=30, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
 @given(data=st.data())
