@@ -117,7 +117,7 @@ def test_every_command_is_covered() -> None:
 
 
 @pytest.mark.parametrize("command", COVERED)
-@settings(max_examples=30, deadline=None, derandomize=True,
+@settings(max_examples=25, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
 @given(data=st.data())
 def test_no_traceback_and_nothing_outside_the_output_changes(command: str, data: st.DataObject, world: Path,
