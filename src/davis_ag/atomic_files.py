@@ -1,4 +1,6 @@
-"""Atomic file writes: a temporary sibling file, flushed to disk, then renamed over the target.
+"""Atomic file writes, output paths proven writable before long work, and rescued results.
+
+Atomic writes: a temporary sibling file, flushed to disk, then renamed over the target.
 
 A reader, or a run that was killed midway, sees the old file or the new one, never half of one.
 The temporary file is always ``.NAME.tmp`` beside the target, so a run can recognise and clear
@@ -9,9 +11,13 @@ from __future__ import annotations
 
 import json
 import os
+import tempfile
+import time
 from contextlib import contextmanager
 from pathlib import Path
-from typing import IO, Any, Iterator
+from typing import IO, Any, Callable, Iterator
+
+from davis_ag.errors import UserError
 
 
 def temporary_sibling(path: Path) -> Path:
@@ -59,3 +65,129 @@ def write_text_atomic(path: str | os.PathLike[str], text: str) -> Path:
 def write_json_atomic(path: str | os.PathLike[str], data: Any, indent: int = 1) -> Path:
     """Write ``data`` as JSON (with a final newline) to ``path`` atomically; returns the path."""
     return write_text_atomic(path, json.dumps(data, indent=indent) + "\n")
+
+
+# ---------------------------------------------------------------------------------------------
+# Proving an output path writable, and keeping a result whose final write failed
+
+
+#: Name prefix of the short-lived file that proves a folder writable (others must ignore it).
+PROBE_PREFIX = ".davis_ag-write-test-"
+
+
+def _nearest_existing(path: Path) -> Path:
+    """``path`` or its nearest ancestor that exists."""
+    for candidate in (path, *path.parents):
+        if os.path.lexists(candidate):
+            return candidate
+    return Path(path.anchor or "/")
+
+
+def _try_create_file_in(folder: Path) -> str | None:
+    """Create and remove a temporary file in ``folder``; None when that worked, else the reason.
+
+    ``os.access`` cannot answer this: as root it says yes to ``/proc`` and to read-only mounts.
+    """
+    try:
+        handle, name = tempfile.mkstemp(prefix=PROBE_PREFIX, dir=folder)
+    except OSError as error:
+        return error.strerror or type(error).__name__
+    os.close(handle)
+    os.unlink(name)
+    return None
+
+
+def prove_writable_folder(path: str | os.PathLike[str], flag: str = "--out") -> Path:
+    """Check that a folder can be written (made if missing) before any long work, creating nothing.
+
+    A temporary file is created and removed in the folder, or in its nearest existing ancestor
+    when it does not exist yet (the folder itself is made later, by the work).
+
+    Args:
+        path: The folder.
+        flag: The option the path came from, for the message.
+
+    Returns:
+        The absolute path.
+
+    Raises:
+        UserError: when the path is a file, lies under a file, or cannot be written.
+    """
+    target = Path(path).expanduser().absolute()
+    existing = _nearest_existing(target)
+    if not existing.is_dir():
+        what = "is a file" if existing == target else f"lies under {existing}, which is a file"
+        raise UserError(f"{flag} {target} {what}: choose a folder")
+    reason = _try_create_file_in(existing)
+    if reason:
+        raise UserError(f"{flag} {target}: cannot write in {existing} ({reason}): choose a writable folder")
+    return target
+
+
+def prove_writable_file(path: str | os.PathLike[str], flag: str = "--out") -> Path:
+    """Check that a file can be written before any long work, creating nothing that stays.
+
+    Args:
+        path: The file.
+        flag: The option the path came from, for the message.
+
+    Returns:
+        The absolute path.
+
+    Raises:
+        UserError: when the path is a folder, lies under a file, or its folder cannot be written.
+    """
+    target = Path(path).expanduser().absolute()
+    if target.is_dir():
+        raise UserError(f"{flag} {target} is a folder: give a file name, e.g. {target / 'out'}")
+    existing = _nearest_existing(target.parent)
+    if not existing.is_dir():
+        raise UserError(f"{flag} {target} lies under {existing}, which is a file: choose another path")
+    reason = _try_create_file_in(existing)
+    if reason:
+        raise UserError(f"{flag} {target}: cannot write in {existing} ({reason}): choose a writable path")
+    return target
+
+
+def rescue_folder() -> Path:
+    """Where results are kept when their own path cannot be written: a fresh folder in the
+    user's cache (``$XDG_CACHE_HOME`` or ``~/.cache``), else the system's temporary folder."""
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    for base in (Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "davis-ag" / "rescued",
+                 Path(tempfile.gettempdir())):
+        try:
+            base.mkdir(parents=True, exist_ok=True)
+            return Path(tempfile.mkdtemp(prefix=f"davis-ag-{stamp}-", dir=base))
+        except OSError:
+            continue
+    raise UserError("no folder is writable: neither ~/.cache nor the temporary folder")
+
+
+def write_or_rescue(path: str | os.PathLike[str], write: Callable[[Path], None], what: str) -> Path:
+    """Write a result that took long to make; when its path fails, keep it elsewhere and say so.
+
+    Args:
+        path: Where the result should go.
+        write: Writes the result to the path it is given (atomically, ideally).
+        what: What the result is, for the message (e.g. "the trained model").
+
+    Returns:
+        ``path`` when written there.
+
+    Raises:
+        UserError: naming the failure and the file the result was kept in instead.
+    """
+    target = Path(path)
+    try:
+        write(target)
+        return target
+    except OSError as error:
+        reason = error.strerror or str(error)
+    kept = rescue_folder() / target.name
+    try:
+        write(kept)
+    except OSError as error:
+        raise UserError(f"cannot write {what} to {target} ({reason}) nor to {kept} "
+                        f"({error.strerror or error}): {what} is lost; free space and run again") from None
+    raise UserError(f"cannot write {what} to {target} ({reason}); it was kept in {kept}: move it "
+                    "where you want it")

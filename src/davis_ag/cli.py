@@ -35,13 +35,19 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the command line; a :class:`UserError` becomes one line on stderr and exit code 2."""
+    """Run the command line; a :class:`UserError` becomes one line on stderr and exit code 2, an
+    operating-system failure (``OSError``: disk full, folder removed) one line and exit code 1."""
     args = build_parser().parse_args(argv)
     try:
         return int(args.func(args) or 0)
     except UserError as error:
         print(f"davis-ag {args.command}: error: {error}", file=sys.stderr)
         return 2
+    except OSError as error:  # the machine, not the code: a full disk, a folder gone, a lost mount
+        where = f"{error.filename}: " if error.filename else ""
+        print(f"davis-ag {args.command}: error: {where}{error.strerror or error}; nothing finished was "
+              "lost: free the space or fix the path and run the same command again", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print(f"davis-ag {args.command}: interrupted", file=sys.stderr)
         return 130

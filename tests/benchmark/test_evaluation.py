@@ -120,14 +120,21 @@ def test_commands(sp_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture[s
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["--policies", "LRD,Greedy"], "unknown policy"),
-    (["--episodes", "0"], "at least 1"),
-    (["--model", "/nonexistent.zip"], "no such model"),
+    (["--policies", "LRD,Greedy"], "unknown name 'Greedy'"),  # refused as parsed
+    (["--episodes", "0"], "argument --episodes"),
 ])
-def test_evaluate_bad_input(sp_root: Path, tmp_path: Path, argv: list[str], message: str) -> None:
+def test_evaluate_bad_values_are_refused_as_parsed(sp_root: Path, tmp_path: Path, argv: list[str], message: str,
+                                                   capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as exit_:
+        _parser().parse_args(["evaluate", "--dataset", str(sp_root), "--scenario", "sp",
+                              "--out", str(tmp_path / "r.json"), *argv])
+    assert exit_.value.code == 2 and message in capsys.readouterr().err
+
+
+def test_evaluate_missing_model(sp_root: Path, tmp_path: Path) -> None:
     args = _parser().parse_args(["evaluate", "--dataset", str(sp_root), "--scenario", "sp",
-                                 "--out", str(tmp_path / "r.json"), *argv])
-    with pytest.raises(UserError, match=message):
+                                 "--out", str(tmp_path / "r.json"), "--model", "/nonexistent.zip"])
+    with pytest.raises(UserError, match="no such model"):
         args.func(args)
 
 

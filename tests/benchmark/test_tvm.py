@@ -12,7 +12,7 @@ from layout_factory import write_original_style_dataset, write_tiny_dataset
 from PIL import Image
 
 import davis_ag  # noqa: F401 - registers the environments
-from davis_ag.benchmark import TVMEnv, benchmark_steps
+from davis_ag.benchmark import TVMEnv
 from davis_ag.errors import UserError
 
 #: Every environment id davis_ag registers; each must pass the same checks.
@@ -193,12 +193,6 @@ def test_original_layout_without_splits(tmp_path: Path) -> None:
     missing = write_original_style_dataset(tmp_path / "nomask", "sp", scenes=1, missing_mask=True)
     with pytest.raises(UserError, match="mask"):
         TVMEnv(missing, "sp", "all")
-
-
-def test_speed(sp_root: Path) -> None:
-    env = TVMEnv(sp_root, "sp", split="all")
-    rate = benchmark_steps(env, 5000)
-    assert rate >= 5000, f"{rate:.0f} steps/s"
 
 
 def test_fallback_split_is_seeded_70_30() -> None:

@@ -50,10 +50,21 @@ def test_report_writes_pngs_and_links_resolve(tiny_root: Path, tmp_path: Path) -
     assert all((out / link).is_file() for link in links)
 
 
-def test_view_grid_one_panel_per_altitude(tiny_root: Path, tmp_path: Path) -> None:
+def test_view_grid_one_panel_per_altitude(tiny_root: Path, tmp_path: Path,
+                                          monkeypatch: pytest.MonkeyPatch) -> None:
+    import davis_ag.figures.report as report
+
+    figures = []
+    new_figure = report.new_figure
+    monkeypatch.setattr(report, "new_figure", lambda *a, **k: figures.append(new_figure(*a, **k)) or figures[-1])
     for scene in open_dataset(tiny_root).scenes:
         path = draw_view_grid(scene, tmp_path / f"{scene.id.replace('/', '_')}.png")
         assert _is_png(path)
+        altitudes = sorted({round(view.pose[2], 2) for view in scene.views.values()})
+        # The tiny factory's SP grid uses the crop's three altitudes, MP the lowest and highest.
+        assert len(altitudes) == (3 if scene.scenario == "sp" else 2)
+        titles = [ax.get_title() for ax in figures[-1].axes if ax.get_title()]
+        assert [t.split(" m ")[0] for t in titles] == [f"altitude {z:.2f}" for z in altitudes]
 
 
 def test_oer_histogram_handles_empty_and_values(tmp_path: Path) -> None:
@@ -61,9 +72,22 @@ def test_oer_histogram_handles_empty_and_values(tmp_path: Path) -> None:
     assert _is_png(draw_oer_histogram(np.array([0.1, 0.5, 0.9]), tmp_path / "some.png"))
 
 
-def test_phenotypes_without_scene_json_give_no_rows(tiny_root: Path) -> None:
-    header, rows = phenotype_rows(open_dataset(tiny_root).scenes)
+def test_phenotypes_without_scene_json_give_no_rows(tmp_path: Path) -> None:
+    from layout_factory import write_original_style_dataset
+
+    root = write_original_style_dataset(tmp_path / "original", "sp", "strawberry", scenes=2)
+    scenes = open_dataset(root).scenes
+    assert len(scenes) == 2 and all(scene.metadata is None for scene in scenes)
+    header, rows = phenotype_rows(scenes)
+    assert header == ["scene", "plant", "fruit"] and rows == []
+
+
+def test_phenotypes_give_one_row_per_plant_of_scene_json(tiny_root: Path) -> None:
+    scenes = open_dataset(tiny_root).scenes
+    header, rows = phenotype_rows(scenes)
     assert header[:3] == ["scene", "plant", "fruit"]
+    assert len(rows) == sum(len(scene.metadata["plants"]) for scene in scenes) > 0
+    assert [row[0] for row in rows] == [s.id for s in scenes for _ in s.metadata["plants"]]
     assert all(len(row) == len(header) for row in rows)
 
 

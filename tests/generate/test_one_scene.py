@@ -93,7 +93,8 @@ def test_scene_json_records_what_the_annotations_leave_out(generated: tuple[Path
     assert (meta["scenario"], meta["crop"], meta["scene"]) == ("sp", "strawberry", "Single-Strawberry/000")
     assert meta["camera"] == CAMERA.intrinsics()
     assert meta["grid"]["views"] == VIEWS and meta["grid"]["altitudes_m"] == [0.25, 0.40]
-    assert meta["min_fruit_pixels"] == REQUEST.min_fruit_pixels
+    # Section III-C: 210 px for a strawberry at the paper's 1280x720, scaled by the image area.
+    assert meta["min_fruit_pixels"] == max(1, round(210 * 96 * 54 / (1280 * 720)))
 
     crop = CROPS["strawberry"]
     (plant,) = meta["plants"]

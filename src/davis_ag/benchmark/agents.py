@@ -191,16 +191,31 @@ class A2CAgent:
         if seed is not None and not self.deterministic:
             torch.manual_seed(seed)
 
+    def check(self, env: gym.Env) -> None:
+        """Refuse an environment the model was not trained for, before any episode.
+
+        Raises:
+            UserError: when the model was trained for another action or observation space
+                (e.g. an SP model on MP: 7 actions against 9).
+        """
+        inner = tvm(env)
+        n = inner.action_space.n
+        if getattr(self.model.action_space, "n", n) != n:
+            raise UserError(f"the model has {self.model.action_space.n} actions, the {inner.scenario} "
+                            f"environment {n}: use a model trained on the same scenario")
+        shape = getattr(self.model.observation_space, "shape", None)
+        # SB3 stores image spaces channels-first.
+        if shape is not None and sorted(shape) != sorted(inner.observation_space.shape):
+            raise UserError(f"the model takes observations of shape {shape}, the environment gives "
+                            f"{inner.observation_space.shape}: use a model trained by davis-ag train")
+
     def act(self, obs: np.ndarray, env: gym.Env) -> int:
         """The model's action for ``obs``.
 
         Raises:
             UserError: when the model was trained for another action space (e.g. SP vs MP).
         """
-        n = tvm(env).action_space.n
-        if getattr(self.model.action_space, "n", n) != n:
-            raise UserError(f"the model has {self.model.action_space.n} actions, the "
-                            f"environment {n}: use a model trained on the same scenario")
+        self.check(env)
         action, _ = self.model.predict(obs, deterministic=self.deterministic)
         return int(action)
 

@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 from PIL import Image
 
+from davis_ag.data.safe_read import check_inside
 from davis_ag.errors import UserError
 from davis_ag.scene.specs import ALL_ACTIONS
 
@@ -108,7 +109,7 @@ def scene_fingerprint(scene: Any, root: Path) -> str:
         A hex digest; a different one means the cache is stale.
     """
     digest = hashlib.sha256(f"davis-ag-cache:{CACHE_VERSION}:{OBS_SIZE}\n".encode())
-    path = annotations_path(scene, root)
+    path = check_inside(annotations_path(scene, root), getattr(scene, "root", None))
     try:
         digest.update(path.read_bytes())
     except OSError as error:
@@ -156,6 +157,8 @@ def _resized_image(view: Any) -> tuple[np.ndarray, tuple[int, int]]:
         The 224x224x3 uint8 image and the original ``(width, height)``.
     """
     path = getattr(view, "image_path", None)
+    if path is not None:  # never decode a link out of the dataset, even on the fast path
+        check_inside(Path(path), getattr(getattr(view, "scene", None), "root", None))
     try:
         with Image.open(path) as pil:  # type: ignore[arg-type]
             size = pil.size
@@ -244,19 +247,46 @@ def _build(scene: Any, folder: Path, fingerprint: str) -> None:
 
 
 def _load(folder: Path, fingerprint: str) -> SceneCache | None:
-    """Open a cache folder; ``None`` when it is missing, incomplete or stale."""
+    """Open a cache folder; ``None`` when it is missing, incomplete, stale or damaged in any way
+    (the caller rebuilds it from the dataset), so a damaged cache never reaches an episode."""
+    files = [folder / name for name in ("meta.json", "tables.npz", "images.npy")]
+    if folder.is_symlink() or any(path.is_symlink() for path in files):
+        return None  # a link could point anywhere; a cache we wrote never holds one
     try:
-        meta = json.loads((folder / "meta.json").read_text())
+        meta = json.loads(files[0].read_text())
         if meta.get("version") != CACHE_VERSION or meta.get("fingerprint") != fingerprint:
             return None
-        with np.load(folder / "tables.npz") as npz:
-            tables = {name: npz[name] for name in _TABLES}
-        images = np.load(folder / "images.npy", mmap_mode="r")
-    except (OSError, ValueError, KeyError):
+        with np.load(files[1], allow_pickle=False) as npz:
+            tables = {name: np.asarray(npz[name]) for name in _TABLES}
+        images = np.load(files[2], mmap_mode="r", allow_pickle=False)
+        cache = SceneCache(scene_id=str(meta["scene"]), view_names=tuple(str(v) for v in meta["views"]),
+                           image_size=(int(meta["image_size"][0]), int(meta["image_size"][1])),
+                           images=images, **tables)
+    except Exception:  # noqa: BLE001 - whatever is wrong with it, the cache is rebuilt
         return None
-    return SceneCache(scene_id=meta["scene"], view_names=tuple(meta["views"]),
-                      image_size=(int(meta["image_size"][0]), int(meta["image_size"][1])),
-                      images=images, **tables)
+    return cache if _consistent(cache) else None
+
+
+def _consistent(cache: SceneCache) -> bool:
+    """Whether every table has the shape, type and index range the environment relies on."""
+    n, n_boxes, n_fruits = cache.n_views, len(cache.box_view), len(cache.fruit_ids)
+
+    def ints(array: np.ndarray, shape: tuple[int, ...], low: int, high: int) -> bool:
+        return (array.shape == shape and array.dtype.kind in "iu"
+                and (array.size == 0 or (int(array.min()) >= low and int(array.max()) < high)))
+
+    return (n > 0 and min(cache.image_size) > 0
+            and cache.images.shape == (n, OBS_SIZE, OBS_SIZE, 4) and cache.images.dtype == np.uint8
+            and ints(cache.pointers, (n, len(ALL_ACTIONS)), -1, n)
+            and ints(cache.fruit_ids, (n_fruits,), -2**31, 2**31)
+            and ints(cache.box_index, (n, n_fruits), -1, n_boxes)
+            and ints(cache.box_view, (n_boxes,), 0, n)
+            and ints(cache.box_fruit, (n_boxes,), 0, max(n_fruits, 1))
+            and ints(cache.box_xywh, (n_boxes, 4), -2**31, 2**31)
+            and ints(cache.box_scaled, (n_boxes, 4), 0, OBS_SIZE)
+            and cache.box_oer.shape == (n_boxes,) and cache.box_oer.dtype.kind == "f"
+            and bool(np.all(np.isfinite(cache.box_oer)))
+            and ints(cache.box_pixels, (n_boxes,), 0, 2**31))
 
 
 def cache_folder(scene: Any, root: Path, cache_dir: str | os.PathLike[str] | None) -> Path:

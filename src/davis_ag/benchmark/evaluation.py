@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from davis_ag.atomic_files import write_json_atomic
+from davis_ag.atomic_files import atomic_output, write_json_atomic
 from davis_ag.benchmark import TVMEnv
 from davis_ag.benchmark.agents import Agent
 
@@ -88,6 +88,10 @@ def evaluate_agents(env: TVMEnv, agents: list[Agent], episodes: int = 200, sessi
         per policy when ``keep_episodes``.
     """
     inner = env.unwrapped if hasattr(env, "unwrapped") else env
+    for agent in agents:  # a model made for another scenario is refused before any episode runs
+        check = getattr(agent, "check", None)
+        if callable(check):
+            check(env)
     results: dict[str, Any] = {
         "protocol": {"scenario": inner.scenario, "split": inner.split, "tau": inner.tau,
                      "episodes": episodes, "sessions": sessions, "seed": seed,
@@ -181,7 +185,9 @@ def plot_results(results: dict[str, Any], path: str | os.PathLike[str]) -> Path:
                  f"{protocol['episodes']} episodes")
     fig.tight_layout()
     out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=120)
-    plt.close(fig)
+    try:
+        with atomic_output(out) as handle:
+            fig.savefig(handle, format="png", dpi=120)
+    finally:
+        plt.close(fig)
     return out

@@ -104,5 +104,5 @@ def select_scenes(dataset: Any, scenario: str, split: str, crop: str | None = No
     chosen = sorted((s for s in scenes if s.id in keep), key=lambda s: s.id)
     if not chosen:
         raise UserError(f"the {split} split has none of the {len(scenes)} {where}: use "
-                        "split='all' or a dataset with more scenes")
+                        "--split all (split='all') or a dataset with more scenes")
     return chosen

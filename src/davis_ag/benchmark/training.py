@@ -15,9 +15,10 @@ import os
 from pathlib import Path
 from typing import Any
 
+import torch
 from stable_baselines3.common.callbacks import BaseCallback
 
-from davis_ag.atomic_files import atomic_output, write_json_atomic
+from davis_ag.atomic_files import atomic_output, prove_writable_file, write_json_atomic, write_or_rescue
 from davis_ag.benchmark import TVMEnv
 from davis_ag.benchmark.networks import ARCHITECTURES
 from davis_ag.errors import UserError
@@ -146,7 +147,11 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
         raise UserError(f"unknown network {arch!r}: choose one of {', '.join(ARCHITECTURES)}")
     if total_timesteps < 1 or n_envs < 1 or checkpoint_every < 0:
         raise UserError("--timesteps and --n-envs must be positive, --checkpoint-every from 0")
-    final = model_path(out_path)
+    if not 0 <= seed < 2**32:
+        raise UserError(f"--seed {seed}: use a whole number from 0 to {2**32 - 1}")
+    check_device(device)
+    final = model_path(Path(out_path).expanduser().absolute())
+    prove_writable_file(final)  # before hours of training, not after
     model_file, settings_file = checkpoint_paths(final)
     settings = {"dataset": str(getattr(dataset, "root", dataset)), "scenario": scenario, "crop": crop,
                 "seed": seed, "n_envs": n_envs, "arch": arch, "algorithm": "A2C"}
@@ -165,8 +170,22 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
     if total_timesteps > done:
         model.learn(total_timesteps=total_timesteps - done, callback=callbacks or None,
                     reset_num_timesteps=done == 0)
-    save_model(model, final)
     env.close()
+    saved = write_or_rescue(final, lambda path: save_model(model, path), "the trained model")
     model_file.unlink(missing_ok=True)
     settings_file.unlink(missing_ok=True)
-    return final
+    return saved
+
+
+def check_device(device: str) -> None:
+    """Refuse a torch device name torch does not know, before any work.
+
+    Raises:
+        UserError: naming the device and the choices.
+    """
+    if device == "auto":
+        return
+    try:
+        torch.device(device)
+    except (RuntimeError, ValueError, TypeError):
+        raise UserError(f"--device {device!r} is not a torch device: use auto, cpu or cuda") from None

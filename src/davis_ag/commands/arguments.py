@@ -1,10 +1,22 @@
-"""Argument types shared by the sub-commands: sizes, counts and paths, each checked as parsed."""
+"""Argument types shared by the sub-commands: sizes, counts, seeds, lists and paths, each checked
+as parsed, so a bad value is one argparse line (exit 2) before any work starts.
+
+Output paths are checked again by the commands, before their long work, with
+:func:`davis_ag.atomic_files.prove_writable_folder` / ``prove_writable_file`` (re-exported here):
+those create a temporary file where the output will go, the only test that holds for root.
+"""
 
 from __future__ import annotations
 
 import argparse
 import re
 from pathlib import Path
+from typing import Callable
+
+from davis_ag.atomic_files import prove_writable_file, prove_writable_folder  # noqa: F401 - shared
+
+#: Largest seed: NumPy's legacy seeding, Gymnasium and Stable-Baselines3 take 32-bit seeds.
+MAX_SEED = 2**32 - 1
 
 
 def image_size(text: str) -> tuple[int, int]:
@@ -15,18 +27,75 @@ def image_size(text: str) -> tuple[int, int]:
     return int(match[1]), int(match[2])
 
 
+def _digits(text: str) -> int | None:
+    text = text.strip()
+    # isascii: str.isdigit also accepts digits int() refuses, such as superscripts.
+    return int(text) if text.isascii() and text.isdigit() else None
+
+
 def count(text: str) -> int:
     """Parse a positive count."""
-    if not text.isdigit() or int(text) < 1:
+    value = _digits(text)
+    if value is None or value < 1:
         raise argparse.ArgumentTypeError(f"{text!r} is not a positive whole number")
-    return int(text)
+    return value
 
 
 def whole(text: str) -> int:
     """Parse a whole number from 0."""
-    if not text.isdigit():
+    value = _digits(text)
+    if value is None:
         raise argparse.ArgumentTypeError(f"{text!r} is not a whole number from 0")
-    return int(text)
+    return value
+
+
+def bounded(low: int, high: int) -> Callable[[str], int]:
+    """A parser of whole numbers from ``low`` to ``high`` (a sanity bound that keeps a typo such as
+    an extra zero from starting days of work or exhausting memory)."""
+
+    def parse(text: str) -> int:
+        value = _digits(text)
+        if value is None or not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a whole number from {low} to {high}")
+        return value
+
+    parse.__name__ = f"whole number from {low} to {high}"  # argparse names the type in errors
+    return parse
+
+
+def seed(text: str) -> int:
+    """Parse a seed: a whole number from 0 to 2**32 - 1."""
+    value = _digits(text)
+    if value is None or value > MAX_SEED:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a seed: use a whole number from 0 to {MAX_SEED}")
+    return value
+
+
+def name_list(choices: tuple[str, ...]) -> Callable[[str], list[str]]:
+    """A parser of a comma-separated, non-empty list of names from ``choices`` (any case),
+    returned in the spelling of ``choices``, without repeats."""
+    canonical = {c.lower(): c for c in choices}
+
+    def parse(text: str) -> list[str]:
+        names = [n.strip() for n in text.split(",") if n.strip()]
+        if not names:
+            raise argparse.ArgumentTypeError(f"{text!r} names nothing: give a comma-separated list of "
+                                             f"{', '.join(choices)}")
+        unknown = [n for n in names if n.lower() not in canonical]
+        if unknown:
+            raise argparse.ArgumentTypeError(f"unknown name {unknown[0]!r}: choose from {', '.join(choices)}")
+        return list(dict.fromkeys(canonical[n.lower()] for n in names))
+
+    return parse
+
+
+def number_list(text: str) -> list[int]:
+    """Parse a comma-separated, non-empty list of numbers from 1, e.g. ``1,40,200``."""
+    parts = [p.strip() for p in text.split(",")]
+    values = [_digits(p) for p in parts]
+    if not parts or any(v is None or v < 1 for v in values):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a list of numbers from 1 like 1,40,200")
+    return list(dict.fromkeys(v for v in values if v is not None))
 
 
 def path(text: str) -> Path:
@@ -37,4 +106,9 @@ def path(text: str) -> Path:
     """
     if not text.strip():
         raise argparse.ArgumentTypeError("an empty path")
-    return Path(text).expanduser().absolute()
+    if "\0" in text:
+        raise argparse.ArgumentTypeError(f"{text!r} holds a NUL character, which no path may")
+    try:
+        return Path(text).expanduser().absolute()
+    except RuntimeError:  # expanduser of ~name for a user that does not exist
+        raise argparse.ArgumentTypeError(f"{text!r}: no such user's home folder") from None

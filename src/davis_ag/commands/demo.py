@@ -19,13 +19,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--out", type=arguments.path, required=True, metavar="DIR",
                         help="output folder (DIR/dataset, DIR/report/index.html)")
-    parser.add_argument("--scenes", type=int, default=2,
+    parser.add_argument("--scenes", type=arguments.bounded(1, 1000), default=2,
                         help="SP strawberry scenes (default 2: one train, one test scene)")
     parser.add_argument("--size", type=arguments.image_size, default="1280x720",
                         help="image size WIDTHxHEIGHT (default 1280x720, the paper's)")
-    parser.add_argument("--seed", type=int, default=0, help="dataset and evaluation seed (default 0)")
-    parser.add_argument("--episodes", type=int, default=200, help="episodes per session (default 200)")
-    parser.add_argument("--sessions", type=int, default=3, help="evaluation sessions (default 3)")
+    parser.add_argument("--seed", type=arguments.seed, default=0, help="dataset and evaluation seed (default 0)")
+    parser.add_argument("--episodes", type=arguments.bounded(1, 10**6), default=200,
+                        help="episodes per session (default 200)")
+    parser.add_argument("--sessions", type=arguments.bounded(1, 1000), default=3,
+                        help="evaluation sessions (default 3)")
     parser.set_defaults(func=run)
 
 

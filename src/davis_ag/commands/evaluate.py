@@ -3,10 +3,13 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
+from davis_ag.atomic_files import write_or_rescue
 from davis_ag.commands import arguments
 from davis_ag.errors import UserError
+
+#: What --policies accepts (A2C needs --model too).
+POLICIES = ("LRD", "UDD", "Rand", "Oracle", "A2C")
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -26,13 +29,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help="scenes to evaluate on (default: test)")
     parser.add_argument("--model", type=arguments.path, default=None, metavar="MODEL.zip",
                         help="trained A2C model; adds the A2C column")
-    parser.add_argument("--policies", default="LRD,UDD,Rand,Oracle",
+    parser.add_argument("--policies", type=arguments.name_list(POLICIES), default="LRD,UDD,Rand,Oracle",
                         help="comma-separated baselines (default: LRD,UDD,Rand,Oracle)")
     parser.add_argument("--stochastic", action="store_true",
                         help="let A2C sample its actions instead of taking the most likely one")
-    parser.add_argument("--episodes", type=int, default=200, help="episodes per session (200)")
-    parser.add_argument("--sessions", type=int, default=3, help="sessions (3)")
-    parser.add_argument("--seed", type=int, default=0, help="base seed of the episodes (0)")
+    parser.add_argument("--episodes", type=arguments.bounded(1, 10**6), default=200,
+                        help="episodes per session (200)")
+    parser.add_argument("--sessions", type=arguments.bounded(1, 1000), default=3, help="sessions (3)")
+    parser.add_argument("--seed", type=arguments.seed, default=0, help="base seed of the episodes (0)")
     parser.add_argument("--cache-dir", type=arguments.path, default=None, metavar="DIR",
                         help="observation cache folder (default: DIR/.davis_ag_cache)")
     parser.add_argument("--out", type=arguments.path, required=True, metavar="RESULTS.json", help="results file")
@@ -47,18 +51,27 @@ def run(args: argparse.Namespace) -> int:
     from davis_ag.benchmark.agents import build_agents
     from davis_ag.benchmark.evaluation import evaluate_agents, format_table, plot_results, write_json
 
-    if args.episodes < 1 or args.sessions < 1:
-        raise UserError("--episodes and --sessions must be at least 1")
-    names = [n for n in args.policies.split(",") if n.strip()]
-    if args.model and not any(n.strip().lower() == "a2c" for n in names):
+    names = list(args.policies)
+    if args.model and "A2C" not in names:
         names.append("A2C")
+    out = arguments.prove_writable_file(args.out)
+    plot = arguments.prove_writable_file(args.plot or out.with_suffix(".png"), "--plot")
+    if plot == out:
+        raise UserError(f"--plot and --out are both {out}: give the chart another name")
+    if args.cache_dir is not None:
+        arguments.prove_writable_folder(args.cache_dir, "--cache-dir")
     agents = build_agents(names, model=args.model, deterministic=not args.stochastic)
     env = TVMEnv(args.dataset, scenario=args.scenario, split=args.split, crop=args.crop,
                  cache_dir=args.cache_dir)
     results = evaluate_agents(env, agents, episodes=args.episodes, sessions=args.sessions,
                               seed=args.seed)
     print(format_table(results))
-    out = write_json(results, args.out)
-    plot = plot_results(results, args.plot or Path(args.out).with_suffix(".png"))
+    # The JSON is the result: keep it somewhere even when --out fails at the end.
+    write_or_rescue(out, lambda path: write_json(results, path), "the results")
+    try:
+        plot_results(results, plot)
+    except OSError as error:
+        raise UserError(f"the results are in {out}, but the chart could not be written to {plot} "
+                        f"({error.strerror or error}): run again with another --plot") from None
     print(f"wrote {out} and {plot}")
     return 0

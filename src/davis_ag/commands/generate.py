@@ -28,24 +28,24 @@ def register(subparsers) -> None:
     parser.add_argument("--config", help="dataset config: a preset (paper, mini) or a YAML file")
     parser.add_argument("--crop", help="strawberry, tomato or vine (default strawberry; not with --config)")
     parser.add_argument("--scenario", help="sp (single plant) or mp (multi plant) (default sp)")
-    parser.add_argument("--scenes", type=arguments.count, help="how many scenes (default 1)")
-    parser.add_argument("--first", type=int, help="index of the first scene (default 0)")
-    parser.add_argument("--seed", type=int, help="dataset seed (default 0, or the config's)")
+    parser.add_argument("--scenes", type=arguments.bounded(1, 100_000), help="how many scenes (default 1)")
+    parser.add_argument("--first", type=arguments.whole, help="index of the first scene (default 0)")
+    parser.add_argument("--seed", type=arguments.seed, help="dataset seed (default 0, or the config's)")
     parser.add_argument("--size", type=arguments.image_size, help="image size (default 1280x720, or the config's)")
     parser.add_argument("--out", type=arguments.path, required=True, help="dataset folder")
     parser.add_argument("--only", action="append", metavar="SCENE",
                         help="make only this scene or group, e.g. Single-Strawberry/003 (repeatable, or "
                              "comma-separated)")
-    parser.add_argument("--workers", type=arguments.count,
+    parser.add_argument("--workers", type=arguments.bounded(1, 1024),
                         help=f"scene processes on this machine, each drawing with one Mesa thread (default: "
                              f"one per core as memory allows, {default_workers()} here; 1 draws in this process "
                              "with every core)")
     parser.add_argument("--executor", choices=("local", "ray"), default="local",
                         help="local processes (default) or one Ray task per scene on a cluster")
     parser.add_argument("--address", help="Ray cluster address: auto (on a cluster machine) or ray://HEAD:10001")
-    parser.add_argument("--cpus-per-scene", type=arguments.count, default=1,
+    parser.add_argument("--cpus-per-scene", type=arguments.bounded(1, 1024), default=1,
                         help="Ray: CPUs (and Mesa threads) each scene task reserves (default 1)")
-    parser.add_argument("--max-retries", type=arguments.whole, default=DEFAULT_MAX_RETRIES,
+    parser.add_argument("--max-retries", type=arguments.bounded(0, 100), default=DEFAULT_MAX_RETRIES,
                         help=f"tries again for a scene whose worker died (default {DEFAULT_MAX_RETRIES})")
     parser.add_argument("--quiet", action="store_true", help="no progress bars")
     parser.set_defaults(func=run)
@@ -59,8 +59,6 @@ def run(args: argparse.Namespace) -> int:
                             "groups; use --only to pick scenes of it")
         config = load_dataset_config(args.config)
         if args.seed is not None or args.size is not None:
-            if args.seed is not None and args.seed < 0:
-                raise UserError(f"--seed {args.seed} is negative: use a whole number from 0")
             config = dataclasses.replace(config, seed=config.seed if args.seed is None else args.seed,
                              camera=config.camera if args.size is None else Camera(*args.size))
     else:
@@ -72,6 +70,7 @@ def run(args: argparse.Namespace) -> int:
     if args.executor == "ray" and args.workers is not None:
         raise UserError("--workers is for the local executor: Ray runs one task per scene on the cluster "
                         "(see --cpus-per-scene)")
+    arguments.prove_writable_folder(args.out)
     only = [item for value in args.only or [] for item in value.split(",") if item.strip()]
     requests = config.requests(only)
     options = RunOptions(workers=args.workers or default_workers(), executor=args.executor, address=args.address,

@@ -11,9 +11,11 @@ import argparse
 import numpy as np
 from PIL import Image, ImageDraw
 
+from davis_ag.atomic_files import atomic_output
 from davis_ag.commands import arguments
 from davis_ag.errors import UserError
 from davis_ag.generate.one_scene import SceneRequest
+from davis_ag.generate.run_progress import count_views
 from davis_ag.labels.fruit_labels import fruit_lookup, label_view, visible_fractions
 from davis_ag.render.helios import HeliosRenderer
 from davis_ag.scene.build import build_scene
@@ -27,9 +29,10 @@ def register(subparsers) -> None:
                                    description=__doc__)
     parser.add_argument("--crop", default="strawberry", help="strawberry, tomato or vine")
     parser.add_argument("--scenario", default="sp", help="sp or mp")
-    parser.add_argument("--seed", type=int, default=0, help="dataset seed (default 0)")
-    parser.add_argument("--index", type=int, default=0, help="scene index (default 0)")
-    parser.add_argument("--views", default="1", help="comma-separated view numbers (default 1)")
+    parser.add_argument("--seed", type=arguments.seed, default=0, help="dataset seed (default 0)")
+    parser.add_argument("--index", type=arguments.whole, default=0, help="scene index (default 0)")
+    parser.add_argument("--views", type=arguments.number_list, default=[1],
+                        help="comma-separated view numbers (default 1)")
     parser.add_argument("--size", type=arguments.image_size, default=(1280, 720), help="image size (default 1280x720)")
     parser.add_argument("--out", type=arguments.path, required=True, help="folder for the pictures")
     parser.set_defaults(func=run)
@@ -37,19 +40,16 @@ def register(subparsers) -> None:
 
 def run(args: argparse.Namespace) -> int:
     crop, scenario = crop_spec(args.crop), scenario_spec(args.scenario)
-    try:
-        numbers = [int(v) for v in args.views.split(",")]
-    except ValueError:
-        raise UserError(f"--views {args.views!r} is not a list of view numbers like 1,40,200") from None
-    if args.out.exists() and not args.out.is_dir():
-        raise UserError(f"{args.out} is a file: choose a folder for --out")
+    numbers = args.views
+    # Every check before the plant grows (a minute for a vine): the view count needs only the
+    # nominal grid, which slip does not change.
+    _check_views(numbers, count_views(scenario, crop))
+    arguments.prove_writable_folder(args.out)
     request = SceneRequest(scenario, crop, args.index, args.seed, Camera(*args.size))
     rng = np.random.default_rng(request.seed)
     model = build_scene(scenario, crop, rng)
     grid = build_view_grid(scenario, crop, plant_centres(scenario, crop), model.aim_height, rng)
-    bad = [n for n in numbers if not 1 <= n <= len(grid.viewpoints)]
-    if bad:
-        raise UserError(f"view {bad[0]} does not exist: this scene has views 1..{len(grid.viewpoints)}")
+    _check_views(numbers, len(grid.viewpoints))
     lookup = fruit_lookup({f.id: f.uuids for f in model.fruits}, model.uuid_count)
     polygons = {f.id: f.polygons for f in model.fruits}
     args.out.mkdir(parents=True, exist_ok=True)
@@ -60,12 +60,21 @@ def run(args: argparse.Namespace) -> int:
             labels = label_view(primitive_ids, lookup, request.min_fruit_pixels)
             fractions = visible_fractions(request.camera, view, labels, polygons)
             stem = f"{crop.name}-{scenario.name}-{args.index:03d}-{number:04d}"
-            Image.fromarray(colour).save(args.out / f"{stem}.jpeg", quality=95)
+            with atomic_output(args.out / f"{stem}.jpeg") as handle:
+                Image.fromarray(colour).save(handle, format="JPEG", quality=95)
             boxed = Image.fromarray(colour)
             draw = ImageDraw.Draw(boxed)
             for x, y, w, h, fruit_id, _ in labels.boxes:
                 draw.rectangle([x, y, x + w - 1, y + h - 1], outline=(255, 220, 0), width=2)
                 draw.text((x, max(0, y - 12)), f"{fruit_id}: {fractions[fruit_id]:.2f}", fill=(255, 220, 0))
-            boxed.save(args.out / f"{stem}-boxes.jpeg", quality=90)
+            with atomic_output(args.out / f"{stem}-boxes.jpeg") as handle:
+                boxed.save(handle, format="JPEG", quality=90)
             print(f"{args.out / stem}.jpeg: {len(labels.boxes)} fruit boxed, pose {view.pose}")
     return 0
+
+
+def _check_views(numbers: list[int], views: int) -> None:
+    """Refuse view numbers the scene does not have."""
+    bad = [n for n in numbers if not 1 <= n <= views]
+    if bad:
+        raise UserError(f"--views: view {bad[0]} does not exist: this scene has views 1..{views}")

@@ -33,10 +33,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help="Markdown results file (default: docs/results.md)")
     parser.add_argument("--config", choices=list(CONFIGS), default="small",
                         help="small (43 min measured on 2 CPU cores, default) or paper-scale")
-    parser.add_argument("--sp-scenes", type=int, default=None, help="override the SP scene count")
-    parser.add_argument("--mp-scenes", type=int, default=None, help="override the MP scene count")
-    parser.add_argument("--sp-timesteps", type=int, default=None, help="override SP A2C steps")
-    parser.add_argument("--mp-timesteps", type=int, default=None, help="override MP A2C steps")
+    parser.add_argument("--sp-scenes", type=arguments.bounded(1, 1000), default=None,
+                        help="override the SP scene count")
+    parser.add_argument("--mp-scenes", type=arguments.bounded(1, 1000), default=None,
+                        help="override the MP scene count")
+    parser.add_argument("--sp-timesteps", type=arguments.bounded(1, 10**9), default=None,
+                        help="override SP A2C steps")
+    parser.add_argument("--mp-timesteps", type=arguments.bounded(1, 10**9), default=None,
+                        help="override MP A2C steps")
     parser.add_argument("--only", choices=["sp", "mp"], default=None, help="run one scenario only")
     parser.add_argument("--rewrite-results", action="store_true",
                         help="only rewrite --results from DIR/state.json; run nothing")
@@ -48,9 +52,8 @@ def run(args: argparse.Namespace) -> int:
     config = CONFIGS[args.config]
     overrides = {k: getattr(args, k) for k in ("sp_scenes", "mp_scenes", "sp_timesteps", "mp_timesteps")
                  if getattr(args, k) is not None}
-    if any(v < 1 for v in overrides.values()):
-        raise UserError("scene counts and timesteps must be at least 1")
     config = replace(config, **overrides)
+    arguments.prove_writable_file(args.results, "--results")
     if args.rewrite_results:
         state = load_state(args.out / "state.json")
         if not state.get("config"):
@@ -61,6 +64,7 @@ def run(args: argparse.Namespace) -> int:
         write_results_md(args.results, ReproduceConfig(**saved), state, args.out)
         print(f"wrote {args.results}")
         return 0
+    arguments.prove_writable_folder(args.out)
     pairs = [p for p in SCENARIO_CROPS if args.only in (None, p[0])]
     return reproduce(config, args.out, args.results, pairs)
 

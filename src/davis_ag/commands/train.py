@@ -19,10 +19,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--scenario", required=True, choices=["sp", "mp"],
                         help="single plant (tau=3) or multi plant (tau=5)")
     parser.add_argument("--crop", default=None, help="train on one crop only (default: all)")
-    parser.add_argument("--timesteps", type=int, default=300_000, metavar="N",
+    parser.add_argument("--timesteps", type=arguments.bounded(1, 10**9), default=300_000, metavar="N",
                         help="environment steps (default: 300000, as in the paper)")
-    parser.add_argument("--seed", type=int, default=0, help="seed of SB3 and the environments")
-    parser.add_argument("--n-envs", type=int, default=8, help="parallel environments (default: 8)")
+    parser.add_argument("--seed", type=arguments.seed, default=0, help="seed of SB3 and the environments")
+    parser.add_argument("--n-envs", type=arguments.bounded(1, 256), default=8,
+                        help="parallel environments (default: 8)")
     parser.add_argument("--arch", choices=["paper", "nature", "pooled"], default="paper",
                         help="network: paper (section V-B, default), nature (SB3's NatureCNN) or pooled "
                              "(fast smoke tests)")
@@ -33,14 +34,18 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--checkpoint-every", type=arguments.whole, default=10_000, metavar="N",
                         help="save a checkpoint beside --out every N steps (0: never); running the same "
                              "command again resumes from it (default: 10000)")
-    parser.add_argument("--verbose", type=int, default=1, help="SB3 verbosity (default: 1)")
+    parser.add_argument("--verbose", type=int, choices=(0, 1, 2), default=1, help="SB3 verbosity (default: 1)")
     parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     """Train and save; prints the model's path."""
-    from davis_ag.benchmark.training import train_a2c
+    from davis_ag.benchmark.training import check_device, train_a2c
 
+    check_device(args.device)
+    arguments.prove_writable_file(args.out)
+    if args.cache_dir is not None:
+        arguments.prove_writable_folder(args.cache_dir, "--cache-dir")
     path = train_a2c(args.dataset, args.scenario, total_timesteps=args.timesteps, seed=args.seed,
                      out_path=args.out, n_envs=args.n_envs, crop=args.crop,
                      cache_dir=args.cache_dir, arch=args.arch, device=args.device,

@@ -6,7 +6,6 @@ import argparse
 import sys
 
 from davis_ag.commands import arguments
-from davis_ag.errors import UserError
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -22,7 +21,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                                                    "or scene folder")
     parser.add_argument("--quick", action="store_true",
                         help="skip pixel checks (image and mask sizes, boxes against masks)")
-    parser.add_argument("--box-tolerance", type=int, default=None, metavar="PX",
+    parser.add_argument("--box-tolerance", type=arguments.whole, default=None, metavar="PX",
                         help="pixels a box edge may differ from its mask's extent (default: 0 for scenes "
                              "with scene.json, 1 for the original download)")
     parser.set_defaults(func=run)
@@ -34,8 +33,6 @@ def run(args: argparse.Namespace) -> int:
 
     from davis_ag.data.validate import validate_dataset
 
-    if args.box_tolerance is not None and args.box_tolerance < 0:
-        raise UserError(f"--box-tolerance must be 0 or more, got {args.box_tolerance}")
     # tqdm.write keeps the problem lines from tearing the progress bar on stderr.
     report = validate_dataset(args.dir, quick=args.quick, box_tolerance=args.box_tolerance,
                               on_problem=lambda p: tqdm.write(str(p), file=sys.stdout), progress=True)

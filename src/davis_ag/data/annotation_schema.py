@@ -18,6 +18,8 @@ from davis_ag.scene import specs as config
 from davis_ag.scene.specs import NO_FRUIT
 
 _IMAGE_SUFFIXES = (".jpeg", ".jpg")
+#: Box values beyond this are damage, not pixels.
+BOX_LIMIT = 2**20
 
 
 @dataclass(frozen=True)
@@ -112,6 +114,9 @@ def parse_box(raw: Any) -> Box:
         raise ValueError(f"a box must be [xmin, ymin, width, height, fruit_id, 0], got {raw!r}")
     names = ("xmin", "ymin", "width", "height", "fruit_id")
     values = [int(round(_number(v, f"box {n}"))) for v, n in zip(raw, names)]
+    for value, name in zip(values, names):
+        if not -BOX_LIMIT < value < BOX_LIMIT:  # no image is that large; tables hold 32-bit ints
+            raise ValueError(f"box {name} {value} is out of range (|value| < {BOX_LIMIT})")
     return Box(*values)
 
 

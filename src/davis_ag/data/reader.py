@@ -12,7 +12,6 @@ here, so ``from davis_ag.data.reader import Box, exposure_rate`` works.
 
 from __future__ import annotations
 
-import json
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -32,6 +31,7 @@ from davis_ag.data.annotation_schema import (
     parse_entry,
     parse_pose,
 )
+from davis_ag.data.safe_read import check_inside, load_pixels, read_json
 from davis_ag.errors import UserError
 from davis_ag.scene import specs as config
 
@@ -51,21 +51,6 @@ class NotFoundError(UserError, KeyError):
 
     def __str__(self) -> str:  # KeyError would quote the message
         return str(self.args[0]) if self.args else ""
-
-
-def read_json(path: Path, what: str) -> Any:
-    """Load a JSON file, turning every failure into one :class:`UserError` line."""
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as error:
-        raise UserError(f"{path}: cannot read {what} ({error.strerror or error}); check the file") from None
-    except UnicodeDecodeError:
-        raise UserError(f"{path}: {what} is not UTF-8 text; re-download or regenerate it") from None
-    try:
-        return json.loads(text)
-    except json.JSONDecodeError as error:
-        raise UserError(f"{path}: {what} is not valid JSON (line {error.lineno} column {error.colno}: "
-                        f"{error.msg}); re-download or regenerate it") from None
 
 
 def _view_order(name: str) -> tuple[int, str]:
@@ -137,7 +122,7 @@ class View:
         Raises:
             UserError: when the file is missing or unreadable.
         """
-        return _load_pixels(self.image_path, "RGB")
+        return load_pixels(check_inside(self.image_path, self.scene.root), "RGB")
 
     def mask(self) -> np.ndarray | None:
         """Decode the instance mask.
@@ -150,27 +135,7 @@ class View:
         """
         if not self.mask_path.is_file():
             return None
-        return _load_pixels(self.mask_path, None)
-
-
-def _load_pixels(path: Path, mode: str | None) -> np.ndarray:
-    from PIL import Image, UnidentifiedImageError
-
-    try:
-        with Image.open(path) as im:
-            if mode:
-                im = im.convert(mode)
-            pixels = np.asarray(im)
-    except FileNotFoundError:
-        raise UserError(f"{path}: image file missing; re-download or regenerate the scene") from None
-    except (OSError, UnidentifiedImageError, ValueError) as error:
-        raise UserError(f"{path}: cannot decode ({error}); re-download or regenerate the scene") from None
-    if mode is None:
-        # A mask saved as RGB still carries the id in every channel; keep one.
-        if pixels.ndim == 3:
-            pixels = pixels[..., 0]
-        pixels = pixels.astype(np.uint8, copy=False)
-    return pixels
+        return load_pixels(check_inside(self.mask_path, self.scene.root), None)
 
 
 @dataclass(eq=False)
@@ -180,10 +145,12 @@ class Scene:
     Attributes:
         path: The scene folder.
         group: Its group folder's name, e.g. ``Single-Strawberry``.
+        root: The dataset root; files resolving outside it are refused (None: no check).
     """
 
     path: Path
     group: str
+    root: Path | None = None
 
     @property
     def id(self) -> str:
@@ -215,7 +182,7 @@ class Scene:
         Raises:
             UserError: when it is unreadable, not JSON or not a JSON object.
         """
-        raw = read_json(self.annotations_path, "annotations")
+        raw = read_json(check_inside(self.annotations_path, self.root), "annotations")
         if not isinstance(raw, dict):
             raise UserError(f"{self.annotations_path}: must hold a JSON object keyed by image name, "
                             f"got {type(raw).__name__}; re-download or regenerate the scene")
@@ -279,7 +246,7 @@ class Scene:
         path = self.path / SCENE_METADATA
         if not path.is_file():
             return None
-        data = read_json(path, "scene metadata")
+        data = read_json(check_inside(path, self.root), "scene metadata")
         if not isinstance(data, dict):
             raise UserError(f"{path}: must hold a JSON object, got {type(data).__name__}; regenerate the scene")
         return data
@@ -329,9 +296,14 @@ class Dataset:
         path = self.root / SPLITS
         if not path.is_file():
             return None
-        data = read_json(path, "splits")
+        data = read_json(check_inside(path, self.root), "splits")
         if not isinstance(data, dict):
             raise UserError(f"{path}: must hold a JSON object with train and test lists; fix or delete it")
+        for name in ("train", "test"):
+            ids = data.get(name, [])
+            if not isinstance(ids, list) or not all(isinstance(i, str) for i in ids):
+                raise UserError(f"{path}: {name!r} must be a list of scene ids like \"Single-Strawberry/000\"; "
+                                "fix or delete it")
         return data
 
     def __len__(self) -> int:
@@ -362,17 +334,20 @@ def open_dataset(path: str | Path) -> Dataset:
         raise UserError(f"{path}: no such folder; give the dataset root, a group folder or a scene folder")
     if not path.is_dir():
         raise UserError(f"{path}: is a file; give the folder that holds it")
-    if (path / ANNOTATIONS).is_file():
-        root, scenes = path.parent.parent, [Scene(path, path.parent.name)]
-    elif scene_dirs := _scene_dirs(path):
-        root, scenes = path.parent, [Scene(p, path.name) for p in scene_dirs]
-    else:
-        scenes = [Scene(s, g.name) for g in sorted(path.iterdir()) if g.is_dir() for s in _scene_dirs(g)]
-        root = path
-        if not scenes:
-            raise UserError(
-                f"{path}: not a DAVIS-Ag dataset: no {ANNOTATIONS} in it, in its sub-folders or theirs; "
-                f"give the root that holds e.g. Single-Strawberry/000/{ANNOTATIONS}, a group folder "
-                "or a scene folder")
+    try:
+        if (path / ANNOTATIONS).is_file():
+            root, scenes = path.parent.parent, [Scene(path, path.parent.name, path.parent.parent)]
+        elif scene_dirs := _scene_dirs(path):
+            root, scenes = path.parent, [Scene(p, path.name, path.parent) for p in scene_dirs]
+        else:
+            scenes = [Scene(s, g.name, path) for g in sorted(path.iterdir()) if g.is_dir() for s in _scene_dirs(g)]
+            root = path
+    except OSError as error:  # a folder we may not list
+        raise UserError(f"{error.filename or path}: cannot list ({error.strerror}); check its permissions") from None
+    if not scenes:
+        raise UserError(
+            f"{path}: not a DAVIS-Ag dataset: no {ANNOTATIONS} in it, in its sub-folders or theirs; "
+            f"give the root that holds e.g. Single-Strawberry/000/{ANNOTATIONS}, a group folder "
+            "or a scene folder")
     scenes.sort(key=lambda s: s.id)
     return Dataset(root, scenes)

@@ -35,6 +35,8 @@ from davis_ag.data.reader import (
     open_dataset,
     parse_entry,
 )
+from davis_ag.data.safe_read import check_inside
+from davis_ag.errors import UserError
 
 
 @dataclass(frozen=True)
@@ -117,6 +119,10 @@ def validate_scene(scene: Scene, quick: bool = False, box_tolerance: int | None 
             on_problem(problem)
 
     ann_path = scene.path / ANNOTATIONS
+    outside = _outside(ann_path, scene.root)
+    if outside:
+        flag(ann_path, outside)
+        return report
     raw, error = _read_json(ann_path)
     if error is None and (not isinstance(raw, dict) or not raw):
         error = "must be a non-empty JSON object keyed by image name"
@@ -126,7 +132,8 @@ def validate_scene(scene: Scene, quick: bool = False, box_tolerance: int | None 
 
     metadata = None
     if (scene.path / SCENE_METADATA).is_file():
-        metadata, error = _read_json(scene.path / SCENE_METADATA)
+        metadata, error = (None, outside) if (outside := _outside(scene.path / SCENE_METADATA, scene.root)) \
+            else _read_json(scene.path / SCENE_METADATA)
         if error or not isinstance(metadata, dict):
             flag(scene.path / SCENE_METADATA, error or "must hold a JSON object")
             metadata = None
@@ -156,9 +163,15 @@ def validate_scene(scene: Scene, quick: bool = False, box_tolerance: int | None 
             flag(ann_path, problem)
         image, mask = images / record.name, images / f"{record.name.removesuffix('.jpeg')}_seg.png"
         has_image, has_mask = image.is_file(), mask.is_file()
-        if not has_image:
+        for path, present in ((image, has_image), (mask, has_mask)):
+            if present and (outside := _outside(path, scene.root)):
+                flag(path, outside)
+        # A link out of the dataset is never decoded.
+        has_image = has_image and not _outside(image, scene.root)
+        has_mask = has_mask and not _outside(mask, scene.root)
+        if not image.is_file():
             flag(image, f"missing: annotations.json has an entry {record.name} for it")
-        if not has_mask:
+        if not mask.is_file():
             flag(mask, f"missing: the instance mask of {record.name}")
         if quick:
             size = _camera_size(metadata)
@@ -176,6 +189,15 @@ def validate_scene(scene: Scene, quick: bool = False, box_tolerance: int | None 
             if path.suffix.lower() in (".jpeg", ".jpg", ".png") and f"{stem}.jpeg" not in names:
                 flag(path, "has no entry in annotations.json")
     return report
+
+
+def _outside(path: Path, root: Path | None) -> str | None:
+    """Why ``path`` must not be read (it resolves outside the dataset), or None."""
+    try:
+        check_inside(path, root)
+    except UserError as error:
+        return str(error).split(": ", 1)[1]
+    return None
 
 
 def _name_or_key(key: str) -> str:
@@ -270,7 +292,8 @@ def _check_splits(dataset: Dataset, whole: bool) -> list[Problem]:
     path = dataset.root / SPLITS
     if not path.is_file():
         return []
-    data, error = _read_json(path)
+    outside = _outside(path, dataset.root)
+    data, error = (None, outside) if outside else _read_json(path)
     if error:
         return [Problem(path, error)]
     if not isinstance(data, dict):

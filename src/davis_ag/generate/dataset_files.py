@@ -83,7 +83,8 @@ def reconcile_settings(root: Path, wanted: dict[str, Any]) -> dict[str, Any]:
         return wanted
     for key, flag in (("seed", "--seed"), ("image_size", "--size"), ("vfov_deg", "the field of view")):
         if old.get(key) != wanted[key]:
-            raise UserError(f"{root} holds scenes made with {key} {old.get(key)}, not {wanted[key]}: "
+            shown = [_shown(old.get(key)), _shown(wanted[key])]
+            raise UserError(f"{root} holds scenes made with {key} {shown[0]}, not {shown[1]}: "
                             f"use the same {flag} or another --out")
     groups = dict(old["groups"])
     for name, settings in wanted["groups"].items():
@@ -92,6 +93,13 @@ def reconcile_settings(root: Path, wanted: dict[str, Any]) -> dict[str, Any]:
                             f"{settings['grid']}: use the same grid or another --out")
         groups[name] = settings
     return {**wanted, "groups": groups}
+
+
+def _shown(value: Any) -> str:
+    """A setting as a user types it: an image size as WIDTHxHEIGHT."""
+    if isinstance(value, list) and len(value) == 2 and all(isinstance(v, int) for v in value):
+        return f"{value[0]}x{value[1]}"
+    return str(value)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -8,7 +8,6 @@ random choice of that scene (phenotypes, Helios seeds, sun, slip) and is saved i
 from __future__ import annotations
 
 import json
-import os
 import platform
 import time
 from dataclasses import dataclass
@@ -18,6 +17,7 @@ from typing import Callable
 import numpy as np
 
 from davis_ag import __version__
+from davis_ag.atomic_files import PROBE_PREFIX, prove_writable_folder
 from davis_ag.errors import UserError
 from davis_ag.generate.scene_writer import SceneWriter, partial_dir
 from davis_ag.labels.fruit_labels import fruit_lookup, label_view, visible_fractions
@@ -89,6 +89,16 @@ def read_scene_seed(scene_dir: Path) -> int | None:
     try:
         with open(scene_dir / "scene.json") as handle:
             return int(json.load(handle)["seed"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+
+
+def read_scene_size(scene_dir: Path) -> tuple[int, int] | None:
+    """The image size a finished scene was drawn at, or None when its scene.json does not say."""
+    try:
+        with open(scene_dir / "scene.json") as handle:
+            camera = json.load(handle)["camera"]
+        return int(camera["width"]), int(camera["height"])
     except (OSError, ValueError, KeyError, TypeError):
         return None
 
@@ -196,20 +206,20 @@ def check_output_root(root: Path) -> None:
         raise UserError(f"{root} is a file, not a folder: choose another --out")
     if root.is_dir():
         strangers = [p.name for p in root.iterdir()
-                     if p.name not in ROOT_EXTRAS and not (p.is_dir() and parse_group_name(p.name))]
+                     if p.name not in ROOT_EXTRAS and not p.name.startswith(PROBE_PREFIX)
+                     and not (p.is_dir() and parse_group_name(p.name))]
         if strangers:
             raise UserError(f"{root} holds other things ({', '.join(sorted(strangers)[:3])}): "
                             "choose an empty or DAVIS-Ag folder for --out")
-    parent = root if root.exists() else next((p for p in root.parents if p.exists()), Path("/"))
-    if not os.access(parent, os.W_OK | os.X_OK):
-        raise UserError(f"cannot write to {parent}: choose a writable --out")
+    prove_writable_folder(root)
 
 
 def check_scene_slot(root: Path, request: SceneRequest) -> bool:
     """Whether a scene is already complete (True: skip it); clear stale partial folders.
 
     Raises:
-        UserError: when a finished scene was made with a different seed: it is never replaced.
+        UserError: when a finished scene was made with a different seed or image size: it is
+            never replaced.
     """
     scene_dir = root / request.folder
     if scene_dir.exists():
@@ -217,6 +227,10 @@ def check_scene_slot(root: Path, request: SceneRequest) -> bool:
         if seed != request.seed:
             raise UserError(f"{scene_dir} already holds a scene made with other settings (seed {seed}, "
                             f"not {request.seed}): use another --out or --seed, or move it away")
+        size = read_scene_size(scene_dir)
+        if size is not None and size != (request.camera.width, request.camera.height):
+            raise UserError(f"{scene_dir} was drawn at {size[0]}x{size[1]}, not {request.camera.width}x"
+                            f"{request.camera.height}: use the same --size or another --out")
         return True
     return False
 

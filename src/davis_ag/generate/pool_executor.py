@@ -83,6 +83,7 @@ def run_on_pool(todo: Sequence[SceneRequest], root: Path, options: RunOptions, p
                         record_failure(report, progress, request, error)
                     else:
                         report.made.append(request.folder)
+                        report.stats[request.folder] = stats
                         progress.finished(request, stats)
             _drain(events, progress, started)
         except BaseException:

@@ -128,6 +128,7 @@ def run_on_ray(todo: Sequence[SceneRequest], root: Path, options: RunOptions, pr
                         f"its Ray worker died {options.max_retries + 1} times ({type(error).__name__})"))
                 else:
                     report.made.append(request.folder)
+                    report.stats[request.folder] = stats
                     progress.finished(request, stats)
     except BaseException:
         for ref in refs:  # a killed task leaves only a hidden partial folder, cleared next run

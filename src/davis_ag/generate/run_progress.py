@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 import sys
+import time
 import traceback
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -74,6 +75,7 @@ class RunReport:
         skipped: Scene ids that were already complete.
         failed: Scene id to error message.
         splits: splits.json, when written.
+        stats: Scene id to the timing statistics of each scene made by this run.
     """
 
     root: Path
@@ -81,6 +83,7 @@ class RunReport:
     skipped: list[str] = field(default_factory=list)
     failed: dict[str, str] = field(default_factory=dict)
     splits: Path | None = None
+    stats: dict[str, dict] = field(default_factory=dict)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -97,10 +100,17 @@ def count_views(scenario: ScenarioSpec, crop: CropSpec) -> int:
     return len(grid.viewpoints)
 
 
+#: Seconds between progress lines when stderr is not a terminal (a log file, CI).
+LOG_INTERVAL_S = 60.0
+
+
 class Progress:
     """A scenes bar and a views bar (with the time left), fed by events from any executor.
 
-    Events are tuples ``("start", scene_id)`` and ``("view", scene_id, done, total)``.
+    Events are tuples ``("start", scene_id)`` and ``("view", scene_id, done, total)``. When
+    stderr is not a terminal there are no bars (a bar redrawn per view floods a log): a line per
+    finished scene, and one every :data:`LOG_INTERVAL_S` seconds with the views done and the
+    time left.
 
     Args:
         todo: The scenes to make.
@@ -110,6 +120,11 @@ class Progress:
     def __init__(self, todo: Sequence[SceneRequest], enabled: bool) -> None:
         self.enabled = enabled
         total_views = sum(count_views(r.scenario, r.crop) for r in todo)
+        self._log = enabled and not _is_terminal(sys.stderr)
+        self._total_views = total_views
+        self._done_views = 0
+        self._started = self._last_line = time.monotonic()
+        self._finished = 0
         disable = None if enabled else True  # None: no bars when stderr is not a terminal
         self.scenes = tqdm(total=len(todo), desc="scenes", unit="scene", position=0, disable=disable,
                            dynamic_ncols=True)
@@ -122,16 +137,33 @@ class Progress:
         """Apply one event."""
         kind, scene = event[0], event[1]
         if kind == "start":  # a scene (re)starts: views a dead try counted no longer count
-            self.views.update(-self._counted.pop(scene, 0))
+            lost = self._counted.pop(scene, 0)
+            self.views.update(-lost)
+            self._done_views -= lost
             self._counted[scene] = 0
         elif kind == "view":
             done = int(event[2])
             self.views.update(done - self._counted.get(scene, 0))
+            self._done_views += done - self._counted.get(scene, 0)
             self._counted[scene] = done
+            if self._log and time.monotonic() - self._last_line >= LOG_INTERVAL_S:
+                self._log_line()
+
+    def _log_line(self) -> None:
+        """One line with the views done and the time left (instead of a bar, in logs)."""
+        now = time.monotonic()
+        self._last_line = now
+        done, total = self._done_views, max(self._total_views, 1)
+        # Until a scene is finished the rate misses the plant growth of later scenes (or is all
+        # growth): no estimate rather than a wild one.
+        left = (now - self._started) * (total - done) / done if done > 0 and self._finished else None
+        eta = f"{left / 60:.0f} min left" if left is not None else "time left known after the first scene"
+        self.write(f"{done} of {total} views ({100 * done / total:.0f} %), {eta}")
 
     def finished(self, request: SceneRequest, stats: dict) -> None:
         """A scene is complete."""
         self.scenes.update(1)
+        self._finished += 1
         self.write(f"{request.folder}: {stats['views']} views, grown in {stats['grow_s']:.1f} s, "
                    f"{stats['views_s'] / max(stats['views'], 1):.3f} s per view")
 
@@ -146,10 +178,19 @@ class Progress:
         self.scenes.close()
 
 
+def _is_terminal(stream: object) -> bool:
+    isatty = getattr(stream, "isatty", None)
+    try:
+        return bool(isatty and isatty())
+    except (OSError, ValueError):  # a closed stream
+        return False
+
+
 def record_failure(report: RunReport, progress: Progress, request: SceneRequest, error: BaseException) -> None:
-    """Note a failed scene; a traceback is shown for anything but a UserError (a bug, not bad input)."""
+    """Note a failed scene; a traceback is shown for anything but a UserError or an OSError (a full
+    disk, a lost mount: the machine, not a bug), which get one line."""
     message = str(error) if isinstance(error, UserError) else f"{type(error).__name__}: {error}"
     report.failed[request.folder] = message
-    if not isinstance(error, UserError):
+    if not isinstance(error, (UserError, OSError)):
         progress.write("".join(traceback.format_exception(error)).rstrip(), always=True)
     progress.write(f"{request.folder}: failed: {message}", always=True)

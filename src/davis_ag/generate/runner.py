@@ -26,7 +26,7 @@ import os
 from pathlib import Path
 from typing import Sequence
 
-from davis_ag.atomic_files import write_json_atomic
+from davis_ag.atomic_files import PROBE_PREFIX, write_json_atomic
 from davis_ag.errors import UserError
 from davis_ag.generate.dataset_files import (
     DATASET_FILE,
@@ -168,6 +168,7 @@ def _precheck(root: Path) -> None:
     """Refuse a folder we could damage before creating anything in it; our own temporary files,
     which a killed run may have left, are cleared later under the lock."""
     if root.is_dir() and not any(p.name not in ROOT_EXTRAS and p.name not in TEMPORARY_FILES
+                                 and not p.name.startswith(PROBE_PREFIX)
                                  and not (p.is_dir() and parse_group_name(p.name)) for p in root.iterdir()):
         return
     check_output_root(root)
@@ -184,4 +185,5 @@ def _run_here(todo: Sequence[SceneRequest], root: Path, progress: Progress, repo
             record_failure(report, progress, request, error)
             continue
         report.made.append(request.folder)
+        report.stats[request.folder] = stats
         progress.finished(request, stats)

@@ -10,22 +10,17 @@ a crashed scene's partial folder is cleared, and the environment's observation c
 
 from __future__ import annotations
 
-import json
-import os
 from pathlib import Path
 from typing import Any
 
 from tqdm import tqdm
 
-from davis_ag.atomic_files import write_text_atomic
+from davis_ag.atomic_files import prove_writable_folder, write_or_rescue
 from davis_ag.errors import UserError
-from davis_ag.generate.one_scene import (
-    SceneRequest,
-    check_output_root,
-    check_scene_slot,
-    generate_scene,
-    remove_stale_partial,
-)
+from davis_ag.generate.dataset_files import SPLITS_FILE
+from davis_ag.generate.one_scene import SceneRequest
+from davis_ag.generate.run_progress import RunOptions, default_workers
+from davis_ag.generate.runner import run_dataset
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import CropSpec, ScenarioSpec, crop_spec, scenario_spec
 from davis_ag.stage_timer import Timer
@@ -36,105 +31,32 @@ BASELINES: tuple[str, ...] = ("LRD", "UDD", "Rand", "Oracle")
 DEMO_SIZE: tuple[int, int] = (1280, 720)
 
 
-def generate_scenes(requests: list[SceneRequest], root: Path, label: str = "scenes") -> list[dict[str, Any]]:
-    """Generate the scenes not yet complete under ``root``, with progress bars.
+def generate_scenes(requests: list[SceneRequest], root: Path, workers: int | None = None,
+                    progress: bool = True) -> list[dict[str, Any]]:
+    """Make the scenes not yet complete under ``root`` through the one dataset runner.
+
+    :func:`davis_ag.generate.runner.run_dataset` locks the folder (a second run on it is
+    refused), skips finished scenes, clears and redoes a crashed one, spreads scenes over worker
+    processes and writes dataset.json and splits.json (the seeded 70/30 split by scene).
 
     Args:
-        requests: The scenes wanted.
-        root: The dataset root (checked with :func:`check_output_root`).
-        label: Name of the progress bar.
+        requests: The scenes wanted (one dataset seed and image size).
+        root: The dataset root.
+        workers: Scene processes (default: one per core as memory allows, at most one per scene).
+        progress: Show progress (bars on a terminal, a line per scene otherwise).
 
     Returns:
-        One dict per request: ``scene``, ``skipped`` and, for generated scenes, the timing
+        One dict per request: ``scene``, ``skipped`` and, for scenes made now, the timing
         statistics of :func:`davis_ag.generate.one_scene.generate_scene`.
 
     Raises:
-        UserError: for an unusable root or a finished scene made with other settings.
+        UserError: for an unusable root, another run on it, finished scenes made with other
+            settings, or scenes that failed (the finished ones are kept).
     """
-    check_output_root(root)
-    root.mkdir(parents=True, exist_ok=True)
-    done = {r.folder: check_scene_slot(root, r) for r in requests}
-    for request in (r for r in requests if done[r.folder]):
-        _check_image_size(root / request.folder, request.camera)
-    todo = [r for r in requests if not done[r.folder]]
-    results = [{"scene": r.folder, "skipped": True} for r in requests if done[r.folder]]
-    if results:
-        tqdm.write(f"{len(results)} of {len(requests)} {label} already complete in {root}: skipped")
-    with tqdm(total=len(todo), desc=label, unit="scene", position=0) as scenes_bar, \
-         tqdm(desc="views", unit="view", position=1, leave=False) as views_bar:
-        for request in todo:
-            remove_stale_partial(root, request)
-            views_bar.reset()
-            views_bar.set_description(f"views {request.folder}")
-
-            def on_view(count: int, total: int) -> None:
-                views_bar.total = total
-                views_bar.update(1)
-
-            scene_dir, stats = generate_scene(request, root, on_view)
-            scenes_bar.update(1)
-            tqdm.write(f"{scene_dir}: {stats['views']} views, grown in {stats['grow_s']:.1f} s, "
-                       f"{stats['views_s'] / max(stats['views'], 1):.3f} s per view")
-            results.append({"scene": request.folder, "skipped": False, **stats})
-    return results
-
-
-def _check_image_size(scene_dir: Path, camera: Camera) -> None:
-    """Refuse to reuse a finished scene drawn at another image size.
-
-    Raises:
-        UserError: when the scene's scene.json names another width or height.
-    """
-    try:
-        drawn = json.loads((scene_dir / "scene.json").read_text())["camera"]
-        size = (int(drawn["width"]), int(drawn["height"]))
-    except (OSError, ValueError, KeyError, TypeError):
-        return
-    if size != (camera.width, camera.height):
-        raise UserError(f"{scene_dir} was drawn at {size[0]}x{size[1]}, not {camera.width}x"
-                        f"{camera.height}: use the same --size or another --out")
-
-
-def write_splits(root: Path, seed: int = 0) -> Path:
-    """Write ``root/splits.json``: the 70/30 split by scene of every group.
-
-    Uses :func:`davis_ag.generate.runner.write_splits` (the split ``davis-ag generate`` writes: seeded,
-    at least one scene on each side when a group has two or more, a group of one scene is
-    train only) when that module is present; otherwise the same rule with
-    :func:`davis_ag.benchmark.splits.fallback_split`.
-
-    Args:
-        root: The dataset root.
-        seed: The dataset seed (seeds the runner's split).
-
-    Returns:
-        The path of splits.json.
-    """
-    try:
-        from davis_ag.generate.one_scene import runner
-    except ImportError:  # an older checkout without the runner: use the fallback below
-        runner = None  # type: ignore[assignment]
-    writer = getattr(runner, "write_splits", None)
-    if callable(writer):
-        written = writer(root, seed)
-        if isinstance(written, (str, os.PathLike)) and Path(written).is_file():
-            return Path(written)
-    from davis_ag.benchmark.splits import SPLIT_SEED, fallback_split
-    from davis_ag.data.reader import open_dataset
-
-    groups: dict[str, list[str]] = {}
-    for scene in open_dataset(root).scenes:
-        groups.setdefault(scene.id.split("/")[0], []).append(scene.id)
-    train: list[str] = []
-    test: list[str] = []
-    for ids in groups.values():
-        split = fallback_split(ids)
-        train += split["train"]
-        test += split["test"]
-    path = root / "splits.json"
-    write_text_atomic(path, json.dumps({"seed": SPLIT_SEED, "train": sorted(train),
-                                        "test": sorted(test)}, indent=2))
-    return path
+    workers = workers or max(1, min(default_workers(), len(requests)))
+    report = run_dataset(requests, root, RunOptions(workers=workers, progress=progress))
+    return [{"scene": r.folder, "skipped": r.folder in report.skipped, **report.stats.get(r.folder, {})}
+            for r in requests]
 
 
 def evaluation_split(root: Path, scenario: str, crop: str) -> str:
@@ -218,17 +140,16 @@ def run_demo(out: Path, scenes: int = 2, size: tuple[int, int] = DEMO_SIZE, seed
     from davis_ag.data.validate import validate_dataset
     from davis_ag.figures.report import write_report
 
+    if isinstance(seed, bool) or not 0 <= seed < 2**32:
+        raise UserError(f"--seed {seed}: use a whole number from 0 to {2**32 - 1}")
     if scenes < 1 or scenes > 1000:
         raise UserError(f"--scenes {scenes}: choose 1 to 1000")
     if episodes < 1 or sessions < 1:
         raise UserError("--episodes and --sessions must be at least 1")
-    if seed < 0:
-        raise UserError(f"--seed {seed} is negative: use a whole number from 0")
-    out = Path(out).expanduser().absolute()  # Helios moves the working directory as it works
+    # Absolute at once: Helios moves the working directory as it works.
+    out = prove_writable_folder(out)
     scenario = scenario or scenario_spec("sp")
     crop = crop or crop_spec("strawberry")
-    if out.exists() and not out.is_dir():
-        raise UserError(f"{out} is a file, not a folder: choose another --out")
     root = out / "dataset"
     timer = Timer()
     camera = Camera(*size)
@@ -247,7 +168,7 @@ def run_demo(out: Path, scenes: int = 2, size: tuple[int, int] = DEMO_SIZE, seed
         print(f"the dataset in {root} is not sound: see the problems above", flush=True)
         return 1
     with timer.stage("split"):
-        splits = write_splits(root, seed)
+        splits = root / SPLITS_FILE  # written by the runner
         split = evaluation_split(root, scenario.name, crop.name)
     print(f"[3/5] split written to {splits}; evaluating on split {split!r}", flush=True)
     print(f"[4/5] baselines: {sessions} sessions x {episodes} episodes", flush=True)
@@ -256,7 +177,7 @@ def run_demo(out: Path, scenes: int = 2, size: tuple[int, int] = DEMO_SIZE, seed
     table = format_table(results)
     print(table, flush=True)
     report_dir = out / "report"
-    write_json(results, report_dir / "results.json")
+    write_or_rescue(report_dir / "results.json", lambda path: write_json(results, path), "the results")
     print("[5/5] writing the report", flush=True)
     with timer.stage("report"):
         index = write_report(root, report_dir, results=results, validation=report.summary(),

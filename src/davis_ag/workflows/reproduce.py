@@ -11,13 +11,13 @@ from __future__ import annotations
 import json
 import os
 import platform
+import sys
 import time
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
 from davis_ag.atomic_files import write_json_atomic
-from davis_ag.errors import UserError
 
 
 @dataclass(frozen=True)
@@ -90,16 +90,17 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
     Returns:
         0 on success, 1 when a dataset failed validation.
     """
+    from davis_ag.atomic_files import prove_writable_file, prove_writable_folder, write_or_rescue
     from davis_ag.benchmark.evaluation import format_table, plot_results, write_json
     from davis_ag.benchmark.training import train_a2c
     from davis_ag.data.validate import validate_dataset
     from davis_ag.generate.one_scene import SceneRequest
     from davis_ag.scene.camera import Camera
     from davis_ag.scene.specs import crop_spec, scenario_spec
-    from davis_ag.workflows.demo import evaluation_split, generate_scenes, run_baselines, write_splits
+    from davis_ag.workflows.demo import evaluation_split, generate_scenes, run_baselines
 
-    if out.exists() and not out.is_dir():
-        raise UserError(f"{out} is a file, not a folder: choose another --out")
+    out = prove_writable_folder(out)  # absolute at once: Helios moves the working directory
+    results_md = prove_writable_file(results_md, "--results")
     root = out / "dataset"
     state_path = out / "state.json"
     state = load_state(state_path)
@@ -123,7 +124,7 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
         key = f"{scenario_name}-{crop_name}"
         requests = [SceneRequest(scenario, crop, i, config.seed, camera) for i in range(n)]
         print(f"== {key}: {n} scene(s) at {config.size[0]}x{config.size[1]}", flush=True)
-        generated = generate_scenes(requests, root, label=f"{key} scenes")
+        generated = generate_scenes(requests, root)  # also writes splits.json
         # Per-scene times survive resumed runs, so the stage time covers every scene it used.
         scene_log = state.setdefault("scenes", {})
         for g in generated:
@@ -147,7 +148,6 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
             for problem in report.problems[:20]:
                 print(problem, flush=True)
             return 1
-        write_splits(root, config.seed)
         split = evaluation_split(root, scenario_name, crop_name)
         model = out / "models" / f"a2c_{key}.zip"
         timesteps = config.sp_timesteps if scenario_name == "sp" else config.mp_timesteps
@@ -159,7 +159,7 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
                       out_path=model, n_envs=config.n_envs, crop=crop_name, device="cpu",
                       callback=_progress_callback(timesteps, key))
             seconds = time.perf_counter() - start
-            stamp.write_text(json.dumps({"timesteps": timesteps, "seconds": seconds}))
+            write_json_atomic(stamp, {"timesteps": timesteps, "seconds": seconds})
             record(f"{key}: train A2C", seconds,
                    f"{timesteps} steps, {timesteps / seconds:.1f} steps/s (incl. cache build)")
         print(f"benchmark on split {split!r}: {config.sessions} x {config.episodes} episodes", flush=True)
@@ -169,7 +169,7 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
             start = time.perf_counter()
             results = run_baselines(root, scenario_name, crop_name, split, config.episodes,
                                     config.sessions, config.seed, model=model)
-            write_json(results, results_json)
+            write_or_rescue(results_json, lambda path: write_json(results, path), "the results")
             plot_results(results, results_json.with_suffix(".png"))
             record(f"{key}: evaluate", time.perf_counter() - start, f"split {split}")
         else:
@@ -210,11 +210,17 @@ def _progress_callback(total: int, label: str) -> Any:
     from tqdm import tqdm
 
     class Progress(BaseCallback):
+        # A bar on a terminal; in a log (not a terminal), a line a minute instead of a redrawn bar.
         def _on_training_start(self) -> None:
-            self.bar = tqdm(total=total, desc=f"A2C {label}", unit="step", mininterval=5)
+            self.bar = tqdm(total=total, desc=f"A2C {label}", unit="step", mininterval=5, disable=None)
+            self.steps, self.last = 0, time.monotonic()
 
         def _on_step(self) -> bool:
             self.bar.update(self.training_env.num_envs)
+            self.steps += self.training_env.num_envs
+            if self.bar.disable and time.monotonic() - self.last >= 60:
+                self.last = time.monotonic()
+                print(f"A2C {label}: {self.steps} of {total} steps", file=sys.stderr, flush=True)
             return True
 
         def _on_training_end(self) -> None:

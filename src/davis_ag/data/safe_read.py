@@ -1,0 +1,84 @@
+"""Reading a dataset's files safely: JSON, pixels, and nothing that resolves outside the dataset.
+
+Every failure is one :class:`~davis_ag.errors.UserError` naming the file, never a traceback.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from davis_ag.errors import UserError
+
+
+def read_json(path: Path, what: str) -> Any:
+    """Load a JSON file, turning every failure into one :class:`UserError` line."""
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as error:
+        raise UserError(f"{path}: cannot read {what} ({error.strerror or error}); check the file") from None
+    except UnicodeDecodeError:
+        raise UserError(f"{path}: {what} is not UTF-8 text; re-download or regenerate it") from None
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as error:
+        raise UserError(f"{path}: {what} is not valid JSON (line {error.lineno} column {error.colno}: "
+                        f"{error.msg}); re-download or regenerate it") from None
+    except RecursionError:
+        raise UserError(f"{path}: {what} is nested too deeply to be ours; re-download or regenerate it") from None
+
+
+def check_inside(path: Path, root: Path | None) -> Path:
+    """Refuse a file that resolves outside the dataset (a symlink out of it, or ``..``).
+
+    A dataset is read as given; a link out of it could make the reader read, and a later
+    rewrite of the "same" file write, anywhere on the machine.
+
+    Args:
+        path: The file about to be read.
+        root: The dataset root; None skips the check.
+
+    Returns:
+        ``path``.
+
+    Raises:
+        UserError: naming the file and where it points.
+    """
+    if root is None:
+        return path
+    try:
+        resolved, inside = path.resolve(), root.resolve()
+    except (OSError, RuntimeError) as error:  # a symlink loop
+        raise UserError(f"{path}: cannot resolve ({error}); replace the link by the file") from None
+    if resolved != inside and not resolved.is_relative_to(inside):
+        raise UserError(f"{path}: points outside the dataset, to {resolved}; copy the file into {root} "
+                        "instead of linking it")
+    return path
+
+
+def load_pixels(path: Path, mode: str | None) -> np.ndarray:
+    """Decode an image (``mode`` "RGB") or an instance mask (``mode`` None: H x W uint8).
+
+    Raises:
+        UserError: naming the file, when it is missing or cannot be decoded.
+    """
+    from PIL import Image, UnidentifiedImageError
+
+    try:
+        with Image.open(path) as im:
+            if mode:
+                im = im.convert(mode)
+            pixels = np.asarray(im)
+    except FileNotFoundError:
+        raise UserError(f"{path}: image file missing; re-download or regenerate the scene") from None
+    except (OSError, UnidentifiedImageError, ValueError) as error:
+        raise UserError(f"{path}: cannot decode ({error}); re-download or regenerate the scene") from None
+    if mode is None:
+        # A mask saved as RGB still carries the id in every channel; keep one.
+        if pixels.ndim == 3:
+            pixels = pixels[..., 0]
+        pixels = pixels.astype(np.uint8, copy=False)
+    return pixels
