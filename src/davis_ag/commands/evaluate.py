@@ -56,7 +56,7 @@ def run(args: argparse.Namespace) -> int:
     env = TVMEnv(args.dataset, scenario=args.scenario, split=args.split, crop=args.crop,
                  cache_dir=args.cache_dir)
     results = evaluate_agents(env, agents, episodes=args.episodes, sessions=args.sessions,
-                              seed=args.seed)
+                              seed=args.seed, keep_episodes=True)
     print(format_table(results))
     out = write_json(results, args.out)
     plot = plot_results(results, args.plot or Path(args.out).with_suffix(".png"))

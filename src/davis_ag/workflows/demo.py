@@ -182,7 +182,8 @@ def run_baselines(root: Path, scenario: str, crop: str, split: str, episodes: in
     names = list(BASELINES) + (["A2C"] if model else [])
     agents = build_agents(names, model=model)
     env = TVMEnv(root, scenario=scenario, split=split, crop=crop)
-    results = evaluate_agents(env, agents, episodes=episodes, sessions=sessions, seed=seed)
+    results = evaluate_agents(env, agents, episodes=episodes, sessions=sessions, seed=seed,
+                              keep_episodes=True)
     results["protocol"]["crop"] = crop
     env.close()
     return results
