@@ -149,7 +149,7 @@ def make_plot(request: PlotRequest) -> Plotted:
 
 
 def paper_figures(root: Path, out_dir: Path, results: Path | None = None,
-                  formats: tuple[str, ...] = FORMATS) -> dict[str, Plotted]:
+                  formats: tuple[str, ...] = FORMATS, kinds: list[str] | None = None) -> dict[str, Plotted]:
     """Draw every kind a dataset (and its results) allows into ``out_dir``, named by kind.
 
     Kinds the data cannot give (one altitude only, no scene.json, no episodes) are left out
@@ -160,6 +160,7 @@ def paper_figures(root: Path, out_dir: Path, results: Path | None = None,
         out_dir: Folder of the figures.
         results: ``davis-ag evaluate``'s results, for ``actions`` and ``episode``.
         formats: Figure formats.
+        kinds: The kinds to draw (default: all of :data:`KINDS`).
 
     Returns:
         Kind to what was drawn; ``skipped`` (kind to reason) under the key ``"skipped"`` of
@@ -167,7 +168,7 @@ def paper_figures(root: Path, out_dir: Path, results: Path | None = None,
     """
     drawn: dict[str, Plotted] = {}
     skipped: dict[str, str] = {}
-    for kind in KINDS:
+    for kind in kinds or list(KINDS):
         if kind in ("actions", "episode") and results is None:
             skipped[kind] = "no evaluation results"
             continue
