@@ -124,20 +124,26 @@ function drawLayers() {
   $("depth").classList.toggle("hidden", !(viewer.layers.depth && v.depth));
   for (const k of ["boxes", "mask", "depth"]) $(k + "-toggle").classList.toggle("on", viewer.layers[k]);
   const photo = $("photo"), canvas = $("boxes");
+  // The canvas has the displayed size, not the image's: boxes and labels stay crisp and
+  // readable on small images scaled up.
   const paint = () => {
-    canvas.width = photo.naturalWidth; canvas.height = photo.naturalHeight;
-    const g = canvas.getContext("2d");
+    const ratio = window.devicePixelRatio || 1;
+    canvas.width = Math.round(photo.clientWidth * ratio); canvas.height = Math.round(photo.clientHeight * ratio);
+    canvas.style.height = photo.clientHeight + "px";
+    const g = canvas.getContext("2d"), s = canvas.width / photo.naturalWidth;
     g.clearRect(0, 0, canvas.width, canvas.height);
     if (!viewer.layers.boxes) return;
-    g.lineWidth = Math.max(1, canvas.width / 640);
-    g.font = Math.max(8, canvas.width / 80) + "px sans-serif";
+    g.lineWidth = 1.5 * ratio;
+    g.font = (11 * ratio) + "px sans-serif";
+    g.strokeStyle = "yellow"; g.fillStyle = "yellow";
     for (const [x, y, w, h, id] of v.boxes) {
-      g.strokeStyle = "yellow"; g.fillStyle = "yellow";
-      g.strokeRect(x, y, w, h);
-      g.fillText(String(id), x, Math.max(y - 2, 8));
+      g.strokeRect(x * s, y * s, w * s, h * s);
+      g.fillText(String(id), x * s, Math.max(y * s - 3 * ratio, 11 * ratio));
     }
   };
-  if (photo.complete && photo.naturalWidth) paint(); else photo.onload = paint;
+  viewer.repaint = paint;
+  photo.onload = paint;
+  if (photo.complete && photo.naturalWidth) paint();
 }
 
 function drawMoves() {
@@ -227,6 +233,7 @@ $("map").addEventListener("click", (event) => {
 });
 for (const k of ["boxes", "mask", "depth"]) $(k + "-toggle").addEventListener("click", () => toggle(k));
 $("scene-select").addEventListener("change", (event) => loadScene(event.target.value));
+window.addEventListener("resize", () => viewer.repaint && viewer.repaint());
 
 (async () => {
   try {
