@@ -175,3 +175,50 @@ class Chromium:
                 os.close(fd)
             except OSError:
                 pass
+
+
+def screenshot_viewer(dataset: Path, out: Path, view: str | None = None, keys: list[str] | None = None) -> Path:
+    """Open ``davis-ag view`` on a dataset in headless Chromium, press keys, save a screenshot.
+
+    Args:
+        dataset: The dataset folder.
+        out: The PNG to write.
+        view: The view to start from (default: the first scene's first).
+        keys: Keys to press before the screenshot, e.g. ``["d", "r", "m"]``.
+
+    Returns:
+        ``out``.
+    """
+    import tempfile
+
+    from davis_ag.figures.viewer_server import server_url, start_server
+
+    executable = find_chromium()
+    if executable is None:
+        raise SystemExit("no chromium: apt-get install chromium")
+    server = start_server(dataset, 0)
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    with tempfile.TemporaryDirectory() as profile:
+        browser = Chromium(executable, Path(profile))
+        try:
+            browser.goto(server_url(server) + (f"#view={view}" if view else ""))
+            browser.wait_for("window.viewer && window.viewer.ready")
+            for key in keys or []:
+                browser.press(key)
+                time.sleep(0.3)
+            browser.wait_for("document.getElementById('photo').complete")
+            time.sleep(0.5)
+            browser.screenshot(out)
+        finally:
+            browser.close()
+            server.shutdown()
+            server.server_close()
+    return out
+
+
+if __name__ == "__main__":  # python tests/figures/chromium_pipe.py DATASET OUT.png [VIEW] [KEYS]
+    import sys
+
+    args = sys.argv[1:]
+    print(screenshot_viewer(Path(args[0]), Path(args[1]), args[2] if len(args) > 2 else None,
+                            args[3].split(",") if len(args) > 3 else None))

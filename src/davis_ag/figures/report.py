@@ -20,7 +20,6 @@ from typing import TYPE_CHECKING, Any
 
 from davis_ag.atomic_files import write_json_atomic, write_text_atomic
 from davis_ag.data.reader import Scene, open_dataset
-from davis_ag.errors import UserError
 from davis_ag.figures.contact_sheet import draw_contact_sheet, draw_masks
 from davis_ag.figures.plots import KINDS, paper_figures
 from davis_ag.figures.visibility_plots import plot_visibility

@@ -203,6 +203,7 @@ function drawMap() {
 
 function jump(name) {
   const here = viewer.data.views[viewer.view].pose, there = viewer.data.views[name].pose;
+  if (!here) { show(name); return; }
   let best = name, bestTurn = 1e9;
   for (const [n, v] of Object.entries(viewer.data.views)) {
     if (!v.pose || v.pose[0] !== there[0] || v.pose[1] !== there[1] || level(v.pose[2]) !== level(there[2])) continue;
