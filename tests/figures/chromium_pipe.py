@@ -199,7 +199,7 @@ def screenshot_viewer(dataset: Path, out: Path, view: str | None = None, keys: l
     server = start_server(dataset, 0)
     threading.Thread(target=server.serve_forever, daemon=True).start()
     with tempfile.TemporaryDirectory() as profile:
-        browser = Chromium(executable, Path(profile))
+        browser = Chromium(executable, Path(profile), width=1280, height=620)
         try:
             browser.goto(server_url(server) + (f"#view={view}" if view else ""))
             browser.wait_for("window.viewer && window.viewer.ready")

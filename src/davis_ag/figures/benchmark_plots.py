@@ -157,7 +157,8 @@ def plot_actions(results: dict[str, Any], out: str | Path, formats: tuple[str, .
     from matplotlib.colors import BoundaryNorm, ListedColormap
     from matplotlib.patches import Patch
 
-    palette = [colormaps["tab10"](i % 10) for i in range(len(names))]
+    # Set1 (9 colours, one per MP action) so that actions never share the policies' colours of (a).
+    palette = [colormaps["Set1"](i % 9) for i in range(len(names))]
     figure = new_figure(13.0, 3.8)
     left = figure.add_subplot(1, 2, 1)
     width = 0.8 / len(counts)

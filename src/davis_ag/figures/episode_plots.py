@@ -88,8 +88,8 @@ def plot_episode(scene: Scene, path: list[str], actions: list[str], target: int 
     shown = views[:MAX_STRIP]
     columns = min(len(shown), 4)
     rows = math.ceil(len(shown) / columns)
-    figure = new_figure(3.0 * columns + 4.2, 2.0 * rows + 0.8)
-    grid = figure.add_gridspec(rows, columns + 2)
+    figure = new_figure(3.3 * columns + 3.2, 2.3 * rows + 0.7)
+    grid = figure.add_gridspec(rows, columns + 1, width_ratios=[1.0] * columns + [0.95])
     seen: set[int] = set()
     oers = [_oer(v, target) for v in views]
     for i, view in enumerate(shown):
@@ -102,11 +102,12 @@ def plot_episode(scene: Scene, path: list[str], actions: list[str], target: int 
         seen.update(b.fruit_id for b in view.boxes)
         step = actions[i] if i < len(actions) else "end"
         oer = f", OER {oers[i]:.2f}" if oers[i] is not None else ""
-        ax.set_title(f"t={i}: {view.name}{oer}\nnext: {step}", fontsize=7)
+        z = f", z={view.pose[2]:.2f} m" if view.pose is not None else ""
+        ax.set_title(f"t={i}: {view.name}{z}{oer}\nnext: {step}", fontsize=7)
         ax.set_axis_off()
-    ax = figure.add_subplot(grid[:, columns:])
+    ax = figure.add_subplot(grid[:, columns])
     spots = positions(scene)
-    ax.scatter([p.x for p in spots], [p.y for p in spots], s=10, color="#c8c8c8", label="camera positions")
+    ax.scatter([p.x for p in spots], [p.y for p in spots], s=5, color="#c8c8c8", label="camera positions")
     draw_plants(ax, scene)
     xy = [(v.pose[0], v.pose[1]) for v in views if v.pose is not None]
     if xy:
@@ -114,7 +115,7 @@ def plot_episode(scene: Scene, path: list[str], actions: list[str], target: int 
                 linewidth=1.5, label="path")
         ax.scatter([xy[-1][0]], [xy[-1][1]], marker="D", s=60, color="red", zorder=4, label="current")
     ax.set_aspect("equal")
-    ax.legend(fontsize=7, loc="upper right")
+    ax.legend(fontsize=6, loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=2, frameon=False)
     ax.tick_params(labelsize=7)
     ax.set_title("global map (x, y in m)", fontsize=8)
     start, end = oers[0], oers[-1]
