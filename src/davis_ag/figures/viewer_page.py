@@ -175,7 +175,9 @@ function drawMap() {
   const x0 = Math.min(...xs, ...plants.map(p => p[0])), x1 = Math.max(...xs, ...plants.map(p => p[0]));
   const y0 = Math.min(...ys, ...plants.map(p => p[1])), y1 = Math.max(...ys, ...plants.map(p => p[1]));
   const s = (W - 2 * pad) / Math.max(x1 - x0, y1 - y0, 1e-6);
-  const X = x => pad + (x - x0) * s, Y = y => W - pad - (y - y0) * s;
+  // Centred, one scale on both axes: an MP row (wide, shallow) stays in the middle.
+  const cx = (x0 + x1) / 2, cy = (y0 + y1) / 2;
+  const X = x => W / 2 + (x - cx) * s, Y = y => W / 2 - (y - cy) * s;
   const cur = viewer.data.views[viewer.view];
   const z = cur.pose ? level(cur.pose[2]) : null;
   const seen = new Set(); let html = "";
