@@ -141,7 +141,9 @@ def write_report(root: Path, out_dir: Path, results: dict[str, Any] | None = Non
     parts.append(f"<h2>Views of {html.escape(first.id)}</h2><p>Evenly spread views with every "
                  "fruit box:</p><img src='contact_sheet.png' alt='contact sheet'>"
                  f"<p>View {html.escape(view.name)} ({len(view.boxes)} boxes) and its instance "
-                 "mask:</p><img src='mask.png' alt='image and instance mask'>")
+                 "mask:</p><img src='mask.png' alt='image and instance mask'>"
+                 "<p>Drive through the scenes with the keyboard: <code>davis-ag view "
+                 f"{html.escape(str(dataset.root))}</code>, then open http://127.0.0.1:8765/.</p>")
     parts.append("<h2>Visible fruit per camera position</h2><p>Camera positions per altitude, "
                  "coloured by the fruit boxed from there (cf. Fig. 2), cross = plant.</p>")
     for i, scene in enumerate(scenes[:MAX_GRIDS]):
