@@ -105,11 +105,21 @@ def pools_for(command: str, out: str) -> tuple[list[str], dict[str, st.SearchStr
                        "--plot": st.sampled_from([f"{out}/p.png", "/proc/x/p.png", "data", f"{out}/r.json"])}, []
     if command == "validate":
         return [], {"--quick": FLAG, "--box-tolerance": ANY}, []
+    if command == "stats":
+        return [], {"--out": st.sampled_from([f"{out}/s.json", "/proc/x/s.json", "data", "a-file/sub"]),
+                    "--no-oer": FLAG}, []
+    if command == "plot":
+        return [], {"--scene": ANY, "--results": st.sampled_from(["missing.json", "a-file", "data"]),
+                    "--policy": ANY, "--episode": ANY, "--start": ANY, "--actions": ANY, "--target": ANY,
+                    "--formats": st.sampled_from(["png", "png,svg", "gif", "", ","]),
+                    "--out": st.sampled_from([f"{out}/fig", "/proc/x/fig", "a-file/sub"])}, []
+    if command == "view":  # a valid run serves until stopped: the folder given is never a dataset
+        return [], {"--port": ANY, "--scene": ANY}, []
     raise AssertionError(command)
 
 
 #: The commands the property drives; a new command must be added here (and to pools_for).
-COVERED = ("generate", "demo", "reproduce", "preview", "train", "evaluate", "validate")
+COVERED = ("generate", "demo", "reproduce", "preview", "train", "evaluate", "validate", "stats", "plot", "view")
 
 
 def test_every_command_is_covered() -> None:
@@ -128,9 +138,15 @@ def test_no_traceback_and_nothing_outside_the_output_changes(command: str, data:
     monkeypatch.setenv("XDG_CACHE_HOME", str(world / f"{out}-rescued"))  # where a rescued result would go
     first, pools, last = pools_for(command, out)
     argv = [command, *first, *data.draw(options(pools), label="options")]
-    if command == "validate":
+    if command in ("validate", "stats"):
         argv.insert(1, data.draw(st.sampled_from(["data", "data/Single-Strawberry", "empty", "missing", "a-file",
                                                   "/proc/x", "data/Single-Strawberry/000"]), label="dir"))
+    elif command == "plot":
+        argv[1:1] = [data.draw(st.sampled_from(["visibility", "altitude", "oer", "actions", "episode", "phenotypes",
+                                                "bogus"]), label="kind"),
+                     data.draw(st.sampled_from(["data", "empty", "missing", "a-file"]), label="dir")]
+    elif command == "view":
+        argv.insert(1, data.draw(st.sampled_from(["empty", "missing", "a-file", "/proc/x"]), label="dir"))
     if last:
         argv += [*last, data.draw(UNWRITABLE, label="unwritable out")]
     before = snapshot(world)

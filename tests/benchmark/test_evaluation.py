@@ -62,6 +62,13 @@ def test_protocol_and_summary(sp_root: Path) -> None:
             assert summary[metric]["sessions"] == pytest.approx(sessions)
             assert summary[metric]["mean"] == pytest.approx(np.mean(sessions))
             assert summary[metric]["std"] == pytest.approx(np.std(sessions))
+        # Action counts add up the recorded per-episode actions, named as the protocol says.
+        assert results["protocol"]["actions"] == list(env.action_names)
+        counts = summary["action_counts"]
+        assert list(counts) == list(env.action_names)
+        assert sum(counts.values()) == sum(e["length"] for e in episodes)
+        for index, action in enumerate(env.action_names):
+            assert counts[action] == sum(e["actions"].count(index) for e in episodes)
         for e in episodes:
             assert 1 <= e["length"] <= 3
             assert e["reward"] == pytest.approx(max(e["oer_tau"] - e["oer_0"], 0) ** 2)

@@ -5,13 +5,14 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-import numpy as np
 import pytest
 from layout_factory import write_tiny_dataset
 
 from davis_ag.data.reader import open_dataset
 from davis_ag.errors import UserError
-from davis_ag.figures.report import draw_oer_histogram, draw_view_grid, phenotype_rows, write_report
+from davis_ag.figures.benchmark_plots import plot_oer
+from davis_ag.figures.report import phenotype_rows, write_report
+from davis_ag.figures.visibility_plots import plot_visibility
 from davis_ag.workflows.demo import Timer, run_baselines
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
@@ -42,7 +43,8 @@ def test_report_writes_pngs_and_links_resolve(tiny_root: Path, tmp_path: Path) -
     text = index.read_text()
     links = re.findall(r"(?:src|href)='([^']+)'", text)
     images = [link for link in links if link.endswith(".png")]
-    assert {"contact_sheet.png", "mask.png", "oer.png", "baselines.png", "grid_000.png"} <= set(images)
+    assert {"contact_sheet.png", "mask.png", "figures/oer.png", "baselines.png", "visibility_000.png",
+            "figures/actions.png", "figures/episode.png", "figures/altitude.png"} <= set(images)
     for link in images:
         assert not link.startswith("/"), "links must be relative"
         assert _is_png(out / link), link
@@ -50,26 +52,28 @@ def test_report_writes_pngs_and_links_resolve(tiny_root: Path, tmp_path: Path) -
     assert all((out / link).is_file() for link in links)
 
 
-def test_view_grid_one_panel_per_altitude(tiny_root: Path, tmp_path: Path,
-                                          monkeypatch: pytest.MonkeyPatch) -> None:
-    import davis_ag.figures.report as report
-
-    figures = []
-    new_figure = report.new_figure
-    monkeypatch.setattr(report, "new_figure", lambda *a, **k: figures.append(new_figure(*a, **k)) or figures[-1])
+def test_visibility_one_panel_per_altitude(tiny_root: Path, tmp_path: Path) -> None:
     for scene in open_dataset(tiny_root).scenes:
-        path = draw_view_grid(scene, tmp_path / f"{scene.id.replace('/', '_')}.png")
-        assert _is_png(path)
-        altitudes = sorted({round(view.pose[2], 2) for view in scene.views.values()})
-        # The tiny factory's SP grid uses the crop's three altitudes, MP the lowest and highest.
-        assert len(altitudes) == (3 if scene.scenario == "sp" else 2)
-        titles = [ax.get_title() for ax in figures[-1].axes if ax.get_title()]
-        assert [t.split(" m ")[0] for t in titles] == [f"altitude {z:.2f}" for z in altitudes]
+        plotted = plot_visibility(scene, tmp_path / scene.id.replace("/", "_"), ("png",))
+        assert _is_png(plotted.paths[0])
+        heights = sorted({round(v.pose[2], 2) for v in scene.views.values()})
+        assert [panel["z"] for panel in plotted.data["altitudes"]] == heights
+        # Every view lies at exactly one position of its altitude's panel.
+        assert sum(len(panel["x"]) for panel in plotted.data["altitudes"]) == len(
+            {tuple(round(c * 1000) for c in v.pose[:3]) for v in scene.views.values()})
 
 
-def test_oer_histogram_handles_empty_and_values(tmp_path: Path) -> None:
-    assert _is_png(draw_oer_histogram(np.zeros(0), tmp_path / "empty.png"))
-    assert _is_png(draw_oer_histogram(np.array([0.1, 0.5, 0.9]), tmp_path / "some.png"))
+def test_oer_without_masks_is_one_line(tiny_root: Path, tmp_path: Path) -> None:
+    scene = open_dataset(tiny_root).scenes[0]
+    for view in scene.views.values():
+        view.mask_path.rename(view.mask_path.with_suffix(".hidden"))
+    try:
+        with pytest.raises(UserError, match="masks") as error:
+            plot_oer([scene], tmp_path / "oer", ("png",))
+        assert "\n" not in str(error.value)
+    finally:
+        for view in scene.views.values():
+            view.mask_path.with_suffix(".hidden").rename(view.mask_path)
 
 
 def test_phenotypes_without_scene_json_give_no_rows(tmp_path: Path) -> None:

@@ -41,6 +41,12 @@ def test_demo_renders_validates_benchmarks_and_reports(tmp_path: Path, capsys: p
     assert "OER_tau" in printed and "Oracle" in printed
     index = out / "report" / "index.html"
     assert index.is_file() and "contact_sheet.png" in index.read_text()
+    # The paper's figures for the small dataset, and where they and the viewer are.
+    for kind in ("altitude", "oer", "actions", "episode", "phenotypes"):
+        assert (out / "report" / "figures" / f"{kind}.png").is_file(), kind
+        assert f"figures/{kind}.png" in index.read_text()
+    assert str(out / "report" / "figures") in printed
+    assert f"davis-ag view {out / 'dataset'}" in printed
     assert (out / "report" / "results.json").is_file()
     assert (out / "dataset" / "splits.json").is_file()
     # Re-running reuses the finished scene instead of rendering it again.

@@ -65,9 +65,9 @@ def run_episode(env: TVMEnv, agent: Agent, reset_seed: int,
         total += float(reward)
         if terminated or truncated:
             break
-    return {"oer_0": info["oer_0"], "oer_tau": info["oer_t"], "reward": total,
-            "length": len(actions), "scene": info["scene"], "target_fruit": info["target_fruit"],
-            "path": info["path"], "actions": actions}
+    return {"oer_0": float(info["oer_0"]), "oer_tau": float(info["oer_t"]), "reward": total,
+            "length": len(actions), "scene": info["scene"], "target_fruit": int(info["target_fruit"]),
+            "path": list(info["path"]), "actions": [int(a) for a in actions]}
 
 
 def evaluate_agents(env: TVMEnv, agents: list[Agent], episodes: int = 200, sessions: int = 3,
@@ -80,12 +80,15 @@ def evaluate_agents(env: TVMEnv, agents: list[Agent], episodes: int = 200, sessi
         episodes: Episodes per session (200 in the paper).
         sessions: Sessions (3 in the paper).
         seed: Base seed of the episode draw.
-        keep_episodes: Also return every episode's record (large).
+        keep_episodes: Also return every episode's record (what :func:`run_episode` returns
+            plus its ``session``): ``davis-ag plot actions`` and ``episode`` draw from them.
 
     Returns:
         ``{"protocol": {...}, "policies": {name: {metric: {"mean", "std", "sessions"}}}}``
-        with metrics ``oer_tau``, ``reward``, ``length`` and ``oer_0``, plus ``"episodes"``
-        per policy when ``keep_episodes``.
+        with metrics ``oer_tau``, ``reward``, ``length`` and ``oer_0``, ``"action_counts"``
+        per policy (action name to times chosen, over every episode; the protocol's
+        ``"actions"`` lists the names in index order), plus ``"episodes"`` per policy when
+        ``keep_episodes``.
     """
     inner = env.unwrapped if hasattr(env, "unwrapped") else env
     for agent in agents:  # a model made for another scenario is refused before any episode runs
@@ -95,7 +98,8 @@ def evaluate_agents(env: TVMEnv, agents: list[Agent], episodes: int = 200, sessi
     results: dict[str, Any] = {
         "protocol": {"scenario": inner.scenario, "split": inner.split, "tau": inner.tau,
                      "episodes": episodes, "sessions": sessions, "seed": seed,
-                     "scenes": [s.id for s in inner.scenes], "dataset": str(inner.dataset.root)},
+                     "scenes": [s.id for s in inner.scenes], "dataset": str(inner.dataset.root),
+                     "actions": list(inner.action_names)},
         "policies": {},
     }
     for agent in agents:
@@ -111,6 +115,9 @@ def evaluate_agents(env: TVMEnv, agents: list[Agent], episodes: int = 200, sessi
             key: {"mean": float(np.mean(values)), "std": float(np.std(values)),
                   "sessions": values}
             for key, values in per_session.items()}
+        chosen = np.bincount([a for r in records for a in r["actions"]],
+                             minlength=len(inner.action_names))
+        summary["action_counts"] = {n: int(c) for n, c in zip(inner.action_names, chosen)}
         if keep_episodes:
             summary["episodes"] = records
         results["policies"][agent.name] = summary

@@ -64,7 +64,7 @@ def run(args: argparse.Namespace) -> int:
     env = TVMEnv(args.dataset, scenario=args.scenario, split=args.split, crop=args.crop,
                  cache_dir=args.cache_dir)
     results = evaluate_agents(env, agents, episodes=args.episodes, sessions=args.sessions,
-                              seed=args.seed)
+                              seed=args.seed, keep_episodes=True)
     print(format_table(results))
     # The JSON is the result: keep it somewhere even when --out fails at the end.
     write_or_rescue(out, lambda path: write_json(results, path), "the results")

@@ -3,10 +3,12 @@ saved atomically as PNG or SVG by the suffix of the path."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from davis_ag.atomic_files import atomic_output
+from davis_ag.errors import UserError
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -23,9 +25,52 @@ def new_figure(width: float, height: float) -> Figure:
 
 
 def save_figure(figure: Figure, out_path: str | Path) -> Path:
-    """Save ``figure`` to ``out_path`` atomically (format from the suffix; PNG when there is none)."""
+    """Save ``figure`` to ``out_path`` atomically (format from the suffix; PNG when there is none).
+
+    Raises:
+        UserError: when the file cannot be written (a folder in the way, no permission).
+    """
     out = Path(out_path)
     fmt = out.suffix.lstrip(".").lower() or "png"
-    with atomic_output(out, "wb") as handle:
-        figure.savefig(handle, format=fmt)
+    try:
+        with atomic_output(out, "wb") as handle:
+            figure.savefig(handle, format=fmt)
+    except OSError as error:
+        raise UserError(f"{out}: cannot write the figure ({error.strerror or error}); choose "
+                        "another output path") from None
     return out
+
+
+#: Formats ``davis-ag plot`` writes by default.
+FORMATS: tuple[str, ...] = ("png", "svg")
+
+
+@dataclass
+class Plotted:
+    """What a plotting function drew and the numbers behind it.
+
+    Attributes:
+        paths: The files written, one per format.
+        data: JSON-ready numbers the figure shows (counts, histogram bins, ...), so tests and
+            readers can check the picture against the annotations.
+    """
+
+    paths: list[Path]
+    data: dict[str, Any] = field(default_factory=dict)
+
+
+def save_formats(figure: Figure, out: str | Path, formats: tuple[str, ...] = FORMATS) -> list[Path]:
+    """Save ``figure`` once per format beside ``out`` (its suffix replaced), atomically.
+
+    Args:
+        figure: The figure.
+        out: The path without (or with any) suffix, e.g. ``figures/oer``.
+        formats: Suffixes to write, e.g. ``("png", "svg")``.
+
+    Returns:
+        The paths written, in the order of ``formats``.
+    """
+    base = Path(out)
+    if base.suffix.lower().lstrip(".") in ("png", "svg", "pdf"):
+        base = base.with_suffix("")
+    return [save_figure(figure, base.with_name(f"{base.name}.{fmt}")) for fmt in formats]

@@ -19,6 +19,7 @@ from davis_ag.figures.canvas import new_figure, save_figure
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
 _TILE_INCHES = 3.2
 
@@ -30,7 +31,8 @@ def _pose_text(view: View) -> str:
     return " ".join(f"{n}={v:.2f}" if i < 3 else f"{n}={v:.0f}" for i, (n, v) in enumerate(zip(names, view.pose)))
 
 
-def _draw_boxes(ax: Axes, view: View, labels: bool) -> None:
+def draw_boxes(ax: Axes, view: View, labels: bool) -> None:
+    """Outline every fruit box of ``view`` in yellow on ``ax``, with its fruit id when ``labels``."""
     from matplotlib.patches import Rectangle
 
     for box in view.boxes:
@@ -59,17 +61,16 @@ def pick_views(scene: Scene, n_views: int) -> list[View]:
     return [views[i] for i in sorted(set(picks.tolist()))]
 
 
-def draw_contact_sheet(scene: Scene, out_path: str | Path, n_views: int = 12, columns: int = 4) -> Path:
-    """Draw a PNG grid of a scene's views with every fruit box, titled with view name and pose.
+def contact_sheet_figure(scene: Scene, n_views: int = 12, columns: int = 4) -> Figure:
+    """A grid of a scene's views with every fruit box, titled with view name and pose.
 
     Args:
         scene: The scene.
-        out_path: Where the PNG goes; its folder is created.
         n_views: Views to show, spread evenly over the scene.
         columns: Tiles per row.
 
     Returns:
-        ``out_path`` as a :class:`~pathlib.Path`.
+        The figure (not saved).
 
     Raises:
         UserError: for a scene without views or non-positive sizes.
@@ -86,11 +87,29 @@ def draw_contact_sheet(scene: Scene, out_path: str | Path, n_views: int = 12, co
     for i, view in enumerate(views):
         ax = figure.add_subplot(rows, columns, i + 1)
         ax.imshow(view.image(), interpolation="nearest")
-        _draw_boxes(ax, view, labels=False)
+        draw_boxes(ax, view, labels=False)
         ax.set_title(f"{view.name}  {len(view.boxes)} boxes\n{_pose_text(view)}", fontsize=6)
         ax.set_axis_off()
     figure.tight_layout()
-    return save_figure(figure, out_path)
+    return figure
+
+
+def draw_contact_sheet(scene: Scene, out_path: str | Path, n_views: int = 12, columns: int = 4) -> Path:
+    """Draw :func:`contact_sheet_figure` to one file (format from the suffix).
+
+    Args:
+        scene: The scene.
+        out_path: Where the picture goes; its folder is created.
+        n_views: Views to show, spread evenly over the scene.
+        columns: Tiles per row.
+
+    Returns:
+        ``out_path`` as a :class:`~pathlib.Path`.
+
+    Raises:
+        UserError: for a scene without views or non-positive sizes.
+    """
+    return save_figure(contact_sheet_figure(scene, n_views, columns), out_path)
 
 
 def draw_masks(view: View, out_path: str | Path) -> Path:
@@ -112,7 +131,7 @@ def draw_masks(view: View, out_path: str | Path) -> Path:
     figure = new_figure(2 * _TILE_INCHES * 1.4, _TILE_INCHES * 0.9)
     left, right = figure.add_subplot(1, 2, 1), figure.add_subplot(1, 2, 2)
     left.imshow(view.image(), interpolation="nearest")
-    _draw_boxes(left, view, labels=True)
+    draw_boxes(left, view, labels=True)
     left.set_title(f"{view.scene.id} {view.name}\n{_pose_text(view)}", fontsize=7)
     # Ids are labels, not magnitudes: a qualitative colour map, and no-fruit left blank.
     shown = np.ma.masked_equal(mask, NO_FRUIT)
@@ -120,7 +139,7 @@ def draw_masks(view: View, out_path: str | Path) -> Path:
 
     cmap = colormaps["tab20"].with_extremes(bad="black")
     right.imshow(shown % 20, cmap=cmap, vmin=0, vmax=19, interpolation="nearest")
-    _draw_boxes(right, view, labels=True)
+    draw_boxes(right, view, labels=True)
     ids = sorted(int(i) for i in np.unique(mask) if i != NO_FRUIT)
     right.set_title(f"instance mask: {len(ids)} fruits", fontsize=7)
     for ax in (left, right):

@@ -1,12 +1,12 @@
-"""Figures and a plain HTML report of a dataset and its benchmark (``davis-ag demo``).
+"""A plain HTML report of a dataset and its benchmark (``davis-ag demo``).
 
-Figures (matplotlib Agg, each PNG written through a temporary file and a rename):
+Figures (matplotlib Agg, each file written through a temporary file and a rename):
 
-- the viewpoint grid per altitude, coloured by the number of boxed fruit (like the paper's
-  Fig. 2), from annotations.json poses;
-- the distribution of the object exposure rate (OER, eq. 1) over every box (like Fig. 5b), from
-  the environment's observation cache (built from the masks when missing);
 - the contact sheet and an image beside its instance mask (:mod:`davis_ag.figures.contact_sheet`);
+- visible fruit per camera position and altitude for the first scenes (Fig. 2,
+  :func:`davis_ag.figures.visibility_plots.plot_visibility`);
+- every other figure of the paper the data allows (:func:`davis_ag.figures.plots.paper_figures`,
+  PNG and SVG under ``figures/``): altitude changes, OER, actions, an episode, phenotypes;
 - the Table 4 bar chart (:func:`davis_ag.benchmark.evaluation.plot_results`).
 
 ``index.html`` links everything with relative paths, so the report folder can be moved.
@@ -18,127 +18,41 @@ import html
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
-from davis_ag.atomic_files import write_text_atomic
+from davis_ag.atomic_files import write_json_atomic, write_text_atomic
 from davis_ag.data.reader import Scene, open_dataset
-from davis_ag.errors import UserError
-from davis_ag.figures.canvas import new_figure, save_figure
 from davis_ag.figures.contact_sheet import draw_contact_sheet, draw_masks
+from davis_ag.figures.plots import KINDS, paper_figures
+from davis_ag.figures.visibility_plots import plot_visibility
 
 if TYPE_CHECKING:
     from davis_ag.stage_timer import Timer
 
-#: Section V-C: episodes start on a target below this OER.
-START_OER = 0.4
 #: Scenes whose viewpoint grid the report draws (the first ones).
 MAX_GRIDS = 6
-
-
-def _grid_key(scene: Scene, name: str, pose: tuple[float, ...]) -> tuple[Any, ...]:
-    """The camera position a view belongs to: scene.json's grid cell, else the rounded pose."""
-    meta = scene.metadata or {}
-    cell = meta.get("views", {}).get(name, {}).get("grid")
-    if isinstance(cell, list) and len(cell) >= 3:
-        return tuple(cell[:3])
-    return (round(pose[0], 1), round(pose[1], 1), round(pose[2], 2))
-
-
-def draw_view_grid(scene: Scene, out_path: str | Path) -> Path:
-    """Plot a scene's camera positions per altitude, coloured by the number of boxed fruit.
-
-    Where a position has several headings (MP), the colour is the mean over its headings.
-
-    Args:
-        scene: The scene.
-        out_path: The PNG to write.
-
-    Returns:
-        ``out_path`` as a Path.
-
-    Raises:
-        UserError: when no view of the scene has a pose.
-    """
-    cells: dict[tuple[Any, ...], list[tuple[float, float, float, int]]] = {}
-    for view in scene.views.values():
-        if view.pose is None:
-            continue
-        key = _grid_key(scene, view.name, view.pose)
-        cells.setdefault(key, []).append((view.pose[0], view.pose[1], view.pose[2], len(view.boxes)))
-    if not cells:
-        raise UserError(f"{scene.annotations_path}: no view has a pose; cannot draw the grid")
-    points = np.array([[np.mean([p[0] for p in v]), np.mean([p[1] for p in v]),
-                        np.mean([p[2] for p in v]), np.mean([p[3] for p in v])] for v in cells.values()])
-    altitudes = sorted({round(float(z), 2) for z in points[:, 2]})
-    figure = new_figure(3.6 * len(altitudes) + 0.8, 3.6)
-    vmax = max(float(points[:, 3].max()), 1.0)
-    plants = [(p.get("position") or [0, 0])[:2] for p in (scene.metadata or {}).get("plants", [])]
-    scatter = None
-    for i, z in enumerate(altitudes):
-        ax = figure.add_subplot(1, len(altitudes), i + 1)
-        rows = points[np.isclose(np.round(points[:, 2], 2), z)]
-        scatter = ax.scatter(rows[:, 0], rows[:, 1], c=rows[:, 3], cmap="viridis", vmin=0, vmax=vmax,
-                             s=28, edgecolors="none")
-        if plants:
-            ax.scatter([p[0] for p in plants], [p[1] for p in plants], marker="*", s=120,
-                       color="tab:red", label="plant")
-        ax.set_title(f"altitude {z:.2f} m ({len(rows)} positions)", fontsize=9)
-        ax.set_aspect("equal")
-        ax.set_xlabel("x (m)", fontsize=8)
-        if i == 0:
-            ax.set_ylabel("y (m)", fontsize=8)
-        ax.tick_params(labelsize=7)
-    if scatter is not None:
-        bar = figure.colorbar(scatter, ax=figure.axes, shrink=0.85)
-        bar.set_label("boxed fruit per view", fontsize=8)
-    figure.suptitle(f"{scene.id}: viewpoints, colour = visible (boxed) fruit", fontsize=9)
-    return save_figure(figure, out_path)
-
-
-def box_oers(scenes: list[Scene], root: Path) -> np.ndarray:
-    """The OER of every box of the scenes, from the environment's cache (built if missing).
-
-    Args:
-        scenes: The scenes.
-        root: Their dataset root.
-
-    Returns:
-        One float per box.
-    """
-    from davis_ag.benchmark.cache import load_scene_cache
-
-    values = [np.asarray(load_scene_cache(s, root).box_oer, dtype=float) for s in scenes]
-    return np.concatenate(values) if values else np.zeros(0)
-
-
-def draw_oer_histogram(oers: np.ndarray, out_path: str | Path, title: str = "") -> Path:
-    """Histogram of box OERs with the episode-start threshold marked.
-
-    Args:
-        oers: OER per box.
-        out_path: The PNG to write.
-        title: Figure title.
-
-    Returns:
-        ``out_path`` as a Path.
-    """
-    figure = new_figure(5.0, 3.2)
-    ax = figure.add_subplot(1, 1, 1)
-    ax.hist(oers, bins=np.linspace(0, 1, 21), color="tab:green", edgecolor="white")
-    ax.axvline(START_OER, color="tab:red", linestyle="--", label=f"episode start: OER < {START_OER}")
-    below = float(np.mean(oers < START_OER)) if len(oers) else 0.0
-    ax.set_xlabel("object exposure rate (OER)")
-    ax.set_ylabel("boxes")
-    ax.set_title(title or f"{len(oers)} boxes, {below:.0%} below {START_OER}", fontsize=9)
-    ax.legend(fontsize=8)
-    figure.tight_layout()
-    return save_figure(figure, out_path)
 
 
 def _busiest_view(scene: Scene) -> Any:
     """The view with the most boxes, the largest total box area among those: for the mask figure."""
     return max(scene.views.values(),
                key=lambda v: (len(v.boxes), sum(b.width * b.height for b in v.boxes)))
+
+
+def _paper_figures(root: Path, out_dir: Path, results: dict[str, Any] | None) -> str:
+    """Draw the paper's figures into ``out_dir/figures`` and return their HTML section."""
+    results_path = out_dir / "results.json" if results else None  # written by write_report
+    drawn = paper_figures(root, out_dir / "figures", results_path, kinds=[k for k in KINDS if k != "visibility"])
+    parts = ["<h2>Figures of the paper</h2><p>Drawn by <code>davis-ag plot KIND</code>; each as PNG and "
+             "SVG with the numbers behind it as JSON in <code>figures/</code>.</p>"]
+    for kind, plotted in drawn.items():
+        if kind == "skipped":
+            continue
+        parts.append(f"<h3>{html.escape(kind)}: {html.escape(KINDS[kind])}</h3>")
+        for path in (p for p in plotted.paths if p.suffix == ".png"):
+            rel = path.relative_to(out_dir).as_posix()
+            parts.append(f"<img src='{html.escape(rel)}' alt='{html.escape(kind)}'>")
+    for kind, reason in drawn["skipped"].data.items():
+        parts.append(f"<p>{html.escape(kind)}: not drawn ({html.escape(reason)}).</p>")
+    return "\n".join(parts)
 
 
 def _table(header: list[str], rows: list[list[Any]]) -> str:
@@ -218,26 +132,25 @@ def write_report(root: Path, out_dir: Path, results: dict[str, Any] | None = Non
         parts.append("<h2>Benchmark (Table 4 style)</h2>"
                      f"<pre>{html.escape(format_table(results))}</pre>"
                      "<img src='baselines.png' alt='baselines bar chart'>")
-        if (out_dir / "results.json").is_file():
-            parts.append("<p><a href='results.json'>results.json</a> holds every session's "
-                         "numbers.</p>")
+        write_json_atomic(out_dir / "results.json", results, indent=2)
+        parts.append("<p><a href='results.json'>results.json</a> holds every session's and "
+                     "episode's numbers.</p>")
     draw_contact_sheet(first, out_dir / "contact_sheet.png")
     view = _busiest_view(first)
     draw_masks(view, out_dir / "mask.png")
     parts.append(f"<h2>Views of {html.escape(first.id)}</h2><p>Evenly spread views with every "
                  "fruit box:</p><img src='contact_sheet.png' alt='contact sheet'>"
                  f"<p>View {html.escape(view.name)} ({len(view.boxes)} boxes) and its instance "
-                 "mask:</p><img src='mask.png' alt='image and instance mask'>")
-    parts.append("<h2>Viewpoint grids</h2><p>Camera positions per altitude; colour = boxed fruit "
-                 "per view (mean over headings), star = plant (cf. Fig. 2).</p>")
+                 "mask:</p><img src='mask.png' alt='image and instance mask'>"
+                 "<p>Drive through the scenes with the keyboard: <code>davis-ag view "
+                 f"{html.escape(str(dataset.root))}</code>, then open http://127.0.0.1:8765/.</p>")
+    parts.append("<h2>Visible fruit per camera position</h2><p>Camera positions per altitude, "
+                 "coloured by the fruit boxed from there (cf. Fig. 2), cross = plant.</p>")
     for i, scene in enumerate(scenes[:MAX_GRIDS]):
-        name = f"grid_{i:03d}.png"
-        draw_view_grid(scene, out_dir / name)
-        parts.append(f"<img src='{name}' alt='viewpoint grid of {html.escape(scene.id)}'>")
-    oers = box_oers(scenes, dataset.root)
-    draw_oer_histogram(oers, out_dir / "oer.png")
-    parts.append("<h2>Object exposure rate</h2><p>OER of every box over all scenes (cf. Fig. 5b); "
-                 "episodes start on targets left of the dashed line.</p><img src='oer.png' alt='OER'>")
+        name = f"visibility_{i:03d}.png"
+        plot_visibility(scene, out_dir / name, ("png",))
+        parts.append(f"<img src='{name}' alt='visible fruit per position in {html.escape(scene.id)}'>")
+    parts.append(_paper_figures(Path(root), out_dir, results))
     header, rows = phenotype_rows(scenes)
     if rows:
         parts.append("<h2>Measured phenotypes (scene.json)</h2>" + _table(header, rows))

@@ -2,7 +2,9 @@
 
 The demo: generate a small single-plant strawberry dataset, validate it, write a 70/30 split by
 scene, run the paper's baselines (LRD, UDD, Rand and the exact Oracle) on the test split, print
-a Table 4 style table and write an HTML report (:mod:`davis_ag.figures.report`) a person can open.
+a Table 4 style table and write an HTML report (:mod:`davis_ag.figures.report`) a person can open,
+with the paper's figures drawn for the small dataset; it ends by saying where they are and how to
+open the viewer (``davis-ag view``).
 
 Every stage is resumable: finished scenes are skipped (:func:`davis_ag.generate.one_scene.check_scene_slot`),
 a crashed scene's partial folder is cleared, and the environment's observation cache is reused.
@@ -104,7 +106,8 @@ def run_baselines(root: Path, scenario: str, crop: str, split: str, episodes: in
     names = list(BASELINES) + (["A2C"] if model else [])
     agents = build_agents(names, model=model)
     env = TVMEnv(root, scenario=scenario, split=split, crop=crop)
-    results = evaluate_agents(env, agents, episodes=episodes, sessions=sessions, seed=seed)
+    results = evaluate_agents(env, agents, episodes=episodes, sessions=sessions, seed=seed,
+                              keep_episodes=True)
     results["protocol"]["crop"] = crop
     env.close()
     return results
@@ -183,4 +186,7 @@ def run_demo(out: Path, scenes: int = 2, size: tuple[int, int] = DEMO_SIZE, seed
         index = write_report(root, report_dir, results=results, validation=report.summary(),
                              timer=timer, generated=generated, title="DAVIS-Ag demo")
     print(f"report: {index}  (open it in a browser; total {timer.total:.0f} s)", flush=True)
+    print(f"figures of the paper (PNG, SVG, numbers as JSON): {report_dir / 'figures'}", flush=True)
+    print(f"drive through a scene: davis-ag view {root}  (then open http://127.0.0.1:8765/)",
+          flush=True)
     return 0

@@ -1,0 +1,59 @@
+"""``davis-ag plot KIND``: the paper's figures from a dataset and/or evaluation results.
+
+Each figure is written as PNG and SVG, with a JSON file of the numbers it shows beside it.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from davis_ag.commands import arguments
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``plot`` sub-command."""
+    from davis_ag.figures.plots import KINDS
+
+    kinds = "\n".join(f"  {k:<11} {v}" for k, v in KINDS.items())
+    parser = subparsers.add_parser(
+        "plot", help="draw one of the paper's figures (PNG, SVG and the numbers as JSON)",
+        description=f"{__doc__}\nkinds:\n{kinds}", formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("kind", choices=list(KINDS), help="which figure")
+    parser.add_argument("dataset", type=arguments.path, nargs="?", default=None, metavar="DIR",
+                        help="dataset root, group or scene folder (all kinds but actions)")
+    parser.add_argument("--scene", default=None, metavar="ID",
+                        help="scene id, e.g. Single-Strawberry/000 (default: the first scene)")
+    parser.add_argument("--results", type=arguments.path, default=None, metavar="RESULTS.json",
+                        help="`davis-ag evaluate` results (actions, episode)")
+    parser.add_argument("--policy", default=None, help="policy of the per-episode panel or episode")
+    parser.add_argument("--episode", type=arguments.whole, default=0, metavar="N",
+                        help="recorded episode to draw (default 0)")
+    parser.add_argument("--start", default=None, metavar="VIEW",
+                        help="episode: start view to walk from instead of a recorded episode")
+    parser.add_argument("--actions", default="", metavar="A,B,...",
+                        help="episode: action names to walk from --start")
+    parser.add_argument("--target", type=arguments.whole, default=None, metavar="FRUIT",
+                        help="episode: target fruit id (a move losing its box is refused)")
+    parser.add_argument("--out", type=arguments.path, required=True, metavar="PATH",
+                        help="output path without suffix: PATH.png, PATH.svg, PATH.json")
+    parser.add_argument("--formats", default="png,svg", help="figure formats (default png,svg)")
+    parser.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Draw the figure and print where it went."""
+    from davis_ag.errors import UserError
+    from davis_ag.figures.plots import PlotRequest, make_plot
+
+    formats = tuple(f.strip().lower() for f in args.formats.split(",") if f.strip())
+    bad = [f for f in formats if f not in ("png", "svg", "pdf")]
+    if bad or not formats:
+        raise UserError(f"--formats {args.formats!r}: choose from png, svg, pdf (comma-separated)")
+    actions = [a.strip() for a in args.actions.split(",") if a.strip()]
+    plotted = make_plot(PlotRequest(args.kind, args.out, dataset=args.dataset, scene=args.scene,
+                                    results=args.results, policy=args.policy, episode=args.episode,
+                                    start=args.start, actions=actions, target=args.target,
+                                    formats=formats))
+    for path in plotted.paths:
+        print(f"wrote {path}")
+    return 0

@@ -1,0 +1,33 @@
+"""``davis-ag stats DIR``: Table 3 (scenes and images per scenario and crop) and fruit statistics
+of any dataset, ours or the original download, printed and written as JSON."""
+
+from __future__ import annotations
+
+import argparse
+
+from davis_ag.commands import arguments
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``stats`` sub-command."""
+    parser = subparsers.add_parser(
+        "stats", help="Table 3 and fruit statistics of a dataset (table and JSON)", description=__doc__)
+    parser.add_argument("dataset", type=arguments.path, metavar="DIR", help="dataset root, group or scene folder")
+    parser.add_argument("--out", type=arguments.path, default=None, metavar="STATS.json",
+                        help="also write the statistics as JSON here")
+    parser.add_argument("--no-oer", action="store_true",
+                        help="skip the OER distribution (it reads every mask: slow on a large dataset)")
+    parser.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Compute, print and write the statistics."""
+    from davis_ag.atomic_files import write_json_atomic
+    from davis_ag.data.reader import open_dataset
+    from davis_ag.figures.dataset_stats import dataset_statistics, format_statistics
+
+    stats = dataset_statistics(open_dataset(args.dataset), with_oer=not args.no_oer)
+    print(format_statistics(stats))
+    if args.out:
+        print(f"wrote {write_json_atomic(args.out, stats, indent=2)}")
+    return 0
