@@ -24,6 +24,7 @@ STAGES: tuple[tuple[str, ...], ...] = (
     ("generate",),
     ("data",),
     ("benchmark",),
+    ("detection",),
     ("figures",),
     ("workflows",),
     ("commands", "cli", "bench"),
@@ -131,4 +132,4 @@ def test_the_layout_reads_as_the_pipeline() -> None:
     """`ls src/davis_ag` shows every stage as a folder."""
     folders = {p.name for p in PACKAGE.iterdir() if p.is_dir() and (p / "__init__.py").exists()}
     assert {"scene", "render", "labels", "generate", "data", "benchmark", "figures", "workflows",
-            "commands"} <= folders
+            "commands", "detection"} <= folders
