@@ -14,9 +14,11 @@ without network access and without CUDA:
    compiled operators cannot load, and torchvision 0.28 then fails at import (it registers
    meta kernels for ``torchvision::nms`` and ``qnms`` unconditionally). ultralytics imports
    torchvision and, once imported, calls ``torchvision.ops.nms``. Where (and only where) the
-   compiled operators fail to load, we define those two operator schemas and give ``nms`` a
-   CPU kernel: ultralytics' own pure-torch ``TorchNMS.nms``, the one it uses without
-   torchvision. Every other torchvision operator stays unavailable (and says so if called).
+   compiled operators fail to load, we define those two operator schemas, give ``nms`` a CPU
+   kernel: ultralytics' own pure-torch ``TorchNMS.nms``, the one it uses without torchvision,
+   and tell torchvision's Python side (``extension._has_ops``) that operators are there. Every
+   other compiled torchvision operator (``roi_align``, ``deform_conv2d``...) stays missing and
+   fails with "operator torchvision::... does not exist" if called.
 """
 
 from __future__ import annotations
@@ -103,9 +105,14 @@ def prepare_ultralytics() -> ModuleType:
         os.environ.setdefault(key, value)
     config_dir = Path(os.environ.setdefault("YOLO_CONFIG_DIR", str(DEFAULT_CONFIG_DIR)))
     _place_font(config_dir)
-    if "torchvision" not in sys.modules and not torchvision_ops_load():
+    patch = "torchvision" not in sys.modules and not torchvision_ops_load()
+    if patch:
         _define_cpu_nms()
-    import torchvision  # noqa: F401  (now importable, with a working nms)
+    import torchvision.extension  # now importable
+
+    if patch:
+        # torchvision.ops.nms asks this before calling torch.ops.torchvision.nms, defined above.
+        torchvision.extension._has_ops = lambda: True
     import ultralytics
     from ultralytics.utils import SETTINGS
 
