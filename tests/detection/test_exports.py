@@ -151,3 +151,13 @@ def test_export_command_refuses_a_foreign_folder_and_writes_both_formats(dataset
     assert main(["export", "yolo", str(dataset), str(tmp_path / "y")]) == 0
     out = capsys.readouterr().out
     assert "train:" in out and (tmp_path / "y" / "data.yaml").is_file()
+
+
+def test_appearance_shift_changes_the_export_not_the_dataset(dataset: Path, tmp_path: Path) -> None:
+    before = (dataset / "Single-Strawberry" / "001" / "images" / "0001.jpeg").read_bytes()
+    assert main(["export", "yolo", str(dataset), str(tmp_path), "--split", "test", "--appearance-shift", "3"]) == 0
+    shifted = tmp_path / "images" / "test" / "Single-Strawberry_001_0001.jpeg"
+    assert (dataset / "Single-Strawberry" / "001" / "images" / "0001.jpeg").read_bytes() == before
+    a = np.asarray(Image.open(shifted)).astype(float)
+    b = np.asarray(Image.open(dataset / "Single-Strawberry" / "001" / "images" / "0001.jpeg")).astype(float)
+    assert a.shape == b.shape and np.abs(a - b).mean() > 10

@@ -32,6 +32,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         if name == "yolo":
             sub.add_argument("--task", choices=("detect", "segment"), default="detect",
                              help="label lines: boxes (detect, default) or polygons (segment)")
+            sub.add_argument("--appearance-shift", type=arguments.whole, default=None, metavar="SEED",
+                             help="re-colour, light from one side, blur, add noise and re-compress every "
+                                  "exported image (copies; the dataset is untouched): a stand-in for real "
+                                  "photographs when none are at hand")
         sub.set_defaults(func=run)
 
 
@@ -64,6 +68,10 @@ def run(args: argparse.Namespace) -> int:
 
         counts = export_yolo(args.dir, args.out, args.task, splits)
         unit = "instances"
+        if args.appearance_shift is not None:
+            from davis_ag.detection.appearance_shift import shift_folder
+
+            shift_folder(args.out / "images", args.appearance_shift)
     for split, c in counts.items():
         print(f"{split}: {c['images']} images, {c[unit]} {unit}")
     where = args.out / "annotations" if args.format == "coco" else args.out / "data.yaml"

@@ -8,8 +8,8 @@ without network access and without CUDA:
    that off (``YOLO_OFFLINE``, ``YOLO_AUTOINSTALL``, ``ULTRALYTICS_SKIP_REQUIREMENTS_CHECKS``,
    the ``sync`` setting); they are read when ultralytics is first imported, so
    :func:`prepare_ultralytics` sets them before that. Its settings and font live in
-   ``YOLO_CONFIG_DIR`` (ours unless you set one), where matplotlib's DejaVu Sans is placed as
-   the font it asks for, so nothing is ever downloaded.
+   ``YOLO_CONFIG_DIR`` (ours unless you set one), where matplotlib's DejaVu Sans is placed under
+   the font names it asks for, so no font is ever downloaded.
 2. PyPI's torchvision wheels are linked against CUDA torch; with the CPU build of torch their
    compiled operators cannot load, and torchvision 0.28 then fails at import (it registers
    meta kernels for ``torchvision::nms`` and ``qnms`` unconditionally). ultralytics imports
@@ -71,14 +71,15 @@ def _define_cpu_nms() -> None:
     _state["library"] = library  # the registration lasts as long as this object
 
 
-def _place_font(config_dir: Path) -> None:
+def _place_fonts(config_dir: Path) -> None:
     import matplotlib
 
-    font = config_dir / "Arial.ttf"
-    if not font.is_file():
-        source = Path(matplotlib.get_data_path()) / "fonts" / "ttf" / "DejaVuSans.ttf"
-        config_dir.mkdir(parents=True, exist_ok=True)
-        shutil.copyfile(source, font)
+    source = Path(matplotlib.get_data_path()) / "fonts" / "ttf" / "DejaVuSans.ttf"
+    for name in ("Arial.ttf", "Arial.Unicode.ttf"):  # the two ultralytics asks for (ASCII names or not)
+        font = config_dir / name
+        if not font.is_file():
+            config_dir.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(source, font)
 
 
 def prepare_ultralytics() -> ModuleType:
@@ -103,8 +104,7 @@ def prepare_ultralytics() -> ModuleType:
         raise UserError("ultralytics is not installed: pip install 'davis-ag[detect]'")
     for key, value in _OFFLINE_ENV.items():
         os.environ.setdefault(key, value)
-    config_dir = Path(os.environ.setdefault("YOLO_CONFIG_DIR", str(DEFAULT_CONFIG_DIR)))
-    _place_font(config_dir)
+    os.environ.setdefault("YOLO_CONFIG_DIR", str(DEFAULT_CONFIG_DIR))
     patch = "torchvision" not in sys.modules and not torchvision_ops_load()
     if patch:
         _define_cpu_nms()
@@ -114,8 +114,9 @@ def prepare_ultralytics() -> ModuleType:
         # torchvision.ops.nms asks this before calling torch.ops.torchvision.nms, defined above.
         torchvision.extension._has_ops = lambda: True
     import ultralytics
-    from ultralytics.utils import SETTINGS
+    from ultralytics.utils import SETTINGS, USER_CONFIG_DIR
 
+    _place_fonts(Path(USER_CONFIG_DIR))
     if SETTINGS.get("sync"):
         SETTINGS.update({"sync": False})
     _state["ultralytics"] = ultralytics
