@@ -33,8 +33,7 @@ from davis_ag.errors import UserError
 
 #: Where ultralytics keeps its settings and font unless ``YOLO_CONFIG_DIR`` is set.
 DEFAULT_CONFIG_DIR = Path.home() / ".config" / "davis-ag" / "ultralytics"
-_OFFLINE_ENV = {"YOLO_OFFLINE": "1", "YOLO_AUTOINSTALL": "0", "ULTRALYTICS_SKIP_REQUIREMENTS_CHECKS": "1",
-                "YOLO_VERBOSE": "0"}
+_OFFLINE_ENV = {"YOLO_OFFLINE": "1", "YOLO_AUTOINSTALL": "0", "ULTRALYTICS_SKIP_REQUIREMENTS_CHECKS": "1"}
 _state: dict[str, object] = {}
 
 
