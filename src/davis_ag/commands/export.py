@@ -52,7 +52,10 @@ def check_out(out: Path, fmt: str) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Export ``args.dir`` to ``args.out``; prints the counts per split."""
+    from davis_ag.data.reader import open_dataset
+
     splits = ("train", "test") if args.split == "both" else (args.split,)
+    open_dataset(args.dir)  # a bad DIR is reported before anything is created
     check_out(args.out, args.format)
     try:
         args.out.mkdir(parents=True, exist_ok=True)
