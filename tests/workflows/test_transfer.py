@@ -45,7 +45,8 @@ def test_transfer_runs_end_to_end_offline(tmp_path: Path, monkeypatch: pytest.Mo
             assert 0.0 <= split[arm]["map50_95"] <= split[arm]["map50"] <= 1.0
     # The two arms are different models: the fine-tuned one started from the pre-trained weights.
     assert (out / "runs" / "pretrain" / "weights" / "last.pt").is_file()
-    assert json.loads((out / "split1" / "runs" / "transfer" / "done.json").read_text())["start"].endswith("last.pt")
+    fine_tuned = json.loads((out / "split1" / "runs" / "transfer" / "done.json").read_text())
+    assert fine_tuned["start"].endswith("last.pt") and fine_tuned["start_weights_carried"] > 0.9
     assert json.loads((out / "split1" / "runs" / "real_only" / "done.json").read_text())["start"] is None
     report = (tmp_path / "results.md").read_text()
     assert "stand-in" in report and "0.943" in report  # the paper's Table 5 sits beside ours, named

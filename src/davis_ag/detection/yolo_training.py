@@ -13,6 +13,8 @@ import json
 from dataclasses import dataclass
 from pathlib import Path
 
+import torch
+
 from davis_ag.detection.offline import prepare_ultralytics
 
 #: The detector of section VI-B, built from its YAML.
@@ -60,12 +62,32 @@ def train(data_yaml: Path, out_dir: Path, budget: Budget, seed: int, start: Path
     from ultralytics import YOLO
 
     model = YOLO(str(start) if start else MODEL_YAML, task="detect")
+    carried: dict[str, float] = {}
+    if start:
+        model.add_callback("on_train_start", lambda trainer: carried.update(
+            start_weights_carried=carried_fraction(start, trainer.model)))
     model.train(data=str(data_yaml), epochs=budget.epochs, imgsz=budget.imgsz, batch=budget.batch,
                 device=budget.device, workers=budget.workers, project=str(out_dir.parent), name=out_dir.name,
-                exist_ok=True, plots=False, val=False, seed=seed, deterministic=True, pretrained=False,
+                exist_ok=True, plots=False, val=False, seed=seed, deterministic=True,
+                # ultralytics drops a checkpoint's weights when pretrained is False
+                pretrained=start is not None,
                 amp=budget.device != "cpu", verbose=False, patience=0, close_mosaic=min(10, budget.epochs // 2))
-    done.write_text(json.dumps({"epochs": budget.epochs, "start": str(start) if start else None}) + "\n")
+    done.write_text(json.dumps({"epochs": budget.epochs, "start": str(start) if start else None, **carried}) + "\n")
     return last
+
+
+def carried_fraction(start: Path, model: torch.nn.Module) -> float:
+    """Share of a checkpoint's weight tensors that a model holds unchanged (1.0: all carried over).
+
+    Measured when training starts, it shows that fine-tuning began from the pre-trained weights.
+    """
+    from ultralytics.nn.tasks import load_checkpoint
+
+    source = load_checkpoint(str(start))[0].float().state_dict()
+    target = model.state_dict()
+    same = sum(1 for k, v in source.items() if k in target and target[k].shape == v.shape
+               and torch.equal(target[k].float().cpu(), v))
+    return round(same / max(len(source), 1), 4)
 
 
 def evaluate(weights: Path, data_yaml: Path, budget: Budget, split: str = "test") -> dict[str, float]:
