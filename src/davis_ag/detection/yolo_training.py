@@ -71,7 +71,10 @@ def train(data_yaml: Path, out_dir: Path, budget: Budget, seed: int, start: Path
                 exist_ok=True, plots=False, val=False, seed=seed, deterministic=True,
                 # ultralytics drops a checkpoint's weights when pretrained is False
                 pretrained=start is not None,
-                amp=budget.device != "cpu", verbose=False, patience=0, close_mosaic=min(10, budget.epochs // 2))
+                amp=budget.device != "cpu", verbose=False, patience=0, close_mosaic=min(10, budget.epochs // 2),
+                # One optimiser step per batch: by default ultralytics accumulates gradients up to 64
+                # images, which on a set of a few hundred images leaves a handful of steps per run.
+                nbs=budget.batch)
     done.write_text(json.dumps({"epochs": budget.epochs, "start": str(start) if start else None, **carried}) + "\n")
     return last
 
