@@ -115,11 +115,21 @@ def pools_for(command: str, out: str) -> tuple[list[str], dict[str, st.SearchStr
                     "--out": st.sampled_from([f"{out}/fig", "/proc/x/fig", "a-file/sub"])}, []
     if command == "view":  # a valid run serves until stopped: the folder given is never a dataset
         return [], {"--port": ANY, "--scene": ANY}, []
+    if command == "export":
+        return [], {"--split": ANY, "--task": st.sampled_from(["detect", "segment", "x"]),
+                    "--appearance-shift": ANY}, []
+    if command == "transfer":  # trains detectors: the --out given last is never writable
+        paths = st.sampled_from(["data", "empty", "missing", "a-file", "/proc/x"])
+        return [], {"--pretrain": paths, "--real": paths, "--real-images": paths, "--splits": small,
+                    "--train-size": small, "--test-size": small, "--seed": ANY, "--epochs": small,
+                    "--pretrain-epochs": small, "--imgsz": ANY, "--batch": small, "--device": ANY,
+                    "--workers": small, "--results": st.sampled_from([f"{out}/t.md", "/proc/x/t.md"])}, ["--out"]
     raise AssertionError(command)
 
 
 #: The commands the property drives; a new command must be added here (and to pools_for).
-COVERED = ("generate", "demo", "reproduce", "preview", "train", "evaluate", "validate", "stats", "plot", "view")
+COVERED = ("generate", "demo", "reproduce", "preview", "train", "evaluate", "validate", "stats", "plot", "view",
+           "export", "transfer")
 
 
 def test_every_command_is_covered() -> None:
@@ -147,6 +157,12 @@ def test_no_traceback_and_nothing_outside_the_output_changes(command: str, data:
                      data.draw(st.sampled_from(["data", "empty", "missing", "a-file"]), label="dir")]
     elif command == "view":
         argv.insert(1, data.draw(st.sampled_from(["empty", "missing", "a-file", "/proc/x"]), label="dir"))
+    elif command == "export":
+        argv[1:1] = [data.draw(st.sampled_from(["coco", "yolo", "bogus"]), label="format"),
+                     data.draw(st.sampled_from(["data", "data/Single-Strawberry", "empty", "missing", "a-file"]),
+                               label="dir"),
+                     data.draw(st.sampled_from([f"{out}/export", "/proc/x", "a-file", "data", "a-file/sub"]),
+                               label="out")]
     if last:
         argv += [*last, data.draw(UNWRITABLE, label="unwritable out")]
     before = snapshot(world)

@@ -24,13 +24,14 @@ STAGES: tuple[tuple[str, ...], ...] = (
     ("generate",),
     ("data",),
     ("benchmark",),
+    ("detection",),
     ("figures",),
     ("workflows",),
     ("commands", "cli", "bench"),
 )
 RANK = {name: rank for rank, names in enumerate(STAGES) for name in names}
 #: Stages that must import without Helios or a renderer: they are pure geometry and reading.
-NO_HELIOS_AT_IMPORT = ("scene", "data", "benchmark")
+NO_HELIOS_AT_IMPORT = ("scene", "data", "benchmark", "detection")
 
 
 def module_name(path: Path) -> str:
@@ -114,7 +115,7 @@ def test_geometry_and_benchmark_never_load_helios_or_a_renderer_at_import(name: 
 def test_data_and_benchmark_know_nothing_of_helios() -> None:
     """They read any dataset in the published layout, the original download included."""
     for name, path in MODULES.items():
-        if stage(name) in ("data", "benchmark"):
+        if stage(name) in ("data", "benchmark", "detection"):
             for module, line, _ in imports(path):
                 assert not module.startswith(("pyhelios", "davis_ag.render", "davis_ag.generate")), (
                     f"{path}:{line}: imports {module}")
@@ -131,4 +132,4 @@ def test_the_layout_reads_as_the_pipeline() -> None:
     """`ls src/davis_ag` shows every stage as a folder."""
     folders = {p.name for p in PACKAGE.iterdir() if p.is_dir() and (p / "__init__.py").exists()}
     assert {"scene", "render", "labels", "generate", "data", "benchmark", "figures", "workflows",
-            "commands"} <= folders
+            "commands", "detection"} <= folders

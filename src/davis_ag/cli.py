@@ -12,7 +12,7 @@ from davis_ag.errors import UserError
 # Each name is a module of davis_ag.commands defining ``register(subparsers)``; the registered
 # parser's ``func`` default takes the parsed arguments and returns an exit code.
 COMMANDS = ["generate", "validate", "train", "evaluate", "preview", "demo", "reproduce", "stats", "plot",
-            "view"]
+            "view", "export", "transfer"]
 
 
 class OneLineParser(argparse.ArgumentParser):

@@ -1,0 +1,82 @@
+"""``davis-ag export coco|yolo DIR OUT``: a DAVIS-Ag dataset in a detection format, by split."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from davis_ag.commands import arguments
+from davis_ag.errors import UserError
+
+#: What an export folder may already hold (a previous export, which is refreshed in place).
+_OURS = {"coco": {"annotations"}, "yolo": {"images", "labels", "data.yaml"}}
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``export`` sub-command with its ``coco`` and ``yolo`` formats."""
+    parser = subparsers.add_parser(
+        "export", help="write a dataset as COCO (RLE masks) or YOLO (ultralytics) detection data",
+        description="Export a DAVIS-Ag dataset for detectors, one set per split (splits.json, else the "
+                    "benchmark's seeded 70/30 split by scene). coco: OUT/annotations/instances_<split>.json "
+                    "with RLE masks, boxes, fruit ids and visible fractions, images referenced in place. "
+                    "yolo: the ultralytics layout (images/, labels/, data.yaml).")
+    formats = parser.add_subparsers(dest="format", required=True, metavar="{coco,yolo}")
+    for name, help_text in (("coco", "COCO instances JSON, masks as pycocotools RLE"),
+                            ("yolo", "ultralytics layout: images/, labels/, data.yaml")):
+        sub = formats.add_parser(name, help=help_text, description=help_text)
+        sub.add_argument("dir", type=arguments.path, metavar="DIR",
+                         help="dataset root, group folder or scene folder")
+        sub.add_argument("out", type=arguments.path, metavar="OUT", help="export folder (new, or a previous export)")
+        sub.add_argument("--split", choices=("train", "test", "both"), default="both",
+                         help="which split to write (default both)")
+        if name == "yolo":
+            sub.add_argument("--task", choices=("detect", "segment"), default="detect",
+                             help="label lines: boxes (detect, default) or polygons (segment)")
+            sub.add_argument("--appearance-shift", type=arguments.whole, default=None, metavar="SEED",
+                             help="re-colour, light from one side, blur, add noise and re-compress every "
+                                  "exported image (copies; the dataset is untouched): a stand-in for real "
+                                  "photographs when none are at hand")
+        sub.set_defaults(func=run)
+
+
+def check_out(out: Path, fmt: str) -> None:
+    """Refuse an output folder that holds anything but a previous export of the same format."""
+    if out.exists() and not out.is_dir():
+        raise UserError(f"{out}: is a file; give a folder for the export")
+    if out.is_dir():
+        foreign = sorted(p.name for p in out.iterdir() if p.name not in _OURS[fmt])
+        if foreign:
+            raise UserError(f"{out}: holds {', '.join(foreign[:3])}{' ...' if len(foreign) > 3 else ''}, "
+                            f"which is not a {fmt} export; give a new or empty folder")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Export ``args.dir`` to ``args.out``; prints the counts per split."""
+    from davis_ag.data.reader import open_dataset
+
+    splits = ("train", "test") if args.split == "both" else (args.split,)
+    open_dataset(args.dir)  # a bad DIR is reported before anything is created
+    check_out(args.out, args.format)
+    try:
+        args.out.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise UserError(f"{args.out}: cannot create the export folder ({error.strerror}); pick a writable path") from None
+    if args.format == "coco":
+        from davis_ag.detection.coco_export import export_coco
+
+        counts = export_coco(args.dir, args.out, splits)
+        unit = "annotations"
+    else:
+        from davis_ag.detection.yolo_export import export_yolo
+
+        counts = export_yolo(args.dir, args.out, args.task, splits)
+        unit = "instances"
+        if args.appearance_shift is not None:
+            from davis_ag.detection.appearance_shift import shift_folder
+
+            shift_folder(args.out / "images", args.appearance_shift)
+    for split, c in counts.items():
+        print(f"{split}: {c['images']} images, {c[unit]} {unit}")
+    where = args.out / "annotations" if args.format == "coco" else args.out / "data.yaml"
+    print(f"wrote {where}")
+    return 0

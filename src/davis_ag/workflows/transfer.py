@@ -1,0 +1,177 @@
+"""Section VI-B, Table 5: does pre-training on DAVIS-Ag help a detector on real images?
+
+Stages (each resumable: a finished training run's ``done.json`` and a split's scores are kept):
+
+1. export the DAVIS-Ag dataset to the ultralytics layout (its train split trains, its test split
+   validates) and pre-train YOLOv5n on it (``pretrain`` budget);
+2. for each of N random splits of the real set (the paper: three, 654 train / 159 test images),
+   train YOLOv5n on the split's training images from scratch (Real-Only) and from the
+   pre-trained weights (DAVIS-Ag -> Real), with the same budget, and score both on the split's
+   test images: mAP@50 and mAP@50:95.
+
+Writes ``OUT/transfer.json`` and, if asked, a Markdown table shaped like Table 5.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+from davis_ag.atomic_files import write_json_atomic, write_text_atomic
+from davis_ag.detection.real_sets import PAPER_TEST, PAPER_TRAIN, load_pool, split_sizes, write_split
+from davis_ag.detection.yolo_export import export_yolo
+from davis_ag.detection.yolo_training import Budget, evaluate, train
+from davis_ag.errors import UserError
+from davis_ag.stage_timer import Timer
+
+#: Table 5 of the paper (YOLOv5n, real strawberry set of Lemsalu et al. 2022), per split 1-3.
+PAPER_TABLE5: dict[str, dict[str, list[float]]] = {
+    "real_only": {"map50": [0.943, 0.888, 0.920], "map50_95": [0.619, 0.504, 0.505]},
+    "transfer": {"map50": [0.945, 0.911, 0.936], "map50_95": [0.618, 0.511, 0.517]},
+}
+ARMS = (("real_only", "Real-Only"), ("transfer", "DAVIS-Ag -> Real"))
+
+
+@dataclass(frozen=True)
+class TransferConfig:
+    """One run of the experiment.
+
+    Attributes:
+        pretrain: DAVIS-Ag dataset to pre-train on (root, group or scene folder).
+        real: The real set: an ultralytics data YAML, a folder with images/ and labels/, or a COCO JSON.
+        out: Work folder.
+        real_images: Image folder for a COCO ``real`` (default: as its file names say).
+        real_label: How the results name the real set (say "stand-in" when it is not real).
+        splits: Random splits of the real set.
+        train_size: Training images per split (the paper's 654).
+        test_size: Test images per split (the paper's 159).
+        seed: Split ``k`` (from 0) draws with ``seed + k``; training runs are seeded with it too.
+        pretrain_budget: Pre-training budget.
+        budget: Budget of every run on the real set, both arms alike.
+    """
+
+    pretrain: Path
+    real: Path
+    out: Path
+    real_images: Path | None = None
+    real_label: str = "real set"
+    splits: int = 3
+    train_size: int = PAPER_TRAIN
+    test_size: int = PAPER_TEST
+    seed: int = 0
+    pretrain_budget: Budget = field(default_factory=Budget)
+    budget: Budget = field(default_factory=Budget)
+
+
+def _jsonable(config: TransferConfig) -> dict[str, Any]:
+    data = asdict(config)
+    return {k: str(v) if isinstance(v, Path) else v for k, v in data.items()}
+
+
+def run_transfer(config: TransferConfig, say: Callable[[str], None] = print) -> dict[str, Any]:
+    """Run the experiment (see the module docstring); returns what ``transfer.json`` holds.
+
+    Raises:
+        UserError: for unusable inputs (no DAVIS-Ag scene, an unreadable real set, too few images).
+    """
+    if config.splits < 1:
+        raise UserError(f"--splits must be at least 1, got {config.splits}")
+    started = time.perf_counter()
+    timer = Timer()
+    out = config.out
+    pool = load_pool(config.real, config.real_images)
+    n_train, n_test = split_sizes(len(pool.items), config.train_size, config.test_size)
+    if (n_train, n_test) != (config.train_size, config.test_size):
+        say(f"the real set has {len(pool.items)} images: splits of {n_train} train / {n_test} test "
+            f"(the paper's {config.train_size}/{config.test_size} proportions)")
+    with timer.stage("export DAVIS-Ag"):
+        say(f"exporting {config.pretrain} for pre-training")
+        counts = export_yolo(config.pretrain, out / "pretrain-data", "detect")
+    if not counts["train"]["images"]:
+        raise UserError(f"{config.pretrain}: its train split has no view; give a dataset with train scenes")
+    with timer.stage("pre-train"):
+        say("pre-training YOLOv5n on DAVIS-Ag")
+        pretrained = train(out / "pretrain-data" / "data.yaml", out / "runs" / "pretrain",
+                           config.pretrain_budget, config.seed)
+    results: dict[str, Any] = {
+        "what": "Table 5 (section VI-B): YOLOv5n, Real-Only vs DAVIS-Ag -> Real",
+        "real_set": config.real_label, "config": _jsonable(config),
+        "pretrain_images": counts, "real_images": len(pool.items),
+        "split_sizes": {"train": n_train, "test": n_test}, "splits": [], "paper_table5": PAPER_TABLE5,
+    }
+    for k in range(config.splits):
+        seed = config.seed + k
+        split_dir = out / f"split{k + 1}"
+        scores_path = split_dir / "scores.json"
+        if scores_path.is_file():
+            results["splits"].append(json.loads(scores_path.read_text()))
+            timer.notes[f"split {k + 1}"] = "reused"
+            continue
+        with timer.stage(f"split {k + 1}"):
+            data_yaml = write_split(pool, split_dir / "data", seed, n_train, n_test)
+            scores: dict[str, Any] = {"split": k + 1, "seed": seed}
+            for arm, title in ARMS:
+                say(f"split {k + 1}/{config.splits}: {title}")
+                weights = train(data_yaml, split_dir / "runs" / arm, config.budget, seed,
+                                start=pretrained if arm == "transfer" else None)
+                scores[arm] = evaluate(weights, data_yaml, config.budget)
+            write_json_atomic(scores_path, scores)
+            results["splits"].append(scores)
+    results["wall_s"] = {**{name: round(s, 1) for name, s in timer.stages.items()},
+                         "total": round(time.perf_counter() - started, 1)}
+    write_json_atomic(out / "transfer.json", results)
+    return results
+
+
+def table5_markdown(results: dict[str, Any]) -> str:
+    """Our scores in the shape of Table 5, with the paper's Table 5 below for reference."""
+    splits = results["splits"]
+    n = len(splits)
+    head = ("| | " + " | ".join(f"Real-Only {s['split']}" for s in splits) + " | "
+            + " | ".join(f"DAVIS-Ag -> Real {s['split']}" for s in splits) + " |")
+    rule = "|---" * (2 * n + 1) + "|"
+    rows = []
+    for metric, title in (("map50", "mAP@50"), ("map50_95", "mAP@50:95")):
+        cells = [f"{s[arm][metric]:.3f}" for arm, _ in ARMS for s in splits]
+        rows.append(f"| {title} | " + " | ".join(cells) + " |")
+    paper = ["| | Real-Only 1 | 2 | 3 | DAVIS-Ag -> Real 1 | 2 | 3 |", "|---" * 7 + "|"]
+    for metric, title in (("map50", "mAP@50"), ("map50_95", "mAP@50:95")):
+        cells = [f"{v:.3f}" for arm, _ in ARMS for v in PAPER_TABLE5[arm][metric]]
+        paper.append(f"| {title} | " + " | ".join(cells) + " |")
+    return "\n".join([head, rule, *rows, "", "The paper's Table 5 (its real strawberry set, 654/159 images):",
+                      "", *paper])
+
+
+def write_results_md(results: dict[str, Any], path: Path, how: str = "") -> Path:
+    """Write the Markdown report: what ran, the table, the paper's table, the wall time.
+
+    Args:
+        results: What :func:`run_transfer` returned.
+        path: The Markdown file (written atomically).
+        how: The machine it ran on, one line.
+    """
+    cfg = results["config"]
+    pre, bud = cfg["pretrain_budget"], cfg["budget"]
+    wall = results["wall_s"]
+    lines = [
+        "# Sim-to-real transfer (Table 5, section VI-B)", "",
+        "Written by `davis-ag transfer --results`; every number below was measured by that run.", "",
+        f"**Real set: {results['real_set']}.** " + (
+            "These are stand-in numbers, not comparable to the paper's." if "stand-in" in results["real_set"]
+            else ""),
+        "",
+        f"- Pre-training: {cfg['pretrain']} ({results['pretrain_images']['train']['images']} train images); "
+        f"{pre['epochs']} epochs at {pre['imgsz']} px, batch {pre['batch']}, device {pre['device']}.",
+        f"- Real set: {results['real_images']} images, {len(results['splits'])} random splits of "
+        f"{results['split_sizes']['train']} train / {results['split_sizes']['test']} test; "
+        f"every run {bud['epochs']} epochs at {bud['imgsz']} px, batch {bud['batch']}; last-epoch weights scored.",
+        "- Model: ultralytics' YOLOv5n built from `yolov5n.yaml` (anchor-free head), no downloaded weights.",
+        *([f"- Machine: {how}"] if how else []), "",
+        table5_markdown(results), "",
+        "Wall time: " + ", ".join(f"{k} {v:.0f} s" for k, v in wall.items()) + ".", "",
+    ]
+    return write_text_atomic(path, "\n".join(lines))
