@@ -1,0 +1,471 @@
+"""Our renderer: a Helios scene drawn with OpenGL (moderngl, headless EGL), colour, ids and depth.
+
+Same contract as :class:`davis_ag.render.helios.HeliosRenderer`: built from a scene's Context, a
+:class:`~davis_ag.scene.camera.Camera` and its :class:`~davis_ag.scene.lighting.Lighting`;
+:meth:`OpenGLRenderer.render` takes a viewpoint and returns the colour image, the primitive ids
+and the depth image.
+
+- Geometry: the whole scene in one vertex buffer (:mod:`davis_ag.render.scene_geometry`), read
+  from the Context once.
+- Lighting as Helios's ``phong_shadowed`` model: diffuse and specular light from the sun, ambient
+  light blended between a sky and a ground colour by the normal, shadows, sRGB decoding, Helios's
+  colour boost of vertex colours, an ACES-fitted tone curve, the sky dome behind everything.
+- One shadow map per scene: the sun is fixed, so the depth of the shadow casters seen from the
+  sun is drawn once, fitted to the casters (the plants); the soil receives shadows and casts none.
+- Pinhole: Helios's vertical field of view and projection (OpenGL's, pixel centres at +0.5, row 0
+  at the top once read back), so ids and depth line up with :meth:`Camera.project`.
+- Antialiasing (``antialiasing``): 1 draws colour, ids and depth in one 1x pass; 4 (default)
+  draws the colour with 4x multisampling and the ids and depth in a light 1x pass, so ids stay
+  exact (a multisampled id attachment would mix ids at edges). See docs/performance.md.
+- Looks: ``"helios"`` reproduces Helios's frames, its texture handling included (images larger
+  than 2048 pixels resized as Helios does, sampled at the nearest texel without mipmaps), to
+  test fidelity; ``"default"`` samples every texture at full resolution with mipmaps and linear
+  filtering.
+
+Where a GPU with an EGL driver is present, the same code draws on it; which EGL device is used
+follows the EGL vendor library's choice (``__EGL_VENDOR_LIBRARY_FILENAMES``); see the README.
+"""
+
+from __future__ import annotations
+
+import math
+from importlib import resources
+
+import numpy as np
+from PIL import Image
+
+from davis_ag.render.scene_geometry import SceneGeometry, read_scene_geometry
+from davis_ag.scene.camera import Camera
+from davis_ag.scene.lighting import Lighting
+from davis_ag.scene.view_grid import Viewpoint
+
+LOOKS = ("default", "helios")
+#: Helios keeps textures at most this large (Visualizer's ``maximum_texture_size``).
+HELIOS_MAX_TEXTURE = 2048
+#: Helios's shading constants (its Visualizer's defaults): Phong weights and shininess, the
+#: ambient sky and ground colours, the boost of vertex colours, exposure, the sun's tint.
+MATERIAL = (1.0, 0.8, 0.2, 32.0)
+SKY_AMBIENT = (0.5, 0.6, 0.75)
+GROUND_AMBIENT = (0.35, 0.30, 0.22)
+COLOUR_BOOST = 1.5
+EXPOSURE = 1.0
+#: Side of the one shadow map, texels.
+SHADOW_MAP_SIZE = 4096
+#: Depth offset of the shadow test, in the map's [0, 1] depth (besides a polygon offset).
+SHADOW_BIAS = 1e-4
+#: Largest side of a texture layer in the default look (the array is one size for all layers).
+MAX_LAYER = 4096
+
+
+def _shader(name: str) -> str:
+    return (resources.files("davis_ag.render") / "shaders" / name).read_text()
+
+
+def _fragment(name: str, defines: tuple[str, ...] = ()) -> str:
+    lines = ["#version 330 core", *(f"#define {d}" for d in defines), _shader("common.glsl"), _shader(name)]
+    return "\n".join(lines)
+
+
+def default_sky_texture() -> str:
+    """Helios's default sky (``SkyDome_clouds.jpg``, shipped with pyhelios3d)."""
+    from davis_ag.scene.build import helios_texture
+
+    return helios_texture("SkyDome_clouds.jpg")
+
+
+def helios_resize(image: np.ndarray, width: int, height: int) -> np.ndarray:
+    """Resize as Helios's Visualizer does: bilinear from the top-left corner, values rounded up.
+
+    Args:
+        image: (h, w, c) uint8.
+        width, height: The new size.
+
+    Returns:
+        (height, width, c) uint8.
+    """
+    old_h, old_w = image.shape[:2]
+    src_y = np.arange(height, dtype=np.float32) * np.float32(old_h / height)
+    src_x = np.arange(width, dtype=np.float32) * np.float32(old_w / width)
+    y0 = np.minimum(np.floor(src_y).astype(np.int64), old_h - 1)
+    x0 = np.minimum(np.floor(src_x).astype(np.int64), old_w - 1)
+    y1, x1 = np.minimum(y0 + 1, old_h - 1), np.minimum(x0 + 1, old_w - 1)
+    dy = (src_y - y0)[:, None, None]
+    dx = (src_x - x0)[None, :, None]
+    data = image.astype(np.float32)
+    top = data[y0][:, x0] * (1 - dx) + data[y0][:, x1] * dx
+    bottom = data[y1][:, x0] * (1 - dx) + data[y1][:, x1] * dx
+    value = top * (1 - dy) + bottom * dy
+    return np.clip(np.round(value + 0.5), 0, 255).astype(np.uint8)
+
+
+def load_texture(path: str, look: str, size: tuple[int, int] | None = None) -> np.ndarray:
+    """An image as RGBA uint8 rows, first row at texture coordinate v = 0, in a look's resolution.
+
+    Args:
+        path: Image file.
+        look: ``"helios"`` (at most 2048 a side, Helios's resampling) or ``"default"``.
+        size: Resample to this (width, height) (the default look's common layer size).
+    """
+    with Image.open(path) as image:
+        rgba = image.convert("RGBA")
+        if look == "helios":
+            data = np.asarray(rgba)
+            h, w = data.shape[:2]
+            if w > HELIOS_MAX_TEXTURE or h > HELIOS_MAX_TEXTURE:
+                data = helios_resize(data, min(w, HELIOS_MAX_TEXTURE), min(h, HELIOS_MAX_TEXTURE))
+        else:
+            if size is not None and rgba.size != size:
+                rgba = rgba.resize(size, Image.LANCZOS)
+            data = np.asarray(rgba)
+    # Image rows run top to bottom; texture coordinate v = 0 is the image's bottom row.
+    return np.ascontiguousarray(data[::-1])
+
+
+def look_at_matrix(eye: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """World to camera (right, up, backward) with z up in the world, as gluLookAt."""
+    forward = target - eye
+    forward = forward / np.linalg.norm(forward)
+    right = np.cross(forward, (0.0, 0.0, 1.0))
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    m = np.eye(4)
+    m[0, :3], m[1, :3], m[2, :3] = right, up, -forward
+    m[:3, 3] = -m[:3, :3] @ eye
+    return m
+
+
+def perspective_matrix(camera: Camera, near: float) -> np.ndarray:
+    """Helios's projection: vertical field of view, far plane at infinity."""
+    f = 1.0 / math.tan(math.radians(camera.vfov) / 2)
+    m = np.zeros((4, 4))
+    m[0, 0] = f * camera.height / camera.width
+    m[1, 1] = f
+    m[2, 2] = -1.0
+    m[2, 3] = -2.0 * near
+    m[3, 2] = -1.0
+    return m
+
+
+def light_matrix(direction: tuple[float, float, float], lo: np.ndarray, hi: np.ndarray, margin: float | None = None,
+                 exact: np.ndarray | None = None) -> np.ndarray:
+    """World to the shadow map's [0, 1]^3 (x, y across the map, z depth from the sun), fitted to a
+    box (or to the points ``exact``), enlarged by ``margin`` of its extent on every side."""
+    towards = np.asarray(direction, dtype=np.float64)
+    towards /= np.linalg.norm(towards)
+    helper = np.array([0.0, 1.0, 0.0]) if abs(towards[1]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    u = np.cross(helper, towards)
+    u /= np.linalg.norm(u)
+    v = np.cross(towards, u)
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    if exact is not None:
+        corners = exact
+    axes = np.stack([u, v, -towards])  # depth grows away from the sun
+    projected = corners @ axes.T
+    low, high = projected.min(axis=0), projected.max(axis=0)
+    if margin is None:
+        pad = 0.01 * (high - low).max() + 1e-3
+    else:
+        pad = margin * (high - low)
+    low, high = low - pad, high + pad
+    m = np.eye(4)
+    m[:3, :3] = axes / (high - low)[:, None]
+    m[:3, 3] = -low / (high - low)
+    return m
+
+
+def helios_shadow_box(camera: Camera, eye: np.ndarray, target: np.ndarray, sun) -> np.ndarray:
+    """Where Helios computes shadows for a view: world to [0, 1]^3 of the box, seen from the sun,
+    around its camera's view volume cut at max(5 x eye height, 2 x look distance) (1 % margin).
+    Helios lights everything outside it."""
+    distance = float(np.linalg.norm(target - eye))
+    near, far = max(0.1, 0.05 * distance), max(5.0 * eye[2], 2.0 * distance)
+    f = 1.0 / math.tan(math.radians(camera.vfov) / 2)
+    aspect = camera.width / camera.height
+    projection = np.zeros((4, 4))
+    projection[0, 0], projection[1, 1] = f / aspect, f
+    projection[2, 2], projection[2, 3] = -(far + near) / (far - near), -2 * far * near / (far - near)
+    projection[3, 2] = -1.0
+    inverse = np.linalg.inv(projection @ look_at_matrix(eye, target))
+    corners = np.array([[x, y, z, 1.0] for z in (-1, 1) for y in (-1, 1) for x in (-1, 1)]) @ inverse.T
+    corners = corners[:, :3] / corners[:, 3:]
+    return light_matrix(sun, corners.min(axis=0), corners.max(axis=0), margin=0.01, exact=corners)
+
+
+def _gl(matrix: np.ndarray) -> bytes:
+    """A matrix as GLSL reads it (column-major float32)."""
+    return np.asarray(matrix, dtype=np.float32).T.tobytes()
+
+
+def create_context():
+    """A headless OpenGL 3.3+ context through EGL (a GPU's driver where one is installed, else Mesa)."""
+    import moderngl
+
+    try:
+        return moderngl.create_standalone_context(backend="egl", require=330)
+    except Exception as error:  # noqa: BLE001 - moderngl raises plain Exceptions
+        from davis_ag.errors import UserError
+
+        raise UserError(f"cannot open a headless OpenGL context through EGL ({error}): install the "
+                        "system's EGL and GL libraries (Debian: libegl1 libgl1 libgl1-mesa-dri)") from None
+
+
+class OpenGLRenderer:
+    """Draws views of one scene: colour, primitive ids and depth.
+
+    Args:
+        context: The Helios Context with the scene (or a :class:`SceneGeometry` already read).
+        camera: Image size and field of view.
+        lighting: Sun direction and sky.
+        look: ``"default"`` or ``"helios"`` (see the module docstring).
+        antialiasing: 1 (one 1x pass) or 4 (4x multisampled colour, 1x id pass).
+    """
+
+    def __init__(self, context, camera: Camera, lighting: Lighting, look: str = "default",
+                 antialiasing: int = 4) -> None:
+        if look not in LOOKS:
+            raise ValueError(f"look {look!r}: choose one of {', '.join(LOOKS)}")
+        if antialiasing not in (1, 4):
+            raise ValueError("antialiasing must be 1 or 4")
+        self.camera, self.lighting, self.look, self.antialiasing = camera, lighting, look, antialiasing
+        geometry = context if isinstance(context, SceneGeometry) else read_scene_geometry(context)
+        self.geometry = geometry
+        self.ctx = create_context()
+        try:
+            self._build(geometry)
+        except BaseException:
+            self.close()
+            raise
+
+    # -----------------------------------------------------------------------------------------
+    # Set-up
+
+    def _build(self, geometry: SceneGeometry) -> None:
+        import moderngl
+
+        ctx = self.ctx
+        helios = self.look == "helios"
+        self._programs = {
+            "scene": ctx.program(vertex_shader=_shader("scene.vert"), fragment_shader=_fragment("scene.frag")),
+            "ids": ctx.program(vertex_shader=_shader("scene.vert"),
+                               fragment_shader=_fragment("scene.frag", ("IDS_ONLY",))),
+            "shadow": ctx.program(vertex_shader=_shader("shadow.vert"), fragment_shader=_fragment("shadow.frag")),
+            "sky": ctx.program(vertex_shader=_shader("sky.vert"), fragment_shader=_fragment("sky.frag")),
+        }
+        self._upload_textures(geometry)
+        # Helios draws triangles, then patches, each in UUID order; later draws win depth ties
+        # (GL_LEQUAL), so keep that order.
+        order = np.lexsort((geometry.uuids, geometry.patch))
+        n = geometry.triangle_count
+        vertex = np.zeros(n * 3, dtype=[("position", "f4", 3), ("uv", "f4", 2), ("normal", "f4", 3),
+                                        ("colour", "f4", 4), ("id", "u4"), ("texture", "i4"), ("mode", "i4")])
+        vertex["position"] = geometry.positions[order].reshape(-1, 3)
+        vertex["uv"] = geometry.uvs[order].reshape(-1, 2)
+        vertex["normal"] = geometry.normals[order].reshape(-1, 3)
+        vertex["colour"] = np.repeat(geometry.colours[order], 3, axis=0)
+        vertex["id"] = np.repeat(geometry.uuids[order].astype(np.uint64) + 1, 3).astype(np.uint32)
+        vertex["texture"] = np.repeat(np.maximum(geometry.texture[order], 0), 3)
+        vertex["mode"] = np.repeat(geometry.mode[order], 3)
+        self._vbo = ctx.buffer(vertex.tobytes())
+        layout = "3f 2f 3f 4f 1u 1i 1i"
+        names = ["in_position", "in_uv", "in_normal", "in_colour", "in_id", "in_texture", "in_mode"]
+        self._scene = ctx.vertex_array(self._programs["scene"], [(self._vbo, layout, *names)], skip_errors=True)
+        self._ids = ctx.vertex_array(self._programs["ids"], [(self._vbo, layout, *names)], skip_errors=True)
+        shadow_layout = "3f 2f 12x 16x 4x 1i 1i"
+        self._shadow = ctx.vertex_array(self._programs["shadow"], [
+            (self._vbo, shadow_layout, "in_position", "in_uv", "in_texture", "in_mode")], skip_errors=True)
+        self._sky = ctx.vertex_array(self._programs["sky"], [])
+
+        # One shadow map for the scene, fitted to the casters.
+        lo, hi = geometry.caster_bounds()
+        self._light = light_matrix(self.lighting.direction, lo, hi)
+        self._shadow_map = ctx.depth_texture((SHADOW_MAP_SIZE, SHADOW_MAP_SIZE))
+        self._shadow_map.compare_func = ""
+        self._shadow_map.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        caster_first = np.lexsort((~geometry.caster[order],))  # casters only, drawn alone
+        caster_vertex = vertex.reshape(-1, 3)[caster_first][: int(geometry.caster.sum())].reshape(-1)
+        self._caster_vbo = ctx.buffer(caster_vertex.tobytes())
+        caster_vao = ctx.vertex_array(self._programs["shadow"], [
+            (self._caster_vbo, shadow_layout, "in_position", "in_uv", "in_texture", "in_mode")], skip_errors=True)
+        shadow_fbo = ctx.framebuffer(depth_attachment=self._shadow_map)
+        shadow_fbo.use()
+        shadow_fbo.clear(depth=1.0)
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.depth_func = "<="
+        ctx.polygon_offset = (1.0, 1.0)
+        self._programs["shadow"]["light_projection"].write(_gl(self._light))
+        self._bind_textures()
+        if caster_vertex.size:
+            caster_vao.render(moderngl.TRIANGLES)
+        caster_vao.release()
+        shadow_fbo.release()
+
+        # Framebuffers: 1x colour, ids and depth; 4x colour where antialiased.
+        w, h = self.camera.width, self.camera.height
+        self._colour = ctx.renderbuffer((w, h), 4)
+        self._id_buffer = ctx.renderbuffer((w, h), 1, dtype="u4")
+        self._depth_buffer = ctx.renderbuffer((w, h), 1, dtype="f4")
+        self._fbo = ctx.framebuffer([self._colour, self._id_buffer, self._depth_buffer],
+                                    ctx.depth_renderbuffer((w, h)))
+        if self.antialiasing > 1:
+            samples = min(self.antialiasing, ctx.max_samples)
+            # Colour only: the shader's id and depth outputs have no attachment here and are dropped.
+            self._ms_fbo = ctx.framebuffer([ctx.renderbuffer((w, h), 4, samples=samples)],
+                                           ctx.depth_renderbuffer((w, h), samples=samples))
+            self._resolve_fbo = ctx.framebuffer([self._colour])
+            self._ids_fbo = ctx.framebuffer([self._id_buffer, self._depth_buffer], ctx.depth_renderbuffer((w, h)))
+
+        # Uniforms that hold for every view.
+        scene = self._programs["scene"]
+        for program in (scene, self._programs["ids"]):
+            self._set(program, "light_projection", _gl(self._light))
+        for name, value in (("sun", self.lighting.direction), ("exposure", EXPOSURE),
+                            ("colour_boost", COLOUR_BOOST), ("sky_ambient", SKY_AMBIENT),
+                            ("ground_ambient", GROUND_AMBIENT), ("material", MATERIAL),
+                            ("shadow_bias", SHADOW_BIAS)):
+            self._set(scene, name, value)
+        self._set(self._programs["sky"], "exposure", EXPOSURE)
+        for program in self._programs.values():
+            self._set(program, "helios_look", int(helios))
+            self._set(program, "textures", 0)
+            self._set(program, "shadow_map", 1)
+            self._set(program, "sky", 2)
+
+    def _upload_textures(self, geometry: SceneGeometry) -> None:
+        import moderngl
+
+        ctx = self.ctx
+        helios = self.look == "helios"
+        files = geometry.texture_files or []
+        if helios:
+            images = [load_texture(f, "helios") for f in files]
+            width = max([i.shape[1] for i in images] + [1])
+            height = max([i.shape[0] for i in images] + [1])
+        else:
+            sizes = []
+            for f in files:
+                with Image.open(f) as image:
+                    sizes.append(image.size)
+            width = min(MAX_LAYER, max([s[0] for s in sizes] + [1]))
+            height = min(MAX_LAYER, max([s[1] for s in sizes] + [1]))
+            images = [load_texture(f, "default", (width, height)) for f in files]
+        layers = max(1, len(images))
+        data = np.zeros((layers, height, width, 4), dtype=np.uint8)
+        scale = np.ones((64, 2), dtype=np.float32)
+        for k, image in enumerate(images):
+            data[k, : image.shape[0], : image.shape[1]] = image
+            scale[k] = (image.shape[1] / width, image.shape[0] / height)
+        self._textures = ctx.texture_array((width, height, layers), 4, data.tobytes())
+        if helios:
+            self._textures.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            self._textures.repeat_x = self._textures.repeat_y = False
+        else:
+            self._textures.build_mipmaps()
+            self._textures.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+            self._textures.anisotropy = 8.0
+        for program in self._programs.values():
+            if "layer_scale" in program:
+                program["layer_scale"].write(scale.tobytes())
+
+        sky = load_texture(self.lighting.sky_texture or default_sky_texture(), "helios" if helios else "default")
+        self._sky_texture = ctx.texture((sky.shape[1], sky.shape[0]), 4, sky.tobytes())
+        if helios:
+            self._sky_texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        else:
+            self._sky_texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
+        self._sky_texture.repeat_x, self._sky_texture.repeat_y = True, False
+        self._set(self._programs["sky"], "sky_scale", (1.0, 1.0))
+
+    def _bind_textures(self) -> None:
+        self._textures.use(0)
+        self._shadow_map.use(1)
+        self._sky_texture.use(2)
+
+    @staticmethod
+    def _set(program, name: str, value) -> None:
+        if name in program:
+            if isinstance(value, bytes):
+                program[name].write(value)
+            else:
+                program[name].value = value
+
+    # -----------------------------------------------------------------------------------------
+    # Drawing
+
+    def _view_uniforms(self, view: Viewpoint) -> None:
+        eye = np.asarray(view.position, dtype=np.float64)
+        target = np.asarray(view.look_at(1.0), dtype=np.float64)
+        near = max(0.1, 0.05 * float(np.linalg.norm(target - eye)))
+        view_matrix = look_at_matrix(eye, target)
+        projection = perspective_matrix(self.camera, near)
+        view_projection = projection @ view_matrix
+        rotation = view_matrix.copy()
+        rotation[:3, 3] = 0.0
+        # Helios computes shadows only inside a box around its camera's view volume.
+        box = helios_shadow_box(self.camera, eye, target, self.lighting.direction) if self.look == "helios" \
+            else np.diag([0.0, 0.0, 0.0, 1.0]) + np.array([[0, 0, 0, 0.5]] * 3 + [[0, 0, 0, 0]])
+        for program in (self._programs["scene"], self._programs["ids"]):
+            self._set(program, "view_projection", _gl(view_projection))
+            self._set(program, "view", _gl(view_matrix))
+        self._set(self._programs["scene"], "eye", tuple(eye))
+        self._set(self._programs["scene"], "shadow_box", _gl(box))
+        self._set(self._programs["sky"], "inverse_rotation_projection", _gl(np.linalg.inv(projection @ rotation)))
+
+    def draw(self, view: Viewpoint) -> None:
+        """Draw a view into the renderer's buffers (read them with :meth:`read`)."""
+        import moderngl
+
+        ctx = self.ctx
+        self._view_uniforms(view)
+        self._bind_textures()
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.depth_func = "<="
+        ctx.polygon_offset = (1.0, 1.0)
+        if self.antialiasing > 1:
+            self._pass(self._ms_fbo, self._scene)
+            ctx.copy_framebuffer(self._resolve_fbo, self._ms_fbo)
+            self._ids_fbo.use()
+            self._ids_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+            self._ids.render(moderngl.TRIANGLES)
+        else:
+            self._pass(self._fbo, self._scene)
+
+    def _pass(self, fbo, vao) -> None:
+        import moderngl
+
+        fbo.use()
+        fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        self.ctx.disable(moderngl.DEPTH_TEST)
+        self._sky.render(moderngl.TRIANGLES, vertices=3)
+        self.ctx.enable(moderngl.DEPTH_TEST)
+        vao.render(moderngl.TRIANGLES)
+
+    def read(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The last view drawn: colour, primitive ids and depth (see :meth:`render`)."""
+        w, h = self.camera.width, self.camera.height
+        colour = np.frombuffer(self._fbo.read(components=3, attachment=0), dtype=np.uint8).reshape(h, w, 3)
+        ids = np.frombuffer(self._fbo.read(components=1, attachment=1, dtype="u4"), dtype=np.uint32).reshape(h, w)
+        depth = np.frombuffer(self._fbo.read(components=1, attachment=2, dtype="f4"), dtype=np.float32).reshape(h, w)
+        return colour[::-1].copy(), ids[::-1].copy(), depth[::-1].copy()
+
+    def render(self, view: Viewpoint) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Draw one view.
+
+        Returns:
+            Colour (height, width, 3) uint8; primitive ids (height, width) uint32, UUID + 1 of the
+            primitive seen at each pixel centre, 0 for none; depth (height, width) float32, metres
+            along the optical axis, 0 where nothing is hit. Row 0 is the top of the image.
+        """
+        self.draw(view)
+        return self.read()
+
+    def close(self) -> None:
+        """Release the GL context and everything in it."""
+        ctx, self.ctx = getattr(self, "ctx", None), None
+        if ctx is not None:
+            ctx.release()
+
+    def __enter__(self) -> "OpenGLRenderer":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
