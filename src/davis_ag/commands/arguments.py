@@ -38,3 +38,14 @@ def path(text: str) -> Path:
     if not text.strip():
         raise argparse.ArgumentTypeError("an empty path")
     return Path(text).expanduser().absolute()
+
+
+def add_renderer_flags(parser: argparse.ArgumentParser) -> None:
+    """``--renderer`` and ``--look``, shared by generate and preview."""
+    from davis_ag.render.backends import LOOKS, RENDERERS
+
+    parser.add_argument("--renderer", choices=RENDERERS,
+                        help="opengl: ours (default); helios: pyhelios's Visualizer, the slower reference")
+    parser.add_argument("--look", choices=LOOKS,
+                        help="default: full-resolution, filtered textures (default); helios: Helios's frames, "
+                             "reduced unfiltered textures included (the helios renderer draws only this)")

@@ -21,7 +21,7 @@ from davis_ag import __version__
 from davis_ag.errors import UserError
 from davis_ag.generate.scene_writer import SceneWriter, partial_dir
 from davis_ag.labels.fruit_labels import fruit_lookup, label_view, visible_fractions
-from davis_ag.render.helios import HeliosRenderer
+from davis_ag.render.backends import DEFAULT_RENDERER, open_renderer, resolve_look
 from davis_ag.scene.build import build_scene
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import CROPS, SCENARIOS, CropSpec, ScenarioSpec, group_name, plant_centres
@@ -41,6 +41,8 @@ CONVENTIONS = {
     "actions_mp": "forward along the grid axis nearest the heading, backward opposite, left 90 deg "
                   "counter-clockwise of forward, right clockwise; rotate_ccw +30 deg, rotate_cw -30 deg",
     "visible_fraction": "visible pixels of a fruit over the pixels it would cover with nothing in front",
+    "depth": "images/NNNN_depth.png: uint16 millimetres from the camera plane along the optical axis "
+             "(camera-space z), 0 where nothing is hit, 65535 for 65.535 m or more; row 0 at the top",
 }
 
 
@@ -53,6 +55,10 @@ class SceneRequest:
         index: Scene number within its group (folder ``NNN``).
         dataset_seed: The dataset's seed.
         camera: Image size and field of view.
+        renderer: ``opengl`` (ours) or ``helios`` (pyhelios's Visualizer, the reference).
+        look: ``default`` or ``helios`` (see :mod:`davis_ag.render.backends`); None: the
+            renderer's own (``default`` for ours, ``helios`` for Helios).
+        depth: Write ``images/NNNN_depth.png`` for every view.
     """
 
     scenario: ScenarioSpec
@@ -60,6 +66,9 @@ class SceneRequest:
     index: int
     dataset_seed: int
     camera: Camera = Camera()
+    renderer: str = DEFAULT_RENDERER
+    look: str | None = None
+    depth: bool = True
 
     @property
     def seed(self) -> int:
@@ -122,14 +131,16 @@ def generate_scene(
     writer = SceneWriter(scene_dir)
     visible: dict[str, dict[str, float]] = {}
     try:
-        with HeliosRenderer(model.context, camera, model.lighting) as renderer:
+        look = resolve_look(request.renderer, request.look)
+        with open_renderer(request.renderer, model.context, camera, model.lighting, look) as renderer:
             for view in grid.viewpoints:
-                colour, primitive_ids = renderer.render(view)
+                colour, primitive_ids, depth = renderer.render(view, depth=request.depth)
                 labels = label_view(primitive_ids, lookup, request.min_fruit_pixels)
                 fractions = visible_fractions(camera, view, labels, polygons)
                 entry = {"bounding_boxes": labels.boxes, "pose": [round(v, 5) for v in view.pose]}
                 entry.update(grid.pointers(view.index))
-                writer.add_view(view.image_name, colour, labels.segmentation, entry)
+                writer.add_view(view.image_name, colour, labels.segmentation, entry,
+                                depth if request.depth else None)
                 visible[view.image_name] = {str(k): v for k, v in fractions.items()}
                 if on_view:
                     on_view(view.index + 1, len(grid.viewpoints))
@@ -161,6 +172,11 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict) -> dict:
         "scene": request.folder,
         "conventions": CONVENTIONS,
         "camera": request.camera.intrinsics(),
+        "renderer": {"name": request.renderer, "look": resolve_look(request.renderer, request.look),
+                     "antialiasing": "4x multisampled colour, ids and depth from a 1x pass"
+                     if request.renderer == "opengl" else "Helios Visualizer, 4x multisampled colour"},
+        "depth": {"file": "images/NNNN_depth.png", "dtype": "uint16", "unit": "mm",
+                  "axis": "optical (camera-space z)", "no_hit": 0} if request.depth else None,
         "lighting": {"model": "phong_shadowed", "sun_elevation_deg": model.lighting.sun_elevation,
                      "sun_azimuth_deg": model.lighting.sun_azimuth, "sun_direction": model.lighting.direction},
         "grid": {"extent_m": list(request.scenario.extent), "step_m": request.scenario.step,

@@ -28,6 +28,7 @@ follows the EGL vendor library's choice (``__EGL_VENDOR_LIBRARY_FILENAMES``); se
 
 from __future__ import annotations
 
+import functools
 import math
 from importlib import resources
 
@@ -53,6 +54,10 @@ EXPOSURE = 1.0
 SHADOW_MAP_SIZE = 4096
 #: Depth offset of the shadow test, in the map's [0, 1] depth (besides a polygon offset).
 SHADOW_BIAS = 1e-4
+#: Default look: one copy of a ground texture covers this many metres of soil. The Context's own
+#: texture coordinates stretch one soil image over a whole 12 m tile (Helios shows its texels as
+#: 2 cm blocks); the default look lays the image at this size instead, with mipmaps.
+GROUND_REPEAT = 0.5
 #: Largest side of a texture layer in the default look (the array is one size for all layers).
 MAX_LAYER = 4096
 
@@ -74,7 +79,8 @@ def default_sky_texture() -> str:
 
 
 def helios_resize(image: np.ndarray, width: int, height: int) -> np.ndarray:
-    """Resize as Helios's Visualizer does: bilinear from the top-left corner, values rounded up.
+    """Resize as Helios's Visualizer does: new pixel (x, y) is the bilinear blend at source
+    (x * old_width / width, y * old_height / height), rounded as round(value + 0.5).
 
     Args:
         image: (h, w, c) uint8.
@@ -83,42 +89,46 @@ def helios_resize(image: np.ndarray, width: int, height: int) -> np.ndarray:
     Returns:
         (height, width, c) uint8.
     """
+    import cv2
+
     old_h, old_w = image.shape[:2]
-    src_y = np.arange(height, dtype=np.float32) * np.float32(old_h / height)
-    src_x = np.arange(width, dtype=np.float32) * np.float32(old_w / width)
-    y0 = np.minimum(np.floor(src_y).astype(np.int64), old_h - 1)
-    x0 = np.minimum(np.floor(src_x).astype(np.int64), old_w - 1)
-    y1, x1 = np.minimum(y0 + 1, old_h - 1), np.minimum(x0 + 1, old_w - 1)
-    dy = (src_y - y0)[:, None, None]
-    dx = (src_x - x0)[None, :, None]
-    data = image.astype(np.float32)
-    top = data[y0][:, x0] * (1 - dx) + data[y0][:, x1] * dx
-    bottom = data[y1][:, x0] * (1 - dx) + data[y1][:, x1] * dx
-    value = top * (1 - dy) + bottom * dy
+    # warpAffine maps each destination pixel through the inverse of this matrix: src = dst * ratio.
+    matrix = np.array([[width / old_w, 0.0, 0.0], [0.0, height / old_h, 0.0]])
+    value = cv2.warpAffine(image.astype(np.float32), matrix, (width, height), flags=cv2.INTER_LINEAR,
+                           borderMode=cv2.BORDER_REPLICATE)
     return np.clip(np.round(value + 0.5), 0, 255).astype(np.uint8)
 
 
+@functools.lru_cache(maxsize=16)
 def load_texture(path: str, look: str, size: tuple[int, int] | None = None) -> np.ndarray:
     """An image as RGBA uint8 rows, first row at texture coordinate v = 0, in a look's resolution.
+
+    Kept for the life of the process (every scene uses the same few images).
 
     Args:
         path: Image file.
         look: ``"helios"`` (at most 2048 a side, Helios's resampling) or ``"default"``.
         size: Resample to this (width, height) (the default look's common layer size).
     """
-    with Image.open(path) as image:
-        rgba = image.convert("RGBA")
-        if look == "helios":
-            data = np.asarray(rgba)
-            h, w = data.shape[:2]
-            if w > HELIOS_MAX_TEXTURE or h > HELIOS_MAX_TEXTURE:
-                data = helios_resize(data, min(w, HELIOS_MAX_TEXTURE), min(h, HELIOS_MAX_TEXTURE))
-        else:
-            if size is not None and rgba.size != size:
-                rgba = rgba.resize(size, Image.LANCZOS)
-            data = np.asarray(rgba)
+    import cv2
+
+    data = cv2.imread(path, cv2.IMREAD_UNCHANGED)
+    if data is None:
+        raise OSError(f"cannot read the texture image {path}")
+    if data.ndim == 2:
+        data = cv2.cvtColor(data, cv2.COLOR_GRAY2RGB)
+    data = cv2.cvtColor(data, cv2.COLOR_BGRA2RGBA if data.shape[2] == 4 else cv2.COLOR_BGR2RGB)
+    h, w = data.shape[:2]
+    if look == "helios" and (w > HELIOS_MAX_TEXTURE or h > HELIOS_MAX_TEXTURE):
+        data = helios_resize(data, min(w, HELIOS_MAX_TEXTURE), min(h, HELIOS_MAX_TEXTURE))
+    elif look != "helios" and size is not None and (w, h) != tuple(size):
+        data = cv2.resize(data, tuple(size), interpolation=cv2.INTER_AREA if size[0] < w else cv2.INTER_CUBIC)
+    if data.shape[2] == 3:
+        data = np.dstack([data, np.full(data.shape[:2], 255, np.uint8)])
     # Image rows run top to bottom; texture coordinate v = 0 is the image's bottom row.
-    return np.ascontiguousarray(data[::-1])
+    data = np.ascontiguousarray(data[::-1])
+    data.flags.writeable = False
+    return data
 
 
 def look_at_matrix(eye: np.ndarray, target: np.ndarray) -> np.ndarray:
@@ -259,7 +269,11 @@ class OpenGLRenderer:
         vertex = np.zeros(n * 3, dtype=[("position", "f4", 3), ("uv", "f4", 2), ("normal", "f4", 3),
                                         ("colour", "f4", 4), ("id", "u4"), ("texture", "i4"), ("mode", "i4")])
         vertex["position"] = geometry.positions[order].reshape(-1, 3)
-        vertex["uv"] = geometry.uvs[order].reshape(-1, 2)
+        uvs = geometry.uvs[order]
+        if not helios:  # the soil's image laid at a fixed size on the ground, not stretched over the tile
+            ground = ~geometry.caster[order] & (geometry.texture[order] >= 0)
+            uvs = np.where(ground[:, None, None], geometry.positions[order][:, :, :2] / GROUND_REPEAT, uvs)
+        vertex["uv"] = uvs.reshape(-1, 2)
         vertex["normal"] = geometry.normals[order].reshape(-1, 3)
         vertex["colour"] = np.repeat(geometry.colours[order], 3, axis=0)
         vertex["id"] = np.repeat(geometry.uuids[order].astype(np.uint64) + 1, 3).astype(np.uint32)
@@ -361,7 +375,6 @@ class OpenGLRenderer:
         else:
             self._textures.build_mipmaps()
             self._textures.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
-            self._textures.anisotropy = 8.0
         for program in self._programs.values():
             if "layer_scale" in program:
                 program["layer_scale"].write(scale.tobytes())
@@ -430,14 +443,15 @@ class OpenGLRenderer:
             self._pass(self._fbo, self._scene)
 
     def _pass(self, fbo, vao) -> None:
+        """Scene, then the sky where nothing was drawn (its depth is the far plane)."""
         import moderngl
 
         fbo.use()
         fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-        self.ctx.disable(moderngl.DEPTH_TEST)
-        self._sky.render(moderngl.TRIANGLES, vertices=3)
-        self.ctx.enable(moderngl.DEPTH_TEST)
         vao.render(moderngl.TRIANGLES)
+        self.ctx.polygon_offset = (0.0, 0.0)
+        self._sky.render(moderngl.TRIANGLES, vertices=3)
+        self.ctx.polygon_offset = (1.0, 1.0)
 
     def read(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The last view drawn: colour, primitive ids and depth (see :meth:`render`)."""
@@ -447,8 +461,8 @@ class OpenGLRenderer:
         depth = np.frombuffer(self._fbo.read(components=1, attachment=2, dtype="f4"), dtype=np.float32).reshape(h, w)
         return colour[::-1].copy(), ids[::-1].copy(), depth[::-1].copy()
 
-    def render(self, view: Viewpoint) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Draw one view.
+    def render(self, view: Viewpoint, depth: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Draw one view (the depth comes from the same pass as the ids, so ``depth`` changes nothing).
 
         Returns:
             Colour (height, width, 3) uint8; primitive ids (height, width) uint32, UUID + 1 of the
