@@ -48,7 +48,7 @@ def test_generated_scene_is_a_sound_dataset(generated: tuple[Path, Path, dict]) 
     assert sorted(p.name for p in scene_dir.iterdir()) == ["annotations.json", "images", "scene.json"]
     names = [f"{i:04d}.jpeg" for i in range(1, VIEWS + 1)]
     assert sorted(p.name for p in (scene_dir / "images").iterdir()) == sorted(
-        names + [n.replace(".jpeg", "_seg.png") for n in names])
+        names + [n.replace(".jpeg", suffix) for n in names for suffix in ("_seg.png", "_depth.png")])
 
     report = validate_dataset(root)
     assert report.ok, [str(p) for p in report.problems]

@@ -144,16 +144,58 @@ def look_at_matrix(eye: np.ndarray, target: np.ndarray) -> np.ndarray:
     return m
 
 
-def perspective_matrix(camera: Camera, near: float) -> np.ndarray:
-    """Helios's projection: vertical field of view, far plane at infinity."""
-    f = 1.0 / math.tan(math.radians(camera.vfov) / 2)
-    m = np.zeros((4, 4))
-    m[0, 0] = f * camera.height / camera.width
-    m[1, 1] = f
-    m[2, 2] = -1.0
-    m[2, 3] = -2.0 * near
-    m[3, 2] = -1.0
-    return m
+def camera_matrices(camera: Camera, view: Viewpoint) -> tuple[np.ndarray, np.ndarray]:
+    """World to camera and camera to clip matrices of a view, float32, computed as Helios computes
+    them (glm's lookAt and infinitePerspective in single precision, in glm's order of operations),
+    so that both renderers put every vertex at the same place, to the last bit, and an edge falls
+    on the same side of every pixel centre.
+
+    Returns:
+        (view, projection), each (4, 4) float32 acting on column vectors.
+    """
+    f32 = np.float32
+    eye = np.asarray(view.position, dtype=f32)
+    target = np.asarray(view.look_at(1.0), dtype=f32)
+
+    def normalise(v: np.ndarray) -> np.ndarray:
+        return (v * (f32(1.0) / np.sqrt(f32(np.dot(v, v))))).astype(f32)
+
+    def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        return np.array([a[1] * b[2] - b[1] * a[2], a[2] * b[0] - b[2] * a[0], a[0] * b[1] - b[0] * a[1]], dtype=f32)
+
+    def dot(a: np.ndarray, b: np.ndarray) -> np.float32:
+        return f32(f32(a[0] * b[0] + a[1] * b[1]) + a[2] * b[2])
+
+    forward = normalise((target - eye).astype(f32))
+    side = normalise(cross(forward, np.array([0, 0, 1], dtype=f32)))
+    up = cross(side, forward)
+    view_matrix = np.eye(4, dtype=f32)
+    view_matrix[0, :3], view_matrix[1, :3], view_matrix[2, :3] = side, up, -forward
+    view_matrix[:3, 3] = (-dot(side, eye), -dot(up, eye), dot(forward, eye))
+    offset = (target - eye).astype(f32)
+    distance = np.sqrt(dot(offset, offset))
+    near = max(f32(0.1), f32(f32(0.05) * distance))
+    half = f32(np.tan(f32(f32(np.radians(f32(camera.vfov))) / f32(2.0))) * near)
+    aspect = f32(f32(camera.width) / f32(camera.height))
+    left, right = f32(-half * aspect), f32(half * aspect)
+    projection = np.zeros((4, 4), dtype=f32)
+    projection[0, 0] = f32(f32(2.0) * near) / f32(right - left)
+    projection[1, 1] = f32(f32(2.0) * near) / f32(half - (-half))
+    projection[2, 2], projection[3, 2] = -1.0, -1.0
+    projection[2, 3] = f32(-2.0) * near
+    return view_matrix, projection
+
+
+def matmul32(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """4x4 product in single precision, summed term by term in glm's order."""
+    a, b = a.astype(np.float32), b.astype(np.float32)
+    out = np.zeros((4, 4), dtype=np.float32)
+    for column in range(4):
+        total = a[:, 0] * b[0, column]
+        for k in range(1, 4):
+            total = (total + a[:, k] * b[k, column]).astype(np.float32)
+        out[:, column] = total
+    return out
 
 
 def light_matrix(direction: tuple[float, float, float], lo: np.ndarray, hi: np.ndarray, margin: float | None = None,
@@ -407,11 +449,9 @@ class OpenGLRenderer:
     def _view_uniforms(self, view: Viewpoint) -> None:
         eye = np.asarray(view.position, dtype=np.float64)
         target = np.asarray(view.look_at(1.0), dtype=np.float64)
-        near = max(0.1, 0.05 * float(np.linalg.norm(target - eye)))
-        view_matrix = look_at_matrix(eye, target)
-        projection = perspective_matrix(self.camera, near)
-        view_projection = projection @ view_matrix
-        rotation = view_matrix.copy()
+        view_matrix, projection = camera_matrices(self.camera, view)
+        view_projection = matmul32(projection, view_matrix)
+        rotation = view_matrix.astype(np.float64)
         rotation[:3, 3] = 0.0
         # Helios computes shadows only inside a box around its camera's view volume.
         box = helios_shadow_box(self.camera, eye, target, self.lighting.direction) if self.look == "helios" \
@@ -421,7 +461,8 @@ class OpenGLRenderer:
             self._set(program, "view", _gl(view_matrix))
         self._set(self._programs["scene"], "eye", tuple(eye))
         self._set(self._programs["scene"], "shadow_box", _gl(box))
-        self._set(self._programs["sky"], "inverse_rotation_projection", _gl(np.linalg.inv(projection @ rotation)))
+        self._set(self._programs["sky"], "inverse_rotation_projection",
+                  _gl(np.linalg.inv(projection.astype(np.float64) @ rotation)))
 
     def draw(self, view: Viewpoint) -> None:
         """Draw a view into the renderer's buffers (read them with :meth:`read`)."""
