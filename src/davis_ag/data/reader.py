@@ -114,9 +114,15 @@ class View:
         Raises:
             UserError: when the file exists but cannot be read or is not 16-bit.
         """
+        from PIL import Image, UnidentifiedImageError
+
         if not self.depth_path.is_file():
             return None
-        millimetres = _load_pixels(self.depth_path, None)
+        try:
+            with Image.open(self.depth_path) as im:
+                millimetres = np.asarray(im)
+        except (OSError, UnidentifiedImageError, ValueError) as error:
+            raise UserError(f"{self.depth_path}: cannot decode ({error}); regenerate the scene") from None
         if millimetres.dtype != np.uint16 or millimetres.ndim != 2:
             raise UserError(f"{self.depth_path}: a depth image must be a 16-bit single-channel PNG")
         return millimetres.astype(np.float32) / 1000.0
