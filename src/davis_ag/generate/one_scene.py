@@ -119,11 +119,41 @@ def generate_scene(
     """
     root = Path(root).absolute()  # Helios moves the working directory while it builds and closes
     started = time.perf_counter()
+    model, grid = grow_scene(request)
+    return draw_scene(request, model, grid, root, on_view, grow_s=time.perf_counter() - started)
+
+
+def grow_scene(request: SceneRequest):
+    """Grow a scene's plants and lay out its views, drawing from the scene's seed in a fixed order.
+
+    Returns:
+        The :class:`~davis_ag.scene.build.SceneModel` and its view grid.
+    """
     rng = np.random.default_rng(request.seed)
     model = build_scene(request.scenario, request.crop, rng)
-    grown = time.perf_counter()
     grid = build_view_grid(request.scenario, request.crop, plant_centres(request.scenario, request.crop),
                            model.aim_height, rng)
+    return model, grid
+
+
+def draw_scene(request: SceneRequest, model, grid, root: Path, on_view: Callable[[int, int], None] | None = None,
+               grow_s: float = 0.0, views: list | None = None) -> tuple[Path, dict]:
+    """Draw, label and write every view of a grown scene, then publish the folder atomically.
+
+    Args:
+        request: What to make (renderer, look, depth, image size).
+        model, grid: From :func:`grow_scene`.
+        root: The dataset root.
+        on_view: Called with (views done, views in all) after every view.
+        grow_s: Seconds spent growing, for scene.json.
+        views: Only these viewpoints of the grid (the benchmark); None for all.
+
+    Returns:
+        The scene folder and timing statistics.
+    """
+    root = Path(root).absolute()
+    grown = time.perf_counter()
+    viewpoints = list(grid.viewpoints if views is None else views)
     lookup = fruit_lookup({f.id: f.uuids for f in model.fruits}, model.uuid_count)
     polygons = {f.id: f.polygons for f in model.fruits}
     camera = request.camera
@@ -133,7 +163,7 @@ def generate_scene(
     try:
         look = resolve_look(request.renderer, request.look)
         with open_renderer(request.renderer, model.context, camera, model.lighting, look) as renderer:
-            for view in grid.viewpoints:
+            for done, view in enumerate(viewpoints, 1):
                 colour, primitive_ids, depth = renderer.render(view, depth=request.depth)
                 labels = label_view(primitive_ids, lookup, request.min_fruit_pixels)
                 fractions = visible_fractions(camera, view, labels, polygons)
@@ -143,17 +173,17 @@ def generate_scene(
                                 depth if request.depth else None)
                 visible[view.image_name] = {str(k): v for k, v in fractions.items()}
                 if on_view:
-                    on_view(view.index + 1, len(grid.viewpoints))
+                    on_view(done, len(viewpoints))
             writer.wait()  # every image written before the Visualizer's teardown moves the cwd
         drawn = time.perf_counter()
         metadata = scene_metadata(request, model, grid, visible)
-        metadata["timing_s"] = {"grow": round(grown - started, 3), "draw_and_label": round(drawn - grown, 3)}
+        metadata["timing_s"] = {"grow": round(grow_s, 3), "draw_and_label": round(drawn - grown, 3)}
         writer.finish(metadata)
     except BaseException:
         writer.abort()
         raise
-    stats = {"views": len(grid.viewpoints), "grow_s": grown - started, "views_s": drawn - grown,
-             "total_s": time.perf_counter() - started}
+    stats = {"views": len(viewpoints), "grow_s": grow_s, "views_s": drawn - grown,
+             "total_s": grow_s + time.perf_counter() - grown}
     return scene_dir, stats
 
 
