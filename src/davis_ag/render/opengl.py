@@ -69,6 +69,35 @@ def _fragment(name: str, defines: tuple[str, ...] = ()) -> str:
     return "\n".join(lines)
 
 
+def _egl_current() -> tuple | None:
+    """The EGL context current on this thread (display, draw, read, context), or None."""
+    import ctypes
+    import ctypes.util
+
+    try:
+        egl = ctypes.CDLL(ctypes.util.find_library("EGL") or "libEGL.so.1")
+    except OSError:
+        return None
+    for name in ("eglGetCurrentDisplay", "eglGetCurrentContext", "eglGetCurrentSurface"):
+        getattr(egl, name).restype = ctypes.c_void_p
+    egl.eglGetCurrentSurface.argtypes = [ctypes.c_int]
+    egl.eglMakeCurrent.argtypes = [ctypes.c_void_p] * 4
+    display = egl.eglGetCurrentDisplay()
+    if not display:
+        return None
+    draw_surface, read_surface = 0x3059, 0x305A  # EGL_DRAW, EGL_READ
+    return (egl, display, egl.eglGetCurrentSurface(draw_surface), egl.eglGetCurrentSurface(read_surface),
+            egl.eglGetCurrentContext())
+
+
+def _egl_restore(state: tuple | None) -> None:
+    """Make a context saved by :func:`_egl_current` current again (another GL user's, such as
+    Helios's Visualizer, which expects its context to stay current between its calls)."""
+    if state is not None:
+        egl, display, draw, read, context = state
+        egl.eglMakeCurrent(display, draw, read, context)
+
+
 def create_context():
     """A headless OpenGL 3.3+ context through EGL (a GPU's driver where one is installed, else Mesa)."""
     import moderngl
@@ -102,12 +131,17 @@ class OpenGLRenderer:
         self.camera, self.lighting, self.look, self.antialiasing = camera, lighting, look, antialiasing
         geometry = context if isinstance(context, SceneGeometry) else read_scene_geometry(context)
         self.geometry = geometry
+        # Our context is current only while we draw: another GL user in this process (Helios's
+        # Visualizer) finds its own context current again after every call of ours.
+        previous = _egl_current()
         self.ctx = create_context()
         try:
             self._build(geometry)
         except BaseException:
             self.close()
             raise
+        finally:
+            _egl_restore(previous)
 
     # -----------------------------------------------------------------------------------------
     # Set-up
@@ -124,6 +158,12 @@ class OpenGLRenderer:
             "shadow": ctx.program(vertex_shader=_shader("shadow.vert"), fragment_shader=_fragment("shadow.frag")),
             "sky": ctx.program(vertex_shader=_shader("sky.vert"), fragment_shader=_fragment("sky.frag")),
         }
+        # Samplers and the look first: the shadow pass below samples leaf textures already.
+        for program in self._programs.values():
+            self._set(program, "helios_look", int(helios))
+            self._set(program, "textures", 0)
+            self._set(program, "shadow_map", 1)
+            self._set(program, "sky", 2)
         self._upload_textures(geometry)
         # Helios draws triangles, then patches, each in UUID order; later draws win depth ties
         # (GL_LEQUAL), so keep that order.
@@ -195,18 +235,13 @@ class OpenGLRenderer:
         scene = self._programs["scene"]
         for program in (scene, self._programs["ids"]):
             self._set(program, "light_projection", gl_matrix(self._light))
+        self._set(self._programs["sky"], "exposure", EXPOSURE)
+        self._set(scene, "light_depth_range", float(1.0 / np.linalg.norm(self._light[2, :3])))
         for name, value in (("sun", self.lighting.direction), ("exposure", EXPOSURE),
                             ("colour_boost", COLOUR_BOOST), ("sky_ambient", SKY_AMBIENT),
                             ("ground_ambient", GROUND_AMBIENT), ("material", MATERIAL),
                             ("shadow_bias", SHADOW_BIAS)):
             self._set(scene, name, value)
-        self._set(self._programs["sky"], "exposure", EXPOSURE)
-        for program in self._programs.values():
-            self._set(program, "helios_look", int(helios))
-            self._set(program, "textures", 0)
-            self._set(program, "shadow_map", 1)
-            self._set(program, "sky", 2)
-
     def _upload_textures(self, geometry: SceneGeometry) -> None:
         import moderngl
 
@@ -331,14 +366,22 @@ class OpenGLRenderer:
             primitive seen at each pixel centre, 0 for none; depth (height, width) float32, metres
             along the optical axis, 0 where nothing is hit. Row 0 is the top of the image.
         """
-        self.draw(view)
-        return self.read()
+        previous = _egl_current()
+        try:
+            with self.ctx:
+                self.draw(view)
+                return self.read()
+        finally:
+            _egl_restore(previous)
 
     def close(self) -> None:
         """Release the GL context and everything in it."""
         ctx, self.ctx = getattr(self, "ctx", None), None
         if ctx is not None:
+            previous = _egl_current()
+            ctx.mglo.__enter__()  # release our objects in our context, not in whichever is current
             ctx.release()
+            _egl_restore(previous)
 
     def __enter__(self) -> "OpenGLRenderer":
         return self

@@ -10,6 +10,7 @@ uniform vec3 sky_ambient;
 uniform vec3 ground_ambient;
 uniform vec4 material;          // ambient, diffuse, specular weights and shininess
 uniform float shadow_bias;
+uniform float light_depth_range; // metres from the shadow map's depth 0 to depth 1
 uniform mat4 shadow_box;        // world -> [0, 1]^3 of the region that can be in shadow
 
 in vec3 world_position;
@@ -41,7 +42,13 @@ float sunlit(vec3 normal) {
         return 1.0;  // outside the casters' box: nothing can shade it
     }
     // Receivers below every caster (the ground) are clamped to the far plane and still tested.
-    return texture(shadow_map, p.xy).r < min(p.z, 1.0) - shadow_bias ? 0.0 : 1.0;
+    float occluder_depth = texture(shadow_map, p.xy).r;
+    if (occluder_depth >= min(p.z, 1.0) - shadow_bias) {
+        return 1.0;
+    }
+    // Helios's map holds only casters inside its box: one nearer the sun than the box casts nothing.
+    vec3 occluder = world_position + sun * ((p.z - occluder_depth) * light_depth_range);
+    return (shadow_box * vec4(occluder, 1.0)).z < 0.0 ? 1.0 : 0.0;
 }
 
 void main() {
