@@ -98,17 +98,30 @@ def _egl_restore(state: tuple | None) -> None:
         egl.eglMakeCurrent(display, draw, read, context)
 
 
+#: Environment variable naming the EGL device to draw on (an index into EGL's device list).
+EGL_DEVICE_VARIABLE = "DAVIS_AG_EGL_DEVICE"
+
+
 def create_context():
-    """A headless OpenGL 3.3+ context through EGL (a GPU's driver where one is installed, else Mesa)."""
+    """A headless OpenGL 3.3+ context through EGL: the default EGL display (a GPU's driver where one
+    is installed and chosen by libglvnd, else Mesa's llvmpipe), or EGL device number
+    ``$DAVIS_AG_EGL_DEVICE`` where that is set (README, "Rendering")."""
+    import os
+
     import moderngl
 
-    try:
-        return moderngl.create_standalone_context(backend="egl", require=330)
-    except Exception as error:  # noqa: BLE001 - moderngl raises plain Exceptions
-        from davis_ag.errors import UserError
+    from davis_ag.errors import UserError
 
+    device = os.environ.get(EGL_DEVICE_VARIABLE, "").strip()
+    if device and not device.isdigit():
+        raise UserError(f"{EGL_DEVICE_VARIABLE}={device!r}: give the number of an EGL device (0, 1, ...)")
+    options = {"device_index": int(device)} if device else {}
+    try:
+        return moderngl.create_standalone_context(backend="egl", require=330, **options)
+    except Exception as error:  # noqa: BLE001 - moderngl raises plain Exceptions
         raise UserError(f"cannot open a headless OpenGL context through EGL ({error}): install the "
-                        "system's EGL and GL libraries (Debian: libegl1 libgl1 libgl1-mesa-dri)") from None
+                        "system's EGL and GL libraries (Debian: libegl1 libgl1 libgl1-mesa-dri)"
+                        + (f", or choose another {EGL_DEVICE_VARIABLE}" if device else "")) from None
 
 
 class OpenGLRenderer:
