@@ -60,6 +60,19 @@ GROUND_REPEAT = 0.5
 MAX_LAYER = 4096
 
 
+def decode_srgb(values: np.ndarray) -> np.ndarray:
+    """sRGB-encoded values in [0, 1] to linear light (IEC 61966-2-1)."""
+    values = np.asarray(values, dtype=np.float64)
+    return np.where(values <= 0.04045, values / 12.92, ((values + 0.055) / 1.055) ** 2.4)
+
+
+def linear_albedo(colours: np.ndarray) -> np.ndarray:
+    """Helios's vertex colours as its shader uses them: boosted, clipped, decoded to linear light."""
+    out = np.array(colours, dtype=np.float64)
+    out[:, :3] = decode_srgb(np.clip(out[:, :3] * COLOUR_BOOST, 0.0, 1.0))
+    return out.astype(np.float32)
+
+
 def _shader(name: str) -> str:
     return (resources.files("davis_ag.render") / "shaders" / name).read_text()
 
@@ -191,7 +204,7 @@ class OpenGLRenderer:
             uvs = np.where(ground[:, None, None], geometry.positions[order][:, :, :2] / GROUND_REPEAT, uvs)
         vertex["uv"] = uvs.reshape(-1, 2)
         vertex["normal"] = geometry.normals[order].reshape(-1, 3)
-        vertex["colour"] = np.repeat(geometry.colours[order], 3, axis=0)
+        vertex["colour"] = np.repeat(linear_albedo(geometry.colours[order]), 3, axis=0)
         vertex["id"] = np.repeat(geometry.uuids[order].astype(np.uint64) + 1, 3).astype(np.uint32)
         vertex["texture"] = np.repeat(np.maximum(geometry.texture[order], 0), 3)
         vertex["mode"] = np.repeat(geometry.mode[order], 3)
@@ -251,7 +264,7 @@ class OpenGLRenderer:
         self._set(self._programs["sky"], "exposure", EXPOSURE)
         self._set(scene, "light_depth_range", float(1.0 / np.linalg.norm(self._light[2, :3])))
         for name, value in (("sun", self.lighting.direction), ("exposure", EXPOSURE),
-                            ("colour_boost", COLOUR_BOOST), ("sky_ambient", SKY_AMBIENT),
+                            ("sky_ambient", SKY_AMBIENT),
                             ("ground_ambient", GROUND_AMBIENT), ("material", MATERIAL),
                             ("shadow_bias", SHADOW_BIAS)):
             self._set(scene, name, value)
@@ -274,12 +287,15 @@ class OpenGLRenderer:
             height = min(MAX_LAYER, max([s[1] for s in sizes] + [1]))
             images = [load_texture(f, "default", (width, height)) for f in files]
         layers = max(1, len(images))
-        data = np.zeros((layers, height, width, 4), dtype=np.uint8)
+        # Half floats in linear light: the shader samples colours it need not decode.
+        data = np.zeros((layers, height, width, 4), dtype=np.float16)
         scale = np.ones((64, 2), dtype=np.float32)
         for k, image in enumerate(images):
-            data[k, : image.shape[0], : image.shape[1]] = image
+            texels = image.astype(np.float64) / 255.0
+            texels[..., :3] = decode_srgb(texels[..., :3])
+            data[k, : image.shape[0], : image.shape[1]] = texels
             scale[k] = (image.shape[1] / width, image.shape[0] / height)
-        self._textures = ctx.texture_array((width, height, layers), 4, data.tobytes())
+        self._textures = ctx.texture_array((width, height, layers), 4, data.tobytes(), dtype="f2")
         if helios:
             self._textures.filter = (moderngl.NEAREST, moderngl.NEAREST)
             self._textures.repeat_x = self._textures.repeat_y = False

@@ -5,7 +5,6 @@ uniform sampler2D shadow_map;
 uniform vec3 sun;               // unit vector towards the sun
 uniform vec3 eye;               // camera position
 uniform float exposure;
-uniform float colour_boost;     // Helios brightens vertex colours by this factor
 uniform vec3 sky_ambient;
 uniform vec3 ground_ambient;
 uniform vec4 material;          // ambient, diffuse, specular weights and shininess
@@ -18,7 +17,7 @@ in vec2 uv;
 in vec3 vertex_normal;
 in vec4 shadow_position;
 in float view_depth;
-flat in vec4 colour;
+flat in vec4 colour;             // linear albedo
 flat in uint primitive_id;
 flat in int texture_layer;
 flat in int texture_mode;
@@ -52,14 +51,14 @@ float sunlit(vec3 normal) {
 }
 
 void main() {
+    // Colours arrive linear: vertex colours boosted and decoded once per scene, texels decoded
+    // when the textures were made.
     vec4 albedo = colour;
     if (texture_mode == 1) {
         albedo = sample_layer(uv, texture_layer);
         if (albedo.a < 0.5) discard;
-        albedo.rgb = decode_srgb(albedo.rgb);
-    } else {
-        if (texture_mode == 2 && sample_layer(uv, texture_layer).a < 0.5) discard;
-        albedo.rgb = decode_srgb(clamp(colour.rgb * colour_boost, 0.0, 1.0));
+    } else if (texture_mode == 2 && sample_layer(uv, texture_layer).a < 0.5) {
+        discard;
     }
     out_id = primitive_id;
     out_depth = view_depth;
