@@ -65,10 +65,10 @@ class PerSample:
     def __init__(self, renderer: OpenGLRenderer) -> None:
         ctx, w, h = renderer.ctx, renderer.camera.width, renderer.camera.height
         self.renderer = renderer
-        colour = ctx.renderbuffer((w, h), 4, samples=4)
+        colour = ctx.texture((w, h), 4, samples=4)  # all attachments textures: a complete framebuffer
         self.ids = ctx.texture((w, h), 1, dtype="u4", samples=4)
         self.depths = ctx.texture((w, h), 1, dtype="f4", samples=4)
-        self.fbo = ctx.framebuffer([colour, self.ids, self.depths], ctx.depth_renderbuffer((w, h), samples=4))
+        self.fbo = ctx.framebuffer([colour, self.ids, self.depths], ctx.depth_texture((w, h), samples=4))
         self.colour_only = ctx.framebuffer([colour])
         sky_vertex = (Path(__file__).parents[1] / "src/davis_ag/render/shaders/sky.vert").read_text()
         self.program = ctx.program(vertex_shader=sky_vertex, fragment_shader=RESOLVE)
@@ -76,6 +76,13 @@ class PerSample:
         self.vao = ctx.vertex_array(self.program, [])
 
     def render(self, view) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        import moderngl
+
+        r = self.renderer
+        with r.ctx:
+            return self._render(view)
+
+    def _render(self, view) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         import moderngl
 
         r = self.renderer
