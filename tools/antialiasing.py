@@ -63,6 +63,10 @@ class PerSample:
     """Our renderer's 4x pass with ids and depth kept per sample, resolved from sample 0."""
 
     def __init__(self, renderer: OpenGLRenderer) -> None:
+        with renderer.ctx:  # its objects live in the renderer's context, whichever is current now
+            self._build(renderer)
+
+    def _build(self, renderer: OpenGLRenderer) -> None:
         ctx, w, h = renderer.ctx, renderer.camera.width, renderer.camera.height
         self.renderer = renderer
         colour = ctx.texture((w, h), 4, samples=4)  # all attachments textures: a complete framebuffer
