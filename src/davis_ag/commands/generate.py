@@ -41,9 +41,9 @@ def register(subparsers) -> None:
                         help="make only this scene or group, e.g. Single-Strawberry/003 (repeatable, or "
                              "comma-separated)")
     parser.add_argument("--workers", type=arguments.count,
-                        help=f"scene processes on this machine, each drawing with one Mesa thread (default: "
-                             f"one per core as memory allows, {default_workers()} here; 1 draws in this process "
-                             "with every core)")
+                        help=f"scene processes on this machine, each drawing with its share of the cores as "
+                             f"Mesa threads (default: one per core as memory allows, {default_workers()} here, never "
+                             "more than the scenes; 1, or a single scene, draws in this process with every core)")
     parser.add_argument("--executor", choices=("local", "ray"), default="local",
                         help="local processes (default) or one Ray task per scene on a cluster")
     parser.add_argument("--address", help="Ray cluster address: auto (on a cluster machine) or ray://HEAD:10001")
