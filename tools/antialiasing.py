@@ -80,7 +80,6 @@ class PerSample:
         self.vao = ctx.vertex_array(self.program, [])
 
     def render(self, view) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        import moderngl
 
         r = self.renderer
         with r.ctx:

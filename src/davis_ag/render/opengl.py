@@ -52,6 +52,8 @@ EXPOSURE = 1.0
 SHADOW_MAP_SIZE = 4096
 #: Depth offset of the shadow test, in the map's [0, 1] depth (besides a polygon offset).
 SHADOW_BIAS = 1e-4
+#: The default look's shadow box: every point maps to its middle, so shadows fall everywhere.
+EVERYWHERE = np.array([[0, 0, 0, 0.5], [0, 0, 0, 0.5], [0, 0, 0, 0.5], [0, 0, 0, 1.0]])
 #: Default look: one copy of a ground texture covers this many metres of soil. The Context's own
 #: texture coordinates stretch one soil image over a whole 12 m tile (Helios shows its texels as
 #: 2 cm blocks); the default look lays the image at this size instead, with mipmaps.
@@ -340,7 +342,7 @@ class OpenGLRenderer:
         rotation[:3, 3] = 0.0
         # Helios computes shadows only inside a box around its camera's view volume.
         box = helios_shadow_box(self.camera, eye, target, self.lighting.direction) if self.look == "helios" \
-            else np.diag([0.0, 0.0, 0.0, 1.0]) + np.array([[0, 0, 0, 0.5]] * 3 + [[0, 0, 0, 0]])
+            else EVERYWHERE
         for program in (self._programs["scene"], self._programs["ids"]):
             self._set(program, "view_projection", gl_matrix(view_projection))
             self._set(program, "view", gl_matrix(view_matrix))
