@@ -10,7 +10,10 @@ vec4 sample_layer(vec2 coordinate, int layer) {
     if (helios_look == 1) {
         return texture(textures, vec3(fract(coordinate) * layer_scale[layer], float(layer)));
     }
-    return texture(textures, vec3(coordinate, float(layer)));  // repeat, trilinear
+    // Colour trilinear from the mipmaps; alpha from the full-resolution image, so a leaf keeps its
+    // outline at a distance (averaged alpha would thin it below the 0.5 threshold).
+    vec3 at = vec3(coordinate, float(layer));
+    return vec4(texture(textures, at).rgb, textureLod(textures, at, 0.0).a);
 }
 
 vec3 decode_srgb(vec3 c) {
