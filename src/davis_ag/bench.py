@@ -88,12 +88,12 @@ def time_ours(request: SceneRequest, model, grid, views: list, root: Path) -> tu
     return (end - marks["first"]) / (len(views) - 1), marks["first"] - start
 
 
-def bench_crop(crop: str, scratch: Path, repeats: int, documented: bool = True) -> dict:
+def bench_crop(crop: str, scratch: Path, repeats: int, documented: bool = True, antialiasing: int = 4) -> dict:
     """Grow one scene and time ours, the documented path and the floor on the same views."""
     from davis_ag.render.helios import HeliosRenderer
     from davis_ag.render.opengl import OpenGLRenderer
 
-    request = SceneRequest(GRIDS[crop], CROPS[crop], 0, SEED, CAMERA)
+    request = SceneRequest(GRIDS[crop], CROPS[crop], 0, SEED, CAMERA, antialiasing=antialiasing)
     started = time.perf_counter()
     model, grid = grow_scene(request)
     grow_s = time.perf_counter() - started
@@ -108,7 +108,7 @@ def bench_crop(crop: str, scratch: Path, repeats: int, documented: bool = True) 
     times: dict[str, list[float]] = {"ours": [], "documented": [], "floor": []}
     setup: list[float] = []
     helios = HeliosRenderer(model.context, request.camera, model.lighting) if documented else None
-    ours_renderer = OpenGLRenderer(model.context, request.camera, model.lighting)
+    ours_renderer = OpenGLRenderer(model.context, request.camera, model.lighting, antialiasing=antialiasing)
     try:
         def documented_view(view) -> None:
             helios.set_view(view)
@@ -188,17 +188,18 @@ def env_speed(dataset: Path, steps: int = 20_000) -> dict:
     return {"steps_per_second": round(rate), "steps": steps, "target_min": 5000}
 
 
-def run(out: Path, crops: list[str], repeats: int) -> dict:
+def run(out: Path, crops: list[str], repeats: int, antialiasing: int = 4) -> dict:
     """Run every measurement; return the JSON report."""
     load_start = os.getloadavg()
     report: dict = {"machine": {"cpus": os.cpu_count(), "platform": platform.platform(),
                                 "LP_NUM_THREADS": os.environ.get("LP_NUM_THREADS")},
-                    "image_size": [CAMERA.width, CAMERA.height], "seed": SEED, "crops": {}}
+                    "image_size": [CAMERA.width, CAMERA.height], "seed": SEED, "antialiasing": antialiasing,
+                    "crops": {}}
     per_view: dict[str, float] = {}
     overhead: dict[str, float] = {}
     with tempfile.TemporaryDirectory(prefix="davis-ag-bench-") as scratch:
         for crop in crops:
-            result = bench_crop(crop, Path(scratch), repeats, documented=crop in TARGETS)
+            result = bench_crop(crop, Path(scratch), repeats, documented=crop in TARGETS, antialiasing=antialiasing)
             report["crops"][crop] = result
             per_view[crop] = result["seconds_per_view"]["ours"]
             overhead[crop] = result["grow_s"] + result["setup_and_first_view_s"]
@@ -219,7 +220,8 @@ def run(out: Path, crops: list[str], repeats: int) -> dict:
 
 def table(report: dict) -> str:
     """The human-readable summary (Markdown)."""
-    lines = [f"{report['image_size'][0]}x{report['image_size'][1]}, seed {report['seed']}, scene 0 of each crop, "
+    lines = [f"{report['image_size'][0]}x{report['image_size'][1]}, {report['antialiasing']}x antialiasing (ours), "
+             f"seed {report['seed']}, scene 0 of each crop, "
              f"median of {max(c['repeats'] for c in report['crops'].values())} interleaved repetitions; load "
              f"average {report['machine']['load_average']['start'][0]} at the start, "
              f"{report['machine']['load_average']['end'][0]} at the end, {report['machine']['cpus']} CPUs.", "",
@@ -268,6 +270,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, default=Path("out/bench.json"), help="JSON report")
     parser.add_argument("--crops", default="strawberry,vine", help="crops to time (strawberry, tomato, vine)")
     parser.add_argument("--repeats", type=int, default=REPEATS, help=f"interleaved repetitions (default {REPEATS})")
+    parser.add_argument("--antialiasing", type=int, choices=(4, 1), default=4,
+                        help="our renderer's colour samples per pixel (default 4)")
     parser.add_argument("--doc", type=Path, help="write the tables into this Markdown file's bench section")
     args = parser.parse_args(argv)
     crops = [c for c in args.crops.split(",") if c]
@@ -276,7 +280,7 @@ def main(argv: list[str] | None = None) -> int:
             parser.error(f"--crops: {name!r} is not strawberry, tomato or vine")
     if args.repeats < 1:
         parser.error("--repeats must be at least 1")
-    report = run(args.out, crops, args.repeats)
+    report = run(args.out, crops, args.repeats, args.antialiasing)
     text = table(report)
     print(text)
     if args.doc:

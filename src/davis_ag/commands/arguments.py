@@ -49,3 +49,6 @@ def add_renderer_flags(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--look", choices=LOOKS,
                         help="default: full-resolution, filtered textures (default); helios: Helios's frames, "
                              "reduced unfiltered textures included (the helios renderer draws only this)")
+    parser.add_argument("--antialiasing", type=int, choices=(4, 1),
+                        help="our renderer's colour samples per pixel: 4 (default) or 1 (no antialiasing; "
+                             "several times faster on many small triangles without a GPU; ids exact either way)")

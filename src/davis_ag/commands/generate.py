@@ -67,6 +67,8 @@ def run(args: argparse.Namespace) -> int:
                 raise UserError(f"--seed {args.seed} is negative: use a whole number from 0")
             config = dataclasses.replace(config, seed=config.seed if args.seed is None else args.seed,
                              camera=config.camera if args.size is None else Camera(*args.size))
+        if args.antialiasing is not None:
+            config = dataclasses.replace(config, antialiasing=args.antialiasing)
         if args.renderer is not None or args.look is not None or args.no_depth:
             renderer = args.renderer or config.renderer
             look = args.look if args.look is not None else (config.look if args.renderer is None else None)
@@ -77,7 +79,7 @@ def run(args: argparse.Namespace) -> int:
         config = single_group_config(args.scenario or "sp", args.crop or "strawberry", args.scenes or 1,
                                      0 if args.first is None else args.first, args.seed or 0,
                                      args.size or (1280, 720), args.renderer or DEFAULT_RENDERER, args.look,
-                                     not args.no_depth)
+                                     not args.no_depth, args.antialiasing or 4)
     if args.executor != "ray" and args.address:
         raise UserError("--address is for --executor ray")
     if args.executor == "ray" and args.workers is not None:

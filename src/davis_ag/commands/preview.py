@@ -56,7 +56,8 @@ def run(args: argparse.Namespace) -> int:
     lookup = fruit_lookup({f.id: f.uuids for f in model.fruits}, model.uuid_count)
     polygons = {f.id: f.polygons for f in model.fruits}
     args.out.mkdir(parents=True, exist_ok=True)
-    with open_renderer(renderer_name, model.context, request.camera, model.lighting, look) as renderer:
+    with open_renderer(renderer_name, model.context, request.camera, model.lighting, look,
+                       args.antialiasing or 4) as renderer:
         for number in numbers:
             view = grid.viewpoints[number - 1]
             colour, primitive_ids, _ = renderer.render(view, depth=False)

@@ -59,6 +59,7 @@ class SceneRequest:
         look: ``default`` or ``helios`` (see :mod:`davis_ag.render.backends`); None: the
             renderer's own (``default`` for ours, ``helios`` for Helios).
         depth: Write ``images/NNNN_depth.png`` for every view.
+        antialiasing: Our renderer's colour samples per pixel, 4 or 1.
     """
 
     scenario: ScenarioSpec
@@ -69,6 +70,7 @@ class SceneRequest:
     renderer: str = DEFAULT_RENDERER
     look: str | None = None
     depth: bool = True
+    antialiasing: int = 4
 
     @property
     def seed(self) -> int:
@@ -162,7 +164,8 @@ def draw_scene(request: SceneRequest, model, grid, root: Path, on_view: Callable
     visible: dict[str, dict[str, float]] = {}
     try:
         look = resolve_look(request.renderer, request.look)
-        with open_renderer(request.renderer, model.context, camera, model.lighting, look) as renderer:
+        with open_renderer(request.renderer, model.context, camera, model.lighting, look,
+                           request.antialiasing) as renderer:
             for done, view in enumerate(viewpoints, 1):
                 colour, primitive_ids, depth = renderer.render(view, depth=request.depth)
                 labels = label_view(primitive_ids, lookup, request.min_fruit_pixels)
@@ -203,7 +206,8 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict) -> dict:
         "conventions": CONVENTIONS,
         "camera": request.camera.intrinsics(),
         "renderer": {"name": request.renderer, "look": resolve_look(request.renderer, request.look),
-                     "antialiasing": "4x multisampled colour, ids and depth from a 1x pass"
+                     "antialiasing": ("4x multisampled colour, ids and depth from a 1x pass"
+                                      if request.antialiasing > 1 else "none: one 1x pass")
                      if request.renderer == "opengl" else "Helios Visualizer, 4x multisampled colour"},
         "depth": {"file": "images/NNNN_depth.png", "dtype": "uint16", "unit": "mm",
                   "axis": "optical (camera-space z)", "no_hit": 0} if request.depth else None,
