@@ -282,9 +282,12 @@ def test_depth_and_renderer_settings_flow_from_flags_and_configs() -> None:
     config = single_group_config("sp", "strawberry", 1, 0, 0, (96, 54), "helios", None, depth=False)
     (request,) = config.requests()
     assert (request.renderer, request.look, request.depth) == ("helios", "helios", False)
-    text = "renderer: opengl\nlook: helios\ndepth: false\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n"
+    text = ("renderer: opengl\nlook: helios\ndepth: false\nantialiasing: 1\n"
+            "groups: [{scenario: sp, crop: tomato, scenes: 1}]\n")
     (request,) = parse_dataset_config(text, "test").requests()
-    assert (request.renderer, request.look, request.depth) == ("opengl", "helios", False)
+    assert (request.renderer, request.look, request.depth, request.antialiasing) == ("opengl", "helios", False, 1)
+    with pytest.raises(UserError, match="antialiasing"):
+        parse_dataset_config("antialiasing: 2\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "test")
     with pytest.raises(UserError, match="look"):
         parse_dataset_config("look: blocky\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "test")
     with pytest.raises(UserError, match="helios look"):

@@ -107,6 +107,16 @@ def test_default_look_keeps_the_geometry(frames: dict) -> None:
     assert np.abs(colour.astype(np.int16) - frames["helios"][1][0]).mean() > 2  # a different look
 
 
+def test_one_pass_option_gives_the_same_ids_and_depth(frames: dict) -> None:
+    """antialiasing=1 draws colour, ids and depth in one 1x pass: the same ids and depth."""
+    model = frames["model"]
+    view = frames["views"][0]
+    with open_renderer("opengl", model.context, CAMERA, model.lighting, "helios", antialiasing=1) as renderer:
+        colour, ids, depth = renderer.render(view)
+    assert np.array_equal(ids, frames["opengl"][0][1]) and np.array_equal(depth, frames["opengl"][0][2])
+    assert np.abs(colour.astype(np.int16) - frames["helios"][0][0]).mean() <= 2.0
+
+
 def test_renderer_and_look_choices() -> None:
     from davis_ag.errors import UserError
 
