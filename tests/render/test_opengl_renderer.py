@@ -125,3 +125,21 @@ def test_renderer_and_look_choices() -> None:
     for renderer, look in (("helios", "default"), ("vulkan", None), ("opengl", "blocky")):
         with pytest.raises(UserError):
             resolve_look(renderer, look)
+
+
+def test_drawn_silhouettes_match_the_projected_ones(frames: dict) -> None:
+    """Our renderer's count of a fruit's unoccluded pixels equals the pinhole model's."""
+    from davis_ag.labels.fruit_labels import silhouette_pixels
+
+    model = frames["model"]
+    view = frames["views"][1]
+    with open_renderer("opengl", model.context, CAMERA, model.lighting, "helios") as renderer:
+        checked = 0
+        for fruit in model.fruits:
+            projected = silhouette_pixels(CAMERA, view, fruit.polygons)
+            if projected < MIN_FRUIT_PIXELS:
+                continue
+            drawn = renderer.silhouette_pixels(view, fruit.id, fruit.uuids)
+            assert abs(drawn - projected) <= max(3, 0.01 * projected), (fruit.id, drawn, projected)
+            checked += 1
+    assert checked >= 1

@@ -158,6 +158,7 @@ def draw_scene(request: SceneRequest, model, grid, root: Path, on_view: Callable
     viewpoints = list(grid.viewpoints if views is None else views)
     lookup = fruit_lookup({f.id: f.uuids for f in model.fruits}, model.uuid_count)
     polygons = {f.id: f.polygons for f in model.fruits}
+    fruit_uuids = {f.id: f.uuids for f in model.fruits}
     camera = request.camera
     scene_dir = root / request.folder
     writer = SceneWriter(scene_dir)
@@ -169,7 +170,10 @@ def draw_scene(request: SceneRequest, model, grid, root: Path, on_view: Callable
             for done, view in enumerate(viewpoints, 1):
                 colour, primitive_ids, depth = renderer.render(view, depth=request.depth)
                 labels = label_view(primitive_ids, lookup, request.min_fruit_pixels)
-                fractions = visible_fractions(camera, view, labels, polygons)
+                draw_silhouette = getattr(renderer, "silhouette_pixels", None)
+                silhouette = (lambda fruit_id, view=view: draw_silhouette(view, fruit_id, fruit_uuids[fruit_id])) \
+                    if draw_silhouette else None
+                fractions = visible_fractions(camera, view, labels, polygons, silhouette)
                 entry = {"bounding_boxes": labels.boxes, "pose": [round(v, 5) for v in view.pose]}
                 entry.update(grid.pointers(view.index))
                 writer.add_view(view.image_name, colour, labels.segmentation, entry,

@@ -211,6 +211,8 @@ class OpenGLRenderer:
         vertex["texture"] = np.repeat(np.maximum(geometry.texture[order], 0), 3)
         vertex["mode"] = np.repeat(geometry.mode[order], 3)
         self._vbo = ctx.buffer(vertex.tobytes())
+        self._triangle_uuids = geometry.uuids[order]
+        self._silhouette_vaos: dict[int, object] = {}
         layout = "3f 2f 3f 4f 1u 1i 1i"
         names = ["in_position", "in_uv", "in_normal", "in_colour", "in_id", "in_texture", "in_mode"]
         self._scene = ctx.vertex_array(self._programs["scene"], [(self._vbo, layout, *names)], skip_errors=True)
@@ -402,6 +404,47 @@ class OpenGLRenderer:
             with self.ctx:
                 self.draw(view)
                 return self.read()
+        finally:
+            _egl_restore(previous)
+
+    def silhouette_pixels(self, view: Viewpoint, key: int, uuids: np.ndarray) -> int:
+        """Pixels whose centre some primitive of ``uuids`` covers with nothing else drawn: the area
+        an object (a fruit) would have in the view if nothing hid it. One 1x raster of only its
+        triangles; the same rule the id image follows.
+
+        Args:
+            view: The pose.
+            key: A name for the group (a fruit id): its triangles are looked up once per renderer.
+            uuids: The group's primitive UUIDs.
+        """
+        import moderngl
+
+        previous = _egl_current()
+        try:
+            with self.ctx:
+                vao = self._silhouette_vaos.get(key)
+                if vao is None:
+                    triangles = np.nonzero(np.isin(self._triangle_uuids, np.asarray(uuids, dtype=np.uint32)))[0]
+                    if not len(triangles):
+                        return 0
+                    indices = (triangles[:, None] * 3 + np.arange(3)).astype(np.uint32)
+                    vao = self.ctx.vertex_array(
+                        self._programs["ids"], [(self._vbo, "3f 2f 3f 4f 1u 1i 1i", "in_position", "in_uv", "in_normal",
+                                                 "in_colour", "in_id", "in_texture", "in_mode")],
+                        index_buffer=self.ctx.buffer(indices.tobytes()), index_element_size=4, skip_errors=True)
+                    self._silhouette_vaos[key] = vao
+                if not hasattr(self, "_silhouette_fbo"):
+                    size = (self.camera.width, self.camera.height)
+                    self._silhouette_fbo = self.ctx.framebuffer([self.ctx.renderbuffer(size, 1, dtype="u4")])
+                self._view_uniforms(view)
+                self._bind_textures()
+                self._silhouette_fbo.use()
+                self._silhouette_fbo.clear(0.0, 0.0, 0.0, 0.0)
+                self.ctx.disable(moderngl.DEPTH_TEST)
+                vao.render(moderngl.TRIANGLES)
+                self.ctx.enable(moderngl.DEPTH_TEST)
+                ids = np.frombuffer(self._silhouette_fbo.read(components=1, dtype="u4"), dtype=np.uint32)
+                return int(np.count_nonzero(ids))
         finally:
             _egl_restore(previous)
 
