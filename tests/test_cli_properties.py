@@ -29,6 +29,8 @@ ANY = st.sampled_from(["0", "1", "2", "-1", "-5", "x", "", ",", " 3", "1.5", "²
                        "a-file/sub", "data", "empty", "missing", "~nosuchuser/x", "../escape", "-"])
 #: Where the commands that grow plants write: nowhere they can.
 UNWRITABLE = st.sampled_from(["/proc/x", "a-file", "a-file/sub", "data/Single-Strawberry/000/annotations.json/x"])
+#: Renderer and look names, good and bad.
+RENDER = st.sampled_from(["opengl", "helios", "default", "x", ""])
 _counter = itertools.count()
 
 
@@ -79,7 +81,8 @@ def pools_for(command: str, out: str) -> tuple[list[str], dict[str, st.SearchStr
         return [], {"--config": st.sampled_from(["mini", "paper", "nope", "a-file", "data"]), "--crop": ANY,
                     "--scenario": ANY, "--scenes": ANY, "--first": ANY, "--seed": ANY, "--size": ANY,
                     "--only": ANY, "--workers": ANY, "--executor": ANY, "--address": ANY,
-                    "--cpus-per-scene": ANY, "--max-retries": ANY, "--quiet": FLAG}, ["--out"]
+                    "--cpus-per-scene": ANY, "--max-retries": ANY, "--quiet": FLAG, "--renderer": RENDER,
+                    "--look": RENDER, "--antialiasing": ANY, "--no-depth": FLAG}, ["--out"]
     if command == "demo":
         return [], {"--scenes": ANY, "--size": ANY, "--seed": ANY, "--episodes": ANY, "--sessions": ANY}, ["--out"]
     if command == "reproduce":
@@ -88,7 +91,7 @@ def pools_for(command: str, out: str) -> tuple[list[str], dict[str, st.SearchStr
                     "--only": ANY}, ["--out"]
     if command == "preview":
         return [], {"--crop": ANY, "--scenario": ANY, "--seed": ANY, "--index": ANY, "--views": ANY,
-                    "--size": ANY}, ["--out"]
+                    "--size": ANY, "--renderer": RENDER, "--look": RENDER, "--antialiasing": ANY}, ["--out"]
     if command == "train":
         first = ["--dataset", "data", "--scenario", "sp", "--out", f"{out}/m.zip", "--timesteps", "8",
                  "--n-envs", "2", "--arch", "pooled", "--verbose", "0", "--device", "cpu"]

@@ -48,7 +48,7 @@ def test_generated_scene_is_a_sound_dataset(generated: tuple[Path, Path, dict]) 
     assert sorted(p.name for p in scene_dir.iterdir()) == ["annotations.json", "images", "scene.json"]
     names = [f"{i:04d}.jpeg" for i in range(1, VIEWS + 1)]
     assert sorted(p.name for p in (scene_dir / "images").iterdir()) == sorted(
-        names + [n.replace(".jpeg", "_seg.png") for n in names])
+        names + [n.replace(".jpeg", suffix) for n in names for suffix in ("_seg.png", "_depth.png")])
 
     report = validate_dataset(root)
     assert report.ok, [str(p) for p in report.problems]
@@ -231,3 +231,65 @@ def test_generate_command_refuses_mock_helios_before_any_scene(
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1 and "mock mode" in err[0]
     assert not out.exists()
+
+
+def test_depth_images_are_written_read_and_checked(generated: tuple[Path, Path, dict], tmp_path: Path) -> None:
+    root, scene_dir, _ = generated
+    meta = json.loads((scene_dir / "scene.json").read_text())
+    assert meta["renderer"]["name"] == "opengl" and meta["renderer"]["look"] == "default"
+    assert meta["depth"]["unit"] == "mm" and meta["depth"]["no_hit"] == 0
+    (scene,) = open_dataset(root).scenes
+    fruits = {f["id"]: np.array(f["center"]) for f in meta["fruits"]}
+    checked = 0
+    for view in scene:
+        depth, mask = view.depth, view.mask()
+        raw = np.asarray(Image.open(view.depth_path))
+        assert raw.dtype == np.uint16 and depth.dtype == np.float32 and depth.shape == (CAMERA.height, CAMERA.width)
+        assert (depth[0] == 0).all() and depth.max() > 0  # sky on the top row, ground below
+        x, y, z, yaw, pitch = view.pose
+        forward = np.array([np.cos(np.radians(pitch)) * np.cos(np.radians(yaw)),
+                            np.cos(np.radians(pitch)) * np.sin(np.radians(yaw)), np.sin(np.radians(pitch))])
+        for box in view.boxes:
+            seen = np.median(depth[mask == box.fruit_id])
+            assert abs(seen - (fruits[box.fruit_id] - (x, y, z)) @ forward) < 0.05
+            checked += 1
+    assert checked > 0
+
+    # Without depth (the original download, --no-depth) a scene still reads and validates.
+    copy = tmp_path / "copy"
+    shutil.copytree(root, copy)
+    copied = copy / scene_dir.relative_to(root)
+    for path in (copied / "images").glob("*_depth.png"):
+        path.unlink()
+    meta["depth"] = None
+    (copied / "scene.json").write_text(json.dumps(meta))
+    assert all(view.depth is None for view in open_dataset(copy).scenes[0])
+    assert validate_dataset(copy).ok
+
+    # Depth that disagrees with the fruit's 3-D centres, or has the wrong size, is reported.
+    first = copied / "images" / "0001_depth.png"
+    doubled = np.clip(np.asarray(Image.open(scene_dir / "images" / "0001_depth.png")).astype(np.int64) * 2, 0, 65535)
+    Image.fromarray(doubled.astype(np.uint16)).save(first)
+    Image.fromarray(np.ones((10, 10), np.uint16) * 500).save(copied / "images" / "0002_depth.png")
+    problems = [str(p) for p in validate_dataset(copy).problems]
+    assert any("0002_depth.png" in p and "10x10" in p for p in problems)
+    has_boxes = bool(scene.view("0001.jpeg").boxes)
+    assert any("0001_depth.png" in p and "centre" in p for p in problems) == has_boxes
+
+
+def test_depth_and_renderer_settings_flow_from_flags_and_configs() -> None:
+    from davis_ag.generate.run_config import parse_dataset_config, single_group_config
+
+    config = single_group_config("sp", "strawberry", 1, 0, 0, (96, 54), "helios", None, depth=False)
+    (request,) = config.requests()
+    assert (request.renderer, request.look, request.depth) == ("helios", "helios", False)
+    text = ("renderer: opengl\nlook: helios\ndepth: false\nantialiasing: 1\n"
+            "groups: [{scenario: sp, crop: tomato, scenes: 1}]\n")
+    (request,) = parse_dataset_config(text, "test").requests()
+    assert (request.renderer, request.look, request.depth, request.antialiasing) == ("opengl", "helios", False, 1)
+    with pytest.raises(UserError, match="antialiasing"):
+        parse_dataset_config("antialiasing: 2\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "test")
+    with pytest.raises(UserError, match="look"):
+        parse_dataset_config("look: blocky\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "test")
+    with pytest.raises(UserError, match="helios look"):
+        single_group_config("sp", "strawberry", 1, 0, 0, (96, 54), "helios", "default")

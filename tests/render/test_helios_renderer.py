@@ -121,7 +121,7 @@ def test_id_pass_then_read_colour_equals_a_colour_draw(scene) -> None:  # type: 
     assert np.array_equal(colour, again)
     assert not np.array_equal(colour, elsewhere)
     # render() is the same pair from one call.
-    colour2, ids2 = renderer.render(first)
+    colour2, ids2, _ = renderer.render(first, depth=False)
     assert np.array_equal(colour2, colour) and np.array_equal(ids2, ids)
     # The spheres are red where the ids say so; the top row is sky, not ground.
     red = colour[np.isin(ids, np.concatenate(scene[1]) + 1)].astype(int)

@@ -112,3 +112,18 @@ def path(text: str) -> Path:
         return Path(text).expanduser().absolute()
     except RuntimeError:  # expanduser of ~name for a user that does not exist
         raise argparse.ArgumentTypeError(f"{text!r}: no such user's home folder") from None
+
+
+
+def add_renderer_flags(parser: argparse.ArgumentParser) -> None:
+    """``--renderer`` and ``--look``, shared by generate and preview."""
+    from davis_ag.render.backends import LOOKS, RENDERERS
+
+    parser.add_argument("--renderer", choices=RENDERERS,
+                        help="opengl: ours (default); helios: pyhelios's Visualizer, the slower reference")
+    parser.add_argument("--look", choices=LOOKS,
+                        help="default: full-resolution, filtered textures (default); helios: Helios's frames, "
+                             "reduced unfiltered textures included (the helios renderer draws only this)")
+    parser.add_argument("--antialiasing", type=int, choices=(4, 1),
+                        help="our renderer's colour samples per pixel: 4 (default) or 1 (no antialiasing; "
+                             "several times faster on many small triangles without a GPU; ids exact either way)")

@@ -15,6 +15,7 @@ from davis_ag.errors import UserError
 from davis_ag.generate.run_config import load_dataset_config, single_group_config
 from davis_ag.generate.run_progress import DEFAULT_MAX_RETRIES, RunOptions, default_workers
 from davis_ag.generate.runner import run_dataset
+from davis_ag.render.backends import DEFAULT_RENDERER, resolve_look
 from davis_ag.scene.camera import Camera
 
 #: Flags that describe the one group of a config-less run.
@@ -23,7 +24,7 @@ GROUP_FLAGS = ("crop", "scenario", "scenes", "first")
 
 
 def register(subparsers) -> None:
-    parser = subparsers.add_parser("generate", help="render DAVIS-Ag scenes with Helios",
+    parser = subparsers.add_parser("generate", help="render DAVIS-Ag scenes (Helios plants, our OpenGL renderer)",
                                    description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--config", help="dataset config: a preset (paper, mini) or a YAML file")
     parser.add_argument("--crop", help="strawberry, tomato or vine (default strawberry; not with --config)")
@@ -32,14 +33,17 @@ def register(subparsers) -> None:
     parser.add_argument("--first", type=arguments.whole, help="index of the first scene (default 0)")
     parser.add_argument("--seed", type=arguments.seed, help="dataset seed (default 0, or the config's)")
     parser.add_argument("--size", type=arguments.image_size, help="image size (default 1280x720, or the config's)")
+    arguments.add_renderer_flags(parser)
+    parser.add_argument("--no-depth", action="store_true",
+                        help="do not write images/NNNN_depth.png (uint16 millimetres along the optical axis)")
     parser.add_argument("--out", type=arguments.path, required=True, help="dataset folder")
     parser.add_argument("--only", action="append", metavar="SCENE",
                         help="make only this scene or group, e.g. Single-Strawberry/003 (repeatable, or "
                              "comma-separated)")
     parser.add_argument("--workers", type=arguments.bounded(1, 1024),
-                        help=f"scene processes on this machine, each drawing with one Mesa thread (default: "
-                             f"one per core as memory allows, {default_workers()} here; 1 draws in this process "
-                             "with every core)")
+                        help=f"scene processes on this machine, each drawing with its share of the cores as "
+                             f"Mesa threads (default: one per core as memory allows, {default_workers()} here, never "
+                             "more than the scenes; 1, or a single scene, draws in this process with every core)")
     parser.add_argument("--executor", choices=("local", "ray"), default="local",
                         help="local processes (default) or one Ray task per scene on a cluster")
     parser.add_argument("--address", help="Ray cluster address: auto (on a cluster machine) or ray://HEAD:10001")
@@ -61,10 +65,19 @@ def run(args: argparse.Namespace) -> int:
         if args.seed is not None or args.size is not None:
             config = dataclasses.replace(config, seed=config.seed if args.seed is None else args.seed,
                              camera=config.camera if args.size is None else Camera(*args.size))
+        if args.antialiasing is not None:
+            config = dataclasses.replace(config, antialiasing=args.antialiasing)
+        if args.renderer is not None or args.look is not None or args.no_depth:
+            renderer = args.renderer or config.renderer
+            look = args.look if args.look is not None else (config.look if args.renderer is None else None)
+            resolve_look(renderer, look)
+            config = dataclasses.replace(config, renderer=renderer, look=look,
+                                         depth=config.depth and not args.no_depth)
     else:
         config = single_group_config(args.scenario or "sp", args.crop or "strawberry", args.scenes or 1,
                                      0 if args.first is None else args.first, args.seed or 0,
-                                     args.size or (1280, 720))
+                                     args.size or (1280, 720), args.renderer or DEFAULT_RENDERER, args.look,
+                                     not args.no_depth, args.antialiasing or 4)
     if args.executor != "ray" and args.address:
         raise UserError("--address is for --executor ray")
     if args.executor == "ray" and args.workers is not None:

@@ -17,7 +17,7 @@ from davis_ag.errors import UserError
 from davis_ag.generate.one_scene import SceneRequest
 from davis_ag.generate.run_progress import count_views
 from davis_ag.labels.fruit_labels import fruit_lookup, label_view, visible_fractions
-from davis_ag.render.helios import HeliosRenderer
+from davis_ag.render.backends import DEFAULT_RENDERER, open_renderer, resolve_look
 from davis_ag.scene.build import build_scene
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import crop_spec, plant_centres, scenario_spec
@@ -34,6 +34,7 @@ def register(subparsers) -> None:
     parser.add_argument("--views", type=arguments.number_list, default=[1],
                         help="comma-separated view numbers (default 1)")
     parser.add_argument("--size", type=arguments.image_size, default=(1280, 720), help="image size (default 1280x720)")
+    arguments.add_renderer_flags(parser)
     parser.add_argument("--out", type=arguments.path, required=True, help="folder for the pictures")
     parser.set_defaults(func=run)
 
@@ -41,11 +42,13 @@ def register(subparsers) -> None:
 def run(args: argparse.Namespace) -> int:
     crop, scenario = crop_spec(args.crop), scenario_spec(args.scenario)
     numbers = args.views
+    renderer_name = args.renderer or DEFAULT_RENDERER
+    look = resolve_look(renderer_name, args.look)
     # Every check before the plant grows (a minute for a vine): the view count needs only the
     # nominal grid, which slip does not change.
     _check_views(numbers, count_views(scenario, crop))
     arguments.prove_writable_folder(args.out)
-    request = SceneRequest(scenario, crop, args.index, args.seed, Camera(*args.size))
+    request = SceneRequest(scenario, crop, args.index, args.seed, Camera(*args.size), renderer_name, look)
     rng = np.random.default_rng(request.seed)
     model = build_scene(scenario, crop, rng)
     grid = build_view_grid(scenario, crop, plant_centres(scenario, crop), model.aim_height, rng)
@@ -53,10 +56,11 @@ def run(args: argparse.Namespace) -> int:
     lookup = fruit_lookup({f.id: f.uuids for f in model.fruits}, model.uuid_count)
     polygons = {f.id: f.polygons for f in model.fruits}
     args.out.mkdir(parents=True, exist_ok=True)
-    with HeliosRenderer(model.context, request.camera, model.lighting) as renderer:
+    with open_renderer(renderer_name, model.context, request.camera, model.lighting, look,
+                       args.antialiasing or 4) as renderer:
         for number in numbers:
             view = grid.viewpoints[number - 1]
-            colour, primitive_ids = renderer.render(view)
+            colour, primitive_ids, _ = renderer.render(view, depth=False)
             labels = label_view(primitive_ids, lookup, request.min_fruit_pixels)
             fractions = visible_fractions(request.camera, view, labels, polygons)
             stem = f"{crop.name}-{scenario.name}-{args.index:03d}-{number:04d}"

@@ -86,6 +86,32 @@ class View:
         """Where the instance mask is (``images/0001_seg.png``), whether or not it exists."""
         return self.scene.path / "images" / f"{self.name.removesuffix('.jpeg')}_seg.png"
 
+    @property
+    def depth_path(self) -> Path:
+        """Where the depth image is (``images/0001_depth.png``), whether or not it exists."""
+        return self.scene.path / "images" / f"{self.name.removesuffix('.jpeg')}_depth.png"
+
+    @property
+    def depth(self) -> np.ndarray | None:
+        """The depth image, decoded: ``H x W`` float32 metres along the optical axis, 0 where nothing
+        is hit; ``None`` where the dataset has no depth (the original download, ``--no-depth``).
+
+        Raises:
+            UserError: when the file exists but cannot be read or is not 16-bit.
+        """
+        from PIL import Image, UnidentifiedImageError
+
+        if not self.depth_path.is_file():
+            return None
+        try:
+            with Image.open(self.depth_path) as im:
+                millimetres = np.asarray(im)
+        except (OSError, UnidentifiedImageError, ValueError) as error:
+            raise UserError(f"{self.depth_path}: cannot decode ({error}); regenerate the scene") from None
+        if millimetres.dtype != np.uint16 or millimetres.ndim != 2:
+            raise UserError(f"{self.depth_path}: a depth image must be a 16-bit single-channel PNG")
+        return millimetres.astype(np.float32) / 1000.0
+
     def next(self, action: str) -> View | None:
         """The view an action leads to.
 

@@ -173,6 +173,9 @@ def validate_scene(scene: Scene, quick: bool = False, box_tolerance: int | None 
             flag(image, f"missing: annotations.json has an entry {record.name} for it")
         if not mask.is_file():
             flag(mask, f"missing: the instance mask of {record.name}")
+        depth = images / f"{record.name.removesuffix('.jpeg')}_depth.png"
+        if isinstance(metadata, dict) and metadata.get("depth") and not depth.is_file():
+            flag(depth, f"missing: scene.json records depth images but {record.name} has none")
         if quick:
             size = _camera_size(metadata)
             if size:
@@ -182,10 +185,14 @@ def validate_scene(scene: Scene, quick: bool = False, box_tolerance: int | None 
             for path, problem in _pixel_problems(record, ann_path, image, mask if has_mask else None,
                                                  metadata, tolerance):
                 flag(path, problem)
+            if depth.is_file():
+                for problem in depth_problems(record, depth, mask if has_mask else None, metadata):
+                    flag(depth, problem)
 
     if images.is_dir():
         for path in sorted(images.iterdir()):
-            stem = path.name.removesuffix("_seg.png") if path.name.endswith("_seg.png") else path.stem
+            stem = next((path.name.removesuffix(end) for end in ("_seg.png", "_depth.png") if path.name.endswith(end)),
+                        path.stem)
             if path.suffix.lower() in (".jpeg", ".jpg", ".png") and f"{stem}.jpeg" not in names:
                 flag(path, "has no entry in annotations.json")
     return report
@@ -280,6 +287,72 @@ def _pixel_problems(record: ViewRecord, ann_path: Path, image: Path, mask_path: 
             m = extents[fid]
             problems.append((mask_path, f"{record.name}: box of fruit {fid} is {box.to_list()[:4]} but its mask "
                                         f"pixels span {[m.xmin, m.ymin, m.width, m.height]} (x, y, width, height)"))
+    return problems
+
+
+#: Depth images: surfaces nearer than this cannot be seen (the renderers' near plane), mm.
+DEPTH_NEAR_MM = 50
+#: A fruit's depth in the image may differ from its centre's by its half size plus this, m.
+DEPTH_SLACK_M = 0.02
+
+
+def depth_problems(record: ViewRecord, depth_path: Path, mask_path: Path | None, metadata: dict | None) -> list[str]:
+    """Check a depth image: 16-bit, the image's size, a plausible range, and agreement with the
+    3-D centres of the fruit scene.json records (where a fruit is boxed in the view).
+
+    Args:
+        record: The view's annotation.
+        depth_path: ``images/NNNN_depth.png``.
+        mask_path: Its instance mask, when present.
+        metadata: scene.json, when present.
+
+    Returns:
+        One reason per problem.
+    """
+    import numpy as np
+    from PIL import Image
+
+    try:
+        with Image.open(depth_path) as im:
+            depth = np.asarray(im)
+    except Exception as error:  # Pillow raises many types for a damaged file
+        return [f"cannot decode ({error})"]
+    if depth.dtype != np.uint16 or depth.ndim != 2:
+        return [f"must be a uint16 single-channel PNG (millimetres), got {depth.dtype} {depth.shape}"]
+    problems = []
+    size = _camera_size(metadata)
+    if size and depth.shape[::-1] != size:
+        problems.append(f"is {depth.shape[1]}x{depth.shape[0]} but scene.json's camera says {size[0]}x{size[1]}")
+        return problems
+    hit = depth > 0
+    if not hit.any():
+        problems.append("holds no surface at all (every pixel 0)")
+    elif int(depth[hit].min()) < DEPTH_NEAR_MM:
+        problems.append(f"holds a surface {int(depth[hit].min())} mm from the camera, nearer than any renderer draws")
+    if mask_path is None or not isinstance(metadata, dict) or record.pose is None:
+        return problems
+    fruits = {f.get("id"): f for f in metadata.get("fruits", []) if isinstance(f, dict)}
+    try:
+        with Image.open(mask_path) as im:
+            mask = np.asarray(im)
+    except Exception:  # reported by the mask check
+        return problems
+    if mask.shape != depth.shape:
+        return problems
+    x, y, z, yaw, pitch = (float(v) for v in record.pose[:5])
+    forward = np.array([np.cos(np.radians(pitch)) * np.cos(np.radians(yaw)),
+                        np.cos(np.radians(pitch)) * np.sin(np.radians(yaw)), np.sin(np.radians(pitch))])
+    for box in record.boxes:
+        fruit = fruits.get(box.fruit_id)
+        pixels = (mask == box.fruit_id) & hit
+        if fruit is None or not pixels.any():
+            continue
+        expected = float(np.dot(np.subtract(fruit["center"], (x, y, z)), forward))
+        seen = float(np.median(depth[pixels])) / 1000.0
+        allowed = 0.5 * float(np.linalg.norm(fruit.get("size", (0.0, 0.0, 0.0)))) + DEPTH_SLACK_M
+        if abs(seen - expected) > allowed:
+            problems.append(f"fruit {box.fruit_id} lies at {seen:.3f} m in the depth image but its centre is "
+                            f"{expected:.3f} m from the camera (scene.json), more than {allowed:.3f} m apart")
     return problems
 
 

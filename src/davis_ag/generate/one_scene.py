@@ -21,7 +21,7 @@ from davis_ag.atomic_files import PROBE_PREFIX, prove_writable_folder
 from davis_ag.errors import UserError
 from davis_ag.generate.scene_writer import SceneWriter, partial_dir
 from davis_ag.labels.fruit_labels import fruit_lookup, label_view, visible_fractions
-from davis_ag.render.helios import HeliosRenderer
+from davis_ag.render.backends import DEFAULT_RENDERER, open_renderer, resolve_look
 from davis_ag.scene.build import build_scene
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import CROPS, SCENARIOS, CropSpec, ScenarioSpec, group_name, plant_centres
@@ -41,6 +41,8 @@ CONVENTIONS = {
     "actions_mp": "forward along the grid axis nearest the heading, backward opposite, left 90 deg "
                   "counter-clockwise of forward, right clockwise; rotate_ccw +30 deg, rotate_cw -30 deg",
     "visible_fraction": "visible pixels of a fruit over the pixels it would cover with nothing in front",
+    "depth": "images/NNNN_depth.png: uint16 millimetres from the camera plane along the optical axis "
+             "(camera-space z), 0 where nothing is hit, 65535 for 65.535 m or more; row 0 at the top",
 }
 
 
@@ -53,6 +55,11 @@ class SceneRequest:
         index: Scene number within its group (folder ``NNN``).
         dataset_seed: The dataset's seed.
         camera: Image size and field of view.
+        renderer: ``opengl`` (ours) or ``helios`` (pyhelios's Visualizer, the reference).
+        look: ``default`` or ``helios`` (see :mod:`davis_ag.render.backends`); None: the
+            renderer's own (``default`` for ours, ``helios`` for Helios).
+        depth: Write ``images/NNNN_depth.png`` for every view.
+        antialiasing: Our renderer's colour samples per pixel, 4 or 1.
     """
 
     scenario: ScenarioSpec
@@ -60,6 +67,10 @@ class SceneRequest:
     index: int
     dataset_seed: int
     camera: Camera = Camera()
+    renderer: str = DEFAULT_RENDERER
+    look: str | None = None
+    depth: bool = True
+    antialiasing: int = 4
 
     @property
     def seed(self) -> int:
@@ -120,39 +131,76 @@ def generate_scene(
     """
     root = Path(root).absolute()  # Helios moves the working directory while it builds and closes
     started = time.perf_counter()
+    model, grid = grow_scene(request)
+    return draw_scene(request, model, grid, root, on_view, grow_s=time.perf_counter() - started)
+
+
+def grow_scene(request: SceneRequest):
+    """Grow a scene's plants and lay out its views, drawing from the scene's seed in a fixed order.
+
+    Returns:
+        The :class:`~davis_ag.scene.build.SceneModel` and its view grid.
+    """
     rng = np.random.default_rng(request.seed)
     model = build_scene(request.scenario, request.crop, rng)
-    grown = time.perf_counter()
     grid = build_view_grid(request.scenario, request.crop, plant_centres(request.scenario, request.crop),
                            model.aim_height, rng)
+    return model, grid
+
+
+def draw_scene(request: SceneRequest, model, grid, root: Path, on_view: Callable[[int, int], None] | None = None,
+               grow_s: float = 0.0, views: list | None = None) -> tuple[Path, dict]:
+    """Draw, label and write every view of a grown scene, then publish the folder atomically.
+
+    Args:
+        request: What to make (renderer, look, depth, image size).
+        model, grid: From :func:`grow_scene`.
+        root: The dataset root.
+        on_view: Called with (views done, views in all) after every view.
+        grow_s: Seconds spent growing, for scene.json.
+        views: Only these viewpoints of the grid (the benchmark); None for all.
+
+    Returns:
+        The scene folder and timing statistics.
+    """
+    root = Path(root).absolute()
+    grown = time.perf_counter()
+    viewpoints = list(grid.viewpoints if views is None else views)
     lookup = fruit_lookup({f.id: f.uuids for f in model.fruits}, model.uuid_count)
     polygons = {f.id: f.polygons for f in model.fruits}
+    fruit_uuids = {f.id: f.uuids for f in model.fruits}
     camera = request.camera
     scene_dir = root / request.folder
     writer = SceneWriter(scene_dir)
     visible: dict[str, dict[str, float]] = {}
     try:
-        with HeliosRenderer(model.context, camera, model.lighting) as renderer:
-            for view in grid.viewpoints:
-                colour, primitive_ids = renderer.render(view)
+        look = resolve_look(request.renderer, request.look)
+        with open_renderer(request.renderer, model.context, camera, model.lighting, look,
+                           request.antialiasing) as renderer:
+            for done, view in enumerate(viewpoints, 1):
+                colour, primitive_ids, depth = renderer.render(view, depth=request.depth)
                 labels = label_view(primitive_ids, lookup, request.min_fruit_pixels)
-                fractions = visible_fractions(camera, view, labels, polygons)
+                draw_silhouette = getattr(renderer, "silhouette_pixels", None)
+                silhouette = (lambda fruit_id, view=view: draw_silhouette(view, fruit_id, fruit_uuids[fruit_id])) \
+                    if draw_silhouette else None
+                fractions = visible_fractions(camera, view, labels, polygons, silhouette)
                 entry = {"bounding_boxes": labels.boxes, "pose": [round(v, 5) for v in view.pose]}
                 entry.update(grid.pointers(view.index))
-                writer.add_view(view.image_name, colour, labels.segmentation, entry)
+                writer.add_view(view.image_name, colour, labels.segmentation, entry,
+                                depth if request.depth else None)
                 visible[view.image_name] = {str(k): v for k, v in fractions.items()}
                 if on_view:
-                    on_view(view.index + 1, len(grid.viewpoints))
+                    on_view(done, len(viewpoints))
             writer.wait()  # every image written before the Visualizer's teardown moves the cwd
         drawn = time.perf_counter()
         metadata = scene_metadata(request, model, grid, visible)
-        metadata["timing_s"] = {"grow": round(grown - started, 3), "draw_and_label": round(drawn - grown, 3)}
+        metadata["timing_s"] = {"grow": round(grow_s, 3), "draw_and_label": round(drawn - grown, 3)}
         writer.finish(metadata)
     except BaseException:
         writer.abort()
         raise
-    stats = {"views": len(grid.viewpoints), "grow_s": grown - started, "views_s": drawn - grown,
-             "total_s": time.perf_counter() - started}
+    stats = {"views": len(viewpoints), "grow_s": grow_s, "views_s": drawn - grown,
+             "total_s": grow_s + time.perf_counter() - grown}
     return scene_dir, stats
 
 
@@ -171,6 +219,12 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict) -> dict:
         "scene": request.folder,
         "conventions": CONVENTIONS,
         "camera": request.camera.intrinsics(),
+        "renderer": {"name": request.renderer, "look": resolve_look(request.renderer, request.look),
+                     "antialiasing": ("4x multisampled colour, ids and depth from a 1x pass"
+                                      if request.antialiasing > 1 else "none: one 1x pass")
+                     if request.renderer == "opengl" else "Helios Visualizer, 4x multisampled colour"},
+        "depth": {"file": "images/NNNN_depth.png", "dtype": "uint16", "unit": "mm",
+                  "axis": "optical (camera-space z)", "no_hit": 0} if request.depth else None,
         "lighting": {"model": "phong_shadowed", "sun_elevation_deg": model.lighting.sun_elevation,
                      "sun_azimuth_deg": model.lighting.sun_azimuth, "sun_direction": model.lighting.direction},
         "grid": {"extent_m": list(request.scenario.extent), "step_m": request.scenario.step,

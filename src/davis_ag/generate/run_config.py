@@ -5,6 +5,10 @@ Format (every key but ``groups`` is optional)::
     name: paper                  # a label; defaults to the file name
     seed: 0                      # dataset seed, a whole number from 0 (default 0)
     image_size: 1280x720         # WIDTHxHEIGHT or [WIDTH, HEIGHT] (default 1280x720)
+    renderer: opengl             # opengl (ours, default) or helios (pyhelios's Visualizer)
+    look: default                # default or helios (Helios's texture handling); helios renderer: helios
+    depth: true                  # write images/NNNN_depth.png (uint16 mm) for every view
+    antialiasing: 4              # our renderer's colour samples: 4 (default) or 1 (faster, not antialiased)
     grid:                        # overrides the scenario's Table 2 grid for every group
       extent: [3.0, 3.0]         #   grid size along x and y, m
       step: 0.5                  #   distance between positions, m
@@ -37,6 +41,7 @@ from typing import Any
 
 from davis_ag.errors import UserError
 from davis_ag.generate.one_scene import SceneRequest
+from davis_ag.render.backends import DEFAULT_RENDERER, resolve_look
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import CropSpec, ScenarioSpec, crop_spec, group_name, scenario_spec
 
@@ -44,7 +49,7 @@ from davis_ag.scene.specs import CropSpec, ScenarioSpec, crop_spec, group_name, 
 MIN_IMAGE_SIDE = 16
 #: Scene folders are numbered NNN.
 MAX_SCENES = 1000
-TOP_KEYS = ("name", "seed", "image_size", "grid", "groups")
+TOP_KEYS = ("name", "seed", "image_size", "renderer", "look", "depth", "antialiasing", "grid", "groups")
 GROUP_KEYS = ("scenario", "crop", "scenes", "first", "grid")
 GRID_KEYS = ("extent", "step", "altitude_levels", "headings")
 
@@ -86,6 +91,10 @@ class DatasetConfig:
         camera: Image size and field of view.
         groups: The groups, in file order.
         source: Where it was read from (for messages).
+        renderer: ``opengl`` or ``helios``.
+        look: ``default`` or ``helios``; None for the renderer's own.
+        depth: Whether every view gets a depth image.
+        antialiasing: Our renderer's colour samples per pixel, 4 or 1.
     """
 
     name: str
@@ -93,6 +102,10 @@ class DatasetConfig:
     camera: Camera
     groups: tuple[GroupConfig, ...]
     source: str = "<config>"
+    renderer: str = DEFAULT_RENDERER
+    look: str | None = None
+    depth: bool = True
+    antialiasing: int = 4
 
     def requests(self, only: list[str] | None = None) -> list[SceneRequest]:
         """Every scene to make, in group order, optionally narrowed to some groups or scenes.
@@ -107,7 +120,9 @@ class DatasetConfig:
         Raises:
             UserError: when an ``only`` entry names nothing of this dataset.
         """
-        everything = [SceneRequest(g.scenario, g.crop, i, self.seed, self.camera)
+        look = resolve_look(self.renderer, self.look)
+        everything = [SceneRequest(g.scenario, g.crop, i, self.seed, self.camera, self.renderer, look, self.depth,
+                                   self.antialiasing)
                       for g in self.groups for i in g.indices]
         if not only:
             return everything
@@ -132,7 +147,8 @@ def _normalise_scene_id(text: str) -> str:
 
 
 def single_group_config(scenario: str, crop: str, scenes: int, first: int, seed: int,
-                        size: tuple[int, int]) -> DatasetConfig:
+                        size: tuple[int, int], renderer: str = DEFAULT_RENDERER, look: str | None = None,
+                        depth: bool = True, antialiasing: int = 4) -> DatasetConfig:
     """The dataset the classic flags (--scenario --crop --scenes --first) describe.
 
     Returns:
@@ -146,7 +162,9 @@ def single_group_config(scenario: str, crop: str, scenes: int, first: int, seed:
         raise UserError(f"scene indices {first}..{first + scenes - 1} do not fit 000..{MAX_SCENES - 1}")
     if seed < 0:
         raise UserError(f"--seed {seed} is negative: use a whole number from 0")
-    return DatasetConfig("command line", seed, Camera(*size), (group,), "the command line")
+    resolve_look(renderer, look)
+    return DatasetConfig("command line", seed, Camera(*size), (group,), "the command line", renderer, look, depth,
+                         antialiasing)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -222,6 +240,17 @@ def parse_dataset_config(text: str, source: str, default_name: str = "dataset") 
         check.fail("name", f"must be a non-empty text, not {name!r}")
     seed = check.whole(data.get("seed", 0), "seed", minimum=0)
     camera = Camera(*check.image_size(data.get("image_size", "1280x720"), "image_size"))
+    renderer, look = data.get("renderer", DEFAULT_RENDERER), data.get("look")
+    try:
+        resolve_look(renderer, look)
+    except UserError as error:
+        check.fail("renderer" if renderer not in ("opengl", "helios") else "look", str(error))
+    depth = data.get("depth", True)
+    if not isinstance(depth, bool):
+        check.fail("depth", f"must be true or false, not {depth!r}")
+    antialiasing = data.get("antialiasing", 4)
+    if antialiasing not in (1, 4) or isinstance(antialiasing, bool):
+        check.fail("antialiasing", f"must be 4 or 1, not {antialiasing!r}")
     top_grid = check.grid_mapping(data.get("grid", {}), "grid")
     groups_data = data.get("groups")
     if not isinstance(groups_data, list) or not groups_data:
@@ -235,7 +264,7 @@ def parse_dataset_config(text: str, source: str, default_name: str = "dataset") 
             check.fail(f"groups[{position}]", f"{group.name} is already groups[{seen[group.name]}]: "
                                               "give each scenario and crop once")
         seen[group.name] = position
-    return DatasetConfig(name.strip(), seed, camera, tuple(groups), source)
+    return DatasetConfig(name.strip(), seed, camera, tuple(groups), source, renderer, look, depth, antialiasing)
 
 
 class _Checker:

@@ -21,6 +21,7 @@ see docs/performance.md for the measurements behind :func:`default_workers`.
 
 from __future__ import annotations
 
+import dataclasses
 import fcntl
 import os
 from pathlib import Path
@@ -148,12 +149,15 @@ def run_dataset(requests: Sequence[SceneRequest], root: Path, options: RunOption
                 from davis_ag.generate.ray_executor import run_on_ray
 
                 run_on_ray(todo, root, options, progress, report)
-            elif todo and options.workers <= 1:
+            elif todo and min(options.workers, len(todo)) <= 1:
+                # One scene (or --workers 1): draw here, Mesa spreading each frame over every core.
                 _run_here(todo, root, progress, report)
             elif todo:
                 from davis_ag.generate.pool_executor import run_on_pool
 
-                run_on_pool(todo, root, options, progress, report)
+                # No more processes than scenes, so the cores go to Mesa threads instead.
+                pool = dataclasses.replace(options, workers=min(options.workers, len(todo)))
+                run_on_pool(todo, root, pool, progress, report)
         finally:
             progress.close()
         if report.failed:

@@ -18,6 +18,15 @@ from PIL import Image
 from davis_ag.atomic_files import write_json_atomic
 
 JPEG_QUALITY = 95
+#: Depth images: uint16 millimetres along the optical axis, 0 where nothing is hit; farther
+#: surfaces than this many millimetres are stored as this value.
+DEPTH_MAX_MM = 65535
+
+
+def depth_png(depth: np.ndarray) -> np.ndarray:
+    """Metres (0 = nothing hit) to the uint16 millimetres of ``NNNN_depth.png``."""
+    millimetres = np.rint(np.asarray(depth, dtype=np.float64) * 1000.0)
+    return np.clip(millimetres, 0, DEPTH_MAX_MM).astype(np.uint16)
 
 
 def partial_dir(scene_dir: Path) -> Path:
@@ -48,14 +57,17 @@ class SceneWriter:
         self._pool = ThreadPoolExecutor(max_workers=2)
         self._pending: list[Future] = []
 
-    def add_view(self, name: str, colour: np.ndarray, segmentation: np.ndarray, entry: dict) -> None:
-        """Queue one view's image, segmentation and annotations entry.
+    def add_view(self, name: str, colour: np.ndarray, segmentation: np.ndarray, entry: dict,
+                 depth: np.ndarray | None = None) -> None:
+        """Queue one view's image, segmentation, depth and annotations entry.
 
         Args:
             name: Image name, ``NNNN.jpeg``.
             colour: (height, width, 3) uint8.
             segmentation: (height, width) uint8.
             entry: Its annotations.json entry.
+            depth: (height, width) metres along the optical axis, 0 where nothing is hit; written
+                as ``NNNN_depth.png`` (uint16 millimetres) unless None.
         """
         stem = name.rsplit(".", 1)[0]
         images = self.tmp_dir / "images"
@@ -63,9 +75,12 @@ class SceneWriter:
             lambda: Image.fromarray(colour).save(images / name, quality=JPEG_QUALITY)))
         self._pending.append(self._pool.submit(
             lambda: Image.fromarray(segmentation, mode="L").save(images / f"{stem}_seg.png", compress_level=1)))
+        if depth is not None:
+            self._pending.append(self._pool.submit(
+                lambda: Image.fromarray(depth_png(depth)).save(images / f"{stem}_depth.png", compress_level=1)))
         self.annotations[name] = entry
-        if len(self._pending) > 16:
-            self._drain(keep=8)
+        if len(self._pending) > 24:
+            self._drain(keep=12)
 
     def _drain(self, keep: int = 0) -> None:
         while len(self._pending) > keep:

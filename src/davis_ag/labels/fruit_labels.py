@@ -116,11 +116,19 @@ def silhouette_pixels(camera: Camera, view: Viewpoint, polygons: list[np.ndarray
 
 
 def visible_fractions(
-    camera: Camera, view: Viewpoint, labels: ViewLabels, fruit_polygons: dict[int, list[np.ndarray]]
+    camera: Camera, view: Viewpoint, labels: ViewLabels, fruit_polygons: dict[int, list[np.ndarray]],
+    silhouette=None,
 ) -> dict[int, float]:
-    """Visible pixels over unoccluded pixels for every boxed fruit, rounded to 4 digits."""
+    """Visible pixels over unoccluded pixels for every boxed fruit, rounded to 4 digits.
+
+    Args:
+        camera, view, labels: The view and its labels.
+        fruit_polygons: Each fruit's primitives, for :func:`silhouette_pixels`.
+        silhouette: Optional ``silhouette(fruit_id) -> pixels`` that counts the unoccluded pixels
+            faster (our renderer draws them); :func:`silhouette_pixels` otherwise.
+    """
     fractions = {}
     for fruit_id, visible in labels.visible_pixels.items():
-        whole = silhouette_pixels(camera, view, fruit_polygons[fruit_id])
+        whole = silhouette(fruit_id) if silhouette else silhouette_pixels(camera, view, fruit_polygons[fruit_id])
         fractions[fruit_id] = round(min(1.0, visible / max(whole, visible, 1)), 4)
     return fractions

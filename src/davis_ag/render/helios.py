@@ -1,4 +1,5 @@
-"""Draw views of a Helios scene: colour and primitive-id images straight from native buffers.
+"""Draw views of a Helios scene with pyhelios's Visualizer: colour, primitive ids and depth from
+native buffers. The reference backend (``--renderer helios``); :mod:`davis_ag.render.opengl` is ours.
 
 The camera (:mod:`davis_ag.scene.build.camera`) is an ideal pinhole. Helios' field of view is vertical; pixel (column u, row v) covers
 [u, u+1) x [v, v+1) with row 0 at the top, so a point at camera coordinates (right, up, forward)
@@ -85,11 +86,28 @@ class HeliosRenderer:
         self._check(pointer, size.value)
         return np.ctypeslib.as_array(pointer, shape=(size.value,)).reshape(height.value, width.value).copy()
 
-    def render(self, view: Viewpoint) -> tuple[np.ndarray, np.ndarray]:
-        """Colour image and primitive ids of one view, from a single draw of each pass."""
+    def read_depth(self) -> np.ndarray:
+        """Depth of the current view along the optical axis, metres, 0 where nothing is hit,
+        (height, width) float32, row 0 at the top (Helios's annotation pass)."""
+        from pyhelios.plugins import helios_lib
+
+        width, height, size = ctypes.c_uint(), ctypes.c_uint(), ctypes.c_uint()
+        pointer = helios_lib.visualizerGetDepthImage(
+            self._vis.visualizer, ctypes.byref(width), ctypes.byref(height), ctypes.byref(size)
+        )
+        self._check(pointer, size.value)
+        depth = np.ctypeslib.as_array(pointer, shape=(size.value,)).reshape(height.value, width.value)
+        return np.where(depth > 0, depth, 0).astype(np.float32)
+
+    def render(self, view: Viewpoint, depth: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+        """Colour image, primitive ids and depth of one view (depth None when not asked for).
+
+        The colour and id passes are drawn once each; the depth comes from one more Helios call.
+        """
         self.set_view(view)
         primitive_ids = self.draw_primitive_ids()
-        return self.read_colour(), primitive_ids
+        colour = self.read_colour()
+        return colour, primitive_ids, self.read_depth() if depth else None
 
     def close(self) -> None:
         """Release the Visualizer and its GL context."""

@@ -119,9 +119,8 @@ def run_demo(out: Path, scenes: int = 2, size: tuple[int, int] = DEMO_SIZE, seed
     """The whole demo: generate, validate, split, benchmark the baselines, report.
 
     Defaults: 2 SP strawberry scenes (one train and one test scene under the 70/30 split by
-    scene) at the paper's 1280x720. Measured on a 2-core CPU machine without GPU: 5 min 37 s in
-    all (0.44-0.47 s per view, 704 views); at 640x360, 4 min 29 s. Helios' draw time is set by
-    the geometry (~180K primitives per strawberry scene) more than by the pixel count.
+    scene) at the paper's 1280x720, drawn by our OpenGL renderer (default look, with depth).
+    Before our renderer, with Helios drawing, it took 5 min 37 s on a 2-core CPU machine.
 
     Args:
         out: Output folder: ``out/dataset`` and ``out/report``.

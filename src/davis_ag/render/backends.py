@@ -1,0 +1,68 @@
+"""Which renderer draws a scene, and in which look: the names the commands, configs and scene.json use.
+
+- ``opengl`` (default): ours, :class:`davis_ag.render.opengl.OpenGLRenderer`.
+- ``helios``: pyhelios's own Visualizer, :class:`davis_ag.render.helios.HeliosRenderer`, kept as
+  the reference our renderer is tested against.
+
+Looks (ours only): ``default`` draws textures at full resolution with mipmaps and linear
+filtering; ``helios`` reproduces Helios's frames, its reduced, unfiltered textures included.
+The Helios renderer always draws the ``helios`` look.
+"""
+
+from __future__ import annotations
+
+from davis_ag.errors import UserError
+from davis_ag.scene.camera import Camera
+from davis_ag.scene.lighting import Lighting
+
+RENDERERS = ("opengl", "helios")
+LOOKS = ("default", "helios")
+DEFAULT_RENDERER = "opengl"
+DEFAULT_LOOK = "default"
+
+
+def resolve_look(renderer: str, look: str | None) -> str:
+    """The look a renderer will draw: ``look``, or the renderer's own when None.
+
+    Raises:
+        UserError: for an unknown renderer or look, or a look the renderer cannot draw.
+    """
+    if renderer not in RENDERERS:
+        raise UserError(f"renderer {renderer!r}: choose {' or '.join(RENDERERS)}")
+    if look is not None and look not in LOOKS:
+        raise UserError(f"look {look!r}: choose {' or '.join(LOOKS)}")
+    if renderer == "helios":
+        if look not in (None, "helios"):
+            raise UserError("the helios renderer draws only the helios look: drop --look or use --renderer opengl")
+        return "helios"
+    return look or DEFAULT_LOOK
+
+
+#: Colour samples per pixel of our renderer: 4 (multisampled colour, ids from a 1x pass) or 1.
+ANTIALIASING = (4, 1)
+
+
+def open_renderer(renderer: str, context, camera: Camera, lighting: Lighting, look: str | None = None,
+                  antialiasing: int = 4):
+    """A renderer of a scene; use it as a context manager.
+
+    Args:
+        renderer: ``opengl`` or ``helios``.
+        context: The scene's Helios Context.
+        camera: Image size and field of view.
+        lighting: Sun and sky.
+        look: ``default`` or ``helios`` (None: the renderer's default).
+        antialiasing: Ours only: 4 (default) or 1 (one 1x pass, no antialiasing; faster on
+            llvmpipe for scenes of many small triangles). Ids are exact either way.
+
+    Returns:
+        An object with ``render(view) -> (colour, primitive_ids, depth)`` and ``close()``.
+    """
+    look = resolve_look(renderer, look)
+    if renderer == "helios":
+        from davis_ag.render.helios import HeliosRenderer
+
+        return HeliosRenderer(context, camera, lighting)
+    from davis_ag.render.opengl import OpenGLRenderer
+
+    return OpenGLRenderer(context, camera, lighting, look=look, antialiasing=antialiasing)

@@ -1,0 +1,464 @@
+"""Our renderer: a Helios scene drawn with OpenGL (moderngl, headless EGL), colour, ids and depth.
+
+Same contract as :class:`davis_ag.render.helios.HeliosRenderer`: built from a scene's Context, a
+:class:`~davis_ag.scene.camera.Camera` and its :class:`~davis_ag.scene.lighting.Lighting`;
+:meth:`OpenGLRenderer.render` takes a viewpoint and returns the colour image, the primitive ids
+and the depth image.
+
+- Geometry: the whole scene in one vertex buffer (:mod:`davis_ag.render.scene_geometry`), read
+  from the Context once.
+- Lighting as Helios's ``phong_shadowed`` model: diffuse and specular light from the sun, ambient
+  light blended between a sky and a ground colour by the normal, shadows, sRGB decoding, Helios's
+  colour boost of vertex colours, an ACES-fitted tone curve, the sky dome behind everything.
+- One shadow map per scene: the sun is fixed, so the depth of the shadow casters seen from the
+  sun is drawn once, fitted to the casters (the plants); the soil receives shadows and casts none.
+- Pinhole: Helios's vertical field of view and projection (OpenGL's, pixel centres at +0.5, row 0
+  at the top once read back), so ids and depth line up with :meth:`Camera.project`.
+- Antialiasing (``antialiasing``): 1 draws colour, ids and depth in one 1x pass; 4 (default)
+  draws the colour with 4x multisampling and the ids and depth in a light 1x pass, so ids stay
+  exact (a multisampled id attachment would mix ids at edges). See docs/performance.md.
+- Looks: ``"helios"`` reproduces Helios's frames, its texture handling included (images larger
+  than 2048 pixels resized as Helios does, sampled at the nearest texel without mipmaps), to
+  test fidelity; ``"default"`` samples every texture at full resolution with mipmaps and linear
+  filtering.
+
+Where a GPU with an EGL driver is present, the same code draws on it; which EGL device is used
+follows the EGL vendor library's choice (``__EGL_VENDOR_LIBRARY_FILENAMES``); see the README.
+"""
+
+from __future__ import annotations
+
+from importlib import resources
+
+import numpy as np
+from PIL import Image
+
+from davis_ag.render.projection import camera_matrices, gl_matrix, helios_shadow_box, light_matrix, matmul32
+from davis_ag.render.scene_geometry import SceneGeometry, read_scene_geometry
+from davis_ag.render.textures import default_sky_texture, load_texture
+from davis_ag.scene.camera import Camera
+from davis_ag.scene.lighting import Lighting
+from davis_ag.scene.view_grid import Viewpoint
+
+LOOKS = ("default", "helios")
+#: Helios's shading constants (its Visualizer's defaults): Phong weights and shininess, the
+#: ambient sky and ground colours, the boost of vertex colours, exposure, the sun's tint.
+MATERIAL = (1.0, 0.8, 0.2, 32.0)
+SKY_AMBIENT = (0.5, 0.6, 0.75)
+GROUND_AMBIENT = (0.35, 0.30, 0.22)
+COLOUR_BOOST = 1.5
+EXPOSURE = 1.0
+#: Side of the one shadow map, texels.
+SHADOW_MAP_SIZE = 4096
+#: Depth offset of the shadow test, in the map's [0, 1] depth (besides a polygon offset).
+SHADOW_BIAS = 1e-4
+#: The default look's shadow box: every point maps to its middle, so shadows fall everywhere.
+EVERYWHERE = np.array([[0, 0, 0, 0.5], [0, 0, 0, 0.5], [0, 0, 0, 0.5], [0, 0, 0, 1.0]])
+#: Default look: one copy of a ground texture covers this many metres of soil. The Context's own
+#: texture coordinates stretch one soil image over a whole 12 m tile (Helios shows its texels as
+#: 2 cm blocks); the default look lays the image at this size instead, with mipmaps.
+GROUND_REPEAT = 0.5
+#: Largest side of a texture layer in the default look (the array is one size for all layers).
+MAX_LAYER = 4096
+
+
+def decode_srgb(values: np.ndarray) -> np.ndarray:
+    """sRGB-encoded values in [0, 1] to linear light (IEC 61966-2-1)."""
+    values = np.asarray(values, dtype=np.float64)
+    return np.where(values <= 0.04045, values / 12.92, ((values + 0.055) / 1.055) ** 2.4)
+
+
+def linear_albedo(colours: np.ndarray) -> np.ndarray:
+    """Helios's vertex colours as its shader uses them: boosted, clipped, decoded to linear light."""
+    out = np.array(colours, dtype=np.float64)
+    out[:, :3] = decode_srgb(np.clip(out[:, :3] * COLOUR_BOOST, 0.0, 1.0))
+    return out.astype(np.float32)
+
+
+def _shader(name: str) -> str:
+    return (resources.files("davis_ag.render") / "shaders" / name).read_text()
+
+
+def _fragment(name: str, defines: tuple[str, ...] = ()) -> str:
+    lines = ["#version 330 core", *(f"#define {d}" for d in defines), _shader("common.glsl"), _shader(name)]
+    return "\n".join(lines)
+
+
+def _egl_current() -> tuple | None:
+    """The EGL context current on this thread (display, draw, read, context), or None."""
+    import ctypes
+    import ctypes.util
+
+    try:
+        egl = ctypes.CDLL(ctypes.util.find_library("EGL") or "libEGL.so.1")
+    except OSError:
+        return None
+    for name in ("eglGetCurrentDisplay", "eglGetCurrentContext", "eglGetCurrentSurface"):
+        getattr(egl, name).restype = ctypes.c_void_p
+    egl.eglGetCurrentSurface.argtypes = [ctypes.c_int]
+    egl.eglMakeCurrent.argtypes = [ctypes.c_void_p] * 4
+    display = egl.eglGetCurrentDisplay()
+    if not display:
+        return None
+    draw_surface, read_surface = 0x3059, 0x305A  # EGL_DRAW, EGL_READ
+    return (egl, display, egl.eglGetCurrentSurface(draw_surface), egl.eglGetCurrentSurface(read_surface),
+            egl.eglGetCurrentContext())
+
+
+def _egl_restore(state: tuple | None) -> None:
+    """Make a context saved by :func:`_egl_current` current again (another GL user's, such as
+    Helios's Visualizer, which expects its context to stay current between its calls)."""
+    if state is not None:
+        egl, display, draw, read, context = state
+        egl.eglMakeCurrent(display, draw, read, context)
+
+
+#: Environment variable naming the EGL device to draw on (an index into EGL's device list).
+EGL_DEVICE_VARIABLE = "DAVIS_AG_EGL_DEVICE"
+
+
+def create_context():
+    """A headless OpenGL 3.3+ context through EGL: the default EGL display (a GPU's driver where one
+    is installed and chosen by libglvnd, else Mesa's llvmpipe), or EGL device number
+    ``$DAVIS_AG_EGL_DEVICE`` where that is set (README, "Rendering")."""
+    import os
+
+    import moderngl
+
+    from davis_ag.errors import UserError
+
+    device = os.environ.get(EGL_DEVICE_VARIABLE, "").strip()
+    if device and not device.isdigit():
+        raise UserError(f"{EGL_DEVICE_VARIABLE}={device!r}: give the number of an EGL device (0, 1, ...)")
+    options = {"device_index": int(device)} if device else {}
+    try:
+        return moderngl.create_standalone_context(backend="egl", require=330, **options)
+    except Exception as error:  # noqa: BLE001 - moderngl raises plain Exceptions
+        raise UserError(f"cannot open a headless OpenGL context through EGL ({error}): install the "
+                        "system's EGL and GL libraries (Debian: libegl1 libgl1 libgl1-mesa-dri)"
+                        + (f", or choose another {EGL_DEVICE_VARIABLE}" if device else "")) from None
+
+
+class OpenGLRenderer:
+    """Draws views of one scene: colour, primitive ids and depth.
+
+    Args:
+        context: The Helios Context with the scene (or a :class:`SceneGeometry` already read).
+        camera: Image size and field of view.
+        lighting: Sun direction and sky.
+        look: ``"default"`` or ``"helios"`` (see the module docstring).
+        antialiasing: 1 (one 1x pass) or 4 (4x multisampled colour, 1x id pass).
+    """
+
+    def __init__(self, context, camera: Camera, lighting: Lighting, look: str = "default",
+                 antialiasing: int = 4) -> None:
+        if look not in LOOKS:
+            raise ValueError(f"look {look!r}: choose one of {', '.join(LOOKS)}")
+        if antialiasing not in (1, 4):
+            raise ValueError("antialiasing must be 1 or 4")
+        self.camera, self.lighting, self.look, self.antialiasing = camera, lighting, look, antialiasing
+        geometry = context if isinstance(context, SceneGeometry) else read_scene_geometry(context)
+        self.geometry = geometry
+        # Our context is current only while we draw: another GL user in this process (Helios's
+        # Visualizer) finds its own context current again after every call of ours.
+        previous = _egl_current()
+        self.ctx = create_context()
+        try:
+            self._build(geometry)
+        except BaseException:
+            self.close()
+            raise
+        finally:
+            _egl_restore(previous)
+
+    # -----------------------------------------------------------------------------------------
+    # Set-up
+
+    def _build(self, geometry: SceneGeometry) -> None:
+        import moderngl
+
+        ctx = self.ctx
+        helios = self.look == "helios"
+        self._programs = {
+            "scene": ctx.program(vertex_shader=_shader("scene.vert"), fragment_shader=_fragment("scene.frag")),
+            "ids": ctx.program(vertex_shader=_shader("scene.vert"),
+                               fragment_shader=_fragment("scene.frag", ("IDS_ONLY",))),
+            "shadow": ctx.program(vertex_shader=_shader("shadow.vert"), fragment_shader=_fragment("shadow.frag")),
+            "sky": ctx.program(vertex_shader=_shader("sky.vert"), fragment_shader=_fragment("sky.frag")),
+        }
+        # Samplers and the look first: the shadow pass below samples leaf textures already.
+        for program in self._programs.values():
+            self._set(program, "helios_look", int(helios))
+            self._set(program, "textures", 0)
+            self._set(program, "shadow_map", 1)
+            self._set(program, "sky", 2)
+        self._upload_textures(geometry)
+        # Helios draws triangles, then patches, each in UUID order; later draws win depth ties
+        # (GL_LEQUAL), so keep that order.
+        order = np.lexsort((geometry.uuids, geometry.patch))
+        n = geometry.triangle_count
+        vertex = np.zeros(n * 3, dtype=[("position", "f4", 3), ("uv", "f4", 2), ("normal", "f4", 3),
+                                        ("colour", "f4", 4), ("id", "u4"), ("texture", "i4"), ("mode", "i4")])
+        vertex["position"] = geometry.positions[order].reshape(-1, 3)
+        uvs = geometry.uvs[order]
+        if not helios:  # the soil's image laid at a fixed size on the ground, not stretched over the tile
+            ground = ~geometry.caster[order] & (geometry.texture[order] >= 0)
+            uvs = np.where(ground[:, None, None], geometry.positions[order][:, :, :2] / GROUND_REPEAT, uvs)
+        vertex["uv"] = uvs.reshape(-1, 2)
+        vertex["normal"] = geometry.normals[order].reshape(-1, 3)
+        vertex["colour"] = np.repeat(linear_albedo(geometry.colours[order]), 3, axis=0)
+        vertex["id"] = np.repeat(geometry.uuids[order].astype(np.uint64) + 1, 3).astype(np.uint32)
+        vertex["texture"] = np.repeat(np.maximum(geometry.texture[order], 0), 3)
+        vertex["mode"] = np.repeat(geometry.mode[order], 3)
+        self._vbo = ctx.buffer(vertex.tobytes())
+        self._triangle_uuids = geometry.uuids[order]
+        self._silhouette_vaos: dict[int, object] = {}
+        layout = "3f 2f 3f 4f 1u 1i 1i"
+        names = ["in_position", "in_uv", "in_normal", "in_colour", "in_id", "in_texture", "in_mode"]
+        self._scene = ctx.vertex_array(self._programs["scene"], [(self._vbo, layout, *names)], skip_errors=True)
+        self._ids = ctx.vertex_array(self._programs["ids"], [(self._vbo, layout, *names)], skip_errors=True)
+        shadow_layout = "3f 2f 12x 16x 4x 1i 1i"
+        self._shadow = ctx.vertex_array(self._programs["shadow"], [
+            (self._vbo, shadow_layout, "in_position", "in_uv", "in_texture", "in_mode")], skip_errors=True)
+        self._sky = ctx.vertex_array(self._programs["sky"], [])
+
+        # One shadow map for the scene, fitted to the casters.
+        lo, hi = geometry.caster_bounds()
+        self._light = light_matrix(self.lighting.direction, lo, hi)
+        self._shadow_map = ctx.depth_texture((SHADOW_MAP_SIZE, SHADOW_MAP_SIZE))
+        self._shadow_map.compare_func = ""
+        self._shadow_map.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        caster_first = np.lexsort((~geometry.caster[order],))  # casters only, drawn alone
+        caster_vertex = vertex.reshape(-1, 3)[caster_first][: int(geometry.caster.sum())].reshape(-1)
+        self._caster_vbo = ctx.buffer(caster_vertex.tobytes())
+        caster_vao = ctx.vertex_array(self._programs["shadow"], [
+            (self._caster_vbo, shadow_layout, "in_position", "in_uv", "in_texture", "in_mode")], skip_errors=True)
+        shadow_fbo = ctx.framebuffer(depth_attachment=self._shadow_map)
+        shadow_fbo.use()
+        shadow_fbo.clear(depth=1.0)
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.depth_func = "<="
+        ctx.polygon_offset = (1.0, 1.0)
+        self._programs["shadow"]["light_projection"].write(gl_matrix(self._light))
+        self._bind_textures()
+        if caster_vertex.size:
+            caster_vao.render(moderngl.TRIANGLES)
+        caster_vao.release()
+        shadow_fbo.release()
+
+        # Framebuffers: 1x colour, ids and depth; 4x colour where antialiased.
+        w, h = self.camera.width, self.camera.height
+        self._colour = ctx.renderbuffer((w, h), 4)
+        self._id_buffer = ctx.renderbuffer((w, h), 1, dtype="u4")
+        self._depth_buffer = ctx.renderbuffer((w, h), 1, dtype="f4")
+        self._fbo = ctx.framebuffer([self._colour, self._id_buffer, self._depth_buffer],
+                                    ctx.depth_renderbuffer((w, h)))
+        if self.antialiasing > 1:
+            samples = min(self.antialiasing, ctx.max_samples)
+            # Colour only: the shader's id and depth outputs have no attachment here and are dropped.
+            self._ms_fbo = ctx.framebuffer([ctx.renderbuffer((w, h), 4, samples=samples)],
+                                           ctx.depth_renderbuffer((w, h), samples=samples))
+            self._resolve_fbo = ctx.framebuffer([self._colour])
+            self._ids_fbo = ctx.framebuffer([self._id_buffer, self._depth_buffer], ctx.depth_renderbuffer((w, h)))
+
+        # Uniforms that hold for every view.
+        scene = self._programs["scene"]
+        for program in (scene, self._programs["ids"]):
+            self._set(program, "light_projection", gl_matrix(self._light))
+        self._set(self._programs["sky"], "exposure", EXPOSURE)
+        self._set(scene, "light_depth_range", float(1.0 / np.linalg.norm(self._light[2, :3])))
+        for name, value in (("sun", self.lighting.direction), ("exposure", EXPOSURE),
+                            ("sky_ambient", SKY_AMBIENT),
+                            ("ground_ambient", GROUND_AMBIENT), ("material", MATERIAL),
+                            ("shadow_bias", SHADOW_BIAS)):
+            self._set(scene, name, value)
+    def _upload_textures(self, geometry: SceneGeometry) -> None:
+        import moderngl
+
+        ctx = self.ctx
+        helios = self.look == "helios"
+        files = geometry.texture_files or []
+        if helios:
+            images = [load_texture(f, "helios") for f in files]
+            width = max([i.shape[1] for i in images] + [1])
+            height = max([i.shape[0] for i in images] + [1])
+        else:
+            sizes = []
+            for f in files:
+                with Image.open(f) as image:
+                    sizes.append(image.size)
+            width = min(MAX_LAYER, max([s[0] for s in sizes] + [1]))
+            height = min(MAX_LAYER, max([s[1] for s in sizes] + [1]))
+            images = [load_texture(f, "default", (width, height)) for f in files]
+        layers = max(1, len(images))
+        # Half floats in linear light: the shader samples colours it need not decode.
+        data = np.zeros((layers, height, width, 4), dtype=np.float16)
+        scale = np.ones((64, 2), dtype=np.float32)
+        for k, image in enumerate(images):
+            texels = image.astype(np.float64) / 255.0
+            texels[..., :3] = decode_srgb(texels[..., :3])
+            data[k, : image.shape[0], : image.shape[1]] = texels
+            scale[k] = (image.shape[1] / width, image.shape[0] / height)
+        self._textures = ctx.texture_array((width, height, layers), 4, data.tobytes(), dtype="f2")
+        if helios:
+            self._textures.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            self._textures.repeat_x = self._textures.repeat_y = False
+        else:
+            self._textures.build_mipmaps()
+            self._textures.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+        for program in self._programs.values():
+            if "layer_scale" in program:
+                program["layer_scale"].write(scale.tobytes())
+
+        sky = load_texture(self.lighting.sky_texture or default_sky_texture(), "helios" if helios else "default")
+        self._sky_texture = ctx.texture((sky.shape[1], sky.shape[0]), 4, sky.tobytes())
+        if helios:
+            self._sky_texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        else:
+            self._sky_texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
+        self._sky_texture.repeat_x, self._sky_texture.repeat_y = True, False
+        self._set(self._programs["sky"], "sky_scale", (1.0, 1.0))
+
+    def _bind_textures(self) -> None:
+        self._textures.use(0)
+        self._shadow_map.use(1)
+        self._sky_texture.use(2)
+
+    @staticmethod
+    def _set(program, name: str, value) -> None:
+        if name in program:
+            if isinstance(value, bytes):
+                program[name].write(value)
+            else:
+                program[name].value = value
+
+    # -----------------------------------------------------------------------------------------
+    # Drawing
+
+    def _view_uniforms(self, view: Viewpoint) -> None:
+        eye = np.asarray(view.position, dtype=np.float64)
+        target = np.asarray(view.look_at(1.0), dtype=np.float64)
+        view_matrix, projection = camera_matrices(self.camera, view)
+        view_projection = matmul32(projection, view_matrix)
+        rotation = view_matrix.astype(np.float64)
+        rotation[:3, 3] = 0.0
+        # Helios computes shadows only inside a box around its camera's view volume.
+        box = helios_shadow_box(self.camera, eye, target, self.lighting.direction) if self.look == "helios" \
+            else EVERYWHERE
+        for program in (self._programs["scene"], self._programs["ids"]):
+            self._set(program, "view_projection", gl_matrix(view_projection))
+            self._set(program, "view", gl_matrix(view_matrix))
+        self._set(self._programs["scene"], "eye", tuple(eye))
+        self._set(self._programs["scene"], "shadow_box", gl_matrix(box))
+        self._set(self._programs["sky"], "inverse_rotation_projection",
+                  gl_matrix(np.linalg.inv(projection.astype(np.float64) @ rotation)))
+
+    def draw(self, view: Viewpoint) -> None:
+        """Draw a view into the renderer's buffers (read them with :meth:`read`)."""
+        import moderngl
+
+        ctx = self.ctx
+        self._view_uniforms(view)
+        self._bind_textures()
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.depth_func = "<="
+        ctx.polygon_offset = (1.0, 1.0)
+        if self.antialiasing > 1:
+            self._pass(self._ms_fbo, self._scene)
+            ctx.copy_framebuffer(self._resolve_fbo, self._ms_fbo)
+            self._ids_fbo.use()
+            self._ids_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+            self._ids.render(moderngl.TRIANGLES)
+        else:
+            self._pass(self._fbo, self._scene)
+
+    def _pass(self, fbo, vao) -> None:
+        """Scene, then the sky where nothing was drawn (its depth is the far plane)."""
+        import moderngl
+
+        fbo.use()
+        fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        vao.render(moderngl.TRIANGLES)
+        self.ctx.polygon_offset = (0.0, 0.0)
+        self._sky.render(moderngl.TRIANGLES, vertices=3)
+        self.ctx.polygon_offset = (1.0, 1.0)
+
+    def read(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The last view drawn: colour, primitive ids and depth (see :meth:`render`)."""
+        w, h = self.camera.width, self.camera.height
+        colour = np.frombuffer(self._fbo.read(components=3, attachment=0), dtype=np.uint8).reshape(h, w, 3)
+        ids = np.frombuffer(self._fbo.read(components=1, attachment=1, dtype="u4"), dtype=np.uint32).reshape(h, w)
+        depth = np.frombuffer(self._fbo.read(components=1, attachment=2, dtype="f4"), dtype=np.float32).reshape(h, w)
+        return colour[::-1].copy(), ids[::-1].copy(), depth[::-1].copy()
+
+    def render(self, view: Viewpoint, depth: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Draw one view (the depth comes from the same pass as the ids, so ``depth`` changes nothing).
+
+        Returns:
+            Colour (height, width, 3) uint8; primitive ids (height, width) uint32, UUID + 1 of the
+            primitive seen at each pixel centre, 0 for none; depth (height, width) float32, metres
+            along the optical axis, 0 where nothing is hit. Row 0 is the top of the image.
+        """
+        previous = _egl_current()
+        try:
+            with self.ctx:
+                self.draw(view)
+                return self.read()
+        finally:
+            _egl_restore(previous)
+
+    def silhouette_pixels(self, view: Viewpoint, key: int, uuids: np.ndarray) -> int:
+        """Pixels whose centre some primitive of ``uuids`` covers with nothing else drawn: the area
+        an object (a fruit) would have in the view if nothing hid it. One 1x raster of only its
+        triangles; the same rule the id image follows.
+
+        Args:
+            view: The pose.
+            key: A name for the group (a fruit id): its triangles are looked up once per renderer.
+            uuids: The group's primitive UUIDs.
+        """
+        import moderngl
+
+        previous = _egl_current()
+        try:
+            with self.ctx:
+                vao = self._silhouette_vaos.get(key)
+                if vao is None:
+                    triangles = np.nonzero(np.isin(self._triangle_uuids, np.asarray(uuids, dtype=np.uint32)))[0]
+                    if not len(triangles):
+                        return 0
+                    indices = (triangles[:, None] * 3 + np.arange(3)).astype(np.uint32)
+                    vao = self.ctx.vertex_array(
+                        self._programs["ids"], [(self._vbo, "3f 2f 3f 4f 1u 1i 1i", "in_position", "in_uv", "in_normal",
+                                                 "in_colour", "in_id", "in_texture", "in_mode")],
+                        index_buffer=self.ctx.buffer(indices.tobytes()), index_element_size=4, skip_errors=True)
+                    self._silhouette_vaos[key] = vao
+                if not hasattr(self, "_silhouette_fbo"):
+                    size = (self.camera.width, self.camera.height)
+                    self._silhouette_fbo = self.ctx.framebuffer([self.ctx.renderbuffer(size, 1, dtype="u4")])
+                self._view_uniforms(view)
+                self._bind_textures()
+                self._silhouette_fbo.use()
+                self._silhouette_fbo.clear(0.0, 0.0, 0.0, 0.0)
+                self.ctx.disable(moderngl.DEPTH_TEST)
+                vao.render(moderngl.TRIANGLES)
+                self.ctx.enable(moderngl.DEPTH_TEST)
+                ids = np.frombuffer(self._silhouette_fbo.read(components=1, dtype="u4"), dtype=np.uint32)
+                return int(np.count_nonzero(ids))
+        finally:
+            _egl_restore(previous)
+
+    def close(self) -> None:
+        """Release the GL context and everything in it."""
+        ctx, self.ctx = getattr(self, "ctx", None), None
+        if ctx is not None:
+            previous = _egl_current()
+            ctx.mglo.__enter__()  # release our objects in our context, not in whichever is current
+            ctx.release()
+            _egl_restore(previous)
+
+    def __enter__(self) -> "OpenGLRenderer":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()

@@ -1,0 +1,77 @@
+"""Texture images for our renderer, in either look: Helios's reduced copies or full resolution.
+
+Helios's Visualizer keeps no texture larger than 2048 pixels a side (it resizes larger ones with
+its own bilinear rule) and samples the nearest texel; :func:`load_texture` reproduces that for the
+``helios`` look and keeps the full image for the ``default`` look.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+#: Helios keeps textures at most this large (Visualizer's ``maximum_texture_size``).
+HELIOS_MAX_TEXTURE = 2048
+
+
+def default_sky_texture() -> str:
+    """Helios's default sky (``SkyDome_clouds.jpg``, shipped with pyhelios3d)."""
+    from davis_ag.scene.build import helios_texture
+
+    return helios_texture("SkyDome_clouds.jpg")
+
+
+def helios_resize(image: np.ndarray, width: int, height: int) -> np.ndarray:
+    """Resize as Helios's Visualizer does: new pixel (x, y) is the bilinear blend at source
+    (x * old_width / width, y * old_height / height), rounded as round(value + 0.5).
+
+    Args:
+        image: (h, w, c) uint8.
+        width, height: The new size.
+
+    Returns:
+        (height, width, c) uint8.
+    """
+    import cv2
+
+    old_h, old_w = image.shape[:2]
+    # warpAffine maps each destination pixel through the inverse of this matrix: src = dst * ratio.
+    matrix = np.array([[width / old_w, 0.0, 0.0], [0.0, height / old_h, 0.0]])
+    value = cv2.warpAffine(image.astype(np.float32), matrix, (width, height), flags=cv2.INTER_LINEAR,
+                           borderMode=cv2.BORDER_REPLICATE)
+    return np.clip(np.round(value + 0.5), 0, 255).astype(np.uint8)
+
+
+@functools.lru_cache(maxsize=16)
+def load_texture(path: str, look: str, size: tuple[int, int] | None = None) -> np.ndarray:
+    """An image as RGBA uint8 rows, first row at texture coordinate v = 0, in a look's resolution.
+
+    Kept for the life of the process (every scene uses the same few images).
+
+    Args:
+        path: Image file.
+        look: ``"helios"`` (at most 2048 a side, Helios's resampling) or ``"default"``.
+        size: Resample to this (width, height) (the default look's common layer size).
+    """
+    import cv2
+
+    data = cv2.imread(path, cv2.IMREAD_UNCHANGED)
+    if data is None:
+        raise OSError(f"cannot read the texture image {path}")
+    if data.ndim == 2:
+        data = cv2.cvtColor(data, cv2.COLOR_GRAY2RGB)
+    data = cv2.cvtColor(data, cv2.COLOR_BGRA2RGBA if data.shape[2] == 4 else cv2.COLOR_BGR2RGB)
+    h, w = data.shape[:2]
+    if look == "helios" and (w > HELIOS_MAX_TEXTURE or h > HELIOS_MAX_TEXTURE):
+        data = helios_resize(data, min(w, HELIOS_MAX_TEXTURE), min(h, HELIOS_MAX_TEXTURE))
+    elif look != "helios" and size is not None and (w, h) != tuple(size):
+        data = cv2.resize(data, tuple(size), interpolation=cv2.INTER_AREA if size[0] < w else cv2.INTER_CUBIC)
+    if data.shape[2] == 3:
+        data = np.dstack([data, np.full(data.shape[:2], 255, np.uint8)])
+    # Image rows run top to bottom; texture coordinate v = 0 is the image's bottom row.
+    data = np.ascontiguousarray(data[::-1])
+    data.flags.writeable = False
+    return data
+
+
