@@ -36,7 +36,8 @@ def register(subparsers) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    crop, scenario = crop_spec(args.crop), scenario_spec(args.scenario)
+    crop = crop_spec(args.crop)
+    scenario = scenario_spec(args.scenario, crop)
     try:
         numbers = [int(v) for v in args.views.split(",")]
     except ValueError:

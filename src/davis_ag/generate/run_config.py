@@ -141,7 +141,8 @@ def single_group_config(scenario: str, crop: str, scenes: int, first: int, seed:
     Raises:
         UserError: for unknown names or indices outside 000..999.
     """
-    group = GroupConfig(scenario_spec(scenario), crop_spec(crop), scenes, first)
+    crop_settings = crop_spec(crop)
+    group = GroupConfig(scenario_spec(scenario, crop_settings), crop_settings, scenes, first)
     if first < 0 or first + scenes > MAX_SCENES:
         raise UserError(f"scene indices {first}..{first + scenes - 1} do not fit 000..{MAX_SCENES - 1}")
     if seed < 0:
@@ -309,6 +310,7 @@ class _Checker:
             except UserError as error:
                 self.fail(f"{where}.{key}", str(error))
         scenario, crop = specs
+        scenario = scenario_spec(scenario.name, crop)  # the crop's grid (Table 3's counts)
         scenes = self.whole(item["scenes"], f"{where}.scenes", minimum=1, maximum=MAX_SCENES)
         first = self.whole(item.get("first", 0), f"{where}.first", minimum=0, maximum=MAX_SCENES - 1)
         if first + scenes > MAX_SCENES:

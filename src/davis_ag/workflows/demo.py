@@ -225,8 +225,8 @@ def run_demo(out: Path, scenes: int = 2, size: tuple[int, int] = DEMO_SIZE, seed
     if seed < 0:
         raise UserError(f"--seed {seed} is negative: use a whole number from 0")
     out = Path(out).expanduser().absolute()  # Helios moves the working directory as it works
-    scenario = scenario or scenario_spec("sp")
     crop = crop or crop_spec("strawberry")
+    scenario = scenario or scenario_spec("sp", crop)
     if out.exists() and not out.is_dir():
         raise UserError(f"{out} is a file, not a folder: choose another --out")
     root = out / "dataset"
