@@ -41,7 +41,7 @@ def dataset_settings(requests: Sequence[SceneRequest]) -> dict[str, Any]:
             raise UserError("the scenes of one run must share the dataset seed and the image size")
     groups: dict[str, Any] = {}
     for request in requests:
-        groups[request.folder.split("/")[0]] = {"grid": grid_settings(request.scenario)}
+        groups[request.folder.split("/")[0]] = {"grid": grid_settings(request.scenario, request.crop)}
     return {"format": DATASET_FORMAT, "seed": first.dataset_seed,
             "image_size": [first.camera.width, first.camera.height], "vfov_deg": first.camera.vfov,
             "groups": groups}

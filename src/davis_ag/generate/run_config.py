@@ -5,6 +5,7 @@ Format (every key but ``groups`` is optional)::
     name: paper                  # a label; defaults to the file name
     seed: 0                      # dataset seed, a whole number from 0 (default 0)
     image_size: 1280x720         # WIDTHxHEIGHT or [WIDTH, HEIGHT] (default 1280x720)
+    strawberry_altitudes: table1 # table1 (25/40/55 cm, default) or readme (0.50/0.75/1.00 m)
     grid:                        # overrides the scenario's Table 2 grid for every group
       extent: [3.0, 3.0]         #   grid size along x and y, m
       step: 0.5                  #   distance between positions, m
@@ -38,13 +39,20 @@ from typing import Any
 from davis_ag.errors import UserError
 from davis_ag.generate.one_scene import SceneRequest
 from davis_ag.scene.camera import Camera
-from davis_ag.scene.specs import CropSpec, ScenarioSpec, crop_spec, group_name, scenario_spec
+from davis_ag.scene.specs import (
+    CropSpec,
+    ScenarioSpec,
+    crop_spec,
+    group_name,
+    scenario_spec,
+    with_strawberry_altitudes,
+)
 
 #: Smallest image side accepted, pixels.
 MIN_IMAGE_SIDE = 16
 #: Scene folders are numbered NNN.
 MAX_SCENES = 1000
-TOP_KEYS = ("name", "seed", "image_size", "grid", "groups")
+TOP_KEYS = ("name", "seed", "image_size", "strawberry_altitudes", "grid", "groups")
 GROUP_KEYS = ("scenario", "crop", "scenes", "first", "grid")
 GRID_KEYS = ("extent", "step", "altitude_levels", "headings")
 
@@ -236,7 +244,29 @@ def parse_dataset_config(text: str, source: str, default_name: str = "dataset") 
             check.fail(f"groups[{position}]", f"{group.name} is already groups[{seen[group.name]}]: "
                                               "give each scenario and crop once")
         seen[group.name] = position
+    altitudes = data.get("strawberry_altitudes", "table1")
+    try:
+        groups = [dataclasses.replace(g, crop=with_strawberry_altitudes(g.crop, str(altitudes))) for g in groups]
+    except UserError as error:
+        check.fail("strawberry_altitudes", str(error))
     return DatasetConfig(name.strip(), seed, camera, tuple(groups), source)
+
+
+def use_strawberry_altitudes(config: DatasetConfig, choice: str) -> DatasetConfig:
+    """The config with every strawberry group photographed at the chosen altitudes.
+
+    Args:
+        config: A dataset config.
+        choice: ``table1`` (25/40/55 cm) or ``readme`` (0.50/0.75/1.00 m).
+
+    Returns:
+        The changed config.
+
+    Raises:
+        UserError: for an unknown choice.
+    """
+    groups = tuple(dataclasses.replace(g, crop=with_strawberry_altitudes(g.crop, choice)) for g in config.groups)
+    return dataclasses.replace(config, groups=groups)
 
 
 class _Checker:
@@ -353,8 +383,20 @@ class _Checker:
         return dataclasses.replace(scenario, **changes)
 
 
-def grid_settings(scenario: ScenarioSpec) -> dict[str, Any]:
-    """The grid a scenario spec describes, JSON-ready (recorded in dataset.json)."""
-    return {"extent": list(scenario.extent), "step": scenario.step,
-            "altitude_levels": list(scenario.altitude_levels), "headings": scenario.headings}
+def grid_settings(scenario: ScenarioSpec, crop: CropSpec | None = None) -> dict[str, Any]:
+    """The grid a scenario spec describes, JSON-ready (recorded in dataset.json).
+
+    Args:
+        scenario: The scenario's grid.
+        crop: When given, its camera altitudes in metres are recorded too (strawberry has two
+            choices, see ``specs.STRAWBERRY_ALTITUDES``).
+
+    Returns:
+        The settings.
+    """
+    settings = {"extent": list(scenario.extent), "step": scenario.step,
+                "altitude_levels": list(scenario.altitude_levels), "headings": scenario.headings}
+    if crop is not None:
+        settings["altitudes_m"] = [crop.altitudes[i] for i in scenario.altitude_levels]
+    return settings
 

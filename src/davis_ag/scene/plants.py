@@ -21,7 +21,6 @@ What is measured (metres):
 from __future__ import annotations
 
 import contextlib
-import copy
 import math
 import os
 import sys
@@ -41,6 +40,7 @@ from davis_ag.scene.plant_geometry import (  # noqa: F401 - re-exported for the 
     primitive_vertices,
     principal_extents,
 )
+from davis_ag.scene.fruit_load import with_fruit_load
 from davis_ag.scene.specs import PHENOTYPE_SPREAD, CropSpec
 
 #: Helios maps seeds 0, 1, 2**31 - 1 and 2**32 - 1 to the same plant: stay inside this range.
@@ -214,9 +214,9 @@ def scaled_shoot_parameters(defaults: dict, crop: CropSpec, knobs: dict[str, flo
         knobs: Multiplicative factors ``plant_height``, ``fruit_radius``, ``leaf_length``.
 
     Returns:
-        A modified deep copy.
+        A modified deep copy, with the crop's fruit load (``fruit_load.FRUIT_LOAD``) applied.
     """
-    params = copy.deepcopy(defaults)
+    params = with_fruit_load(defaults, crop)
     phytomer = params["phytomer_parameters"]
     scale_parameter(phytomer["inflorescence"]["fruit_prototype_scale"], knobs["fruit_radius"])
     scale_parameter(phytomer["leaf"]["prototype_scale"], knobs["leaf_length"])

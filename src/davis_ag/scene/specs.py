@@ -101,6 +101,33 @@ CROPS: dict[str, CropSpec] = {
     ),
 }
 
+#: Strawberry camera altitudes, m. The paper disagrees with itself: Table 1 gives 25/40/55 cm (our
+#: default), the Fig. 2 caption and the dataset's README 0.50/0.75/1.00 m.
+STRAWBERRY_ALTITUDES: dict[str, tuple[float, float, float]] = {
+    "table1": (0.25, 0.40, 0.55),
+    "readme": (0.50, 0.75, 1.00),
+}
+
+
+def with_strawberry_altitudes(crop: CropSpec, choice: str) -> CropSpec:
+    """The crop with the chosen strawberry altitudes; other crops come back unchanged.
+
+    Args:
+        crop: Any crop.
+        choice: A key of :data:`STRAWBERRY_ALTITUDES` (``table1`` or ``readme``).
+
+    Returns:
+        The crop, its altitudes replaced when it is the strawberry.
+
+    Raises:
+        UserError: for an unknown choice.
+    """
+    if choice not in STRAWBERRY_ALTITUDES:
+        raise UserError(f"unknown strawberry altitudes {choice!r}: choose {' or '.join(STRAWBERRY_ALTITUDES)} "
+                        "(Table 1's 25/40/55 cm, or the README's 0.50/0.75/1.00 m)")
+    return replace(crop, altitudes=STRAWBERRY_ALTITUDES[choice]) if crop.name == "strawberry" else crop
+
+
 #: Relative spread of the phenotype around Table 1, uniform (section III-A).
 PHENOTYPE_SPREAD: dict[str, float] = {"plant_height": 0.15, "fruit_radius": 0.20, "leaf_length": 0.20}
 
