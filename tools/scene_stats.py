@@ -102,7 +102,7 @@ def visibility_findings(scene, meta: dict) -> dict:
     seen: dict[tuple[int, int, int], set[int]] = {}
     for view in scene:
         ix, iy, level, _ = meta["views"][view.name]["grid"]
-        seen[ix, iy, level] = {int(box[4]) for box in view.boxes}
+        seen[ix, iy, level] = {box.fruit_id for box in view.boxes}
     fruit = len(meta["fruits"])
     pairs = [(below, seen[ix, iy, level + 1]) for (ix, iy, level), below in seen.items()
              if (ix, iy, level + 1) in seen]

@@ -43,7 +43,7 @@ def scene(tmp_path_factory: pytest.TempPathFactory) -> dict:
     scene_dir, _ = generate_scene(REQUEST, root)
     meta = json.loads((scene_dir / "scene.json").read_text())
     opened = open_dataset(root).scene(REQUEST.folder)
-    seen = {tuple(meta["views"][v.name]["grid"][:3]): {int(b[4]) for b in v.boxes} for v in opened}
+    seen = {tuple(meta["views"][v.name]["grid"][:3]): {b.fruit_id for b in v.boxes} for v in opened}
     return {"seen": seen, "fruit": len(meta["fruits"]), "plants": meta["plants"],
             "oer": np.asarray(load_scene_cache(opened, Path(root)).box_oer, dtype=float)}
 
