@@ -11,7 +11,7 @@ when another is refreshed; docs/scenes.md is rewritten from whichever exist:
   that box a fruit), whether any view sees every fruit, how often changing altitude at a fixed
   position loses or gains fruit (Fig. 3), and the share of boxes with OER below 0.4.
 
-Run: ``python tools/scene_stats.py views``, ``... plants 10``, ``... findings 3 320x180``.
+Run: ``python tools/scene_stats.py views``, ``... plants 10 [tomato,vine]``, ``... findings 3 320x180``.
 """
 
 from __future__ import annotations
@@ -45,13 +45,13 @@ def measure_views() -> dict:
     return rows
 
 
-def measure_plants(count: int) -> dict:
-    """Grow ``count`` single plants per crop; their fruit counts and measured phenotypes."""
+def measure_plants(count: int, crops: list[str]) -> dict:
+    """Grow ``count`` single plants of each of ``crops``; their fruit counts and phenotypes."""
     from davis_ag.generate.one_scene import SceneRequest
     from davis_ag.scene.build import build_scene
 
     out: dict = {"plants_per_crop": count, "crops": {}}
-    for crop in CROPS.values():
+    for crop in (CROPS[name] for name in crops):
         scenario = scenario_spec("sp", crop)
         plants = []
         for index in range(count):
@@ -200,7 +200,14 @@ def main(argv: list[str]) -> None:
     if argv and argv[0] == "views":
         write_json_atomic(DOCS / "scenes-views.json", measure_views(), indent=1)
     elif argv and argv[0] == "plants":
-        write_json_atomic(DOCS / "scenes-plants.json", {**measure_plants(int(argv[1])), "machine": machine}, indent=1)
+        # Crops measured earlier are kept: the vine takes long, so crops can be measured apart.
+        path = DOCS / "scenes-plants.json"
+        crops = argv[2].split(",") if len(argv) > 2 else list(CROPS)
+        saved = json.loads(path.read_text()) if path.exists() else {"crops": {}}
+        fresh = measure_plants(int(argv[1]), crops)
+        merged = {**saved, **fresh, "crops": {**saved["crops"], **fresh["crops"]}, "machine": machine}
+        merged["crops"] = {name: merged["crops"][name] for name in CROPS if name in merged["crops"]}
+        write_json_atomic(path, merged, indent=1)
     elif argv and argv[0] == "findings":
         size = tuple(int(v) for v in argv[2].split("x"))
         write_json_atomic(DOCS / "scenes-findings.json",
