@@ -203,8 +203,8 @@ def main(argv: list[str]) -> None:
         # Crops measured earlier are kept: the vine takes long, so crops can be measured apart.
         path = DOCS / "scenes-plants.json"
         crops = argv[2].split(",") if len(argv) > 2 else list(CROPS)
-        saved = json.loads(path.read_text()) if path.exists() else {"crops": {}}
         fresh = measure_plants(int(argv[1]), crops)
+        saved = json.loads(path.read_text()) if path.exists() else {"crops": {}}
         merged = {**saved, **fresh, "crops": {**saved["crops"], **fresh["crops"]}, "machine": machine}
         merged["crops"] = {name: merged["crops"][name] for name in CROPS if name in merged["crops"]}
         write_json_atomic(path, merged, indent=1)
