@@ -11,12 +11,15 @@ when another is refreshed; docs/scenes.md is rewritten from whichever exist:
   that box a fruit), whether any view sees every fruit, how often changing altitude at a fixed
   position loses or gains fruit (Fig. 3), and the share of boxes with OER below 0.4.
 
-Run: ``python tools/scene_stats.py views``, ``... plants 10 [tomato,vine]``, ``... findings 3 320x180``.
+Run: ``python tools/scene_stats.py views``, ``... plants 10 [tomato,vine]``,
+``... findings 3 192x108 [0.5]`` (the last argument: the grid step, default the paper's 0.25 m).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
+import os
 import platform
 import sys
 import tempfile
@@ -66,15 +69,24 @@ def measure_plants(count: int, crops: list[str]) -> dict:
     return out
 
 
-def measure_findings(count: int, size: tuple[int, int]) -> dict:
-    """Generate ``count`` SP strawberry scenes at ``size`` and measure the Fig. 2-3 findings."""
+def measure_findings(count: int, size: tuple[int, int], step: float) -> dict:
+    """Generate ``count`` SP strawberry scenes at ``size`` and measure the Fig. 2-3 findings.
+
+    Args:
+        count: Scenes 0..count-1 of dataset seed 0.
+        size: Image size.
+        step: Grid step, m: 0.25 is the paper's; 0.5 keeps every other row and column (90 views).
+
+    Returns:
+        JSON-ready measurements.
+    """
     from davis_ag.benchmark.cache import load_scene_cache
     from davis_ag.data.reader import open_dataset
     from davis_ag.generate.one_scene import SceneRequest, generate_scene
     from davis_ag.scene.camera import Camera
 
     crop = CROPS["strawberry"]
-    scenario = scenario_spec("sp", crop)
+    scenario = dataclasses.replace(scenario_spec("sp", crop), step=step)
     scenes = []
     with tempfile.TemporaryDirectory() as folder:
         root = Path(folder)
@@ -85,7 +97,7 @@ def measure_findings(count: int, size: tuple[int, int]) -> dict:
                            "box_oer": [round(float(v), 4) for v in load_scene_cache(scene, root).box_oer],
                            "seconds": round(stats["total_s"], 1)})
             print(f"scene {index}: {scenes[-1]['fruit']} fruit", file=sys.stderr, flush=True)
-    return {"size": list(size), "scenes": scenes}
+    return {"size": list(size), "step": step, "scenes": scenes}
 
 
 def visibility_findings(scene, meta: dict) -> dict:
@@ -174,7 +186,8 @@ def render_markdown() -> str:
         oer = np.concatenate([s["box_oer"] for s in scenes])
         lines += ["## The paper's findings on single-plant strawberry scenes", "",
                   f"{len(scenes)} scenes (dataset seed 0, scenes 0-{len(scenes) - 1}) generated at "
-                  f"{data['size'][0]}x{data['size'][1]}, box threshold scaled with the image area; "
+                  f"{data['size'][0]}x{data['size'][1]} on the grid every {data.get('step', 0.25):g} m "
+                  "(the paper's: 0.25 m), box threshold scaled with the image area; "
                   f"{data['machine']}. Section IV: one plant with 24 fruit; visible fruit from fewer than 5 "
                   "to 16 or more across positions; no view sees all 24; Fig. 3: changing altitude at a "
                   "position both loses and gains fruit. Section V-C: 4 % of boxes have OER < 0.4.", "",
@@ -196,7 +209,8 @@ def render_markdown() -> str:
 
 def main(argv: list[str]) -> None:
     """Run one measurement (or none) and rewrite docs/scenes.md."""
-    machine = f"{platform.machine()} with {__import__('os').cpu_count()} cores, measured {time.strftime('%Y-%m-%d')}"
+    machine = (f"{platform.machine()} with {os.cpu_count()} cores, measured {time.strftime('%Y-%m-%d')} "
+               f"(load average {os.getloadavg()[0]:.1f} at the end: times are those of a shared machine)")
     if argv and argv[0] == "views":
         write_json_atomic(DOCS / "scenes-views.json", measure_views(), indent=1)
     elif argv and argv[0] == "plants":
@@ -210,8 +224,9 @@ def main(argv: list[str]) -> None:
         write_json_atomic(path, merged, indent=1)
     elif argv and argv[0] == "findings":
         size = tuple(int(v) for v in argv[2].split("x"))
+        step = float(argv[3]) if len(argv) > 3 else 0.25
         write_json_atomic(DOCS / "scenes-findings.json",
-                          {**measure_findings(int(argv[1]), size), "machine": machine}, indent=1)
+                          {**measure_findings(int(argv[1]), size, step), "machine": machine}, indent=1)
     write_text_atomic(DOCS / "scenes.md", render_markdown())
     update_readme({"views": views_table(), "plants": plants_table()})
 
