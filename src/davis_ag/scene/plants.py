@@ -13,10 +13,9 @@ What is measured (metres):
   of single berries (a cluster is one fruit object, split into berries by mesh connectivity).
   The plant's value is the median over fruit.
 - leaf length: per leaf (every blade on one petiole: seven leaflets for tomato, one for the vine;
-  for strawberry each of the three leaflets, see ``LEAF_UNIT``), the extent of its blades along
-  their principal axis; the plant's value is the median over leaves. Helios numbers a leaf's
-  blades consecutively, so a leaf is a run of consecutive blade object ids, at most
-  ``blades_per_leaf`` long.
+  each strawberry leaflet, see ``LEAF_UNIT``), the extent of its blades along their principal
+  axis; the plant's value is the median over leaves. Helios numbers a leaf's blades
+  consecutively, so a leaf is a run of consecutive blade object ids, at most ``blades_per_leaf`` long.
 """
 
 from __future__ import annotations
@@ -257,9 +256,8 @@ def _lift_to_ground(context, plant_architecture, plant_id: int) -> None:
 HEIGHT_MODEL = {"strawberry": (0.32, 0.173), "tomato": (0.505, 0.68)}
 #: Fruit radius and leaf length of the library models as built, for the first build's guess.
 DEFAULT_SIZES = {"strawberry": (0.029, 0.12), "tomato": (0.016, 0.205)}
-#: Blades measured as one leaf where it is not every blade of a petiole: Table 1's strawberry
-#: leaf length is one leaflet's, as ``leaf_length`` is in Helios's Canopy Generator, which made
-#: the original's strawberries (each stem a trifoliate leaf of leaflets that long).
+#: Blades measured as one leaf where not all of a petiole's: Table 1's strawberry leaf length is
+#: a leaflet's, as ``leaf_length`` is in the Canopy Generator that made the original's plants.
 LEAF_UNIT = {"strawberry": 1}
 
 
