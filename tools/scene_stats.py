@@ -152,7 +152,8 @@ def plants_table() -> list[str]:
     lines = [f"{data['plants_per_crop']} single plants per crop, grown as `davis-ag generate` grows them "
              f"(scene seeds of dataset seed 0, scenes 0-{data['plants_per_crop'] - 1}); {data['machine']}.", "",
              "| crop | fruit per plant: min / median / max | plant (vine: trunk) height, m | "
-             "fruit (vine: berry) radius, mm | leaf length, m | all in Table 1 +- spread | grow s (median, shared machine) |",
+             "fruit (vine: berry) radius, mm | leaf length, m | all in Table 1 +- spread | "
+             "grow s (median, shared machine) |",
              "|---|---|---|---|---|---|---|"]
     for name, plants in data["crops"].items():
         crop = CROPS[name]
@@ -195,7 +196,8 @@ def findings_table() -> list[str]:
                      f"{s['up_loses']} / {s['up_gains']} (of {s['up_pairs']}) | {len(box_oer)} | "
                      f"{(box_oer < 0.4).mean():.1%} |")
     lines += ["", f"All scenes: {len(oer):,} boxes, {(oer < 0.4).mean():.1%} with OER < 0.4 (paper: 4 %); "
-                  f"OER median {np.median(oer):.2f}, mean {oer.mean():.2f} (mass to the right, the paper's \"right-skewed\": mean < median "
+                  f"OER median {np.median(oer):.2f}, mean {oer.mean():.2f} (mass to the right, the "
+                  "paper's \"right-skewed\": mean < median "
                   f"is {'true' if oer.mean() < np.median(oer) else 'false'}).", ""]
     return lines
 
