@@ -40,7 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from davis_ag.scene.specs import SLIP_SIGMA, CropSpec, ScenarioSpec
+from davis_ag.scene.specs import SLIP_SIGMA, CropSpec, ScenarioSpec, plant_centres
 
 #: Horizontal distance ahead at which a multi-plant camera's optical axis meets aim_height, m.
 MP_AIM_DISTANCE = 1.5
@@ -245,8 +245,6 @@ def views_per_scene(scenario: ScenarioSpec, crop: CropSpec) -> int:
     Returns:
         The number of views.
     """
-    from davis_ag.scene.specs import plant_centres
-
     grid = build_view_grid(scenario, crop, plant_centres(scenario, crop), crop.centre_height,
                            np.random.default_rng(0))
     return len(grid.viewpoints)
