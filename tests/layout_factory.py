@@ -45,8 +45,8 @@ _FRUIT_RGB = {"strawberry": (200, 30, 40), "tomato": (230, 70, 30), "vine": (90,
 def tiny_specs(scenario: str = "sp", crop: str = "strawberry") -> tuple[ScenarioSpec, CropSpec]:
     """The shrunk scenario and crop specs the factory lays its grid out with.
 
-    SP: 4 x 4 cells of 0.25 m and three altitudes (about 40 views, some up/down pointers "");
-    MP: 2 x 2 cells of 0.5 m, two altitudes and the real 12 headings (96 views).
+    SP: a 1 x 1 m staggered lattice of 0.25 m steps and three altitudes (54 views);
+    MP: a 1 x 1 m lattice of 0.5 m steps, two altitudes and the real 12 headings (144-168 views).
 
     Args:
         scenario: ``sp`` or ``mp``.
@@ -60,9 +60,8 @@ def tiny_specs(scenario: str = "sp", crop: str = "strawberry") -> tuple[Scenario
         sc = replace(sc, extent=(1.0, 1.0), step=0.25)
     else:
         sc = replace(sc, extent=(1.0, 1.0), step=0.5)
-    # SP: small enough that every crop keeps views at every altitude, large enough that the
-    # inner cells are excluded at some altitudes only (so the grid has holes and "" up/down
-    # moves). MP: the strawberry row is dense, so anything larger empties the low altitude.
+    # Small exclusion radii, so the tiny grids keep positions around the plants (SP) and
+    # beside the dense strawberry row (MP), with a hole where moves point to "".
     return sc, replace(cr, exclusion_radius=0.3 if sc.name == "sp" else 0.25)
 
 

@@ -82,7 +82,8 @@ def pools_for(command: str, out: str) -> tuple[list[str], dict[str, st.SearchStr
                     "--scenario": ANY, "--scenes": ANY, "--first": ANY, "--seed": ANY, "--size": ANY,
                     "--only": ANY, "--workers": ANY, "--executor": ANY, "--address": ANY,
                     "--cpus-per-scene": ANY, "--max-retries": ANY, "--quiet": FLAG, "--renderer": RENDER,
-                    "--look": RENDER, "--antialiasing": ANY, "--no-depth": FLAG}, ["--out"]
+                    "--look": RENDER, "--antialiasing": ANY, "--no-depth": FLAG,
+                    "--strawberry-altitudes": st.sampled_from(["table1", "readme", "x"])}, ["--out"]
     if command == "demo":
         return [], {"--scenes": ANY, "--size": ANY, "--seed": ANY, "--episodes": ANY, "--sessions": ANY}, ["--out"]
     if command == "reproduce":

@@ -20,13 +20,14 @@ from davis_ag.scene.camera import Camera
 from davis_ag.scene.plants import Phenotype, in_table_range, require_native_helios
 from davis_ag.scene.specs import CROPS, SCENARIOS, SP_ACTIONS
 
-#: Single-plant strawberry on a 3 m x 1 m grid with 50 cm steps at two altitudes: 16 views, four
-#: columns of two on either side of the plant, so every kind of move is valid somewhere and
-#: blocked somewhere (grid edge or exclusion zone).
+#: Single-plant strawberry on a 3 m x 1 m grid with 50 cm steps at two altitudes: three rows of
+#: the staggered lattice, 11 positions outside the 0.75 m exclusion zone on either side of the
+#: plant, 22 views, so every kind of move is valid somewhere and blocked somewhere (grid edge or
+#: exclusion zone).
 SCENARIO = replace(SCENARIOS["sp"], extent=(3.0, 1.0), step=0.5, altitude_levels=(0, 1))
 CAMERA = Camera(96, 54)
 REQUEST = SceneRequest(SCENARIO, CROPS["strawberry"], index=0, dataset_seed=0, camera=CAMERA)
-VIEWS = 16
+VIEWS = 22
 
 
 @pytest.fixture(scope="module")

@@ -8,7 +8,13 @@ import pytest
 
 from davis_ag.errors import UserError
 from davis_ag.generate.one_scene import scene_seed
-from davis_ag.generate.run_config import load_dataset_config, parse_dataset_config, preset_names, single_group_config
+from davis_ag.generate.run_config import (
+    load_dataset_config,
+    parse_dataset_config,
+    preset_names,
+    single_group_config,
+    use_strawberry_altitudes,
+)
 from davis_ag.scene.specs import CROPS, SCENARIOS
 
 #: Table 3 of the paper: scenes per group.
@@ -88,6 +94,8 @@ def test_only_picks_scenes_and_groups() -> None:
     ("groups: [{scenario: sp, crop: tomato, scenes: 1, grid: {headings: 4}}]\n", "only 1"),
     ("groups: [{scenario: mp, crop: tomato, scenes: 1, grid: {headings: 8}}]\n", "does not work for multi plant"),
     ("groups: [{scenario: sp, crop: tomato, scenes: 1, grid: {extent: [1, 1], step: 2}}]\n", "no position fits"),
+    ("strawberry_altitudes: fig2\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n",
+     "strawberry_altitudes: unknown strawberry altitudes 'fig2': choose table1 or readme"),
 ])
 def test_bad_configs_name_file_key_and_problem(text: str, message: str) -> None:
     with pytest.raises(UserError) as caught:
@@ -109,3 +117,47 @@ def test_single_group_from_flags() -> None:
     assert [r.folder for r in config.requests()] == ["Multi-Vine/005", "Multi-Vine/006"]
     with pytest.raises(UserError, match="do not fit"):
         single_group_config("sp", "tomato", 2, 999, 0, (640, 360))
+
+
+def test_strawberry_altitudes_are_table_1s_unless_the_readmes_are_asked_for() -> None:
+    groups = "groups:\n  - {scenario: sp, crop: strawberry, scenes: 1}\n  - {scenario: sp, crop: tomato, scenes: 1}\n"
+    table1 = parse_dataset_config(groups, "a.yaml")
+    readme = parse_dataset_config("strawberry_altitudes: readme\n" + groups, "b.yaml")
+    # Table 1: 25/40/55 cm; the Fig. 2 caption and the dataset's README: 0.50/0.75/1.00 m.
+    assert table1.groups[0].crop.altitudes == (0.25, 0.40, 0.55)
+    assert readme.groups[0].crop.altitudes == (0.50, 0.75, 1.00)
+    assert table1.groups[1].crop == readme.groups[1].crop == CROPS["tomato"]  # strawberry only
+    # The --strawberry-altitudes flag's path, on a config from flags.
+    flags = use_strawberry_altitudes(single_group_config("mp", "strawberry", 1, 0, 0, (64, 36)), "readme")
+    assert flags.groups[0].crop.altitudes == (0.50, 0.75, 1.00)
+    with pytest.raises(UserError, match="choose table1 or readme"):
+        use_strawberry_altitudes(table1, "high")
+    # Scenes of either choice keep their seeds; dataset.json records the altitudes, so a folder
+    # never mixes the two.
+    from davis_ag.generate.dataset_files import dataset_settings
+
+    assert table1.requests()[0].seed == readme.requests()[0].seed
+    grids = [dataset_settings(c.requests())["groups"]["Single-Strawberry"]["grid"] for c in (table1, readme)]
+    assert grids[0]["altitudes_m"] == [0.25, 0.40, 0.55] and grids[1]["altitudes_m"] == [0.50, 0.75, 1.00]
+
+
+def test_generate_flag_takes_the_readme_altitudes(capsys: pytest.CaptureFixture, monkeypatch: pytest.MonkeyPatch,
+                                                  tmp_path: Path) -> None:
+    from davis_ag import cli
+    from davis_ag.commands import generate
+
+    asked: list = []
+
+    def stop(requests: list, out: Path, options: object) -> None:  # what generate would make
+        asked.extend(requests)
+        raise UserError("stopped before rendering")
+
+    monkeypatch.setattr(generate, "run_dataset", stop)
+    assert cli.main(["generate", "--strawberry-altitudes", "readme", "--out", str(tmp_path)]) == 2
+    assert [r.crop.altitudes for r in asked] == [(0.50, 0.75, 1.00)]
+    asked.clear()
+    assert cli.main(["generate", "--config", "mini", "--out", str(tmp_path)]) == 2
+    assert [r.crop.altitudes for r in asked if r.crop.name == "strawberry"] == [(0.25, 0.40, 0.55)]
+    with pytest.raises(SystemExit) as stopped:
+        cli.main(["generate", "--strawberry-altitudes", "fig2", "--out", str(tmp_path)])
+    assert stopped.value.code == 2 and "invalid choice: 'fig2'" in capsys.readouterr().err

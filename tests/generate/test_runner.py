@@ -1,5 +1,5 @@
 """Whole-dataset runs: lock, settings guard, splits, a pool run killed with SIGKILL and resumed,
-and Ray tasks on a local Ray instance. Scenes are tiny (4 views of 64x48 pixels) to stay fast."""
+and Ray tasks on a local Ray instance. Scenes are tiny (7 views of 64x48 pixels) to stay fast."""
 
 from __future__ import annotations
 
@@ -26,7 +26,7 @@ from davis_ag.generate.run_progress import RunOptions
 from davis_ag.generate.runner import LOCK_FILE, DatasetLock, run_dataset
 
 TINY = """\
-# Two single-plant strawberry scenes of 4 views each (a 3 x 3 m grid every 1.5 m, lowest altitude).
+# Two single-plant strawberry scenes of 7 views each (a 3 x 3 m grid every 1.5 m, lowest altitude).
 seed: 3
 image_size: 64x48
 grid: {extent: [3.0, 3.0], step: 1.5, altitude_levels: [0]}

@@ -10,22 +10,32 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from davis_ag.scene.specs import CROPS, INVERSE_ACTION, SCENARIOS, SLIP_SIGMA, CropSpec, ScenarioSpec, plant_centres
-from davis_ag.scene.view_grid import MP_AIM_DISTANCE, ViewGrid, build_view_grid, grid_axis
+from davis_ag.scene.specs import (
+    CROPS,
+    INVERSE_ACTION,
+    SCENARIOS,
+    SLIP_SIGMA,
+    CropSpec,
+    ScenarioSpec,
+    plant_centres,
+    scenario_spec,
+)
+from davis_ag.scene.view_grid import (
+    MP_AIM_DISTANCE,
+    ViewGrid,
+    build_view_grid,
+    lattice_point,
+    lattice_shape,
+)
 
-#: Views per scene with the real Table 1/Table 2 settings, as documented in the README ("Images
-#: per scene"). The paper reports 285-348 views per single-plant scene and 1,128-1,800 per
-#: multi-plant scene (Tables 2-3). Our grid is cell-centred with a 3-D exclusion sphere around
-#: each plant's centre (view_grid's docstring), which gives these exact counts; single-plant
-#: strawberry has 352, 4 views (1 %) above the paper's largest single-plant count: on a 25 cm
-#: lattice that sphere admits no count between 336 and 352.
-EXPECTED_VIEWS = {
-    ("sp", "strawberry"): 352,
-    ("sp", "tomato"): 348,
-    ("sp", "vine"): 296,
-    ("mp", "strawberry"): 1776,
-    ("mp", "tomato"): 1776,
-    ("mp", "vine"): 1152,
+#: Table 3 of the paper: images / scenes per crop and scenario, each an exact whole number.
+TABLE_3 = {
+    ("sp", "strawberry"): (24_510, 86),
+    ("sp", "tomato"): (45_240, 130),
+    ("sp", "vine"): (63_336, 182),
+    ("mp", "strawberry"): (86_856, 77),
+    ("mp", "tomato"): (203_400, 113),
+    ("mp", "vine"): (79_200, 44),
 }
 #: Single-plant moves as (dx, dy) grid steps; rotations and altitude moves are checked apart.
 SP_MOVES = {"forward": (0, 1), "backward": (0, -1), "right": (1, 0), "left": (-1, 0)}
@@ -38,9 +48,9 @@ def make_grid(scenario: ScenarioSpec, crop: CropSpec, seed: int = 0) -> ViewGrid
 
 @st.composite
 def grids(draw: st.DrawFn) -> tuple[ScenarioSpec, CropSpec, ViewGrid]:
-    """A grid of either scenario and any crop, often with a reduced extent and step."""
-    scenario = SCENARIOS[draw(st.sampled_from(sorted(SCENARIOS)))]
+    """A grid of either scenario and any crop, the crop's own or with a reduced extent and step."""
     crop = CROPS[draw(st.sampled_from(sorted(CROPS)))]
+    scenario = scenario_spec(draw(st.sampled_from(sorted(SCENARIOS))), crop)
     if draw(st.booleans()):
         step = draw(st.sampled_from([0.25, 0.5, 0.75, 1.0]))
         extent = (draw(st.integers(1, 10)) * step, draw(st.integers(1, 10)) * step)
@@ -48,10 +58,6 @@ def grids(draw: st.DrawFn) -> tuple[ScenarioSpec, CropSpec, ViewGrid]:
         scenario = replace(scenario, extent=extent, step=step, altitude_levels=levels)
     seed = draw(st.integers(0, 2**32 - 1))
     return scenario, crop, make_grid(scenario, crop, seed)
-
-
-def axes(scenario: ScenarioSpec) -> tuple[np.ndarray, np.ndarray]:
-    return grid_axis(scenario.extent[0], scenario.step), grid_axis(scenario.extent[1], scenario.step)
 
 
 @settings(max_examples=60, deadline=None)
@@ -72,24 +78,31 @@ def test_every_view_and_pointer_is_inside_the_grid_and_outside_exclusion(
     case: tuple[ScenarioSpec, CropSpec, ViewGrid],
 ) -> None:
     scenario, crop, grid = case
-    xs, ys = axes(scenario)
-    centres = np.asarray(plant_centres(scenario, crop))
+    shape = lattice_shape(scenario)
+    stems = np.asarray(plant_centres(scenario, crop))[:, :2]
     altitudes = [crop.altitudes[i] for i in scenario.altitude_levels]
+    half_x, half_y = scenario.extent[0] / 2, scenario.extent[1] / 2
     for view in grid.viewpoints:
         x, y, z = view.nominal
-        assert abs(x) <= scenario.extent[0] / 2 and abs(y) <= scenario.extent[1] / 2
-        assert x == pytest.approx(xs[view.ix]) and y == pytest.approx(ys[view.iy])
+        # Even rows lie within the extent; odd rows reach half a step further east.
+        assert -half_x - 1e-9 <= x <= half_x + (scenario.step / 2 if view.iy % 2 else 0.0) + 1e-9
+        assert abs(y) <= half_y + 1e-9
+        assert (x, y) == pytest.approx(lattice_point(view.ix, view.iy, shape, scenario.step))
         assert z == altitudes[view.level]
-        assert np.linalg.norm(centres - view.nominal, axis=1).min() >= crop.exclusion_radius
+        assert np.hypot(*(stems - (x, y)).T).min() > crop.exclusion_radius
         for action in scenario.actions:
             target = grid.pointer(view.index, action)
-            assert target is None or 0 <= target < len(grid.viewpoints)
-    # Every allowed grid cell holds a view: nothing outside the exclusion zone is left out.
+            if target is not None:
+                to = grid.viewpoints[target].nominal
+                assert 0 <= target < len(grid.viewpoints)
+                assert np.hypot(*(stems - to[:2]).T).min() > crop.exclusion_radius
+    # Every allowed lattice position holds a view at every altitude: nothing else is left out.
     stations = {(v.ix, v.iy, v.level) for v in grid.viewpoints}
-    for level, z in enumerate(altitudes):
-        for iy, y in enumerate(ys):
-            for ix, x in enumerate(xs):
-                free = np.linalg.norm(centres - (x, y, z), axis=1).min() >= crop.exclusion_radius
+    for level in range(len(altitudes)):
+        for iy in range(shape[1]):
+            for ix in range(shape[0]):
+                x, y = lattice_point(ix, iy, shape, scenario.step)
+                free = np.hypot(*(stems - (x, y)).T).min() > crop.exclusion_radius + 1e-9
                 assert ((ix, iy, level) in stations) == free
 
 
@@ -110,26 +123,57 @@ def test_moves_go_one_step_the_documented_way(case: tuple[ScenarioSpec, CropSpec
                 assert to.nominal[2] > view.nominal[2] if action == "up" else to.nominal[2] < view.nominal[2]
             elif action.startswith("rotate"):
                 assert (to.ix, to.iy, to.level) == (view.ix, view.iy, view.level)
-            elif scenario.headings == 1:
-                assert (to.ix - view.ix, to.iy - view.iy) == SP_MOVES[action]
-                assert to.level == view.level
             else:
-                # Forward goes along the grid axis nearest the heading; left is 90 deg CCW of it.
-                turn = {"forward": 0, "left": 90, "backward": 180, "right": 270}[action]
-                direction = math.radians(view.yaw + turn)
-                step = np.subtract(to.nominal[:2], view.nominal[:2]) / scenario.step
-                assert np.linalg.norm(step) == pytest.approx(1.0)
-                assert step @ (math.cos(direction), math.sin(direction)) > math.cos(math.radians(45))
                 assert (to.level, to.heading) == (view.level, view.heading)
+                step = np.subtract(to.nominal[:2], view.nominal[:2]) / scenario.step
+                if to.iy == view.iy:
+                    # Along a row: exactly one step east or west.
+                    assert abs(step[0]) == pytest.approx(1.0) and step[1] == 0.0
+                else:
+                    # To the next row at the same column index: the zigzag of the staggered
+                    # lattice, half a step east from an even row, west from an odd one.
+                    assert to.ix == view.ix and abs(step[1]) == pytest.approx(1.0)
+                    assert step[0] == pytest.approx(0.5 if view.iy % 2 == 0 else -0.5)
+                if scenario.headings == 1:
+                    assert (to.ix - view.ix, to.iy - view.iy) == SP_MOVES[action]
+                else:
+                    # Forward goes along the lattice axis nearest the heading; left is 90 deg CCW
+                    # of it: the move is within 45 deg of that axis plus the zigzag's 26.6 deg.
+                    turn = {"forward": 0, "left": 90, "backward": 180, "right": 270}[action]
+                    direction = math.radians(view.yaw + turn)
+                    cosine = step @ (math.cos(direction), math.sin(direction)) / np.linalg.norm(step)
+                    assert cosine > math.cos(math.radians(45 + math.degrees(math.atan(0.5))) + 1e-9)
 
 
-@pytest.mark.parametrize(("scenario", "crop"), sorted(EXPECTED_VIEWS))
-def test_views_per_scene(scenario: str, crop: str) -> None:
-    grid = make_grid(SCENARIOS[scenario], CROPS[crop])
-    assert len(grid.viewpoints) == EXPECTED_VIEWS[scenario, crop]
-    paper_range = (285, 348) if scenario == "sp" else (1128, 1800)
-    # Within the paper's range, allowing our strawberry convention's 1 % (see EXPECTED_VIEWS).
-    assert paper_range[0] <= len(grid.viewpoints) <= paper_range[1] * 1.02
+@pytest.mark.parametrize(("scenario", "crop"), sorted(TABLE_3))
+def test_views_per_scene_are_table_3s(scenario: str, crop: str) -> None:
+    images, scenes = TABLE_3[scenario, crop]
+    assert images % scenes == 0
+    spec = CROPS[crop]
+    grid = make_grid(scenario_spec(scenario, spec), spec)
+    assert len(grid.viewpoints) == images // scenes
+    # Table 2: 285-348 images per single-plant scene, 1,128-1,800 per multi-plant scene.
+    low, high = (285, 348) if scenario == "sp" else (1128, 1800)
+    assert low <= len(grid.viewpoints) <= high
+
+
+def test_single_plant_strawberry_positions_are_the_originals_fig_2() -> None:
+    """The original's Fig. 2 (shared/ref): 95 positions per altitude, x and y from -1.25 to
+    1.25 m every 0.25 m, every other row shifted 0.125 m east, nothing within 0.75 m of the
+    plant, (0, +-0.75) missing, the same positions at every altitude."""
+    crop = CROPS["strawberry"]
+    grid = make_grid(scenario_spec("sp", crop), crop)
+    per_level = [{v.nominal[:2] for v in grid.viewpoints if v.level == level} for level in range(3)]
+    assert per_level[0] == per_level[1] == per_level[2] and len(per_level[0]) == 95
+    xs, ys = (sorted({round(p[axis], 6) for p in per_level[0]}) for axis in (0, 1))
+    assert ys == pytest.approx(np.arange(-1.25, 1.26, 0.25))
+    assert xs[0] == pytest.approx(-1.25) and xs[-1] == pytest.approx(1.375)
+    for y in ys:
+        row = sorted(p[0] for p in per_level[0] if round(p[1], 6) == y)
+        shifted = round((y + 1.25) / 0.25) % 2 == 1
+        assert row[0] == pytest.approx(-1.25 + (0.125 if shifted else 0.0))
+    assert (0.0, 0.75) not in per_level[0] and (0.0, -0.75) not in per_level[0]
+    assert min(math.hypot(*p) for p in per_level[0]) > 0.75
 
 
 def test_slip_is_gaussian_with_the_papers_sigma_and_shared_by_headings() -> None:
@@ -227,12 +271,12 @@ def test_pointers_name_images_and_give_empty_string_for_invalid_moves(
 
 
 def test_grid_edges_and_exclusion_give_empty_pointers() -> None:
-    grid = make_grid(SCENARIOS["sp"], CROPS["strawberry"])
+    grid = make_grid(scenario_spec("sp", CROPS["strawberry"]), CROPS["strawberry"])
     pointers = [grid.pointers(v.index) for v in grid.viewpoints]
     for action in ("forward", "backward", "left", "right", "up", "down"):
         assert any(p[action] == "" for p in pointers), action
         assert any(p[action] != "" for p in pointers), action
     # Next to the exclusion zone a move towards the plant is invalid although the grid goes on.
-    columns = len(grid_axis(SCENARIOS["sp"].extent[0], SCENARIOS["sp"].step))
+    columns = lattice_shape(scenario_spec("sp", CROPS["strawberry"]))[0]
     blocked = [v for v in grid.viewpoints if v.ix + 1 < columns and grid.pointer(v.index, "right") is None]
     assert blocked and all(v.nominal[0] < 0 for v in blocked)

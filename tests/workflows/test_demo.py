@@ -16,7 +16,7 @@ from davis_ag.workflows.demo import run_demo
 
 
 def _tiny_specs() -> tuple:
-    """SP strawberry on a 1 x 1 m grid of 0.5 m steps (12 views instead of 352)."""
+    """SP strawberry on a 1 x 1 m grid of 0.5 m steps (21 views instead of 285)."""
     scenario = replace(scenario_spec("sp"), extent=(1.0, 1.0), step=0.5)
     crop = replace(crop_spec("strawberry"), exclusion_radius=0.3)
     return scenario, crop

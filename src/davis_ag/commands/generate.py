@@ -12,7 +12,7 @@ import dataclasses
 
 from davis_ag.commands import arguments
 from davis_ag.errors import UserError
-from davis_ag.generate.run_config import load_dataset_config, single_group_config
+from davis_ag.generate.run_config import load_dataset_config, single_group_config, use_strawberry_altitudes
 from davis_ag.generate.run_progress import DEFAULT_MAX_RETRIES, RunOptions, default_workers
 from davis_ag.generate.runner import run_dataset
 from davis_ag.render.backends import DEFAULT_RENDERER, resolve_look
@@ -37,6 +37,9 @@ def register(subparsers) -> None:
     parser.add_argument("--no-depth", action="store_true",
                         help="do not write images/NNNN_depth.png (uint16 millimetres along the optical axis)")
     parser.add_argument("--out", type=arguments.path, required=True, help="dataset folder")
+    parser.add_argument("--strawberry-altitudes", choices=("table1", "readme"),
+                        help="strawberry camera altitudes: table1 = Table 1's 25/40/55 cm (default), "
+                             "readme = the dataset README's and Fig. 2's 0.50/0.75/1.00 m")
     parser.add_argument("--only", action="append", metavar="SCENE",
                         help="make only this scene or group, e.g. Single-Strawberry/003 (repeatable, or "
                              "comma-separated)")
@@ -78,6 +81,8 @@ def run(args: argparse.Namespace) -> int:
                                      0 if args.first is None else args.first, args.seed or 0,
                                      args.size or (1280, 720), args.renderer or DEFAULT_RENDERER, args.look,
                                      not args.no_depth, args.antialiasing or 4)
+    if args.strawberry_altitudes:
+        config = use_strawberry_altitudes(config, args.strawberry_altitudes)
     if args.executor != "ray" and args.address:
         raise UserError("--address is for --executor ray")
     if args.executor == "ray" and args.workers is not None:

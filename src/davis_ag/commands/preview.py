@@ -40,7 +40,8 @@ def register(subparsers) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    crop, scenario = crop_spec(args.crop), scenario_spec(args.scenario)
+    crop = crop_spec(args.crop)
+    scenario = scenario_spec(args.scenario, crop)
     numbers = args.views
     renderer_name = args.renderer or DEFAULT_RENDERER
     look = resolve_look(renderer_name, args.look)

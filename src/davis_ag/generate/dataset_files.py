@@ -44,7 +44,7 @@ def dataset_settings(requests: Sequence[SceneRequest]) -> dict[str, Any]:
                             "and the look")
     groups: dict[str, Any] = {}
     for request in requests:
-        groups[request.folder.split("/")[0]] = {"grid": grid_settings(request.scenario)}
+        groups[request.folder.split("/")[0]] = {"grid": grid_settings(request.scenario, request.crop)}
     return {"format": DATASET_FORMAT, "seed": first.dataset_seed,
             "image_size": [first.camera.width, first.camera.height], "vfov_deg": first.camera.vfov,
             "renderer": first.renderer, "look": resolve_look(first.renderer, first.look), "groups": groups}

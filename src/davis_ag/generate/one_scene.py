@@ -37,9 +37,14 @@ CONVENTIONS = {
             "pitch above the horizon (negative looks down)",
     "box": "[xmin, ymin, width, height, fruit_id, 0]: inclusive pixel extent, row 0 at the top",
     "segmentation": "uint8 fruit_id per pixel for fruit with a box in the view, 255 elsewhere",
-    "actions_sp": "forward +y, backward -y, right +x, left -x (world-fixed), up/down between altitudes",
-    "actions_mp": "forward along the grid axis nearest the heading, backward opposite, left 90 deg "
-                  "counter-clockwise of forward, right clockwise; rotate_ccw +30 deg, rotate_cw -30 deg",
+    "grid": "staggered lattice: rows step apart along y, numbered from -y, odd rows shifted half a "
+            "step along +x; positions within the exclusion radius (2-D) of a stem are left out",
+    "actions_sp": "forward +y, backward -y to the next row at the same column index (half a step "
+                  "sideways on the staggered lattice), right +x, left -x (world-fixed), up/down "
+                  "between altitudes",
+    "actions_mp": "forward along the lattice axis nearest the heading (a row move zigzags as in SP), "
+                  "backward opposite, left 90 deg counter-clockwise of forward, right clockwise; "
+                  "rotate_ccw +30 deg, rotate_cw -30 deg",
     "visible_fraction": "visible pixels of a fruit over the pixels it would cover with nothing in front",
     "depth": "images/NNNN_depth.png: uint16 millimetres from the camera plane along the optical axis "
              "(camera-space z), 0 where nothing is hit, 65535 for 65.535 m or more; row 0 at the top",

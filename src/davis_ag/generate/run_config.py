@@ -9,6 +9,7 @@ Format (every key but ``groups`` is optional)::
     look: default                # default or helios (Helios's texture handling); helios renderer: helios
     depth: true                  # write images/NNNN_depth.png (uint16 mm) for every view
     antialiasing: 4              # our renderer's colour samples: 4 (default) or 1 (faster, not antialiased)
+    strawberry_altitudes: table1 # table1 (25/40/55 cm, default) or readme (0.50/0.75/1.00 m)
     grid:                        # overrides the scenario's Table 2 grid for every group
       extent: [3.0, 3.0]         #   grid size along x and y, m
       step: 0.5                  #   distance between positions, m
@@ -43,13 +44,21 @@ from davis_ag.errors import UserError
 from davis_ag.generate.one_scene import SceneRequest
 from davis_ag.render.backends import DEFAULT_RENDERER, resolve_look
 from davis_ag.scene.camera import Camera
-from davis_ag.scene.specs import CropSpec, ScenarioSpec, crop_spec, group_name, scenario_spec
+from davis_ag.scene.specs import (
+    CropSpec,
+    ScenarioSpec,
+    crop_spec,
+    group_name,
+    scenario_spec,
+    with_strawberry_altitudes,
+)
 
 #: Smallest image side accepted, pixels.
 MIN_IMAGE_SIDE = 16
 #: Scene folders are numbered NNN.
 MAX_SCENES = 1000
-TOP_KEYS = ("name", "seed", "image_size", "renderer", "look", "depth", "antialiasing", "grid", "groups")
+TOP_KEYS = ("name", "seed", "image_size", "renderer", "look", "depth", "antialiasing", "strawberry_altitudes",
+            "grid", "groups")
 GROUP_KEYS = ("scenario", "crop", "scenes", "first", "grid")
 GRID_KEYS = ("extent", "step", "altitude_levels", "headings")
 
@@ -157,7 +166,8 @@ def single_group_config(scenario: str, crop: str, scenes: int, first: int, seed:
     Raises:
         UserError: for unknown names or indices outside 000..999.
     """
-    group = GroupConfig(scenario_spec(scenario), crop_spec(crop), scenes, first)
+    crop_settings = crop_spec(crop)
+    group = GroupConfig(scenario_spec(scenario, crop_settings), crop_settings, scenes, first)
     if first < 0 or first + scenes > MAX_SCENES:
         raise UserError(f"scene indices {first}..{first + scenes - 1} do not fit 000..{MAX_SCENES - 1}")
     if seed < 0:
@@ -264,7 +274,29 @@ def parse_dataset_config(text: str, source: str, default_name: str = "dataset") 
             check.fail(f"groups[{position}]", f"{group.name} is already groups[{seen[group.name]}]: "
                                               "give each scenario and crop once")
         seen[group.name] = position
+    altitudes = data.get("strawberry_altitudes", "table1")
+    try:
+        groups = [dataclasses.replace(g, crop=with_strawberry_altitudes(g.crop, str(altitudes))) for g in groups]
+    except UserError as error:
+        check.fail("strawberry_altitudes", str(error))
     return DatasetConfig(name.strip(), seed, camera, tuple(groups), source, renderer, look, depth, antialiasing)
+
+
+def use_strawberry_altitudes(config: DatasetConfig, choice: str) -> DatasetConfig:
+    """The config with every strawberry group photographed at the chosen altitudes.
+
+    Args:
+        config: A dataset config.
+        choice: ``table1`` (25/40/55 cm) or ``readme`` (0.50/0.75/1.00 m).
+
+    Returns:
+        The changed config.
+
+    Raises:
+        UserError: for an unknown choice.
+    """
+    groups = tuple(dataclasses.replace(g, crop=with_strawberry_altitudes(g.crop, choice)) for g in config.groups)
+    return dataclasses.replace(config, groups=groups)
 
 
 class _Checker:
@@ -338,6 +370,7 @@ class _Checker:
             except UserError as error:
                 self.fail(f"{where}.{key}", str(error))
         scenario, crop = specs
+        scenario = scenario_spec(scenario.name, crop)  # the crop's grid (Table 3's counts)
         scenes = self.whole(item["scenes"], f"{where}.scenes", minimum=1, maximum=MAX_SCENES)
         first = self.whole(item.get("first", 0), f"{where}.first", minimum=0, maximum=MAX_SCENES - 1)
         if first + scenes > MAX_SCENES:
@@ -380,8 +413,20 @@ class _Checker:
         return dataclasses.replace(scenario, **changes)
 
 
-def grid_settings(scenario: ScenarioSpec) -> dict[str, Any]:
-    """The grid a scenario spec describes, JSON-ready (recorded in dataset.json)."""
-    return {"extent": list(scenario.extent), "step": scenario.step,
-            "altitude_levels": list(scenario.altitude_levels), "headings": scenario.headings}
+def grid_settings(scenario: ScenarioSpec, crop: CropSpec | None = None) -> dict[str, Any]:
+    """The grid a scenario spec describes, JSON-ready (recorded in dataset.json).
+
+    Args:
+        scenario: The scenario's grid.
+        crop: When given, its camera altitudes in metres are recorded too (strawberry has two
+            choices, see ``specs.STRAWBERRY_ALTITUDES``).
+
+    Returns:
+        The settings.
+    """
+    settings = {"extent": list(scenario.extent), "step": scenario.step,
+                "altitude_levels": list(scenario.altitude_levels), "headings": scenario.headings}
+    if crop is not None:
+        settings["altitudes_m"] = [crop.altitudes[i] for i in scenario.altitude_levels]
+    return settings
 

@@ -12,16 +12,15 @@ What is measured (metres):
   axes (the body: the fruit object without its green calyx and stalk); for the vine, the radius
   of single berries (a cluster is one fruit object, split into berries by mesh connectivity).
   The plant's value is the median over fruit.
-- leaf length: per leaf (every blade on one petiole: three leaflets for strawberry, seven for
-  tomato, one for the vine), the extent of its blades along their principal axis; the plant's
-  value is the median over leaves. Helios numbers a leaf's blades consecutively, so a leaf is a
-  run of consecutive blade object ids, at most ``blades_per_leaf`` long.
+- leaf length: per leaf (every blade on one petiole: seven leaflets for tomato, one for the vine;
+  each strawberry leaflet, see ``LEAF_UNIT``), the extent of its blades along their principal
+  axis; the plant's value is the median over leaves. Helios numbers a leaf's blades
+  consecutively, so a leaf is a run of consecutive blade object ids, at most ``blades_per_leaf`` long.
 """
 
 from __future__ import annotations
 
 import contextlib
-import copy
 import math
 import os
 import sys
@@ -41,6 +40,7 @@ from davis_ag.scene.plant_geometry import (  # noqa: F401 - re-exported for the 
     primitive_vertices,
     principal_extents,
 )
+from davis_ag.scene.shoot_recipes import with_shoot_recipe
 from davis_ag.scene.specs import PHENOTYPE_SPREAD, CropSpec
 
 #: Helios maps seeds 0, 1, 2**31 - 1 and 2**32 - 1 to the same plant: stay inside this range.
@@ -214,9 +214,9 @@ def scaled_shoot_parameters(defaults: dict, crop: CropSpec, knobs: dict[str, flo
         knobs: Multiplicative factors ``plant_height``, ``fruit_radius``, ``leaf_length``.
 
     Returns:
-        A modified deep copy.
+        A modified deep copy, with the crop's recipe (``shoot_recipes.SHOOT_RECIPES``) applied.
     """
-    params = copy.deepcopy(defaults)
+    params = with_shoot_recipe(defaults, crop)
     phytomer = params["phytomer_parameters"]
     scale_parameter(phytomer["inflorescence"]["fruit_prototype_scale"], knobs["fruit_radius"])
     scale_parameter(phytomer["leaf"]["prototype_scale"], knobs["leaf_length"])
@@ -255,7 +255,10 @@ def _lift_to_ground(context, plant_architecture, plant_id: int) -> None:
 #: the first build's guess; later builds correct it by the secant through the last two builds.
 HEIGHT_MODEL = {"strawberry": (0.32, 0.173), "tomato": (0.505, 0.68)}
 #: Fruit radius and leaf length of the library models as built, for the first build's guess.
-DEFAULT_SIZES = {"strawberry": (0.029, 0.23), "tomato": (0.016, 0.205)}
+DEFAULT_SIZES = {"strawberry": (0.029, 0.12), "tomato": (0.016, 0.205)}
+#: Blades measured as one leaf where not all of a petiole's: Table 1's strawberry leaf length is
+#: a leaflet's, as ``leaf_length`` is in the Canopy Generator that made the original's plants.
+LEAF_UNIT = {"strawberry": 1}
 
 
 def _next_height_knob(history: list[tuple[float, float]], target: float) -> float:
@@ -392,5 +395,6 @@ def grow_library_plant(
         "fruit_radius": target.fruit_radius / DEFAULT_SIZES[crop.name][0],
         "leaf_length": target.leaf_length / DEFAULT_SIZES[crop.name][1],
     }
+    blades = LEAF_UNIT.get(crop.name, blades_per_leaf(shoot_defaults))
     return grow_to_target(context, plant_architecture, crop, index, position, target, seed, build,
-                          first_knobs, blades_per_leaf(shoot_defaults))
+                          first_knobs, blades)

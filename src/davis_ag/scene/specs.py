@@ -5,7 +5,7 @@ Everything here is plain data. Lengths are metres, angles degrees.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from davis_ag.errors import UserError
 
@@ -41,11 +41,14 @@ class CropSpec:
         leaf_length: Leaf length (Table 1), m.
         altitudes: The three camera altitudes, low to high (Table 1), m.
         min_fruit_pixels: Visible pixels a fruit needs to get a box (section III-C).
-        exclusion_radius: Cameras closer than this to a plant's centre are not placed, m.
-        centre_height: Height of the plant's centre, which single-plant cameras aim at and
-            exclusion is measured from: half the plant, or the middle of the vine's canopy, m.
+        exclusion_radius: Cameras at most this far from a plant's stem, measured horizontally,
+            are not placed, m (section III-C: "<75cm for strawberry and <100cm for others").
+        centre_height: Height of the plant's centre, which single-plant cameras aim at: half
+            the plant, or the middle of the vine's canopy, m.
         mp_plants: Plants in the multi-plant row.
         mp_spacing: Distance between neighbouring plants in the multi-plant row, m.
+        sp_extent: The single-plant grid's size along x and y, m (the comment above ``CROPS`` says why).
+        mp_extent: The multi-plant grid's size along x and y, m.
         min_fruit: A plant with fewer fruit is regrown from the next seed.
         helios_model: The pyhelios3d PlantArchitecture model the plant starts from.
         age_days: Age the plant is grown to: old enough to bear fruit.
@@ -65,19 +68,29 @@ class CropSpec:
     min_fruit: int
     helios_model: str
     age_days: float
+    sp_extent: tuple[float, float] = (3.0, 3.0)
+    mp_extent: tuple[float, float] = (7.0, 3.0)
 
 
+# Why the grids differ by crop. Table 2 gives 3 x 3 m (SP) and 7 x 3 m (MP) grids, but Table 3's
+# images per scene are exact (SP strawberry 285, tomato and vine 348; MP strawberry 1,128, tomato
+# and vine 1,800). On the staggered lattice of view_grid, tomato and vine fit 3 x 3 m (13 x 13
+# positions, 116 kept x 3 altitudes) and 7 x 3 m with three plants 2 m apart (15 x 7, 75 kept x 24
+# views). Strawberry does not: its single-plant grid is 2.5 x 2.5 m (11 x 11, 95 kept x 3), as
+# the original's Fig. 2 shows (-1.25..1.25 m); no 7 x 3 m lattice leaves 47 positions around five
+# plants with a 0.75 m exclusion radius, a 4 x 3 m one (9 x 7) around plants 0.3 m apart does.
+# These are inferences from the counts and the figure (tools/grid_conventions.py), not the paper's.
 CROPS: dict[str, CropSpec] = {
     "strawberry": CropSpec(
         name="strawberry", title="Strawberry", plant_height=0.40, fruit_radius=0.025,
         leaf_length=0.10, altitudes=(0.25, 0.40, 0.55), min_fruit_pixels=210,
         exclusion_radius=0.75, centre_height=0.20, mp_plants=5, mp_spacing=0.30, min_fruit=4,
-        helios_model="strawberry", age_days=90.0,
+        helios_model="strawberry", age_days=90.0, sp_extent=(2.5, 2.5), mp_extent=(4.0, 3.0),
     ),
     "tomato": CropSpec(
         name="tomato", title="Tomato", plant_height=1.00, fruit_radius=0.030,
         leaf_length=0.20, altitudes=(0.70, 1.10, 1.50), min_fruit_pixels=240,
-        exclusion_radius=1.00, centre_height=0.50, mp_plants=3, mp_spacing=0.60, min_fruit=4,
+        exclusion_radius=1.00, centre_height=0.50, mp_plants=3, mp_spacing=2.00, min_fruit=4,
         helios_model="tomato", age_days=100.0,
     ),
     "vine": CropSpec(
@@ -87,6 +100,33 @@ CROPS: dict[str, CropSpec] = {
         helios_model="grapevine_VSP", age_days=95.0,
     ),
 }
+
+#: Strawberry camera altitudes, m. The paper disagrees with itself: Table 1 gives 25/40/55 cm (our
+#: default), the Fig. 2 caption and the dataset's README 0.50/0.75/1.00 m.
+STRAWBERRY_ALTITUDES: dict[str, tuple[float, float, float]] = {
+    "table1": (0.25, 0.40, 0.55),
+    "readme": (0.50, 0.75, 1.00),
+}
+
+
+def with_strawberry_altitudes(crop: CropSpec, choice: str) -> CropSpec:
+    """The crop with the chosen strawberry altitudes; other crops come back unchanged.
+
+    Args:
+        crop: Any crop.
+        choice: A key of :data:`STRAWBERRY_ALTITUDES` (``table1`` or ``readme``).
+
+    Returns:
+        The crop, its altitudes replaced when it is the strawberry.
+
+    Raises:
+        UserError: for an unknown choice.
+    """
+    if choice not in STRAWBERRY_ALTITUDES:
+        raise UserError(f"unknown strawberry altitudes {choice!r}: choose {' or '.join(STRAWBERRY_ALTITUDES)} "
+                        "(Table 1's 25/40/55 cm, or the README's 0.50/0.75/1.00 m)")
+    return replace(crop, altitudes=STRAWBERRY_ALTITUDES[choice]) if crop.name == "strawberry" else crop
+
 
 #: Relative spread of the phenotype around Table 1, uniform (section III-A).
 PHENOTYPE_SPREAD: dict[str, float] = {"plant_height": 0.15, "fruit_radius": 0.20, "leaf_length": 0.20}
@@ -99,7 +139,8 @@ class ScenarioSpec:
     Attributes:
         name: ``sp`` (single plant) or ``mp`` (multi plant).
         title: Prefix of published folder names (``Single``, ``Multi``).
-        extent: Grid size along x and y, m.
+        extent: Grid size along x and y, m: the lattice's first and last positions along each
+            axis (odd rows reach half a step further along +x; view_grid).
         step: Distance between neighbouring grid positions, m.
         altitude_levels: Which of the crop's three altitudes are used (indices, low to high).
         headings: Camera headings per position (1 means: always aimed at the plant).
@@ -155,8 +196,16 @@ def crop_spec(name: str) -> CropSpec:
     return CROPS[key]
 
 
-def scenario_spec(name: str) -> ScenarioSpec:
+def scenario_spec(name: str, crop: CropSpec | None = None) -> ScenarioSpec:
     """Look a scenario up by name (``sp``/``single`` or ``mp``/``multi``).
+
+    Args:
+        name: The scenario's name.
+        crop: When given, the grid is that crop's (``sp_extent`` / ``mp_extent``), which gives
+            Table 3's images per scene; without it, Table 2's nominal 3 x 3 m / 7 x 3 m.
+
+    Returns:
+        Its :class:`ScenarioSpec`.
 
     Raises:
         UserError: for any other name.
@@ -164,7 +213,10 @@ def scenario_spec(name: str) -> ScenarioSpec:
     key = {"single": "sp", "multi": "mp"}.get(name.lower(), name.lower())
     if key not in SCENARIOS:
         raise UserError(f"unknown scenario {name!r}: choose sp (single plant) or mp (multi plant)")
-    return SCENARIOS[key]
+    scenario = SCENARIOS[key]
+    if crop is None:
+        return scenario
+    return replace(scenario, extent=crop.sp_extent if key == "sp" else crop.mp_extent)
 
 
 def group_name(scenario: ScenarioSpec, crop: CropSpec) -> str:

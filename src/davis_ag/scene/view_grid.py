@@ -1,24 +1,32 @@
 """The viewpoint grid and its action graph: pure geometry, no renderer.
 
-Conventions (also in the README):
+Conventions (also in the README, "Images per scene"):
 
 - World frame: x east, y north, z up, metres; the ground is z = 0. The single plant stands at the
   origin; the multi-plant row runs along x, centred on the origin.
-- Grid: the scenario's extent is tiled with square cells of ``step`` metres, centred on the
-  origin; a camera position is a cell centre, so no camera stands on a stem. A camera closer
-  than the crop's exclusion radius to any plant, measured in 3-D from the camera to the plant's
-  centre (its stem at the crop's ``centre_height``: half the plant, or the middle of the vine's
-  canopy), is not placed; so the exclusion zone
-  shrinks with altitude, and ``up``/``down`` can point to "" too.
+- Grid: a staggered lattice, as the original dataset's Fig. 2 shows it. Rows are ``step`` apart
+  along y; within a row positions are ``step`` apart along x; rows are numbered from the -y edge
+  and every odd row is shifted half a step along +x. The even rows span the scenario's extent
+  exactly (``floor(extent / step) + 1`` positions per axis, centred on the origin), the odd rows
+  reach half a step further east. A position whose horizontal (2-D) distance to any plant's
+  stem is at most the crop's exclusion radius is not placed, so the same positions exist at
+  every altitude. With the crop's grid (``scenario_spec(name, crop)``) this gives Table 3's
+  images per scene: see ``tools/grid_conventions.py`` for the conventions tried.
 - Yaw: degrees counter-clockwise from +x; pitch: degrees above the horizon (negative looks down).
+- Moves keep the lattice indices simple: right/left go to the next position in the same row
+  (+x / -x, exactly one step); forward/backward go to the next row (+y / -y) at the same column
+  index, which on the staggered lattice also moves half a step sideways (+x from an even row,
+  -x from an odd row), a zigzag that is back in line every two rows. Every move is therefore
+  undone by its opposite.
 - Single plant: the camera always aims at ``(0, 0, aim_height)``; forward, backward, right and
-  left move one step along +y, -y, +x and -x (world-fixed, since the camera's heading follows
-  the plant anyway).
-- Multi plant: 12 headings 30 degrees apart; forward moves one step along the grid axis nearest
-  to the heading (no heading is exactly diagonal), backward the opposite, left 90 degrees
-  counter-clockwise of forward, right clockwise. rotate_ccw adds 30 degrees, rotate_cw subtracts.
-  The pitch aims at ``aim_height`` at ``mp_aim_distance`` metres ahead.
-- up and down move between the scenario's altitude levels.
+  left are world-fixed as above (+y, -y, +x, -x), since the camera's heading follows the plant.
+- Multi plant: 12 headings 30 degrees apart; forward moves along the lattice axis (row or
+  column) nearest the heading (no heading is exactly diagonal), backward the opposite, left 90
+  degrees counter-clockwise of forward, right clockwise; a move along y zigzags as above.
+  rotate_ccw adds 30 degrees, rotate_cw subtracts. The pitch aims at ``aim_height`` at
+  ``mp_aim_distance`` metres ahead.
+- up and down move between the scenario's altitude levels; they are invalid only at the top and
+  bottom level.
 - Slip: each station (position and altitude) draws one Gaussian offset per x and y; every
   heading at that station shares it (turning in place does not slip). Pointers and exclusion use
   the nominal grid; poses record where the camera really was.
@@ -32,7 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from davis_ag.scene.specs import SLIP_SIGMA, CropSpec, ScenarioSpec
+from davis_ag.scene.specs import SLIP_SIGMA, CropSpec, ScenarioSpec, plant_centres
 
 #: Horizontal distance ahead at which a multi-plant camera's optical axis meets aim_height, m.
 MP_AIM_DISTANCE = 1.5
@@ -115,10 +123,55 @@ class ViewGrid:
         }
 
 
-def grid_axis(extent: float, step: float) -> np.ndarray:
-    """Cell-centre coordinates of one grid axis, centred on 0."""
-    count = int(round(extent / step))
-    return (np.arange(count) - (count - 1) / 2) * step
+def lattice_size(extent: float, step: float) -> int:
+    """Positions along one lattice axis: the first and last are at most ``extent`` apart.
+
+    Args:
+        extent: Grid size along the axis, m.
+        step: Distance between neighbouring positions, m.
+
+    Returns:
+        ``floor(extent / step) + 1`` (a small tolerance absorbs floating-point error).
+    """
+    return int(math.floor(extent / step + 1e-9)) + 1
+
+
+def lattice_point(ix: int, iy: int, shape: tuple[int, int], step: float) -> tuple[float, float]:
+    """Nominal (x, y) of lattice column ``ix`` in row ``iy``; odd rows sit half a step east.
+
+    Args:
+        ix: Column index within the row.
+        iy: Row index, 0 at the -y edge.
+        shape: Positions per row and number of rows, ``(nx, ny)``.
+        step: Distance between neighbouring positions, m.
+
+    Returns:
+        The position, m; rows are centred on the origin before the odd rows' shift.
+    """
+    nx, ny = shape
+    shift = step / 2 if iy % 2 else 0.0
+    return (ix - (nx - 1) / 2) * step + shift, (iy - (ny - 1) / 2) * step
+
+
+def lattice_shape(scenario: ScenarioSpec) -> tuple[int, int]:
+    """Positions per row and number of rows of a scenario's lattice."""
+    return lattice_size(scenario.extent[0], scenario.step), lattice_size(scenario.extent[1], scenario.step)
+
+
+def excluded(x: float, y: float, stems: np.ndarray, radius: float) -> bool:
+    """Whether a position is within ``radius`` (2-D, inclusive) of any plant's stem.
+
+    Args:
+        x, y: The position, m.
+        stems: ``(n, 2)`` or ``(n, 3)`` plant stems or centres; only x and y count.
+        radius: The crop's exclusion radius, m.
+
+    Returns:
+        True where no camera may stand. The 1e-9 tolerance keeps a lattice position at exactly
+        the radius (0, 0.75 m for strawberry) out, as the original's Fig. 2 has it.
+    """
+    gaps = np.hypot(stems[:, 0] - x, stems[:, 1] - y)
+    return bool(np.any(gaps <= radius + 1e-9))
 
 
 def _aim(position: tuple[float, float, float], target: tuple[float, float, float]) -> tuple[float, float]:
@@ -138,33 +191,29 @@ def build_view_grid(
     Args:
         scenario: Grid extent, step, altitude levels, headings and actions.
         crop: Altitudes and exclusion radius.
-        plant_centres: (x, y, z) of every plant's centre; cameras keep ``crop.exclusion_radius``
-            away from each.
+        plant_centres: (x, y, z) of every plant's centre; cameras keep more than
+            ``crop.exclusion_radius`` away from each, measured horizontally.
         aim_height: Height the camera aims at, m (half the plant height is a good choice).
         rng: Draws the slip; the only source of randomness.
 
     Returns:
         The :class:`ViewGrid`.
     """
-    xs = grid_axis(scenario.extent[0], scenario.step)
-    ys = grid_axis(scenario.extent[1], scenario.step)
+    shape = lattice_shape(scenario)
     altitudes = [crop.altitudes[level] for level in scenario.altitude_levels]
     centres = np.asarray(plant_centres, dtype=float).reshape(-1, 3)
-
-    def allowed(x: float, y: float, z: float) -> bool:
-        gaps = np.linalg.norm(centres - np.array([x, y, z]), axis=1)
-        return bool(np.all(gaps >= crop.exclusion_radius))
 
     viewpoints: list[Viewpoint] = []
     index_of: dict[tuple[int, int, int, int], int] = {}
     for level, z in enumerate(altitudes):
-        for iy in range(len(ys)):
-            for ix in range(len(xs)):
-                if not allowed(xs[ix], ys[iy], z):
+        for iy in range(shape[1]):
+            for ix in range(shape[0]):
+                x, y = lattice_point(ix, iy, shape, scenario.step)
+                if excluded(x, y, centres, crop.exclusion_radius):
                     continue
                 slip_x, slip_y = rng.normal(0.0, SLIP_SIGMA, size=2)
-                nominal = (float(xs[ix]), float(ys[iy]), float(z))
-                position = (float(xs[ix] + slip_x), float(ys[iy] + slip_y), float(z))
+                nominal = (float(x), float(y), float(z))
+                position = (float(x + slip_x), float(y + slip_y), float(z))
                 for heading in range(scenario.headings):
                     if scenario.headings == 1:
                         yaw, pitch = _aim(position, (0.0, 0.0, aim_height))
@@ -184,6 +233,21 @@ def build_view_grid(
             key = _move(view, action, scenario)
             next_view[view.index, column] = index_of.get(key, -1)
     return ViewGrid(tuple(viewpoints), scenario.actions, next_view)
+
+
+def views_per_scene(scenario: ScenarioSpec, crop: CropSpec) -> int:
+    """How many views a scene of this scenario and crop has (the slip changes no count).
+
+    Args:
+        scenario: The grid (use ``scenario_spec(name, crop)`` for the crop's own).
+        crop: Altitudes and exclusion radius.
+
+    Returns:
+        The number of views.
+    """
+    grid = build_view_grid(scenario, crop, plant_centres(scenario, crop), crop.centre_height,
+                           np.random.default_rng(0))
+    return len(grid.viewpoints)
 
 
 def _move(view: Viewpoint, action: str, scenario: ScenarioSpec) -> tuple[int, int, int, int]:

@@ -150,8 +150,8 @@ def run_demo(out: Path, scenes: int = 2, size: tuple[int, int] = DEMO_SIZE, seed
         raise UserError("--episodes and --sessions must be at least 1")
     # Absolute at once: Helios moves the working directory as it works.
     out = prove_writable_folder(out)
-    scenario = scenario or scenario_spec("sp")
     crop = crop or crop_spec("strawberry")
+    scenario = scenario or scenario_spec("sp", crop)
     root = out / "dataset"
     timer = Timer()
     camera = Camera(*size)

@@ -117,7 +117,8 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
 
     camera = Camera(*config.size)
     for scenario_name, crop_name in pairs:
-        scenario, crop = scenario_spec(scenario_name), crop_spec(crop_name)
+        crop = crop_spec(crop_name)
+        scenario = scenario_spec(scenario_name, crop)
         if scenario_name == "mp" and config.mp_extent:
             scenario = replace(scenario, extent=tuple(config.mp_extent))
         n = config.sp_scenes if scenario_name == "sp" else config.mp_scenes
@@ -306,8 +307,12 @@ def write_results_md(path: Path, config: ReproduceConfig, state: dict[str, Any],
         ``path``.
     """
     from davis_ag.atomic_files import write_text_atomic
+    from davis_ag.scene.specs import crop_spec, scenario_spec
+    from davis_ag.scene.view_grid import views_per_scene
 
     titles = {"sp": "SP strawberry", "mp": "MP vine"}
+    strawberry = crop_spec("strawberry")
+    sp_views = views_per_scene(scenario_spec("sp", strawberry), strawberry)
     mp_grid = (f"{config.mp_extent[0]:g} x {config.mp_extent[1]:g} m around the middle vine"
                if config.mp_extent else "Table 2's 7 x 3 m")
     lines = [
@@ -316,8 +321,8 @@ def write_results_md(path: Path, config: ReproduceConfig, state: dict[str, Any],
         "Written by `davis-ag reproduce` (`make reproduce`). Every number in the *ours* columns "
         "was measured by the run described here; the *paper* columns are Table 4 of the paper.",
         "",
-        f"- **Configuration** `{config.name}`: {config.sp_scenes} SP strawberry scene(s) (Table 2 "
-        f"grid, 352 views each) and {config.mp_scenes} MP vine scene(s) (grid {mp_grid}, 0.5 m "
+        f"- **Configuration** `{config.name}`: {config.sp_scenes} SP strawberry scene(s) (Table 3's "
+        f"grid, {sp_views} views each) and {config.mp_scenes} MP vine scene(s) (grid {mp_grid}, 0.5 m "
         f"step, 12 headings, 2 altitudes) at {config.size[0]}x{config.size[1]}, dataset seed "
         f"{config.seed}; box thresholds scaled by image area; A2C (SB3 defaults, the paper's "
         f"network of section V-B, {config.n_envs} environments) for {config.sp_timesteps:,} (SP) and "

@@ -1,0 +1,91 @@
+"""The paper's findings on a generated single-plant strawberry scene (sections IV and V-C).
+
+One real scene: real Helios plants, the paper's grid thinned to every 0.5 m (90 of its 285
+views, every altitude kept), drawn small.
+Section IV (Fig. 2) shows one strawberry plant with 24 fruit whose visible-fruit count ranges
+from fewer than 5 to 16 or more across positions, no view seeing all 24; Fig. 3 shows that
+changing altitude at a fixed position both loses and gains fruit. Section V-C: the OER of SP
+strawberry boxes is right-skewed, 4 % of them below 0.4 (tools/scene_stats.py measures this
+over several scenes; docs/scenes.md has the result).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from davis_ag.errors import UserError
+from davis_ag.generate.one_scene import SceneRequest, generate_scene
+from davis_ag.scene.camera import Camera
+from davis_ag.scene.specs import CROPS, scenario_spec
+
+#: Small, so that the views draw in about a minute; boxes need the crop's 210 pixels scaled by
+#: the image area (5 here).
+CAMERA = Camera(192, 108)
+#: Scene 0 of dataset seed 0, as `davis-ag generate --crop strawberry` grows it, on the paper's
+#: 2.5 x 2.5 m lattice every 0.5 m: 30 positions at each of the three altitudes.
+GRID = replace(scenario_spec("sp", CROPS["strawberry"]), step=0.5)
+REQUEST = SceneRequest(GRID, CROPS["strawberry"], 0, 0, CAMERA)
+POSITIONS = 30
+
+
+@pytest.fixture(scope="module")
+def scene(tmp_path_factory: pytest.TempPathFactory) -> dict:
+    """Per view: the fruit ids boxed; plus the scene's fruit count and box OERs."""
+    from davis_ag.benchmark.cache import load_scene_cache
+    from davis_ag.data.reader import open_dataset
+    from davis_ag.scene.plants import require_native_helios
+
+    try:
+        require_native_helios()
+    except UserError as error:
+        pytest.skip(str(error))
+    root = tmp_path_factory.mktemp("findings")
+    scene_dir, _ = generate_scene(REQUEST, root)
+    meta = json.loads((scene_dir / "scene.json").read_text())
+    opened = open_dataset(root).scene(REQUEST.folder)
+    seen = {tuple(meta["views"][v.name]["grid"][:3]): {b.fruit_id for b in v.boxes} for v in opened}
+    return {"seen": seen, "fruit": len(meta["fruits"]), "plants": meta["plants"],
+            "oer": np.asarray(load_scene_cache(opened, Path(root)).box_oer, dtype=float)}
+
+
+def test_the_plant_carries_about_as_many_fruit_as_the_papers(scene: dict) -> None:
+    # Section IV: 24 fruit. Ours spread around it (docs/scenes.md: min / median / max).
+    assert 18 <= scene["fruit"] <= 30
+    assert len(scene["seen"]) == POSITIONS * 3
+
+
+@pytest.mark.xfail(strict=True, reason="a finding to fix: our strawberry hides too few fruit; measured "
+                   "(docs/scenes.md) no position sees fewer than 5, where Fig. 2 has several")
+def test_visible_fruit_range_from_fewer_than_5_to_16_or_more(scene: dict) -> None:
+    counts = [len(ids) for ids in scene["seen"].values()]
+    assert min(counts) < 5 and max(counts) >= 16
+
+
+def test_no_view_sees_every_fruit(scene: dict) -> None:
+    assert max(len(ids) for ids in scene["seen"].values()) < scene["fruit"]
+
+
+def test_changing_altitude_both_loses_and_gains_fruit(scene: dict) -> None:
+    seen = scene["seen"]
+    pairs = [(low, seen[ix, iy, level + 1]) for (ix, iy, level), low in seen.items() if (ix, iy, level + 1) in seen]
+    assert len(pairs) == POSITIONS * 2  # the same positions at every altitude
+    # Fig. 3: going up hides fruit seen below at some positions and reveals new ones at others,
+    # and at many positions both happen.
+    loses = sum(bool(low - high) for low, high in pairs)
+    gains = sum(bool(high - low) for low, high in pairs)
+    both = sum(bool(low - high) and bool(high - low) for low, high in pairs)
+    assert loses >= len(pairs) // 4 and gains >= len(pairs) // 4 and both > 0
+
+
+def test_oer_is_right_skewed_with_few_boxes_below_0_4(scene: dict) -> None:
+    oer = scene["oer"]
+    assert len(oer) > 1000
+    # Section V-C: right-skewed, 4 % below 0.4. One scene varies more than several
+    # (tools/scene_stats.py measures those): 1-10 % here, 2-8 % over several scenes.
+    assert 0.01 <= (oer < 0.4).mean() <= 0.10
+    assert np.median(oer) > oer.mean()

@@ -1,0 +1,257 @@
+"""Measure our scenes against the paper and write docs/scenes.md (a tool, not shipped).
+
+Three measurements, each saved to its own JSON file under docs/ so that a slow one is not redone
+when another is refreshed; docs/scenes.md is rewritten from whichever exist:
+
+- ``views``: images per scene for every crop and scenario, beside Table 3's (instant).
+- ``plants N``: fruit per plant and the measured phenotype of N single plants per crop, grown as
+  ``davis-ag generate`` grows them (scene seeds of dataset seed 0, indices 0..N-1).
+- ``findings N WxH``: N single-plant strawberry scenes generated at WxH (dataset seed 0), and the
+  paper's section IV and V-C findings measured on them: visible fruit per position (the views
+  that box a fruit), whether any view sees every fruit, how often changing altitude at a fixed
+  position loses or gains fruit (Fig. 3), and the share of boxes with OER below 0.4.
+
+Run: ``python tools/scene_stats.py views``, ``... plants 10 [tomato,vine]``,
+``... findings 3 192x108 [0.5]`` (the last argument: the grid step, default the paper's 0.25 m).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+import platform
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from davis_ag.atomic_files import write_json_atomic, write_text_atomic
+from davis_ag.scene.specs import CROPS, PHENOTYPE_SPREAD, scenario_spec
+from davis_ag.scene.view_grid import views_per_scene
+
+DOCS = Path(__file__).resolve().parent.parent / "docs"
+#: Table 3 of the paper: (images, scenes) per scenario and crop.
+TABLE_3 = {("sp", "strawberry"): (24_510, 86), ("sp", "tomato"): (45_240, 130), ("sp", "vine"): (63_336, 182),
+           ("mp", "strawberry"): (86_856, 77), ("mp", "tomato"): (203_400, 113), ("mp", "vine"): (79_200, 44)}
+
+
+def measure_views() -> dict:
+    """Our images per scene and the paper's, per scenario and crop."""
+    rows = {}
+    for (scenario, crop_name), (images, scenes) in TABLE_3.items():
+        crop = CROPS[crop_name]
+        rows[f"{scenario}-{crop_name}"] = {"ours": views_per_scene(scenario_spec(scenario, crop), crop),
+                                            "paper": images // scenes}
+    return rows
+
+
+def measure_plants(count: int, crops: list[str]) -> dict:
+    """Grow ``count`` single plants of each of ``crops``; their fruit counts and phenotypes."""
+    from davis_ag.generate.one_scene import SceneRequest
+    from davis_ag.scene.build import build_scene
+
+    out: dict = {"plants_per_crop": count, "crops": {}}
+    for crop in (CROPS[name] for name in crops):
+        scenario = scenario_spec("sp", crop)
+        plants = []
+        for index in range(count):
+            started = time.perf_counter()
+            seed = SceneRequest(scenario, crop, index, 0).seed
+            model = build_scene(scenario, crop, np.random.default_rng(seed))
+            plant = model.plants[0]
+            plants.append({**plant.summary(), "scene_seed": seed, "grow_s": round(time.perf_counter() - started, 1)})
+            print(f"{crop.name} {index}: {len(plant.fruit_objects)} fruit", file=sys.stderr, flush=True)
+            del model
+        out["crops"][crop.name] = plants
+    return out
+
+
+def measure_findings(count: int, size: tuple[int, int], step: float) -> dict:
+    """Generate ``count`` SP strawberry scenes at ``size`` and measure the Fig. 2-3 findings.
+
+    Args:
+        count: Scenes 0..count-1 of dataset seed 0.
+        size: Image size.
+        step: Grid step, m: 0.25 is the paper's; 0.5 keeps every other row and column (90 views).
+
+    Returns:
+        JSON-ready measurements.
+    """
+    from davis_ag.benchmark.cache import load_scene_cache
+    from davis_ag.data.reader import open_dataset
+    from davis_ag.generate.one_scene import SceneRequest, generate_scene
+    from davis_ag.scene.camera import Camera
+
+    crop = CROPS["strawberry"]
+    scenario = dataclasses.replace(scenario_spec("sp", crop), step=step)
+    scenes = []
+    with tempfile.TemporaryDirectory() as folder:
+        root = Path(folder)
+        for index in range(count):
+            scene_dir, stats = generate_scene(SceneRequest(scenario, crop, index, 0, Camera(*size)), root)
+            scene = open_dataset(root).scene(f"Single-Strawberry/{index:03d}")
+            scenes.append({**visibility_findings(scene, json.loads((scene_dir / "scene.json").read_text())),
+                           "box_oer": [round(float(v), 4) for v in load_scene_cache(scene, root).box_oer],
+                           "seconds": round(stats["total_s"], 1)})
+            print(f"scene {index}: {scenes[-1]['fruit']} fruit", file=sys.stderr, flush=True)
+    return {"size": list(size), "step": step, "scenes": scenes}
+
+
+def visibility_findings(scene, meta: dict) -> dict:
+    """Visible fruit per position and altitude changes of one generated scene.
+
+    Args:
+        scene: The scene, from :func:`davis_ag.data.reader.open_dataset`.
+        meta: Its scene.json.
+
+    Returns:
+        Fruit count, boxed fruit per view (``visible``), views that box every fruit, and the
+        (position, altitude) pairs where moving up loses and gains fruit.
+    """
+    seen: dict[tuple[int, int, int], set[int]] = {}
+    for view in scene:
+        ix, iy, level, _ = meta["views"][view.name]["grid"]
+        seen[ix, iy, level] = {box.fruit_id for box in view.boxes}
+    fruit = len(meta["fruits"])
+    pairs = [(below, seen[ix, iy, level + 1]) for (ix, iy, level), below in seen.items()
+             if (ix, iy, level + 1) in seen]
+    return {
+        "fruit": fruit,
+        "fruit_per_plant": [p["fruit_count"] for p in meta["plants"]],
+        "visible": [len(s) for s in seen.values()],
+        "views_seeing_all": sum(len(s) == fruit for s in seen.values()),
+        "up_pairs": len(pairs),
+        "up_loses": sum(bool(low - high) for low, high in pairs),
+        "up_gains": sum(bool(high - low) for low, high in pairs),
+    }
+
+
+def views_table() -> list[str]:
+    """Markdown rows: images per scene, ours beside Table 3's."""
+    views_file = DOCS / "scenes-views.json"
+    if not views_file.exists():
+        return []
+    views = json.loads(views_file.read_text())
+    lines = ["| images per scene | strawberry | tomato | vine |", "|---|---|---|---|"]
+    for scenario, title in (("sp", "SP"), ("mp", "MP")):
+        for who in ("ours", "paper (Table 3)"):
+            cells = [f"{views[f'{scenario}-{c}'][who.split()[0]]:,}" for c in ("strawberry", "tomato", "vine")]
+            lines.append(f"| {title}, {who} | {' | '.join(cells)} |")
+    return lines
+
+
+def plants_table() -> list[str]:
+    """Markdown: fruit per plant and measured phenotypes per crop."""
+    plants_file = DOCS / "scenes-plants.json"
+    if not plants_file.exists():
+        return []
+    data = json.loads(plants_file.read_text())
+    lines = [f"{data['plants_per_crop']} single plants per crop, grown as `davis-ag generate` grows them "
+             f"(scene seeds of dataset seed 0, scenes 0-{data['plants_per_crop'] - 1}); {data['machine']}.", "",
+             "| crop | fruit per plant: min / median / max | plant (vine: trunk) height, m | "
+             "fruit (vine: berry) radius, mm | leaf length, m | all in Table 1 +- spread | "
+             "grow s (median, shared machine) |",
+             "|---|---|---|---|---|---|---|"]
+    for name, plants in data["crops"].items():
+        crop = CROPS[name]
+        fruit = [p["fruit_count"] for p in plants]
+        measured = {k: [p["phenotype_measured"][k] for p in plants]
+                    for k in ("plant_height", "fruit_radius", "leaf_length")}
+        inside = all(abs(p["phenotype_measured"][k] / getattr(crop, k) - 1) <= PHENOTYPE_SPREAD[k] + 1e-9
+                     for p in plants for k in measured)
+        span = {k: f"{min(v) * (1000 if k == 'fruit_radius' else 1):.{1 if k == 'fruit_radius' else 2}f}-"
+                   f"{max(v) * (1000 if k == 'fruit_radius' else 1):.{1 if k == 'fruit_radius' else 2}f}"
+                for k, v in measured.items()}
+        lines.append(f"| {name} | {min(fruit)} / {np.median(fruit):g} / {max(fruit)} | {span['plant_height']} | "
+                     f"{span['fruit_radius']} | {span['leaf_length']} | {'yes' if inside else 'no'} | "
+                     f"{np.median([p['grow_s'] for p in plants]):.0f} |")
+    return lines
+
+
+def findings_table() -> list[str]:
+    """Markdown: the section IV and V-C findings measured on generated strawberry scenes."""
+    findings_file = DOCS / "scenes-findings.json"
+    if not findings_file.exists():
+        return []
+    data = json.loads(findings_file.read_text())
+    scenes = data["scenes"]
+    oer = np.concatenate([s["box_oer"] for s in scenes])
+    lines = [f"{len(scenes)} scenes (dataset seed 0, scenes 0-{len(scenes) - 1}) generated at "
+              f"{data['size'][0]}x{data['size'][1]} on the grid every {data.get('step', 0.25):g} m "
+              "(the paper's: 0.25 m), box threshold scaled with the image area; "
+              f"{data['machine']}. Section IV: one plant with 24 fruit; visible fruit from fewer than 5 "
+              "to 16 or more across positions; no view sees all 24; Fig. 3: changing altitude at a "
+              "position both loses and gains fruit. Section V-C: 4 % of boxes have OER < 0.4.", "",
+              "| scene | fruit | visible per view: min / median / max | views < 5 | views >= 16 | "
+              "views seeing all | going up loses / gains fruit (of pairs) | boxes | OER < 0.4 |",
+              "|---|---|---|---|---|---|---|---|---|"]
+    for index, s in enumerate(scenes):
+        visible = np.asarray(s["visible"])
+        box_oer = np.asarray(s["box_oer"])
+        lines.append(f"| {index:03d} | {s['fruit']} | {visible.min()} / {np.median(visible):g} / {visible.max()} | "
+                     f"{(visible < 5).sum()} | {(visible >= 16).sum()} | {s['views_seeing_all']} | "
+                     f"{s['up_loses']} / {s['up_gains']} (of {s['up_pairs']}) | {len(box_oer)} | "
+                     f"{(box_oer < 0.4).mean():.1%} |")
+    lines += ["", f"All scenes: {len(oer):,} boxes, {(oer < 0.4).mean():.1%} with OER < 0.4 (paper: 4 %); "
+                  f"OER median {np.median(oer):.2f}, mean {oer.mean():.2f} (mass to the right, the "
+                  "paper's \"right-skewed\": mean < median "
+                  f"is {'true' if oer.mean() < np.median(oer) else 'false'}).", ""]
+    return lines
+
+
+def render_markdown() -> str:
+    """docs/scenes.md from the saved measurements."""
+    lines = ["# Our scenes beside the paper's", "",
+             "Written by `tools/scene_stats.py` from its measurements (docs/scenes-*.json); "
+             "do not edit by hand.", ""]
+    if views := views_table():
+        lines += ["## Images per scene (Table 3)", "", *views, ""]
+    if plants := plants_table():
+        lines += ["## Fruit per plant", "", *plants, ""]
+    if findings := findings_table():
+        lines += ["## The paper's findings on single-plant strawberry scenes", "", *findings]
+    return "\n".join(lines)
+
+
+def main(argv: list[str]) -> None:
+    """Run one measurement (or none) and rewrite docs/scenes.md."""
+    machine = (f"{platform.machine()} with {os.cpu_count()} cores, measured {time.strftime('%Y-%m-%d')} "
+               f"(load average {os.getloadavg()[0]:.1f} at the end: times are those of a shared machine)")
+    if argv and argv[0] == "views":
+        write_json_atomic(DOCS / "scenes-views.json", measure_views(), indent=1)
+    elif argv and argv[0] == "plants":
+        # Crops measured earlier are kept: the vine takes long, so crops can be measured apart.
+        path = DOCS / "scenes-plants.json"
+        crops = argv[2].split(",") if len(argv) > 2 else list(CROPS)
+        fresh = measure_plants(int(argv[1]), crops)
+        saved = json.loads(path.read_text()) if path.exists() else {"crops": {}}
+        merged = {**saved, **fresh, "crops": {**saved["crops"], **fresh["crops"]}, "machine": machine}
+        merged["crops"] = {name: merged["crops"][name] for name in CROPS if name in merged["crops"]}
+        write_json_atomic(path, merged, indent=1)
+    elif argv and argv[0] == "findings":
+        size = tuple(int(v) for v in argv[2].split("x"))
+        step = float(argv[3]) if len(argv) > 3 else 0.25
+        write_json_atomic(DOCS / "scenes-findings.json",
+                          {**measure_findings(int(argv[1]), size, step), "machine": machine}, indent=1)
+    write_text_atomic(DOCS / "scenes.md", render_markdown())
+    update_readme({"views": views_table(), "plants": plants_table(), "findings": findings_table()})
+
+
+def update_readme(blocks: dict[str, list[str]]) -> None:
+    """Replace the README's ``<!-- scene-stats:NAME -->`` blocks with the measured tables."""
+    readme = DOCS.parent / "README.md"
+    text = readme.read_text()
+    for name, lines in blocks.items():
+        begin, end = f"<!-- scene-stats:{name} -->", f"<!-- /scene-stats:{name} -->"
+        if lines and begin in text and end in text:
+            head, _, tail = text.partition(begin)
+            _, _, tail = tail.partition(end)
+            text = head + begin + "\n" + "\n".join(lines) + "\n" + end + tail
+    write_text_atomic(readme, text)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
