@@ -1,6 +1,7 @@
-"""One small real dataset for every figure test: a single-plant strawberry scene grown and drawn by
-Helios (12 views: 4 positions x 3 altitudes, 128x72), and an evaluation of it with every episode
-recorded. Skipped where pyhelios cannot render natively."""
+"""One small real dataset for every figure test: a single-plant strawberry scene grown with Helios
+and drawn on a 1.5 m staggered grid (7 positions x 3 altitudes, 128x72), without depth images (the
+viewer test adds them to a copy), and an evaluation of it with every episode recorded. Skipped
+where pyhelios cannot render natively."""
 
 from __future__ import annotations
 
@@ -13,6 +14,7 @@ from davis_ag.errors import UserError
 TINY_REAL = """\
 seed: 5
 image_size: 128x72
+depth: false
 grid: {extent: [3.0, 3.0], step: 1.5}
 groups:
   - {scenario: sp, crop: strawberry, scenes: 1}

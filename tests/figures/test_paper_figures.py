@@ -73,7 +73,8 @@ def test_altitude_histograms_follow_the_up_pointers(real_root: Path, tmp_path: P
             column[heights.index(round(e["pose"][2], 2))] = {b[4] for b in e["bounding_boxes"]}
             current = e.get("up", "")
         columns.append(column)
-    assert data["columns"] == len(columns) == 4
+    # Every position has one column of views, one per altitude.
+    assert data["columns"] == len(columns) == len(raw) // len(heights) > 1
     h1_h2 = [len(c[0]) - len(c[1]) for c in columns]
     new_3 = [len(c[2] - (c[0] | c[1])) for c in columns]
     assert sorted(data["differences"]["|H1|-|H2|"]) == sorted(h1_h2)
@@ -157,7 +158,7 @@ def test_stats_table3_and_fruit(real_root: Path, tmp_path: Path, capsys: pytest.
     stats = json.loads(out.read_text())
     raw = _raw(real_root)
     group = stats["table3"]["groups"]["Single-Strawberry"]
-    assert (group["scenes"], group["images"], len(raw)) == (1, 12, 12)
+    assert (group["scenes"], group["images"]) == (1, len(raw))
     fruit = stats["fruit"]["Single-Strawberry"]
     meta = json.loads((_scene_dir(real_root) / "scene.json").read_text())
     assert fruit["fruit_per_plant"]["mean"] == meta["plants"][0]["fruit_count"]

@@ -189,15 +189,16 @@ function drawMap() {
     html += "<circle class='spot' data-view='" + esc(name) + "' cx='" + X(v.pose[0]) + "' cy='" + Y(v.pose[1]) +
       "' r='5' fill='#9ab' stroke='#345' style='cursor:pointer'><title>" + name + "</title></circle>";
   }
-  for (const p of plants) html += "<text x='" + (X(p[0]) - 5) + "' y='" + (Y(p[1]) + 5) + "' font-size='16'>&#x2715;</text>";
+  // Marks drawn over the spots let clicks through, so a spot under the path can still be clicked.
+  for (const p of plants) html += "<text pointer-events='none' x='" + (X(p[0]) - 5) + "' y='" + (Y(p[1]) + 5) + "' font-size='16'>&#x2715;</text>";
   const trail = viewer.path.map(n => viewer.data.views[n].pose).filter(p => p);
-  if (trail.length > 1) html += "<polyline fill='none' stroke='#1f77b4' stroke-width='2' points='" +
+  if (trail.length > 1) html += "<polyline pointer-events='none' fill='none' stroke='#1f77b4' stroke-width='2' points='" +
     trail.map(p => X(p[0]) + "," + Y(p[1])).join(" ") + "'/>";
   if (cur.pose) {
     const cx = X(cur.pose[0]), cy = Y(cur.pose[1]), yaw = cur.pose[3] * Math.PI / 180;
-    html += "<line x1='" + cx + "' y1='" + cy + "' x2='" + (cx + 22 * Math.cos(yaw)) + "' y2='" +
+    html += "<line pointer-events='none' x1='" + cx + "' y1='" + cy + "' x2='" + (cx + 22 * Math.cos(yaw)) + "' y2='" +
       (cy - 22 * Math.sin(yaw)) + "' stroke='red' stroke-width='2'/>";
-    html += "<rect id='current' x='" + (cx - 6) + "' y='" + (cy - 6) + "' width='12' height='12' fill='red' " +
+    html += "<rect id='current' pointer-events='none' x='" + (cx - 6) + "' y='" + (cy - 6) + "' width='12' height='12' fill='red' " +
       "transform='rotate(45 " + cx + " " + cy + ")'/>";
   }
   svg.innerHTML = html;
