@@ -22,16 +22,6 @@ from davis_ag.benchmark.training import train_a2c
 from davis_ag.errors import UserError
 
 
-@pytest.fixture(scope="module")
-def sp_root(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return write_tiny_dataset(tmp_path_factory.mktemp("sp"), "sp", "strawberry", scenes=2)
-
-
-@pytest.fixture(scope="module")
-def mp_root(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return write_tiny_dataset(tmp_path_factory.mktemp("mp"), "mp", "strawberry", scenes=2)
-
-
 @pytest.mark.parametrize("scenario", ["sp", "mp"])
 def test_heuristic_action_sets(scenario: str, sp_root: Path, mp_root: Path) -> None:
     env = TVMEnv(sp_root if scenario == "sp" else mp_root, scenario, "all")

@@ -8,7 +8,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from layout_factory import write_tiny_dataset
 
 from davis_ag.benchmark import TVMEnv
 from davis_ag.benchmark.agents import build_agents
@@ -23,11 +22,6 @@ from davis_ag.benchmark.evaluation import (
 from davis_ag.commands import evaluate as evaluate_command
 from davis_ag.commands import train as train_command
 from davis_ag.errors import UserError
-
-
-@pytest.fixture(scope="module")
-def sp_root(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return write_tiny_dataset(tmp_path_factory.mktemp("sp"), "sp", "strawberry", scenes=2)
 
 
 def _parser() -> argparse.ArgumentParser:

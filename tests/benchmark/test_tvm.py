@@ -8,7 +8,7 @@ import gymnasium
 import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
-from layout_factory import write_original_style_dataset, write_tiny_dataset
+from layout_factory import write_original_style_dataset
 from PIL import Image
 
 import davis_ag  # noqa: F401 - registers the environments
@@ -19,16 +19,6 @@ from davis_ag.errors import UserError
 ENV_IDS = sorted(i for i in gymnasium.registry if i.startswith("davis_ag/"))
 
 
-@pytest.fixture(scope="module")
-def sp_root(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """Two single-plant strawberry scenes (splits.json: 000 train, 001 test)."""
-    return write_tiny_dataset(tmp_path_factory.mktemp("sp"), "sp", "strawberry", scenes=2)
-
-
-@pytest.fixture(scope="module")
-def mp_root(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """Two multi-plant strawberry scenes."""
-    return write_tiny_dataset(tmp_path_factory.mktemp("mp"), "mp", "strawberry", scenes=2)
 
 
 def _episode(env: gymnasium.Env, seed: int, actions: list[int]) -> list:

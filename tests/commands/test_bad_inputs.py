@@ -14,16 +14,6 @@ from layout_factory import write_tiny_dataset
 from davis_ag import cli
 
 
-@pytest.fixture(scope="module")
-def sp_root(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return write_tiny_dataset(tmp_path_factory.mktemp("sp"), "sp", "strawberry", scenes=2)
-
-
-@pytest.fixture(scope="module")
-def mp_root(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return write_tiny_dataset(tmp_path_factory.mktemp("mp"), "mp", "strawberry", scenes=2)
-
-
 def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
     """``davis-ag ARGV`` in this process: exit status, stdout, stderr."""
     try:
