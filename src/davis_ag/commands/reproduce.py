@@ -19,8 +19,8 @@ from davis_ag.workflows.reproduce import (
     ReproduceConfig,
     load_state,
     reproduce,
-    write_results_md,
 )
+from davis_ag.workflows.results_page import write_results_md
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
