@@ -8,6 +8,7 @@ Visualizer (the reference: 4x multisampled colour, ids from a 1x pass) and by ou
 ``helios`` look with each option:
 
 - ``1x``: one 1x pass writes colour, ids and depth (no antialiasing; the baseline);
+- ``1x + FXAA on silhouettes``: that pass, then FXAA where the depth jumps (our default);
 - ``4x colour + 1x ids``: colour with 4x multisampling, then a light 1x pass for ids and depth;
 - ``4x per-sample``: one 4x multisampled pass writes colour, ids and depth; the colour is averaged,
   the ids and depth are taken from one sample of each pixel (no sample lies at the pixel centre,
@@ -117,9 +118,11 @@ def measure(crop: str, camera: Camera) -> list[dict]:
     lookup = fruit_lookup({f.id: f.uuids for f in model.fruits}, model.uuid_count)
     with HeliosRenderer(model.context, camera, model.lighting) as helios:
         reference = [helios.render(v, depth=False) for v in views]
-    one = OpenGLRenderer(model.context, camera, model.lighting, look="helios", antialiasing=1)
-    four = OpenGLRenderer(model.context, camera, model.lighting, look="helios", antialiasing=4)
-    options = {"1x": one.render, "4x colour + 1x ids": four.render, "4x per-sample": PerSample(four).render}
+    one = OpenGLRenderer(model.context, camera, model.lighting, look="helios", antialiasing="none")
+    fxaa = OpenGLRenderer(model.context, camera, model.lighting, look="helios", antialiasing="fxaa")
+    four = OpenGLRenderer(model.context, camera, model.lighting, look="helios", antialiasing="msaa")
+    options = {"1x": one.render, "1x + FXAA on silhouettes": fxaa.render, "4x colour + 1x ids": four.render,
+               "4x per-sample": PerSample(four).render}
     timings: dict[str, list[tuple[float, float]]] = {name: [] for name in options}
     frames: dict[str, list] = {}
     for _ in range(REPEATS):
@@ -128,8 +131,8 @@ def measure(crop: str, camera: Camera) -> list[dict]:
             start, start_cpu = time.perf_counter(), cpu()
             frames[name] = [render(v) for v in views]
             timings[name].append(((time.perf_counter() - start) / len(views), (cpu() - start_cpu) / len(views)))
-    one.close()
-    four.close()
+    for renderer in (one, fxaa, four):
+        renderer.close()
     rows = []
     for name in options:
         differ, ious, box_error, colour = 0, [], 0, []

@@ -88,7 +88,7 @@ def time_ours(request: SceneRequest, model, grid, views: list, root: Path) -> tu
     return (end - marks["first"]) / (len(views) - 1), marks["first"] - start
 
 
-def bench_crop(crop: str, scratch: Path, repeats: int, documented: bool = True, antialiasing: int = 4) -> dict:
+def bench_crop(crop: str, scratch: Path, repeats: int, documented: bool = True, antialiasing: str = "fxaa") -> dict:
     """Grow one scene and time ours, the documented path and the floor on the same views."""
     from davis_ag.render.helios import HeliosRenderer
     from davis_ag.render.opengl import OpenGLRenderer
@@ -195,7 +195,7 @@ def env_speed(dataset: Path, steps: int = 20_000) -> dict:
     return {"steps_per_second": round(rate), "steps": steps, "target_min": 5000}
 
 
-def run(out: Path, crops: list[str], repeats: int, antialiasing: int = 4) -> dict:
+def run(out: Path, crops: list[str], repeats: int, antialiasing: str = "fxaa") -> dict:
     """Run every measurement; return the JSON report."""
     load_start = os.getloadavg()
     report: dict = {"machine": {"cpus": os.cpu_count(), "platform": platform.platform(),
@@ -231,7 +231,7 @@ def run(out: Path, crops: list[str], repeats: int, antialiasing: int = 4) -> dic
 
 def table(report: dict) -> str:
     """The human-readable summary (Markdown)."""
-    lines = [f"{report['image_size'][0]}x{report['image_size'][1]}, {report['antialiasing']}x antialiasing (ours), "
+    lines = [f"{report['image_size'][0]}x{report['image_size'][1]}, antialiasing {report['antialiasing']} (ours), "
              f"seed {report['seed']}, scene 0 of each crop, "
              f"median of {max(c['repeats'] for c in report['crops'].values())} interleaved repetitions; load "
              f"average {report['machine']['load_average']['start'][0]} at the start, "
@@ -286,7 +286,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--crops", default="strawberry,tomato,vine",
                         help="crops to time (strawberry, tomato, vine); the documented path only where a target is set")
     parser.add_argument("--repeats", type=int, default=REPEATS, help=f"interleaved repetitions (default {REPEATS})")
-    parser.add_argument("--antialiasing", type=int, choices=(4, 1), default=4,
+    parser.add_argument("--antialiasing", choices=("fxaa", "msaa", "none"), default="fxaa",
                         help="our renderer's colour samples per pixel (default 4)")
     parser.add_argument("--doc", type=Path, help="write the tables into this Markdown file's bench section")
     args = parser.parse_args(argv)

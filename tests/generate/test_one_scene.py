@@ -287,7 +287,7 @@ def test_depth_and_renderer_settings_flow_from_flags_and_configs() -> None:
     text = ("renderer: opengl\nlook: helios\ndepth: false\nantialiasing: 1\n"
             "groups: [{scenario: sp, crop: tomato, scenes: 1}]\n")
     (request,) = parse_dataset_config(text, "test").requests()
-    assert (request.renderer, request.look, request.depth, request.antialiasing) == ("opengl", "helios", False, 1)
+    assert (request.renderer, request.look, request.depth, request.antialiasing) == ("opengl", "helios", False, "none")
     with pytest.raises(UserError, match="antialiasing"):
         parse_dataset_config("antialiasing: 2\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "test")
     with pytest.raises(UserError, match="look"):

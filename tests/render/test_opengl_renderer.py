@@ -107,14 +107,40 @@ def test_default_look_keeps_the_geometry(frames: dict) -> None:
     assert np.abs(colour.astype(np.int16) - frames["helios"][1][0]).mean() > 2  # a different look
 
 
-def test_one_pass_option_gives_the_same_ids_and_depth(frames: dict) -> None:
-    """antialiasing=1 draws colour, ids and depth in one 1x pass: the same ids and depth."""
+@pytest.mark.parametrize("antialiasing", ["msaa", "none"])
+def test_every_antialiasing_gives_the_same_ids_and_depth(frames: dict, antialiasing: str) -> None:
+    """The default (FXAA along silhouettes), 4x multisampling and none: ids and depth are the same,
+    and every colour is within the fidelity limit of Helios's frames."""
     model = frames["model"]
     view = frames["views"][0]
-    with open_renderer("opengl", model.context, CAMERA, model.lighting, "helios", antialiasing=1) as renderer:
+    with open_renderer("opengl", model.context, CAMERA, model.lighting, "helios", antialiasing) as renderer:
         colour, ids, depth = renderer.render(view)
     assert np.array_equal(ids, frames["opengl"][0][1]) and np.array_equal(depth, frames["opengl"][0][2])
     assert np.abs(colour.astype(np.int16) - frames["helios"][0][0]).mean() <= 2.0
+    assert not np.array_equal(colour, frames["opengl"][0][0])  # the option changed the colour
+
+
+def test_fxaa_touches_only_silhouettes(frames: dict) -> None:
+    """FXAA changes only pixels whose depth jumps by more than 2 % to a 4-neighbour: silhouettes,
+    never the inside of a surface."""
+    model = frames["model"]
+    view = frames["views"][1]
+    with open_renderer("opengl", model.context, CAMERA, model.lighting, "helios", "none") as renderer:
+        plain, _, depth = renderer.render(view)
+    smoothed = frames["opengl"][1][0]
+    changed = (plain != smoothed).any(axis=2)
+    assert 0 < changed.mean() < 0.2
+    edge = np.zeros_like(changed)
+    for axis in (0, 1):
+        # The shader's test at the nearer pixel of a pair, a hair looser for float rounding.
+        jump = np.abs(np.diff(depth, axis=axis)) > 0.019 * np.minimum(
+            depth.take(range(depth.shape[axis] - 1), axis=axis), depth.take(range(1, depth.shape[axis]), axis=axis))
+        pad = [(0, 0), (0, 0)]
+        pad[axis] = (0, 1)
+        edge |= np.pad(jump, pad)
+        pad[axis] = (1, 0)
+        edge |= np.pad(jump, pad)
+    assert not (changed & ~edge).any()
 
 
 def test_renderer_and_look_choices() -> None:

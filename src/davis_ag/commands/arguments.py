@@ -115,6 +115,18 @@ def path(text: str) -> Path:
 
 
 
+def antialiasing_mode(text: str) -> str:
+    """Parse ``--antialiasing``: fxaa, msaa or none (4 and 1, the samples per pixel earlier versions
+    took, still mean msaa and none)."""
+    from davis_ag.errors import UserError
+    from davis_ag.render.backends import resolve_antialiasing
+
+    try:
+        return resolve_antialiasing(text)
+    except UserError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
+
+
 def add_renderer_flags(parser: argparse.ArgumentParser) -> None:
     """``--renderer`` and ``--look``, shared by generate and preview."""
     from davis_ag.render.backends import LOOKS, RENDERERS
@@ -124,6 +136,6 @@ def add_renderer_flags(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--look", choices=LOOKS,
                         help="default: full-resolution, filtered textures (default); helios: Helios's frames, "
                              "reduced unfiltered textures included (the helios renderer draws only this)")
-    parser.add_argument("--antialiasing", type=int, choices=(4, 1),
-                        help="our renderer's colour samples per pixel: 4 (default) or 1 (no antialiasing; "
-                             "several times faster on many small triangles without a GPU; ids exact either way)")
+    parser.add_argument("--antialiasing", type=antialiasing_mode, metavar="{fxaa,msaa,none}",
+                        help="our renderer's: fxaa along silhouettes (default), msaa (4x samples: closest to "
+                             "Helios's frames, several times slower without a GPU) or none; ids exact in every mode")

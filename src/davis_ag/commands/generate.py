@@ -15,7 +15,7 @@ from davis_ag.errors import UserError
 from davis_ag.generate.run_config import load_dataset_config, single_group_config, use_strawberry_altitudes
 from davis_ag.generate.run_progress import DEFAULT_MAX_RETRIES, RunOptions, default_workers
 from davis_ag.generate.runner import run_dataset
-from davis_ag.render.backends import DEFAULT_RENDERER, resolve_look
+from davis_ag.render.backends import DEFAULT_ANTIALIASING, DEFAULT_RENDERER, resolve_look
 from davis_ag.scene.camera import Camera
 
 #: Flags that describe the one group of a config-less run.
@@ -80,7 +80,7 @@ def run(args: argparse.Namespace) -> int:
         config = single_group_config(args.scenario or "sp", args.crop or "strawberry", args.scenes or 1,
                                      0 if args.first is None else args.first, args.seed or 0,
                                      args.size or (1280, 720), args.renderer or DEFAULT_RENDERER, args.look,
-                                     not args.no_depth, args.antialiasing or 4)
+                                     not args.no_depth, args.antialiasing or DEFAULT_ANTIALIASING)
     if args.strawberry_altitudes:
         config = use_strawberry_altitudes(config, args.strawberry_altitudes)
     if args.executor != "ray" and args.address:

@@ -58,7 +58,7 @@ def run(args: argparse.Namespace) -> int:
     polygons = {f.id: f.polygons for f in model.fruits}
     args.out.mkdir(parents=True, exist_ok=True)
     with open_renderer(renderer_name, model.context, request.camera, model.lighting, look,
-                       args.antialiasing or 4) as renderer:
+                       args.antialiasing) as renderer:
         for number in numbers:
             view = grid.viewpoints[number - 1]
             colour, primitive_ids, _ = renderer.render(view, depth=False)

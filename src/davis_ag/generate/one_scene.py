@@ -21,7 +21,7 @@ from davis_ag.atomic_files import PROBE_PREFIX, prove_writable_folder
 from davis_ag.errors import UserError
 from davis_ag.generate.scene_writer import SceneWriter, partial_dir
 from davis_ag.labels.fruit_labels import fruit_lookup, label_view, visible_fractions
-from davis_ag.render.backends import DEFAULT_RENDERER, open_renderer, resolve_look
+from davis_ag.render.backends import ANTIALIASING_DESCRIPTIONS, DEFAULT_RENDERER, open_renderer, resolve_look
 from davis_ag.scene.build import build_scene
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import CROPS, SCENARIOS, CropSpec, ScenarioSpec, group_name, plant_centres
@@ -64,7 +64,7 @@ class SceneRequest:
         look: ``default`` or ``helios`` (see :mod:`davis_ag.render.backends`); None: the
             renderer's own (``default`` for ours, ``helios`` for Helios).
         depth: Write ``images/NNNN_depth.png`` for every view.
-        antialiasing: Our renderer's colour samples per pixel, 4 or 1.
+        antialiasing: Our renderer's antialiasing: ``fxaa``, ``msaa`` or ``none``.
     """
 
     scenario: ScenarioSpec
@@ -75,7 +75,7 @@ class SceneRequest:
     renderer: str = DEFAULT_RENDERER
     look: str | None = None
     depth: bool = True
-    antialiasing: int = 4
+    antialiasing: str = "fxaa"
 
     @property
     def seed(self) -> int:
@@ -225,8 +225,7 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict) -> dict:
         "conventions": CONVENTIONS,
         "camera": request.camera.intrinsics(),
         "renderer": {"name": request.renderer, "look": resolve_look(request.renderer, request.look),
-                     "antialiasing": ("4x multisampled colour, ids and depth from a 1x pass"
-                                      if request.antialiasing > 1 else "none: one 1x pass")
+                     "antialiasing": ANTIALIASING_DESCRIPTIONS[request.antialiasing]
                      if request.renderer == "opengl" else "Helios Visualizer, 4x multisampled colour"},
         "depth": {"file": "images/NNNN_depth.png", "dtype": "uint16", "unit": "mm",
                   "axis": "optical (camera-space z)", "no_hit": 0} if request.depth else None,

@@ -8,7 +8,7 @@ Format (every key but ``groups`` is optional)::
     renderer: opengl             # opengl (ours, default) or helios (pyhelios's Visualizer)
     look: default                # default or helios (Helios's texture handling); helios renderer: helios
     depth: true                  # write images/NNNN_depth.png (uint16 mm) for every view
-    antialiasing: 4              # our renderer's colour samples: 4 (default) or 1 (faster, not antialiased)
+    antialiasing: fxaa           # our renderer's: fxaa (default), msaa (4x samples, slower) or none
     strawberry_altitudes: table1 # table1 (25/40/55 cm, default) or readme (0.50/0.75/1.00 m)
     grid:                        # overrides the scenario's Table 2 grid for every group
       extent: [3.0, 3.0]         #   grid size along x and y, m
@@ -42,7 +42,7 @@ from typing import Any
 
 from davis_ag.errors import UserError
 from davis_ag.generate.one_scene import SceneRequest
-from davis_ag.render.backends import DEFAULT_RENDERER, resolve_look
+from davis_ag.render.backends import DEFAULT_RENDERER, resolve_antialiasing, resolve_look
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import (
     CropSpec,
@@ -103,7 +103,7 @@ class DatasetConfig:
         renderer: ``opengl`` or ``helios``.
         look: ``default`` or ``helios``; None for the renderer's own.
         depth: Whether every view gets a depth image.
-        antialiasing: Our renderer's colour samples per pixel, 4 or 1.
+        antialiasing: Our renderer's antialiasing: ``fxaa``, ``msaa`` or ``none``.
     """
 
     name: str
@@ -114,7 +114,7 @@ class DatasetConfig:
     renderer: str = DEFAULT_RENDERER
     look: str | None = None
     depth: bool = True
-    antialiasing: int = 4
+    antialiasing: str = "fxaa"
 
     def requests(self, only: list[str] | None = None) -> list[SceneRequest]:
         """Every scene to make, in group order, optionally narrowed to some groups or scenes.
@@ -157,7 +157,7 @@ def _normalise_scene_id(text: str) -> str:
 
 def single_group_config(scenario: str, crop: str, scenes: int, first: int, seed: int,
                         size: tuple[int, int], renderer: str = DEFAULT_RENDERER, look: str | None = None,
-                        depth: bool = True, antialiasing: int = 4) -> DatasetConfig:
+                        depth: bool = True, antialiasing: str = "fxaa") -> DatasetConfig:
     """The dataset the classic flags (--scenario --crop --scenes --first) describe.
 
     Returns:
@@ -258,9 +258,10 @@ def parse_dataset_config(text: str, source: str, default_name: str = "dataset") 
     depth = data.get("depth", True)
     if not isinstance(depth, bool):
         check.fail("depth", f"must be true or false, not {depth!r}")
-    antialiasing = data.get("antialiasing", 4)
-    if antialiasing not in (1, 4) or isinstance(antialiasing, bool):
-        check.fail("antialiasing", f"must be 4 or 1, not {antialiasing!r}")
+    try:
+        antialiasing = resolve_antialiasing(data.get("antialiasing"))
+    except UserError as error:
+        check.fail("antialiasing", str(error))
     top_grid = check.grid_mapping(data.get("grid", {}), "grid")
     groups_data = data.get("groups")
     if not isinstance(groups_data, list) or not groups_data:

@@ -38,12 +38,40 @@ def resolve_look(renderer: str, look: str | None) -> str:
     return look or DEFAULT_LOOK
 
 
-#: Colour samples per pixel of our renderer: 4 (multisampled colour, ids from a 1x pass) or 1.
-ANTIALIASING = (4, 1)
+#: Antialiasing of our renderer's colour (ids and depth are exact in every mode): FXAA along
+#: silhouettes of a 1x pass (default), 4x multisampled colour with a 1x id pass, or none.
+ANTIALIASING = ("fxaa", "msaa", "none")
+DEFAULT_ANTIALIASING = "fxaa"
+#: What scene.json says of each mode.
+ANTIALIASING_DESCRIPTIONS = {
+    "fxaa": "FXAA along silhouettes of one 1x pass that also gives ids and depth",
+    "msaa": "4x multisampled colour, ids and depth from a 1x pass",
+    "none": "none: one 1x pass",
+}
+#: Earlier versions took colour samples per pixel: 4 was multisampling, 1 none.
+SAMPLES = {"4": "msaa", "1": "none"}
+
+
+def resolve_antialiasing(value: str | int | None) -> str:
+    """An antialiasing mode from a flag or a config value (``fxaa``, ``msaa``, ``none``; the
+    samples per pixel earlier versions took, 4 or 1, still mean ``msaa`` and ``none``).
+
+    Raises:
+        UserError: naming the value and the choices.
+    """
+    if value is None:
+        return DEFAULT_ANTIALIASING
+    if isinstance(value, bool) or not isinstance(value, (str, int)):
+        raise UserError(f"antialiasing {value!r}: choose one of {', '.join(ANTIALIASING)}")
+    text = str(value).strip().lower()
+    text = SAMPLES.get(text, text)
+    if text not in ANTIALIASING:
+        raise UserError(f"antialiasing {value!r}: choose one of {', '.join(ANTIALIASING)}")
+    return text
 
 
 def open_renderer(renderer: str, context, camera: Camera, lighting: Lighting, look: str | None = None,
-                  antialiasing: int = 4):
+                  antialiasing: str = DEFAULT_ANTIALIASING):
     """A renderer of a scene; use it as a context manager.
 
     Args:
@@ -52,8 +80,7 @@ def open_renderer(renderer: str, context, camera: Camera, lighting: Lighting, lo
         camera: Image size and field of view.
         lighting: Sun and sky.
         look: ``default`` or ``helios`` (None: the renderer's default).
-        antialiasing: Ours only: 4 (default) or 1 (one 1x pass, no antialiasing; faster on
-            llvmpipe for scenes of many small triangles). Ids are exact either way.
+        antialiasing: Ours only: one of :data:`ANTIALIASING`. Ids are exact in every mode.
 
     Returns:
         An object with ``render(view) -> (colour, primitive_ids, depth)`` and ``close()``.
@@ -65,4 +92,4 @@ def open_renderer(renderer: str, context, camera: Camera, lighting: Lighting, lo
         return HeliosRenderer(context, camera, lighting)
     from davis_ag.render.opengl import OpenGLRenderer
 
-    return OpenGLRenderer(context, camera, lighting, look=look, antialiasing=antialiasing)
+    return OpenGLRenderer(context, camera, lighting, look=look, antialiasing=resolve_antialiasing(antialiasing))

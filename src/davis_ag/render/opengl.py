@@ -14,9 +14,11 @@ and the depth image.
   sun is drawn once, fitted to the casters (the plants); the soil receives shadows and casts none.
 - Pinhole: Helios's vertical field of view and projection (OpenGL's, pixel centres at +0.5, row 0
   at the top once read back), so ids and depth line up with :meth:`Camera.project`.
-- Antialiasing (``antialiasing``): 1 draws colour, ids and depth in one 1x pass; 4 (default)
-  draws the colour with 4x multisampling and the ids and depth in a light 1x pass, so ids stay
-  exact (a multisampled id attachment would mix ids at edges). See docs/performance.md.
+- Antialiasing (``antialiasing``): ``"fxaa"`` (default) draws colour, ids and depth in one 1x
+  pass, then smooths the colour along silhouettes (where the depth jumps) with FXAA; ``"msaa"``
+  draws the colour with 4x multisampling and the ids and depth in a light 1x pass; ``"none"`` is
+  the 1x pass alone. Ids and depth are exact in every mode (a multisampled id attachment would mix
+  ids at edges). docs/performance.md measures each against Helios's frames.
 - Looks: ``"helios"`` reproduces Helios's frames, its texture handling included (images larger
   than 2048 pixels resized as Helios does, sampled at the nearest texel without mipmaps), to
   test fidelity; ``"default"`` samples every texture at full resolution with mipmaps and linear
@@ -157,15 +159,15 @@ class OpenGLRenderer:
         camera: Image size and field of view.
         lighting: Sun direction and sky.
         look: ``"default"`` or ``"helios"`` (see the module docstring).
-        antialiasing: 1 (one 1x pass) or 4 (4x multisampled colour, 1x id pass).
+        antialiasing: ``"fxaa"``, ``"msaa"`` or ``"none"`` (see the module docstring).
     """
 
     def __init__(self, context, camera: Camera, lighting: Lighting, look: str = "default",
-                 antialiasing: int = 4) -> None:
+                 antialiasing: str = "fxaa") -> None:
         if look not in LOOKS:
             raise ValueError(f"look {look!r}: choose one of {', '.join(LOOKS)}")
-        if antialiasing not in (1, 4):
-            raise ValueError("antialiasing must be 1 or 4")
+        if antialiasing not in ("fxaa", "msaa", "none"):
+            raise ValueError(f"antialiasing {antialiasing!r}: choose fxaa, msaa or none")
         self.camera, self.lighting, self.look, self.antialiasing = camera, lighting, look, antialiasing
         geometry = context if isinstance(context, SceneGeometry) else read_scene_geometry(context)
         self.geometry = geometry
@@ -196,6 +198,8 @@ class OpenGLRenderer:
             "shadow": ctx.program(vertex_shader=_shader("shadow.vert"), fragment_shader=_fragment("shadow.frag")),
             "sky": ctx.program(vertex_shader=_shader("sky.vert"), fragment_shader=_fragment("sky.frag")),
         }
+        if self.antialiasing == "fxaa":
+            self._programs["fxaa"] = ctx.program(vertex_shader=_shader("sky.vert"), fragment_shader=_shader("fxaa.frag"))
         # Samplers and the look first: the shadow pass below samples leaf textures already.
         for program in self._programs.values():
             self._set(program, "helios_look", int(helios))
@@ -257,15 +261,25 @@ class OpenGLRenderer:
         caster_vao.release()
         shadow_fbo.release()
 
-        # Framebuffers: 1x colour, ids and depth; 4x colour where antialiased.
+        # Framebuffers: 1x colour, ids and depth (textures, which the FXAA pass samples); the FXAA
+        # pass's output, or 4x colour.
         w, h = self.camera.width, self.camera.height
-        self._colour = ctx.renderbuffer((w, h), 4)
+        self._colour = ctx.texture((w, h), 4)
         self._id_buffer = ctx.renderbuffer((w, h), 1, dtype="u4")
-        self._depth_buffer = ctx.renderbuffer((w, h), 1, dtype="f4")
+        self._depth_buffer = ctx.texture((w, h), 1, dtype="f4")
         self._fbo = ctx.framebuffer([self._colour, self._id_buffer, self._depth_buffer],
                                     ctx.depth_renderbuffer((w, h)))
-        if self.antialiasing > 1:
-            samples = min(self.antialiasing, ctx.max_samples)
+        self._colour_fbo = self._fbo  # where the finished colour is read from
+        if self.antialiasing == "fxaa":
+            self._colour.filter = (moderngl.LINEAR, moderngl.LINEAR)
+            self._colour.repeat_x = self._colour.repeat_y = False
+            self._colour_fbo = ctx.framebuffer([ctx.renderbuffer((w, h), 4)])
+            self._fxaa = ctx.vertex_array(self._programs["fxaa"], [])
+            self._set(self._programs["fxaa"], "colour", 3)
+            self._set(self._programs["fxaa"], "depths", 4)
+            self._set(self._programs["fxaa"], "texel", (1.0 / w, 1.0 / h))
+        if self.antialiasing == "msaa":
+            samples = min(4, ctx.max_samples)
             # Colour only: the shader's id and depth outputs have no attachment here and are dropped.
             self._ms_fbo = ctx.framebuffer([ctx.renderbuffer((w, h), 4, samples=samples)],
                                            ctx.depth_renderbuffer((w, h), samples=samples))
@@ -374,7 +388,7 @@ class OpenGLRenderer:
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<="
         ctx.polygon_offset = (1.0, 1.0)
-        if self.antialiasing > 1:
+        if self.antialiasing == "msaa":
             self._pass(self._ms_fbo, self._scene)
             ctx.copy_framebuffer(self._resolve_fbo, self._ms_fbo)
             self._ids_fbo.use()
@@ -382,6 +396,13 @@ class OpenGLRenderer:
             self._ids.render(moderngl.TRIANGLES)
         else:
             self._pass(self._fbo, self._scene)
+        if self.antialiasing == "fxaa":
+            self._colour_fbo.use()
+            self._colour.use(location=3)
+            self._depth_buffer.use(location=4)
+            ctx.disable(moderngl.DEPTH_TEST)
+            self._fxaa.render(moderngl.TRIANGLES, vertices=3)
+            ctx.enable(moderngl.DEPTH_TEST)
 
     def _pass(self, fbo, vao) -> None:
         """Scene, then the sky where nothing was drawn (its depth is the far plane)."""
@@ -397,7 +418,7 @@ class OpenGLRenderer:
     def read(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The last view drawn: colour, primitive ids and depth (see :meth:`render`)."""
         w, h = self.camera.width, self.camera.height
-        colour = np.frombuffer(self._fbo.read(components=3, attachment=0), dtype=np.uint8).reshape(h, w, 3)
+        colour = np.frombuffer(self._colour_fbo.read(components=3, attachment=0), dtype=np.uint8).reshape(h, w, 3)
         ids = np.frombuffer(self._fbo.read(components=1, attachment=1, dtype="u4"), dtype=np.uint32).reshape(h, w)
         depth = np.frombuffer(self._fbo.read(components=1, attachment=2, dtype="f4"), dtype=np.float32).reshape(h, w)
         return colour[::-1].copy(), ids[::-1].copy(), depth[::-1].copy()
