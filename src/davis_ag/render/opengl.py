@@ -30,12 +30,12 @@ follows the EGL vendor library's choice (``__EGL_VENDOR_LIBRARY_FILENAMES``); se
 
 from __future__ import annotations
 
-import functools
 from importlib import resources
 
 import numpy as np
 from PIL import Image
 
+from davis_ag.render.egl_context import create_context, egl_current, egl_restore
 from davis_ag.render.projection import camera_matrices, gl_matrix, helios_shadow_box, light_matrix, matmul32
 from davis_ag.render.scene_geometry import SceneGeometry, read_scene_geometry
 from davis_ag.render.textures import default_sky_texture, load_texture
@@ -87,70 +87,6 @@ def _fragment(name: str, defines: tuple[str, ...] = ()) -> str:
     return "\n".join(lines)
 
 
-@functools.cache
-def _egl_library():
-    """libEGL through ctypes, or None; looked up once (``find_library`` runs ``ldconfig``)."""
-    import ctypes
-    import ctypes.util
-
-    try:
-        egl = ctypes.CDLL(ctypes.util.find_library("EGL") or "libEGL.so.1")
-    except OSError:
-        return None
-    for name in ("eglGetCurrentDisplay", "eglGetCurrentContext", "eglGetCurrentSurface"):
-        getattr(egl, name).restype = ctypes.c_void_p
-    egl.eglGetCurrentSurface.argtypes = [ctypes.c_int]
-    egl.eglMakeCurrent.argtypes = [ctypes.c_void_p] * 4
-    return egl
-
-
-def _egl_current() -> tuple | None:
-    """The EGL context current on this thread (display, draw, read, context), or None."""
-    egl = _egl_library()
-    if egl is None:
-        return None
-    display = egl.eglGetCurrentDisplay()
-    if not display:
-        return None
-    draw_surface, read_surface = 0x3059, 0x305A  # EGL_DRAW, EGL_READ
-    return (egl, display, egl.eglGetCurrentSurface(draw_surface), egl.eglGetCurrentSurface(read_surface),
-            egl.eglGetCurrentContext())
-
-
-def _egl_restore(state: tuple | None) -> None:
-    """Make a context saved by :func:`_egl_current` current again (another GL user's, such as
-    Helios's Visualizer, which expects its context to stay current between its calls)."""
-    if state is not None:
-        egl, display, draw, read, context = state
-        egl.eglMakeCurrent(display, draw, read, context)
-
-
-#: Environment variable naming the EGL device to draw on (an index into EGL's device list).
-EGL_DEVICE_VARIABLE = "DAVIS_AG_EGL_DEVICE"
-
-
-def create_context():
-    """A headless OpenGL 3.3+ context through EGL: the default EGL display (a GPU's driver where one
-    is installed and chosen by libglvnd, else Mesa's llvmpipe), or EGL device number
-    ``$DAVIS_AG_EGL_DEVICE`` where that is set (README, "Rendering")."""
-    import os
-
-    import moderngl
-
-    from davis_ag.errors import UserError
-
-    device = os.environ.get(EGL_DEVICE_VARIABLE, "").strip()
-    if device and not device.isdigit():
-        raise UserError(f"{EGL_DEVICE_VARIABLE}={device!r}: give the number of an EGL device (0, 1, ...)")
-    options = {"device_index": int(device)} if device else {}
-    try:
-        return moderngl.create_standalone_context(backend="egl", require=330, **options)
-    except Exception as error:  # noqa: BLE001 - moderngl raises plain Exceptions
-        raise UserError(f"cannot open a headless OpenGL context through EGL ({error}): install the "
-                        "system's EGL and GL libraries (Debian: libegl1 libgl1 libgl1-mesa-dri)"
-                        + (f", or choose another {EGL_DEVICE_VARIABLE}" if device else "")) from None
-
-
 class OpenGLRenderer:
     """Draws views of one scene: colour, primitive ids and depth.
 
@@ -173,7 +109,7 @@ class OpenGLRenderer:
         self.geometry = geometry
         # Our context is current only while we draw: another GL user in this process (Helios's
         # Visualizer) finds its own context current again after every call of ours.
-        previous = _egl_current()
+        previous = egl_current()
         self.ctx = create_context()
         try:
             self._build(geometry)
@@ -181,7 +117,7 @@ class OpenGLRenderer:
             self.close()
             raise
         finally:
-            _egl_restore(previous)
+            egl_restore(previous)
 
     # -----------------------------------------------------------------------------------------
     # Set-up
@@ -431,13 +367,13 @@ class OpenGLRenderer:
             primitive seen at each pixel centre, 0 for none; depth (height, width) float32, metres
             along the optical axis, 0 where nothing is hit. Row 0 is the top of the image.
         """
-        previous = _egl_current()
+        previous = egl_current()
         try:
             with self.ctx:
                 self.draw(view)
                 return self.read()
         finally:
-            _egl_restore(previous)
+            egl_restore(previous)
 
     def silhouette_pixels(self, view: Viewpoint, key: int, uuids: np.ndarray) -> int:
         """Pixels whose centre some primitive of ``uuids`` covers with nothing else drawn: the area
@@ -453,7 +389,7 @@ class OpenGLRenderer:
         """
         import moderngl
 
-        previous = _egl_current()
+        previous = egl_current()
         try:
             with self.ctx:
                 group = self._silhouette_groups.get(key)
@@ -482,7 +418,7 @@ class OpenGLRenderer:
                 fbo.scissor = None
                 return int(np.count_nonzero(ids))
         finally:
-            _egl_restore(previous)
+            egl_restore(previous)
 
     def _silhouette_group(self, uuids: np.ndarray) -> tuple | None:
         """A vertex array of the triangles of ``uuids`` and their corners, or None if none is drawn."""
@@ -522,10 +458,10 @@ class OpenGLRenderer:
         """Release the GL context and everything in it."""
         ctx, self.ctx = getattr(self, "ctx", None), None
         if ctx is not None:
-            previous = _egl_current()
+            previous = egl_current()
             ctx.mglo.__enter__()  # release our objects in our context, not in whichever is current
             ctx.release()
-            _egl_restore(previous)
+            egl_restore(previous)
 
     def __enter__(self) -> "OpenGLRenderer":
         return self
