@@ -40,7 +40,7 @@ from davis_ag.scene.plant_geometry import (  # noqa: F401 - re-exported for the 
     primitive_vertices,
     principal_extents,
 )
-from davis_ag.scene.shoot_recipes import CROWN_INTERNODE, with_shoot_recipe
+from davis_ag.scene.shoot_recipes import CROWN_INTERNODE, fixed_internode, with_shoot_recipe
 from davis_ag.scene.specs import PHENOTYPE_SPREAD, CropSpec
 
 #: Helios maps seeds 0, 1, 2**31 - 1 and 2**32 - 1 to the same plant: stay inside this range.
@@ -251,7 +251,7 @@ def _lift_to_ground(context, plant_architecture, plant_id: int) -> None:
         context.translatePrimitive(loose, shift)
 
 
-#: Measured height ~ a + b * knob for the library models (fitted on a few seeds), used only for
+#: Measured height ~ a + b * knob for our plants (fitted on a few seeds), used only for
 #: the first build's guess; later builds correct it by the secant through the last two builds.
 HEIGHT_MODEL = {"strawberry": (-0.07, 0.43), "tomato": (0.505, 0.68)}
 #: Fruit radius and leaf length of the library models as built, for the first build's guess.
@@ -357,21 +357,8 @@ def prepare_build(context, plant_architecture, shoot_defaults: dict[str, dict], 
     for label, defaults in shoot_defaults.items():
         plant_architecture.defineShootType(label, scaled_shoot_parameters(defaults, crop, knobs))
         if internode is not None:
-            plant_architecture.setPhytomerCreationFunction(label, _fixed_internode(plant_architecture, internode))
+            plant_architecture.setPhytomerCreationFunction(label, fixed_internode(plant_architecture, internode))
     context.seedRandomGenerator(seed)
-
-
-def _fixed_internode(plant_architecture, length: float) -> Callable[..., None]:
-    """A phytomer creation callback that sets each new internode's elongated length.
-
-    The library's strawberry builder ignores ``internode_length_max``, so the length is set per
-    phytomer as it is created (the strawberry has no library creation function to replace).
-    """
-
-    def creation(plant_id: int, shoot_id: int, node_index: int, *_: object) -> None:
-        plant_architecture.setInternodeMaxLength(plant_id, shoot_id, node_index, length)
-
-    return creation
 
 
 def grow_library_plant(

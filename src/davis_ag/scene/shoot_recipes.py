@@ -15,13 +15,12 @@ Generator's ``leaf_length`` is (``plants.LEAF_UNIT``), which doubles the leaflet
 Where the fruit hang decides how many a camera sees (Fig. 2). The library builder makes every
 internode 4 mm whatever ``internode_length_max`` says, so 50 nodes stacked into a 20 cm column
 with fruit hanging all the way up it, outside a narrow tuft of leaves: no view of ours saw fewer
-than 8-11 fruit, where Fig. 2 has views with fewer than 5. We set each internode to 1 mm as it
+than 5 fruit, where Fig. 2 has several. We set each internode to 1 mm as it
 is created (``CROWN_INTERNODE``: a crown of 5 cm), shorten the peduncles (0.04-0.08 m instead
 of 0.16-0.20) so the fruit lie around the crown on the soil, and let the petioles lean further
 out and arch over them (pitch 20-50 degrees from vertical instead of 10-45, curvature -200 to
--100 instead of -150 to -50): the leaves roof the fruit as in the original's bush. Measured on
-four scenes at 192x108 (Table 1 altitudes, every 0.5 m), visible fruit per view went from 11-24
-to 1-21 (docs/scenes.md has the measurement over more scenes). What did not work (shared notes,
+-100 instead of -150 to -50): the leaves roof the fruit as in the original's bush. docs/scenes.md has
+what this does to the fruit in view (tools/scene_stats.py). What did not work (shared notes,
 measured): two floral buds per node fuse fruit pairs and lift the plant; more nodes without a
 shorter phyllochron change nothing; vegetative bud break grows dozens of crowns; petioles
 leaning out 45-85 degrees dive under the soil once the crown is compact.
@@ -35,6 +34,7 @@ grapevine library's own.
 from __future__ import annotations
 
 import copy
+from typing import Callable
 
 from davis_ag.scene.specs import CropSpec
 
@@ -91,3 +91,23 @@ def with_shoot_recipe(params: dict, crop: CropSpec) -> dict:
         if isinstance(parent, dict) and path[-1] in parent:
             parent[path[-1]] = copy.deepcopy(spec)
     return out
+
+
+def fixed_internode(plant_architecture, length: float) -> Callable[..., None]:
+    """A phytomer creation callback that sets each new internode's fully elongated length.
+
+    The library's strawberry builder ignores ``internode_length_max``, so the length is set per
+    phytomer as it is created (the strawberry has no library creation function to replace).
+
+    Args:
+        plant_architecture: The PlantArchitecture the callback is installed on.
+        length: Internode length, m (``CROWN_INTERNODE``).
+
+    Returns:
+        The callback for ``setPhytomerCreationFunction``.
+    """
+
+    def creation(plant_id: int, shoot_id: int, node_index: int, *_: object) -> None:
+        plant_architecture.setInternodeMaxLength(plant_id, shoot_id, node_index, length)
+
+    return creation
