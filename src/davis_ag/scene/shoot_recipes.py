@@ -15,15 +15,15 @@ Generator's ``leaf_length`` is (``plants.LEAF_UNIT``), which doubles the leaflet
 Where the fruit hang decides how many a camera sees (Fig. 2). The library builder makes every
 internode 4 mm whatever ``internode_length_max`` says, so 50 nodes stacked into a 20 cm column
 with fruit hanging all the way up it, outside a narrow tuft of leaves: no view of ours saw fewer
-than 5 fruit, where Fig. 2 has several. We set each internode to 1 mm as it
-is created (``CROWN_INTERNODE``: a crown of 5 cm), shorten the peduncles (0.04-0.08 m instead
-of 0.16-0.20) so the fruit lie around the crown on the soil, and let the petioles lean further
-out and arch over them (pitch 20-50 degrees from vertical instead of 10-45, curvature -200 to
--100 instead of -150 to -50): the leaves roof the fruit as in the original's bush. docs/scenes.md has
-what this does to the fruit in view (tools/scene_stats.py). What did not work (shared notes,
-measured): two floral buds per node fuse fruit pairs and lift the plant; more nodes without a
-shorter phyllochron change nothing; vegetative bud break grows dozens of crowns; petioles
-leaning out 45-85 degrees dive under the soil once the crown is compact.
+than 5 fruit, where Fig. 2 has several. We set each internode to 1 mm as it is created
+(``CROWN_INTERNODE``: a crown of 5 cm), shorten the peduncles (0.04-0.08 m instead of 0.16-0.20)
+so the fruit lie around the crown on the soil, and let the petioles lean further out and arch
+over them (pitch 20-50 degrees from vertical instead of 10-45, curvature -200 to -100 instead of
+-150 to -50): the leaves roof the fruit as in the original's bush. docs/scenes.md has what this
+does to the fruit in view (tools/scene_stats.py). What did not work (shared notes, measured):
+two floral buds per node fuse fruit pairs and lift the plant; more nodes without a shorter
+phyllochron change nothing; vegetative bud break grows dozens of crowns; petioles leaning out
+45-85 degrees dive under the soil once the crown is compact.
 
 Tomato: the library's trusses carry 6 flowers each (so every plant came out a multiple of 6,
 most 18), and one node in five breaks a floral bud; a greenhouse tomato has a truss every third
