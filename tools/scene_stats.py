@@ -12,7 +12,8 @@ when another is refreshed; docs/scenes.md is rewritten from whichever exist:
   position loses or gains fruit (Fig. 3), and the share of boxes with OER below 0.4.
 
 Run: ``python tools/scene_stats.py views``, ``... plants 10 [tomato,vine]``,
-``... findings 3 192x108 [0.5]`` (the last argument: the grid step, default the paper's 0.25 m).
+``... findings 3 192x108 [0.5]`` (the last argument: the grid step, default the paper's 0.25 m;
+one file per image size, docs/scenes-findings-WxH.json, since the OER share depends on it).
 """
 
 from __future__ import annotations
@@ -171,12 +172,22 @@ def plants_table() -> list[str]:
     return lines
 
 
+def findings_file(size: tuple[int, int]) -> Path:
+    """Where the findings measured at one image size are kept (the OER share depends on it)."""
+    return DOCS / f"scenes-findings-{size[0]}x{size[1]}.json"
+
+
 def findings_table() -> list[str]:
-    """Markdown: the section IV and V-C findings measured on generated strawberry scenes."""
-    findings_file = DOCS / "scenes-findings.json"
-    if not findings_file.exists():
-        return []
-    data = json.loads(findings_file.read_text())
+    """Markdown: the findings measured at every image size measured, smallest first."""
+    files = sorted(DOCS.glob("scenes-findings-*x*.json"), key=lambda f: int(f.stem.split("-")[-1].split("x")[0]))
+    lines: list[str] = []
+    for path in files:
+        lines += findings_lines(json.loads(path.read_text()))
+    return lines
+
+
+def findings_lines(data: dict) -> list[str]:
+    """Markdown: the section IV and V-C findings measured on generated strawberry scenes of one size."""
     scenes = data["scenes"]
     oer = np.concatenate([s["box_oer"] for s in scenes])
     lines = [f"{len(scenes)} scenes (dataset seed 0, scenes 0-{len(scenes) - 1}) generated at "
@@ -243,7 +254,7 @@ def main(argv: list[str]) -> None:
     elif argv and argv[0] == "findings":
         size = tuple(int(v) for v in argv[2].split("x"))
         step = float(argv[3]) if len(argv) > 3 else 0.25
-        write_json_atomic(DOCS / "scenes-findings.json",
+        write_json_atomic(findings_file(size),
                           {**measure_findings(int(argv[1]), size, step), "machine": machine}, indent=1)
     write_text_atomic(DOCS / "scenes.md", render_markdown())
     update_readme({"views": views_table(), "plants": plants_table(), "findings": findings_table()})
