@@ -12,7 +12,8 @@ when another is refreshed; docs/scenes.md is rewritten from whichever exist:
   position loses or gains fruit (Fig. 3), and the share of boxes with OER below 0.4.
 
 Run: ``python tools/scene_stats.py views``, ``... plants 10 [tomato,vine]``,
-``... findings 3 192x108 [0.5]`` (the last argument: the grid step, default the paper's 0.25 m).
+``... findings 3 192x108 [0.5]`` (the last argument: the grid step, default the paper's 0.25 m;
+one file per image size, docs/scenes-findings-WxH.json, since the OER share depends on it).
 """
 
 from __future__ import annotations
@@ -171,12 +172,22 @@ def plants_table() -> list[str]:
     return lines
 
 
+def findings_file(size: tuple[int, int]) -> Path:
+    """Where the findings measured at one image size are kept (the OER share depends on it)."""
+    return DOCS / f"scenes-findings-{size[0]}x{size[1]}.json"
+
+
 def findings_table() -> list[str]:
-    """Markdown: the section IV and V-C findings measured on generated strawberry scenes."""
-    findings_file = DOCS / "scenes-findings.json"
-    if not findings_file.exists():
-        return []
-    data = json.loads(findings_file.read_text())
+    """Markdown: the findings measured at every image size measured, smallest first."""
+    files = sorted(DOCS.glob("scenes-findings-*x*.json"), key=lambda f: int(f.stem.split("-")[-1].split("x")[0]))
+    lines: list[str] = []
+    for path in files:
+        lines += findings_lines(json.loads(path.read_text()))
+    return lines
+
+
+def findings_lines(data: dict) -> list[str]:
+    """Markdown: the section IV and V-C findings measured on generated strawberry scenes of one size."""
     scenes = data["scenes"]
     oer = np.concatenate([s["box_oer"] for s in scenes])
     lines = [f"{len(scenes)} scenes (dataset seed 0, scenes 0-{len(scenes) - 1}) generated at "
@@ -195,11 +206,20 @@ def findings_table() -> list[str]:
                      f"{(visible < 5).sum()} | {(visible >= 16).sum()} | {s['views_seeing_all']} | "
                      f"{s['up_loses']} / {s['up_gains']} (of {s['up_pairs']}) | {len(box_oer)} | "
                      f"{(box_oer < 0.4).mean():.1%} |")
+    skew = skewness(oer)
+    per_scene = ", ".join(f"{skewness(np.asarray(scene['box_oer'])):.2f}" for scene in scenes)
     lines += ["", f"All scenes: {len(oer):,} boxes, {(oer < 0.4).mean():.1%} with OER < 0.4 (paper: 4 %); "
-                  f"OER median {np.median(oer):.2f}, mean {oer.mean():.2f} (mass to the right, the "
-                  "paper's \"right-skewed\": mean < median "
-                  f"is {'true' if oer.mean() < np.median(oer) else 'false'}).", ""]
+                  f"OER median {np.median(oer):.2f}, mean {oer.mean():.2f}, skewness {skew:.2f} (the "
+                  "paper's \"right-skewed\": the mass to the right, a tail towards 0, i.e. skewness < 0, "
+                  f"is {'true' if skew < 0 else 'false'}; per scene "
+                  f"{per_scene}).", ""]
     return lines
+
+
+def skewness(values: np.ndarray) -> float:
+    """Sample skewness (third standardised moment): negative when the tail points to low values."""
+    centred = np.asarray(values, dtype=float) - np.mean(values)
+    return float(np.mean(centred**3) / np.mean(centred**2) ** 1.5)
 
 
 def render_markdown() -> str:
@@ -234,7 +254,7 @@ def main(argv: list[str]) -> None:
     elif argv and argv[0] == "findings":
         size = tuple(int(v) for v in argv[2].split("x"))
         step = float(argv[3]) if len(argv) > 3 else 0.25
-        write_json_atomic(DOCS / "scenes-findings.json",
+        write_json_atomic(findings_file(size),
                           {**measure_findings(int(argv[1]), size, step), "machine": machine}, indent=1)
     write_text_atomic(DOCS / "scenes.md", render_markdown())
     update_readme({"views": views_table(), "plants": plants_table(), "findings": findings_table()})

@@ -184,6 +184,19 @@ def test_grown_plant_matches_its_target_within_table_1(crop: str, seed: int) -> 
         # Goblet: free standing, no trellis wires along a row.
         assert np.ptp(points[:, 0]) < 2.0 and np.ptp(points[:, 1]) < 2.0
 
+    if crop == "strawberry":
+        # A compact crown with the fruit hanging low under a broader canopy of leaves, as in the
+        # original's bush (the library's 4 mm internodes made a 20 cm column hung with fruit).
+        (plant_id,) = plant_architecture.getAllPlantIDs()
+        assert plant_architecture.getPlantStemHeight(plant_id) < 0.08
+        fruit = np.array([np.concatenate(primitive_vertices(context, context.getObjectPrimitiveUUIDs(f))).mean(axis=0)
+                          for f in plant.fruit_objects])
+        leaves = np.concatenate([primitive_vertices(context, context.getObjectPrimitiveUUIDs(b))[0]
+                                 for b in plant_architecture.getPlantLeafObjectIDs(plant_id)])
+        assert fruit[:, 2].max() < plant.measured.plant_height / 2
+        fruit_reach = np.hypot(*(fruit[:, :2] - position).T).max()
+        assert np.percentile(np.hypot(*(leaves[:, :2] - position).T), 90) > fruit_reach + 0.05
+
     summary = plant.summary()
     assert summary["phenotype_measured"] == asdict(plant.measured)
     assert summary["fruit_count"] == len(plant.fruit_objects) and summary["seed"] == plant.seed

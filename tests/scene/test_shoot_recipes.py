@@ -15,7 +15,7 @@ def library_like() -> dict:
     return {
         "max_nodes": dict(constant), "phyllochron_min": dict(constant), "fruit_set_probability": dict(constant),
         "flower_bud_break_probability": dict(constant),
-        "phytomer_parameters": {"petiole": {"pitch": dict(constant)},
+        "phytomer_parameters": {"petiole": {"pitch": dict(constant), "curvature": dict(constant)},
                                 "peduncle": {"length": dict(constant), "curvature": dict(constant)},
                                 "inflorescence": {"flowers_per_peduncle": dict(constant)}},
     }

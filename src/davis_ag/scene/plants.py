@@ -40,7 +40,7 @@ from davis_ag.scene.plant_geometry import (  # noqa: F401 - re-exported for the 
     primitive_vertices,
     principal_extents,
 )
-from davis_ag.scene.shoot_recipes import with_shoot_recipe
+from davis_ag.scene.shoot_recipes import CROWN_INTERNODE, fixed_internode, with_shoot_recipe
 from davis_ag.scene.specs import PHENOTYPE_SPREAD, CropSpec
 
 #: Helios maps seeds 0, 1, 2**31 - 1 and 2**32 - 1 to the same plant: stay inside this range.
@@ -251,11 +251,11 @@ def _lift_to_ground(context, plant_architecture, plant_id: int) -> None:
         context.translatePrimitive(loose, shift)
 
 
-#: Measured height ~ a + b * knob for the library models (fitted on a few seeds), used only for
+#: Measured height ~ a + b * knob for our plants (fitted on a few seeds), used only for
 #: the first build's guess; later builds correct it by the secant through the last two builds.
-HEIGHT_MODEL = {"strawberry": (0.32, 0.173), "tomato": (0.505, 0.68)}
+HEIGHT_MODEL = {"strawberry": (-0.07, 0.43), "tomato": (0.505, 0.68)}
 #: Fruit radius and leaf length of the library models as built, for the first build's guess.
-DEFAULT_SIZES = {"strawberry": (0.029, 0.12), "tomato": (0.016, 0.205)}
+DEFAULT_SIZES = {"strawberry": (0.037, 0.139), "tomato": (0.016, 0.205)}
 #: Blades measured as one leaf where not all of a petiole's: Table 1's strawberry leaf length is
 #: a leaflet's, as ``leaf_length`` is in the Canopy Generator that made the original's plants.
 LEAF_UNIT = {"strawberry": 1}
@@ -353,8 +353,11 @@ def blades_per_leaf(shoot_defaults: dict[str, dict]) -> int:
 def prepare_build(context, plant_architecture, shoot_defaults: dict[str, dict], crop: CropSpec,
                   knobs: dict[str, float], seed: int) -> None:
     """Redefine every shoot type with the knobs applied and seed Helios, before a build."""
+    internode = CROWN_INTERNODE.get(crop.name)
     for label, defaults in shoot_defaults.items():
         plant_architecture.defineShootType(label, scaled_shoot_parameters(defaults, crop, knobs))
+        if internode is not None:
+            plant_architecture.setPhytomerCreationFunction(label, fixed_internode(plant_architecture, internode))
     context.seedRandomGenerator(seed)
 
 
