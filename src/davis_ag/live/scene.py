@@ -74,6 +74,44 @@ def min_pixels_for(settings: SceneSettings, width: int, height: int) -> int:
     return max(1, round(settings.crop.min_fruit_pixels * width * height / REFERENCE_PIXELS))
 
 
+def merge_ground(geometry):
+    """The scene with its soil (every non-caster triangle: 10,000 near patches and the far ring) as
+    two triangles, where that draws the same image: soil of one texture and colour, drawn in the
+    default look (which lays the soil texture by world position, not by the tiles' coordinates).
+    Ids and depth of fruit and leaves do not change; the soil's id becomes its first tile's.
+
+    Returns:
+        A :class:`~davis_ag.render.scene_geometry.SceneGeometry` (``geometry`` itself when the
+        soil cannot be merged).
+    """
+    from davis_ag.render.scene_geometry import SceneGeometry
+
+    ground = ~geometry.caster
+    if ground.sum() <= 2 or len(np.unique(geometry.texture[ground])) != 1 \
+            or len(np.unique(geometry.colours[ground], axis=0)) != 1:
+        return geometry
+    first = int(np.flatnonzero(ground)[0])
+    lo = geometry.positions[ground].reshape(-1, 3).min(axis=0)
+    hi = geometry.positions[ground].reshape(-1, 3).max(axis=0)
+    corners = np.array([[lo[0], lo[1], 0.0], [hi[0], lo[1], 0.0], [hi[0], hi[1], 0.0], [lo[0], hi[1], 0.0]],
+                       dtype=np.float32)
+    quad = corners[[[0, 1, 2], [0, 2, 3]]]
+    keep = np.flatnonzero(~ground)
+    pick = np.concatenate([keep, [first, first]])
+
+    def merged(values: np.ndarray, extra: np.ndarray | None = None) -> np.ndarray:
+        out = values[pick].copy()
+        if extra is not None:
+            out[-2:] = extra
+        return out
+
+    return SceneGeometry(
+        positions=merged(geometry.positions, quad), uvs=merged(geometry.uvs, np.zeros((2, 3, 2), np.float32)),
+        normals=merged(geometry.normals, np.tile(np.float32([0, 0, 1]), (2, 3, 1))), uuids=merged(geometry.uuids),
+        colours=merged(geometry.colours), texture=merged(geometry.texture), mode=merged(geometry.mode),
+        caster=merged(geometry.caster), patch=merged(geometry.patch), texture_files=list(geometry.texture_files))
+
+
 class LiveScene:
     """A reopened scene; draw it with :meth:`render`. Holds one renderer per image size."""
 
@@ -127,21 +165,27 @@ class LiveScene:
 
     # ------------------------------------------------------------------------------ drawing
 
-    def renderer(self, width: int, height: int, vfov: float | None = None, antialiasing: int | None = None):
-        """The renderer for an image size (made once, kept until :meth:`close`)."""
+    def renderer(self, width: int, height: int, vfov: float | None = None, antialiasing: int | None = None,
+                 fast_ground: bool = False):
+        """The renderer for an image size (made once, kept until :meth:`close`); ``fast_ground``
+        draws the soil as one quad (:func:`merge_ground`)."""
         settings = self.settings
         camera = Camera(int(width), int(height), float(vfov if vfov is not None else settings.camera.vfov))
         aa = settings.antialiasing if antialiasing is None else antialiasing
-        key = (camera, aa)
+        key = (camera, aa, fast_ground)
         if key not in self._renderers:
             from davis_ag.render.opengl import OpenGLRenderer
 
-            self._renderers[key] = OpenGLRenderer(self.assets.geometry, camera, self.assets.lighting,
+            geometry = self.assets.geometry
+            if fast_ground and settings.look == "default":
+                geometry = merge_ground(geometry)
+            self._renderers[key] = OpenGLRenderer(geometry, camera, self.assets.lighting,
                                                   look=settings.look, antialiasing=aa)
         return self._renderers[key]
 
     def render(self, view: Viewpoint, width: int | None = None, height: int | None = None,
-               vfov: float | None = None, antialiasing: int | None = None, fractions: bool = True) -> LiveView:
+               vfov: float | None = None, antialiasing: int | None = None, fractions: bool = True,
+               fast_ground: bool = False) -> LiveView:
         """Draw and label one pose.
 
         Args:
@@ -150,13 +194,15 @@ class LiveScene:
             vfov: Vertical field of view, degrees (default the scene's).
             antialiasing: 4 or 1 colour samples per pixel (default the scene's); ids are exact either way.
             fractions: Also count each boxed fruit's unoccluded pixels (one small pass per fruit).
+            fast_ground: Draw the soil as one quad (:func:`merge_ground`): the same image for
+                fewer triangles; off by default so that a grid pose redraws exactly as stored.
 
         Returns:
             The :class:`LiveView`.
         """
         width = int(width or self.settings.camera.width)
         height = int(height or self.settings.camera.height)
-        renderer = self.renderer(width, height, vfov, antialiasing)
+        renderer = self.renderer(width, height, vfov, antialiasing, fast_ground)
         colour, ids, depth = renderer.render(view)
         labels = label_view(ids, self.lookup, min_pixels_for(self.settings, width, height))
         visible = None

@@ -28,6 +28,7 @@ follows the EGL vendor library's choice (``__EGL_VENDOR_LIBRARY_FILENAMES``); se
 
 from __future__ import annotations
 
+import functools
 from importlib import resources
 
 import numpy as np
@@ -84,8 +85,9 @@ def _fragment(name: str, defines: tuple[str, ...] = ()) -> str:
     return "\n".join(lines)
 
 
-def _egl_current() -> tuple | None:
-    """The EGL context current on this thread (display, draw, read, context), or None."""
+@functools.lru_cache(maxsize=1)
+def _egl_library():
+    """libEGL through ctypes, looked up once (find_library runs a subprocess: milliseconds a view)."""
     import ctypes
     import ctypes.util
 
@@ -97,6 +99,14 @@ def _egl_current() -> tuple | None:
         getattr(egl, name).restype = ctypes.c_void_p
     egl.eglGetCurrentSurface.argtypes = [ctypes.c_int]
     egl.eglMakeCurrent.argtypes = [ctypes.c_void_p] * 4
+    return egl
+
+
+def _egl_current() -> tuple | None:
+    """The EGL context current on this thread (display, draw, read, context), or None."""
+    egl = _egl_library()
+    if egl is None:
+        return None
     display = egl.eglGetCurrentDisplay()
     if not display:
         return None
