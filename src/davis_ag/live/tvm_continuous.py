@@ -115,6 +115,8 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         if self.tau < 1:
             raise UserError(f"tau must be at least 1, got {self.tau}")
         folders = scene_folders(dataset, spec.name, split, crop)
+        if folders == [Path(os.fspath(dataset))]:
+            self.split = "scene"  # one scene folder: no split
         if not folders:
             raise UserError(f"{dataset}: no {spec.name} scene in the {split} split")
         self.scenes: list[LiveScene] = []
