@@ -161,7 +161,6 @@ def regrow(settings: SceneSettings) -> SceneAssets:
             (another pyhelios or davis-ag version grows differently).
     """
     from davis_ag.generate.one_scene import SceneRequest, grow_scene
-    from davis_ag.render.scene_geometry import read_scene_geometry
 
     request = SceneRequest(settings.scenario, settings.crop, settings.index, settings.dataset_seed,
                            settings.camera, renderer=settings.renderer, look=settings.look)
@@ -177,6 +176,13 @@ def regrow(settings: SceneSettings) -> SceneAssets:
         raise UserError(f"{settings.folder}: regrowing from the seed gave other plants than scene.json records "
                         f"(made with {version}); reopen it with those versions")
     check_grid(settings, list(grid.viewpoints))
+    return assets_from_model(model, grid)
+
+
+def assets_from_model(model, grid) -> SceneAssets:
+    """A grown scene's drawable content (:func:`davis_ag.generate.one_scene.grow_scene`'s output)."""
+    from davis_ag.render.scene_geometry import read_scene_geometry
+
     return SceneAssets(read_scene_geometry(model.context), {f.id: np.asarray(f.uuids, dtype=np.int64)
                                                             for f in model.fruits},
                        model.uuid_count, model.lighting, float(model.aim_height), list(grid.viewpoints), False)
