@@ -205,6 +205,9 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         rng = self.np_random
         if options and "pose" in options:
             self._scene = int(options.get("scene", 0))
+            if not 0 <= self._scene < len(self.scenes) or len(options["pose"]) != 5:
+                raise UserError(f"start {options}: give a scene index below {len(self.scenes)} and a pose "
+                                "[x, y, z, yaw, pitch]")
             x, y, z, yaw, pitch = (float(v) for v in options["pose"])
             self._view = self._pose(np.array([x, y, z]), yaw, pitch)
             self._labels = self._draw(self._view)
