@@ -42,7 +42,8 @@ def main() -> None:
         scene_dir = continuous_scene(Path(scratch))
         started = time.perf_counter()
         model, records = train_continuous(scene_dir, "sp", total_timesteps=args.timesteps, seed=0,
-                                          out_path=Path(scratch) / "ppo.zip", arch=args.arch)
+                                          out_path=Path(scratch) / "ppo.zip", arch=args.arch,
+                                          progress_every=1000)
         train_s = time.perf_counter() - started
         plot_training_curve(records, args.png, f"PPO ({args.arch} network) on TVMContinuous-v0, "
                                                f"SP strawberry scene 0, {args.timesteps:,} steps", window=100)

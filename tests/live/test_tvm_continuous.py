@@ -132,10 +132,12 @@ def test_policies_play_the_same_starts(env: TVMContinuousEnv, tmp_path: Path) ->
         build_policies(["Oracle"])
 
 
-def test_ppo_trains_briefly_and_plays(live_scene_dir: Path, env: TVMContinuousEnv, tmp_path: Path) -> None:
+def test_ppo_trains_briefly_and_plays(live_scene_dir: Path, env: TVMContinuousEnv, tmp_path: Path,
+                                      capsys: pytest.CaptureFixture[str]) -> None:
     path, records = train_continuous(live_scene_dir, "sp", total_timesteps=48, seed=0, out_path=tmp_path / "ppo",
-                                     arch="pooled", n_steps=24, batch_size=12)
+                                     arch="pooled", n_steps=24, batch_size=12, progress_every=24)
     assert path.suffix == ".zip" and path.is_file()
+    assert "PPO: 48/48 steps" in capsys.readouterr().out
     assert len(records) >= 48 // env.tau - 1 and all(r["reward"] >= 0 for r in records)
     assert plot_training_curve(records, tmp_path / "curve.png", "PPO", window=4).stat().st_size > 0
     agent = ModelAgent(path)

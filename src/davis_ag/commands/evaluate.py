@@ -39,7 +39,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         default=None, help="comma-separated baselines (grid default: LRD,UDD,Rand,Oracle; "
                                            "continuous: LR,UD,Rand,Greedy)")
     parser.add_argument("--stochastic", action="store_true",
-                        help="let A2C sample its actions instead of taking the most likely one")
+                        help="let A2C (or the continuous Model) sample its actions instead of taking the most likely one")
     parser.add_argument("--episodes", type=arguments.bounded(1, 10**6), default=200,
                         help="episodes per session (200)")
     parser.add_argument("--sessions", type=arguments.bounded(1, 1000), default=3, help="sessions (3)")
@@ -76,7 +76,7 @@ def run(args: argparse.Namespace) -> int:
         from davis_ag.live.policies import build_policies
         from davis_ag.live.tvm_continuous import TVMContinuousEnv
 
-        agents = build_policies(names, model=args.model)
+        agents = build_policies(names, model=args.model, deterministic=not args.stochastic)
         env = TVMContinuousEnv(args.dataset, scenario=args.scenario, split=args.split, crop=args.crop)
         try:
             results = evaluate_continuous(env, agents, episodes=args.episodes, sessions=args.sessions,

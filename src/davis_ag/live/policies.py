@@ -148,8 +148,10 @@ def load_model(path: Path) -> Any:
 POLICY_NAMES: tuple[str, ...] = ("LR", "UD", "Rand", "Greedy", "Model")
 
 
-def build_policies(names: list[str], model: str | os.PathLike[str] | None = None) -> list[Any]:
-    """Policies by name, in order (case-insensitive; see :data:`POLICY_NAMES`).
+def build_policies(names: list[str], model: str | os.PathLike[str] | None = None,
+                   deterministic: bool = True) -> list[Any]:
+    """Policies by name, in order (case-insensitive; see :data:`POLICY_NAMES`); ``deterministic``
+    is the model's (False: it samples its actions).
 
     Raises:
         UserError: for an unknown name, or ``Model`` without a model file.
@@ -165,7 +167,7 @@ def build_policies(names: list[str], model: str | os.PathLike[str] | None = None
         elif key in ("model", "a2c", "ppo", "sac"):
             if model is None:
                 raise UserError(f"policy {name} needs a trained model: pass --model model.zip")
-            policies.append(ModelAgent(model))
+            policies.append(ModelAgent(model, deterministic=deterministic))
         else:
             raise UserError(f"unknown continuous policy {name!r}: choose from {', '.join(POLICY_NAMES)}")
     return policies

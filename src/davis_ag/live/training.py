@@ -58,9 +58,25 @@ def make_logged_env(dataset: Any, scenario: str, seed: int, **env_kwargs: Any) -
     return env, log
 
 
+def _progress_printer(log: EpisodeLog, total: int, every: int):
+    """An SB3 callback that prints steps done and the recent mean reward every ``every`` steps."""
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    class Progress(BaseCallback):
+        def _on_step(self) -> bool:
+            if self.num_timesteps % every == 0 or self.num_timesteps == total:
+                recent = [r["reward"] for r in log.records[-100:]]
+                print(f"PPO: {self.num_timesteps:,}/{total:,} steps, {len(log.records):,} episodes, mean reward "
+                      f"of the last {len(recent)}: {np.mean(recent) if recent else 0.0:.4f}", flush=True)
+            return True
+
+    return Progress()
+
+
 def train_continuous(dataset: Any, scenario: str = "sp", total_timesteps: int = 10_000, seed: int = 0,
                      out_path: str | os.PathLike[str] = "ppo.zip", arch: str = "paper", n_steps: int = 128,
-                     batch_size: int = 32, verbose: int = 0, **env_kwargs: Any) -> tuple[Path, list[dict]]:
+                     batch_size: int = 32, verbose: int = 0, progress_every: int = 0,
+                     **env_kwargs: Any) -> tuple[Path, list[dict]]:
     """Train PPO on the train split (or one scene folder) and save it.
 
     Args:
@@ -72,6 +88,7 @@ def train_continuous(dataset: Any, scenario: str = "sp", total_timesteps: int = 
         arch: ``paper``, ``nature`` or ``pooled``.
         n_steps, batch_size: PPO's rollout length and minibatch size.
         verbose: SB3 verbosity.
+        progress_every: Print progress every this many steps (0: silent).
         env_kwargs: More :class:`~davis_ag.live.tvm_continuous.TVMContinuousEnv` settings.
 
     Returns:
@@ -93,7 +110,8 @@ def train_continuous(dataset: Any, scenario: str = "sp", total_timesteps: int = 
     try:
         model = PPO("CnnPolicy", env, n_steps=n_steps, batch_size=batch_size, seed=seed, device="cpu",
                     verbose=verbose, policy_kwargs=dict(ARCHITECTURES[arch]))
-        model.learn(total_timesteps=total_timesteps)
+        model.learn(total_timesteps=total_timesteps,
+                    callback=_progress_printer(log, total_timesteps, progress_every) if progress_every else None)
     finally:
         env.close()
     records = list(log.records)
