@@ -28,7 +28,6 @@ follows the EGL vendor library's choice (``__EGL_VENDOR_LIBRARY_FILENAMES``); se
 
 from __future__ import annotations
 
-import functools
 from importlib import resources
 
 import numpy as np
@@ -85,9 +84,8 @@ def _fragment(name: str, defines: tuple[str, ...] = ()) -> str:
     return "\n".join(lines)
 
 
-@functools.lru_cache(maxsize=1)
-def _egl_library():
-    """libEGL through ctypes, looked up once (find_library runs a subprocess: milliseconds a view)."""
+def _egl_current() -> tuple | None:
+    """The EGL context current on this thread (display, draw, read, context), or None."""
     import ctypes
     import ctypes.util
 
@@ -99,14 +97,6 @@ def _egl_library():
         getattr(egl, name).restype = ctypes.c_void_p
     egl.eglGetCurrentSurface.argtypes = [ctypes.c_int]
     egl.eglMakeCurrent.argtypes = [ctypes.c_void_p] * 4
-    return egl
-
-
-def _egl_current() -> tuple | None:
-    """The EGL context current on this thread (display, draw, read, context), or None."""
-    egl = _egl_library()
-    if egl is None:
-        return None
     display = egl.eglGetCurrentDisplay()
     if not display:
         return None
