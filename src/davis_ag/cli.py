@@ -6,7 +6,7 @@ import argparse
 import importlib
 import sys
 
-from davis_ag import __version__
+from davis_ag.provenance import code_version
 from davis_ag.errors import UserError
 
 # Each name is a module of davis_ag.commands defining ``register(subparsers)``; the registered
@@ -28,7 +28,7 @@ class OneLineParser(argparse.ArgumentParser):
 def build_parser() -> argparse.ArgumentParser:
     """Build the top-level parser with every sub-command registered."""
     parser = OneLineParser(prog="davis-ag", description=__doc__)
-    parser.add_argument("--version", action="version", version=f"davis-ag {__version__}")
+    parser.add_argument("--version", action="version", version=f"davis-ag {code_version()}")
     subparsers = parser.add_subparsers(dest="command", required=True)
     for name in COMMANDS:
         importlib.import_module(f"davis_ag.commands.{name}").register(subparsers)

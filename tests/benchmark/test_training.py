@@ -10,7 +10,8 @@ from layout_factory import write_tiny_dataset
 from stable_baselines3 import A2C
 from stable_baselines3.common.callbacks import BaseCallback
 
-from davis_ag.benchmark.training import checkpoint_paths, train_a2c
+from davis_ag.benchmark.training import checkpoint_paths, train_a2c, training_record_path
+from davis_ag.provenance import code_version
 
 
 class _Kill(BaseCallback):
@@ -54,6 +55,13 @@ def test_a_killed_run_resumes_from_its_checkpoint(tmp_path: Path, one_thread: No
     assert path == tmp_path / "models" / "a2c.zip"
     assert A2C.load(path, device="cpu").num_timesteps == 240  # no step trained twice or skipped
     assert not model_file.exists() and not settings_file.exists()
+    # The record says it was made in two sittings, which steps each made, and with what code.
+    record = json.loads(training_record_path(out).read_text())
+    sittings = record["sittings"]
+    assert [(s["from_step"], s["to_step"]) for s in sittings] == [(0, saved["timesteps_done"]),
+                                                                  (saved["timesteps_done"], 240)]
+    assert all(s["code"] == code_version() and s["seconds"] > 0 for s in sittings)
+    assert record["timesteps"] == 240 and record["seconds"] == pytest.approx(sum(s["seconds"] for s in sittings), abs=0.2)
 
 
 def test_other_settings_never_resume_a_checkpoint(tmp_path: Path, one_thread: None,

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import os
+import time
 from pathlib import Path
 from typing import Any
 
@@ -22,6 +23,7 @@ from davis_ag.atomic_files import atomic_output, prove_writable_file, write_json
 from davis_ag.benchmark import TVMEnv
 from davis_ag.benchmark.networks import ARCHITECTURES
 from davis_ag.errors import UserError
+from davis_ag.provenance import code_version
 
 #: Steps between checkpoints by default: about a minute of training on a 2-core CPU.
 CHECKPOINT_EVERY = 10_000
@@ -67,18 +69,41 @@ def checkpoint_paths(out_path: str | os.PathLike[str]) -> tuple[Path, Path]:
     return stem.with_name(stem.name + ".checkpoint.zip"), stem.with_name(stem.name + ".checkpoint.json")
 
 
+def training_record_path(out_path: str | os.PathLike[str]) -> Path:
+    """``NAME.training.json`` beside the model ``NAME.zip``: settings, sittings, steps/s."""
+    stem = model_path(out_path).with_suffix("")
+    return stem.with_name(stem.name + ".training.json")
+
+
 def save_model(model: Any, path: Path) -> None:
     """Save an SB3 model atomically (a kill mid-save leaves the previous file)."""
     with atomic_output(path, "wb") as handle:
         model.save(handle)
 
 
-class _Checkpoint(BaseCallback):
-    """Saves the model and the run's settings every ``every`` environment steps."""
+class _Sittings:
+    """The sittings of one training run: for each, the code that ran, the steps and the seconds.
+    A run resumed from a checkpoint keeps the sittings before it, so its record says how it was
+    made (and whether the code changed between sittings)."""
 
-    def __init__(self, every: int, model_file: Path, settings_file: Path, settings: dict[str, Any]) -> None:
+    def __init__(self, earlier: list[dict[str, Any]], first_step: int) -> None:
+        self.earlier, self.first_step, self.start = earlier, first_step, time.perf_counter()
+
+    def upto(self, step: int) -> list[dict[str, Any]]:
+        """Every sitting, this one up to ``step``."""
+        now = {"code": code_version(), "from_step": self.first_step, "to_step": step,
+               "seconds": round(time.perf_counter() - self.start, 1)}
+        return [*self.earlier, now]
+
+
+class _Checkpoint(BaseCallback):
+    """Saves the model, the run's settings and its sittings every ``every`` environment steps."""
+
+    def __init__(self, every: int, model_file: Path, settings_file: Path, settings: dict[str, Any],
+                 sittings: _Sittings) -> None:
         super().__init__()
         self.every, self.model_file, self.settings_file, self.settings = every, model_file, settings_file, settings
+        self.sittings = sittings
         self._last = 0
 
     def _on_training_start(self) -> None:
@@ -88,12 +113,13 @@ class _Checkpoint(BaseCallback):
         if self.model.num_timesteps - self._last >= self.every:
             self._last = self.model.num_timesteps
             save_model(self.model, self.model_file)
-            write_json_atomic(self.settings_file, {**self.settings, "timesteps_done": self._last})
+            write_json_atomic(self.settings_file, {**self.settings, "timesteps_done": self._last,
+                                                   "sittings": self.sittings.upto(self._last)})
         return True
 
 
-def _resumable(settings_file: Path, model_file: Path, settings: dict[str, Any]) -> int | None:
-    """Steps done by a checkpoint of a run with the same settings, else None."""
+def _resumable(settings_file: Path, model_file: Path, settings: dict[str, Any]) -> tuple[int, list] | None:
+    """Steps done and sittings so far of a checkpoint of a run with the same settings, else None."""
     try:
         saved = json.loads(settings_file.read_text())
     except (OSError, ValueError):
@@ -101,7 +127,10 @@ def _resumable(settings_file: Path, model_file: Path, settings: dict[str, Any]) 
     if not model_file.is_file() or not isinstance(saved, dict):
         return None
     done = saved.pop("timesteps_done", None)
-    return int(done) if saved == settings and isinstance(done, int) else None
+    sittings = saved.pop("sittings", [])
+    if saved != settings or not isinstance(done, int) or not isinstance(sittings, list):
+        return None
+    return done, sittings
 
 
 def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed: int = 0,
@@ -156,22 +185,29 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
     settings = {"dataset": str(getattr(dataset, "root", dataset)), "scenario": scenario, "crop": crop,
                 "seed": seed, "n_envs": n_envs, "arch": arch, "algorithm": "A2C"}
     env = make_vec_tvm(dataset, scenario, n_envs, seed, "train", crop, cache_dir)
-    done = _resumable(settings_file, model_file, settings)
-    if done is not None:
+    resumed = _resumable(settings_file, model_file, settings)
+    if resumed is not None:
+        done, earlier = resumed
         model = A2C.load(model_file, env=env, device=device)
         print(f"resuming {final.name} from its checkpoint at {done} of {total_timesteps} steps", flush=True)
     else:
         model = A2C("CnnPolicy", env, seed=seed, device=device, verbose=verbose,
                     policy_kwargs=dict(ARCHITECTURES[arch]))
-        done = 0
+        done, earlier = 0, []
+    sittings = _Sittings(earlier, done)
     callbacks = [c for c in (callback,) if c is not None]
     if checkpoint_every:
-        callbacks.append(_Checkpoint(checkpoint_every, model_file, settings_file, settings))
+        callbacks.append(_Checkpoint(checkpoint_every, model_file, settings_file, settings, sittings))
     if total_timesteps > done:
         model.learn(total_timesteps=total_timesteps - done, callback=callbacks or None,
                     reset_num_timesteps=done == 0)
     env.close()
     saved = write_or_rescue(final, lambda path: save_model(model, path), "the trained model")
+    record = sittings.upto(int(model.num_timesteps))
+    seconds = sum(s["seconds"] for s in record)
+    write_json_atomic(training_record_path(final), {
+        **settings, "timesteps": int(model.num_timesteps), "sittings": record, "seconds": round(seconds, 1),
+        "steps_per_second": round((int(model.num_timesteps) - record[0]["from_step"]) / max(seconds, 1e-9), 1)})
     model_file.unlink(missing_ok=True)
     settings_file.unlink(missing_ok=True)
     return saved

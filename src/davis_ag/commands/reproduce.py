@@ -19,8 +19,8 @@ from davis_ag.workflows.reproduce import (
     ReproduceConfig,
     load_state,
     reproduce,
-    write_results_md,
 )
+from davis_ag.workflows.results_page import write_results_md
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -32,7 +32,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--results", type=arguments.path, default="docs/results.md", metavar="MD",
                         help="Markdown results file (default: docs/results.md)")
     parser.add_argument("--config", choices=list(CONFIGS), default="small",
-                        help="small (43 min measured on 2 CPU cores, default) or paper-scale")
+                        help="small (43 min measured on 2 CPU cores, default; not comparable with Table 4), "
+                             "medium (the paper's grids and 300K A2C steps, hours) or paper-scale (days)")
     parser.add_argument("--sp-scenes", type=arguments.bounded(1, 1000), default=None,
                         help="override the SP scene count")
     parser.add_argument("--mp-scenes", type=arguments.bounded(1, 1000), default=None,

@@ -16,7 +16,7 @@ from typing import Callable
 
 import numpy as np
 
-from davis_ag import __version__
+from davis_ag.provenance import code_version
 from davis_ag.atomic_files import PROBE_PREFIX, prove_writable_folder
 from davis_ag.errors import UserError
 from davis_ag.generate.scene_writer import SceneWriter, partial_dir
@@ -215,7 +215,7 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict) -> dict:
 
     return {
         "format": SCENE_FORMAT,
-        "generator": {"name": "davis-ag", "version": __version__, "pyhelios3d": pyhelios.__version__,
+        "generator": {"name": "davis-ag", "version": code_version(), "pyhelios3d": pyhelios.__version__,
                       "python": platform.python_version()},
         "seed": request.seed,
         "dataset_seed": request.dataset_seed,

@@ -28,6 +28,7 @@ follows the EGL vendor library's choice (``__EGL_VENDOR_LIBRARY_FILENAMES``); se
 
 from __future__ import annotations
 
+import functools
 from importlib import resources
 
 import numpy as np
@@ -84,8 +85,9 @@ def _fragment(name: str, defines: tuple[str, ...] = ()) -> str:
     return "\n".join(lines)
 
 
-def _egl_current() -> tuple | None:
-    """The EGL context current on this thread (display, draw, read, context), or None."""
+@functools.cache
+def _egl_library():
+    """libEGL through ctypes, or None; looked up once (``find_library`` runs ``ldconfig``)."""
     import ctypes
     import ctypes.util
 
@@ -97,6 +99,14 @@ def _egl_current() -> tuple | None:
         getattr(egl, name).restype = ctypes.c_void_p
     egl.eglGetCurrentSurface.argtypes = [ctypes.c_int]
     egl.eglMakeCurrent.argtypes = [ctypes.c_void_p] * 4
+    return egl
+
+
+def _egl_current() -> tuple | None:
+    """The EGL context current on this thread (display, draw, read, context), or None."""
+    egl = _egl_library()
+    if egl is None:
+        return None
     display = egl.eglGetCurrentDisplay()
     if not display:
         return None
@@ -212,7 +222,8 @@ class OpenGLRenderer:
         vertex["mode"] = np.repeat(geometry.mode[order], 3)
         self._vbo = ctx.buffer(vertex.tobytes())
         self._triangle_uuids = geometry.uuids[order]
-        self._silhouette_vaos: dict[int, object] = {}
+        self._silhouette_groups: dict[int, tuple | None] = {}
+        self._positions = np.ascontiguousarray(vertex["position"]).reshape(-1, 3, 3)
         layout = "3f 2f 3f 4f 1u 1i 1i"
         names = ["in_position", "in_uv", "in_normal", "in_colour", "in_id", "in_texture", "in_mode"]
         self._scene = ctx.vertex_array(self._programs["scene"], [(self._vbo, layout, *names)], skip_errors=True)
@@ -410,7 +421,9 @@ class OpenGLRenderer:
     def silhouette_pixels(self, view: Viewpoint, key: int, uuids: np.ndarray) -> int:
         """Pixels whose centre some primitive of ``uuids`` covers with nothing else drawn: the area
         an object (a fruit) would have in the view if nothing hid it. One 1x raster of only its
-        triangles; the same rule the id image follows.
+        triangles, the same rule the id image follows, cleared, drawn and read back inside the
+        rectangle its vertices project to (a whole-frame clear and read-back cost ten times the
+        raster of a small fruit).
 
         Args:
             view: The pose.
@@ -422,31 +435,67 @@ class OpenGLRenderer:
         previous = _egl_current()
         try:
             with self.ctx:
-                vao = self._silhouette_vaos.get(key)
-                if vao is None:
-                    triangles = np.nonzero(np.isin(self._triangle_uuids, np.asarray(uuids, dtype=np.uint32)))[0]
-                    if not len(triangles):
-                        return 0
-                    indices = (triangles[:, None] * 3 + np.arange(3)).astype(np.uint32)
-                    vao = self.ctx.vertex_array(
-                        self._programs["ids"], [(self._vbo, "3f 2f 3f 4f 1u 1i 1i", "in_position", "in_uv", "in_normal",
-                                                 "in_colour", "in_id", "in_texture", "in_mode")],
-                        index_buffer=self.ctx.buffer(indices.tobytes()), index_element_size=4, skip_errors=True)
-                    self._silhouette_vaos[key] = vao
+                group = self._silhouette_groups.get(key)
+                if group is None:
+                    group = self._silhouette_group(uuids)
+                    self._silhouette_groups[key] = group
+                if group is None:
+                    return 0
+                vao, corners = group
+                rect = self._screen_rect(view, corners)
+                if rect is None:
+                    return 0
                 if not hasattr(self, "_silhouette_fbo"):
                     size = (self.camera.width, self.camera.height)
                     self._silhouette_fbo = self.ctx.framebuffer([self.ctx.renderbuffer(size, 1, dtype="u4")])
                 self._view_uniforms(view)
                 self._bind_textures()
-                self._silhouette_fbo.use()
-                self._silhouette_fbo.clear(0.0, 0.0, 0.0, 0.0)
+                fbo = self._silhouette_fbo
+                fbo.scissor = rect
+                fbo.use()
+                fbo.clear(0.0, 0.0, 0.0, 0.0, viewport=rect)
                 self.ctx.disable(moderngl.DEPTH_TEST)
                 vao.render(moderngl.TRIANGLES)
                 self.ctx.enable(moderngl.DEPTH_TEST)
-                ids = np.frombuffer(self._silhouette_fbo.read(components=1, dtype="u4"), dtype=np.uint32)
+                ids = np.frombuffer(fbo.read(viewport=rect, components=1, dtype="u4"), dtype=np.uint32)
+                fbo.scissor = None
                 return int(np.count_nonzero(ids))
         finally:
             _egl_restore(previous)
+
+    def _silhouette_group(self, uuids: np.ndarray) -> tuple | None:
+        """A vertex array of the triangles of ``uuids`` and their corners, or None if none is drawn."""
+        triangles = np.nonzero(np.isin(self._triangle_uuids, np.asarray(uuids, dtype=np.uint32)))[0]
+        if not len(triangles):
+            return None
+        indices = (triangles[:, None] * 3 + np.arange(3)).astype(np.uint32)
+        vao = self.ctx.vertex_array(
+            self._programs["ids"], [(self._vbo, "3f 2f 3f 4f 1u 1i 1i", "in_position", "in_uv", "in_normal",
+                                     "in_colour", "in_id", "in_texture", "in_mode")],
+            index_buffer=self.ctx.buffer(indices.tobytes()), index_element_size=4, skip_errors=True)
+        # The eight corners of the triangles' bounding box: their projection bounds the fruit's.
+        points = self._positions[triangles].reshape(-1, 3)
+        lo, hi = points.min(axis=0).astype(np.float64), points.max(axis=0).astype(np.float64)
+        corners = np.array([[x, y, z, 1.0] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+        return vao, corners
+
+    def _screen_rect(self, view: Viewpoint, corners: np.ndarray) -> tuple[int, int, int, int] | None:
+        """The framebuffer rectangle (x, y, width, height; y up) that holds every pixel centre a
+        shape inside the box of ``corners`` can cover; the whole frame where a corner lies behind
+        the eye (the near plane clips there); None where it misses the frame."""
+        width, height = self.camera.width, self.camera.height
+        view_matrix, projection = camera_matrices(self.camera, view)
+        clip = corners @ (projection.astype(np.float64) @ view_matrix.astype(np.float64)).T
+        if (clip[:, 3] <= 1e-6).any():
+            return (0, 0, width, height)
+        x = (clip[:, 0] / clip[:, 3] * 0.5 + 0.5) * width
+        y = (clip[:, 1] / clip[:, 3] * 0.5 + 0.5) * height
+        # One pixel of margin on each side absorbs the float32 rounding of the GPU's transform.
+        x0, x1 = max(int(np.floor(x.min())) - 1, 0), min(int(np.ceil(x.max())) + 1, width)
+        y0, y1 = max(int(np.floor(y.min())) - 1, 0), min(int(np.ceil(y.max())) + 1, height)
+        if x0 >= x1 or y0 >= y1:
+            return None
+        return (x0, y0, x1 - x0, y1 - y0)
 
     def close(self) -> None:
         """Release the GL context and everything in it."""

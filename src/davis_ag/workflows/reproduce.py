@@ -9,8 +9,6 @@ run cut short still leaves what it measured.
 from __future__ import annotations
 
 import json
-import os
-import platform
 import sys
 import time
 from dataclasses import asdict, dataclass, replace
@@ -25,7 +23,7 @@ class ReproduceConfig:
     """One reproduction's size.
 
     Attributes:
-        name: ``small`` or ``paper-scale``.
+        name: ``small``, ``medium`` or ``paper-scale``.
         size: Image width and height.
         sp_scenes, mp_scenes: SP strawberry and MP vine scenes.
         mp_extent: MP grid extent (x, y) in metres; ``None`` keeps Table 2's 7 x 3 m.
@@ -48,24 +46,21 @@ class ReproduceConfig:
     seed: int = 0
 
 
-#: ``small``: 43 min of stages measured on a 2-core CPU machine without GPU (docs/results.md).
+#: ``small``: 43 min of stages measured on a 2-core CPU machine without GPU (docs/results.md);
+#: a 3 x 2 m MP grid and 10 % / 5 % of the paper's A2C steps: not comparable with Table 4.
+#: ``medium``: the paper's grids (Table 2: 3 x 3 m SP, 7 x 3 m MP) and protocol (300K A2C steps,
+#: 3 sessions of 200 episodes) on 10 SP strawberry and 4 MP vine scenes at 640x360 (the policy
+#: sees 224x224 either way), a few hours on such a machine, resumable across sittings.
 #: ``paper-scale``: Table 3's scene counts at 1280x720 and 300K A2C steps (days on such a machine).
 CONFIGS: dict[str, ReproduceConfig] = {
     "small": ReproduceConfig("small", (640, 360), sp_scenes=3, mp_scenes=2, mp_extent=(3.0, 2.0),
                              sp_timesteps=30_000, mp_timesteps=15_000),
+    "medium": ReproduceConfig("medium", (640, 360), sp_scenes=10, mp_scenes=4, mp_extent=None,
+                              sp_timesteps=300_000, mp_timesteps=300_000),
     "paper-scale": ReproduceConfig("paper-scale", (1280, 720), sp_scenes=86, mp_scenes=44,
                                    mp_extent=None, sp_timesteps=300_000, mp_timesteps=300_000),
 }
 
-#: Table 4 of the paper: scenario -> metric -> policy -> value.
-PAPER_TABLE4: dict[str, dict[str, dict[str, float]]] = {
-    "sp": {"oer_tau": {"A2C": .520, "LRD": .433, "UDD": .371, "Rand": .438},
-           "reward": {"A2C": .052, "LRD": .026, "UDD": .008, "Rand": .027},
-           "length": {"A2C": 2.987, "LRD": 2.157, "UDD": 2.137, "Rand": 2.652}},
-    "mp": {"oer_tau": {"A2C": .369, "LRD": .316, "UDD": .313, "Rand": .340},
-           "reward": {"A2C": .020, "LRD": .006, "UDD": .004, "Rand": .012},
-           "length": {"A2C": 5.000, "LRD": 2.558, "UDD": 2.683, "Rand": 4.163}},
-}
 #: The scenario and crop pairs of Table 4.
 SCENARIO_CROPS: tuple[tuple[str, str], ...] = (("sp", "strawberry"), ("mp", "vine"))
 
@@ -97,7 +92,9 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
     from davis_ag.generate.one_scene import SceneRequest
     from davis_ag.scene.camera import Camera
     from davis_ag.scene.specs import crop_spec, scenario_spec
+    from davis_ag.provenance import code_version
     from davis_ag.workflows.demo import evaluation_split, generate_scenes, run_baselines
+    from davis_ag.workflows.results_page import write_results_md
 
     out = prove_writable_folder(out)  # absolute at once: Helios moves the working directory
     results_md = prove_writable_file(results_md, "--results")
@@ -112,7 +109,7 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
     state.setdefault("results", {})
 
     def record(stage: str, seconds: float, note: str = "") -> None:
-        state["stages"][stage] = {"seconds": round(seconds, 1), "note": note}
+        state["stages"][stage] = {"seconds": round(seconds, 1), "note": note, "code": code_version()}
         write_json_atomic(state_path, state, indent=2)
 
     camera = Camera(*config.size)
@@ -124,6 +121,7 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
         n = config.sp_scenes if scenario_name == "sp" else config.mp_scenes
         key = f"{scenario_name}-{crop_name}"
         requests = [SceneRequest(scenario, crop, i, config.seed, camera) for i in range(n)]
+        state.setdefault("scene_folders", {})[key] = [r.folder for r in requests]
         print(f"== {key}: {n} scene(s) at {config.size[0]}x{config.size[1]}", flush=True)
         generated = generate_scenes(requests, root)  # also writes splits.json
         # Per-scene times survive resumed runs, so the stage time covers every scene it used.
@@ -228,144 +226,3 @@ def _progress_callback(total: int, label: str) -> Any:
             self.bar.close()
 
     return Progress()
-
-
-def machine_description() -> str:
-    """CPU model, core count, memory and accelerator of this machine, one line."""
-    import torch
-
-    cpu = platform.processor() or platform.machine()
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    gpu = torch.cuda.get_device_name(0) if torch.cuda.is_available() else "no GPU"
-    return (f"{os.cpu_count()} CPU cores ({cpu}), {gpu}; Python {platform.python_version()}, "
-            f"torch {torch.__version__}, {platform.system()} {platform.release()}")
-
-
-def _cell(value: float | None) -> str:
-    if value is None:
-        return "–"
-    text = f"{value:.3f}"
-    return text[1:] if text.startswith("0.") else text
-
-
-def _notes(config: ReproduceConfig, state: dict[str, Any], out: Path | None) -> list[str]:
-    """Plain statements of where this run differs from the paper's, from what it measured."""
-    notes = []
-    for key, scenario in (("sp-strawberry", "sp"), ("mp-vine", "mp")):
-        stamp = load_state(out / "models" / f"a2c_{key}.json") if out else {}
-        steps, seconds = stamp.get("timesteps"), stamp.get("seconds")
-        if steps and seconds:
-            rate = steps / seconds
-            notes.append(f"A2C on {key} trained for {steps:,} environment steps, "
-                         f"{steps / 300_000:.1%} of the paper's 300K: {rate:.1f} steps/s with "
-                         f"the paper's network on this CPU (cache build included), so 300K would take about "
-                         f"{300_000 / rate / 3600:.1f} h per scenario here. The A2C column is "
-                         "therefore an under-trained agent, not the paper's.")
-        result = state.get("results", {}).get(scenario)
-        if result:
-            protocol = result["protocol"]
-            scenes = protocol.get("scenes", [])
-            if protocol["split"] == "all":
-                notes.append(f"{key}: only {len(scenes)} scene(s), so no test scene exists; the "
-                             "benchmark ran on split `all`, i.e. on the scene(s) A2C trained on "
-                             "(in-sample for A2C; the heuristics and the Oracle do not learn).")
-            else:
-                notes.append(f"{key}: evaluated on the test split, {len(scenes)} scene(s): "
-                             f"{', '.join(scenes)} (70/30 split by scene, seeded).")
-    for scenario, result in state.get("results", {}).items():
-        lengths = {n: p.get("length", {}).get("mean") for n, p in result["policies"].items()}
-        if lengths.get("LRD") is not None and lengths.get("LRD") == lengths.get("UDD"):
-            notes.append(f"{scenario.upper()}: LRD and UDD have the same episode lengths because every "
-                         "policy plays the same seeded episodes with the same agent seeds, and both "
-                         "draw `done` with probability 1/3 at each step (common random numbers).")
-    notes.append("Stage times are wall times; a resumed run keeps each scene's own time. Other "
-                 "work may share the machine, so rates (e.g. A2C steps/s) can vary between stages.")
-    notes.append("Oracle is not in the paper: it plays the best reachable final OER within tau "
-                 "steps from the environment's tables, an upper bound for any policy.")
-    notes.append("Episode starts follow section V-C: a boxed target with OER < 0.4 and at least the "
-                 "crop's pixel threshold; reward max(OER_end - OER_0, 0)^2 at the end.")
-    return notes
-
-
-def write_results_md(path: Path, config: ReproduceConfig, state: dict[str, Any],
-                     out: Path | None = None) -> Path:
-    """Write the Markdown results: our Table 4 beside the paper's, the setup and the timings.
-
-    Args:
-        path: The Markdown file.
-        config: The run's configuration.
-        state: ``results`` (per scenario) and ``stages`` (seconds and notes).
-        out: The work folder, for the training records (``models/*.json``).
-
-    Returns:
-        ``path``.
-    """
-    from davis_ag.atomic_files import write_text_atomic
-    from davis_ag.scene.specs import crop_spec, scenario_spec
-    from davis_ag.scene.view_grid import views_per_scene
-
-    titles = {"sp": "SP strawberry", "mp": "MP vine"}
-    strawberry = crop_spec("strawberry")
-    sp_views = views_per_scene(scenario_spec("sp", strawberry), strawberry)
-    mp_grid = (f"{config.mp_extent[0]:g} x {config.mp_extent[1]:g} m around the middle vine"
-               if config.mp_extent else "Table 2's 7 x 3 m")
-    lines = [
-        "# Table 4 reproduction",
-        "",
-        "Written by `davis-ag reproduce` (`make reproduce`). Every number in the *ours* columns "
-        "was measured by the run described here; the *paper* columns are Table 4 of the paper.",
-        "",
-        f"- **Configuration** `{config.name}`: {config.sp_scenes} SP strawberry scene(s) (Table 3's "
-        f"grid, {sp_views} views each) and {config.mp_scenes} MP vine scene(s) (grid {mp_grid}, 0.5 m "
-        f"step, 12 headings, 2 altitudes) at {config.size[0]}x{config.size[1]}, dataset seed "
-        f"{config.seed}; box thresholds scaled by image area; A2C (SB3 defaults, the paper's "
-        f"network of section V-B, {config.n_envs} environments) for {config.sp_timesteps:,} (SP) and "
-        f"{config.mp_timesteps:,} (MP) environment steps; evaluation {config.sessions} sessions x "
-        f"{config.episodes} episodes, seed {config.seed}, A2C deterministic.",
-        "- **Paper**: 86 SP strawberry and 44 MP vine scenes at 1280x720 (Table 3), A2C for 300K "
-        "steps, 3 sessions x 200 episodes on the test split.",
-        f"- **Machine**: {machine_description()}.",
-        "",
-    ]
-    for scenario in ("sp", "mp"):
-        lines.append(f"## {titles[scenario]}")
-        lines.append("")
-        result = state.get("results", {}).get(scenario)
-        if not result:
-            lines += ["Not run (yet): the run stopped before this benchmark.", ""]
-            continue
-        protocol, policies = result["protocol"], result["policies"]
-        lines.append(f"Split `{protocol['split']}` ({len(protocol.get('scenes', []))} scene(s)), "
-                     f"tau = {protocol['tau']}; ours: mean ± std over {protocol['sessions']} "
-                     f"sessions of {protocol['episodes']} episodes.")
-        lines.append("")
-        lines.append("| Policy | OER_tau ours | OER_tau paper | Cum. reward ours | Cum. reward paper "
-                     "| Ep. length ours | Ep. length paper |")
-        lines.append("|---|---|---|---|---|---|---|")
-        for name in ("A2C", "LRD", "UDD", "Rand", "Oracle"):
-            if name not in policies:
-                continue
-            cells = [name]
-            for metric in ("oer_tau", "reward", "length"):
-                stat = policies[name][metric]
-                cells.append(f"{_cell(stat['mean'])} ± {_cell(stat['std'])}")
-                cells.append(_cell(PAPER_TABLE4[scenario][metric].get(name)))
-            lines.append("| " + " | ".join(cells) + " |")
-        if "oer_0" in policies.get("LRD", {}):
-            lines += ["", f"Mean start OER (OER_0) of these episodes: "
-                          f"{_cell(policies['LRD']['oer_0']['mean'])}."]
-        lines.append("")
-    lines += ["## Notes", ""] + [f"- {note}" for note in _notes(config, state, out)] + [""]
-    lines += ["## Wall time per stage", "", "| Stage | Seconds | Note |", "|---|---|---|"]
-    total = 0.0
-    for stage, entry in state.get("stages", {}).items():
-        total += entry["seconds"]
-        lines.append(f"| {stage} | {entry['seconds']:.0f} | {entry['note']} |")
-    lines += [f"| total | {total:.0f} | |", ""]
-    return write_text_atomic(path, "\n".join(lines) + "\n")

@@ -1,0 +1,291 @@
+"""``docs/results.md`` of a ``davis-ag reproduce`` run, written wholly from the run's own records.
+
+What it reads: the run's ``state.json`` (configuration, stage times, evaluation summaries), each
+scene's ``scene.json`` (the code version, renderer and image size that made it), each model's
+``NAME.training.json`` (the sittings a training run took, with their code versions) and this
+machine. Nothing in the file is typed by hand, so a re-run rewrites all of it, and a run resumed
+across code changes says so itself.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import platform
+from collections import Counter
+from pathlib import Path
+from typing import Any
+
+#: Table 4 of the paper: scenario -> metric -> policy -> value.
+PAPER_TABLE4: dict[str, dict[str, dict[str, float]]] = {
+    "sp": {"oer_tau": {"A2C": .520, "LRD": .433, "UDD": .371, "Rand": .438},
+           "reward": {"A2C": .052, "LRD": .026, "UDD": .008, "Rand": .027},
+           "length": {"A2C": 2.987, "LRD": 2.157, "UDD": 2.137, "Rand": 2.652}},
+    "mp": {"oer_tau": {"A2C": .369, "LRD": .316, "UDD": .313, "Rand": .340},
+           "reward": {"A2C": .020, "LRD": .006, "UDD": .004, "Rand": .012},
+           "length": {"A2C": 5.000, "LRD": 2.558, "UDD": 2.683, "Rand": 4.163}},
+}
+#: Table 4's standard deviations (over its three sets of 200 episodes), in the same layout.
+PAPER_TABLE4_STD: dict[str, dict[str, dict[str, float]]] = {
+    "sp": {"oer_tau": {"A2C": .004, "LRD": .007, "UDD": .008, "Rand": .101},
+           "reward": {"A2C": .001, "LRD": .002, "UDD": .002, "Rand": .002},
+           "length": {"A2C": .008, "LRD": .043, "UDD": .036, "Rand": .056}},
+    "mp": {"oer_tau": {"A2C": .009, "LRD": .008, "UDD": .006, "Rand": .002},
+           "reward": {"A2C": .003, "LRD": .002, "UDD": .001, "Rand": .002},
+           "length": {"A2C": .000, "LRD": .097, "UDD": .118, "Rand": .058}},
+}
+#: The orderings of OER_tau that section VI reads from Table 4: each step is ``>`` (better) or
+#: ``~`` (about equal), left to right.
+PAPER_ORDERINGS: dict[str, tuple[str, ...]] = {
+    "sp": ("A2C", ">", "Rand", "~", "LRD", ">", "UDD"),
+    "mp": ("A2C", ">", "Rand", ">", "LRD", "~", "UDD"),
+}
+#: The 300K environment steps of A2C training in section VI.
+PAPER_TIMESTEPS = 300_000
+TITLES = {"sp": "SP strawberry", "mp": "MP vine"}
+GROUPS = {"sp": "sp-strawberry", "mp": "mp-vine"}
+
+
+def machine_description() -> str:
+    """CPU model, core count and accelerator of this machine, with Python's and torch's versions."""
+    import torch
+
+    cpu = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    gpu = torch.cuda.get_device_name(0) if torch.cuda.is_available() else "no GPU"
+    return (f"{os.cpu_count()} CPU cores ({cpu}), {gpu}; Python {platform.python_version()}, "
+            f"torch {torch.__version__}, {platform.system()} {platform.release()}")
+
+
+def ordering_holds(order: tuple[str, ...], policies: dict[str, dict[str, Any]],
+                   metric: str = "oer_tau") -> bool | None:
+    """Whether an ordering such as ``A2C > Rand ~ LRD > UDD`` holds for measured means and stds.
+
+    ``a > b`` holds when a's mean exceeds b's; ``a ~ b`` when the means differ by no more than the
+    two standard deviations (over sessions) added.
+
+    Returns:
+        True or False; None when a policy in the ordering was not measured.
+    """
+    try:
+        stats = {name: policies[name][metric] for name in order[::2]}
+    except KeyError:
+        return None
+    for left, relation, right in zip(order[0::2], order[1::2], order[2::2]):
+        a, b = stats[left], stats[right]
+        if relation == ">" and not a["mean"] > b["mean"]:
+            return False
+        if relation == "~" and abs(a["mean"] - b["mean"]) > a["std"] + b["std"]:
+            return False
+    return True
+
+
+def _cell(value: float | None) -> str:
+    if value is None:
+        return "–"
+    text = f"{value:.3f}"
+    return text[1:] if text.startswith("0.") else text
+
+
+def _load(path: Path) -> dict[str, Any]:
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return {}
+    return data if isinstance(data, dict) else {}
+
+
+def _counted(counter: Counter) -> str:
+    return "; ".join(f"{value} ({n} scene{'s' if n > 1 else ''})" for value, n in counter.most_common())
+
+
+def scene_provenance(dataset: Path, scenes: list[str]) -> list[str]:
+    """One line per fact about how a group's scenes were made, from their scene.json files."""
+    versions, renderers, sizes = Counter(), Counter(), Counter()
+    for scene in scenes:
+        meta = _load(dataset / scene / "scene.json")
+        versions[meta.get("generator", {}).get("version", "unrecorded")] += 1
+        renderer = meta.get("renderer", {})
+        renderers[f"{renderer.get('name', '?')} renderer, {renderer.get('look', '?')} look, antialiasing: "
+                  f"{renderer.get('antialiasing', '?')}"] += 1
+        camera = meta.get("camera", {})
+        sizes[f"{camera.get('width', '?')}x{camera.get('height', '?')}"] += 1
+    lines = [f"code: {_counted(versions)}"
+             + (" — made by more than one version of the code" if len(versions) > 1 else ""),
+             f"drawn with the {_counted(renderers)}", f"image size {_counted(sizes)}"]
+    return lines
+
+
+def training_provenance(record: dict[str, Any]) -> str:
+    """A sentence on how a model was trained: steps, sittings, the code of each, steps per second."""
+    sittings = record.get("sittings", [])
+    codes = Counter(s.get("code", "unrecorded") for s in sittings)
+    text = (f"{record.get('timesteps', 0):,} steps in {len(sittings)} sitting(s), "
+            f"{record.get('seconds', 0) / 3600:.2f} h, {record.get('steps_per_second', 0):.1f} steps/s; "
+            f"network `{record.get('arch', '?')}`, {record.get('n_envs', '?')} environments, code "
+            + ", ".join(codes))
+    if len(codes) > 1:
+        text += " — the code changed between sittings"
+    return text
+
+
+def _notes(config: Any, state: dict[str, Any], out: Path | None) -> list[str]:
+    """Plain statements of where this run differs from the paper's, from what it measured."""
+    from davis_ag.benchmark.training import training_record_path
+
+    notes = []
+    for scenario, key in GROUPS.items():
+        record = _load(training_record_path(out / "models" / f"a2c_{key}.zip")) if out else {}
+        steps, rate = record.get("timesteps"), record.get("steps_per_second")
+        if steps and rate and steps < PAPER_TIMESTEPS:
+            notes.append(f"A2C on {key} trained for {steps:,} environment steps, {steps / PAPER_TIMESTEPS:.1%} of "
+                         f"the paper's 300K, at {rate:.1f} steps/s on this machine: the A2C column is an "
+                         "under-trained agent, not the paper's.")
+        result = state.get("results", {}).get(scenario)
+        if result:
+            protocol = result["protocol"]
+            scenes = protocol.get("scenes", [])
+            if protocol["split"] == "all":
+                notes.append(f"{key}: only {len(scenes)} scene(s), so no test scene exists; the "
+                             "benchmark ran on split `all`, i.e. on the scene(s) A2C trained on "
+                             "(in-sample for A2C; the heuristics and the Oracle do not learn).")
+            else:
+                notes.append(f"{key}: evaluated on the test split, {len(scenes)} scene(s): "
+                             f"{', '.join(scenes)} (70/30 split by scene, seeded).")
+    for scenario, result in state.get("results", {}).items():
+        lengths = {n: p.get("length", {}).get("mean") for n, p in result["policies"].items()}
+        if lengths.get("LRD") is not None and lengths.get("LRD") == lengths.get("UDD"):
+            notes.append(f"{scenario.upper()}: LRD and UDD have the same episode lengths because every "
+                         "policy plays the same seeded episodes with the same agent seeds, and both "
+                         "draw `done` with probability 1/3 at each step (common random numbers).")
+    notes.append("Stage times are wall times; a resumed run keeps each scene's own time. Other "
+                 "work may share the machine, so rates (e.g. A2C steps/s) can vary between stages.")
+    notes.append("Oracle is not in the paper: it plays the best reachable final OER within tau "
+                 "steps from the environment's tables, an upper bound for any policy.")
+    notes.append("Episode starts follow section V-C: a boxed target with OER < 0.4 and at least the "
+                 "crop's pixel threshold; reward max(OER_end - OER_0, 0)^2 at the end.")
+    return notes
+
+
+def _how_made(state: dict[str, Any], out: Path | None) -> list[str]:
+    """The "How this run was made" section, from scene.json files, training records and stages."""
+    from davis_ag.benchmark.training import training_record_path
+
+    lines = ["## How this run was made", ""]
+    if out is None:
+        return lines + ["No work folder was given, so the run's records were not read.", ""]
+    for scenario, key in GROUPS.items():
+        scenes = state.get("scene_folders", {}).get(key, [])
+        if not scenes:
+            continue
+        lines.append(f"- **{key}**, {len(scenes)} scene(s):")
+        lines += [f"  - {line}" for line in scene_provenance(out / "dataset", scenes)]
+        record = _load(training_record_path(out / "models" / f"a2c_{key}.zip"))
+        if record:
+            lines.append(f"  - A2C: {training_provenance(record)}")
+    stage_codes = Counter(entry.get("code", "unrecorded") for entry in state.get("stages", {}).values())
+    if stage_codes:
+        lines.append(f"- Stages run by code {', '.join(stage_codes)}"
+                     + (" (more than one version)" if len(stage_codes) > 1 else "") + ".")
+    return lines + [""]
+
+
+def _comparison(scenario: str, policies: dict[str, dict[str, Any]]) -> str:
+    order = PAPER_ORDERINGS[scenario]
+    paper = {name: {"mean": value, "std": PAPER_TABLE4_STD[scenario]["oer_tau"][name]}
+             for name, value in PAPER_TABLE4[scenario]["oer_tau"].items()}
+    holds = ordering_holds(order, policies)
+    text = " ".join(order)
+    if holds is None:
+        return f"The paper's ordering of OER_tau, {text}, cannot be checked: a policy was not run."
+    measured = ", ".join(f"{name} {_cell(policies[name]['oer_tau']['mean'])} ± {_cell(policies[name]['oer_tau']['std'])}"
+                         for name in order[::2])
+    verdict = "holds" if holds else "does not hold"
+    paper_note = "" if ordering_holds(order, paper) else " (nor does it hold in Table 4's own numbers)"
+    return (f"The paper's ordering of OER_tau, {text} (`>`: higher mean; `~`: means within the two standard "
+            f"deviations added), **{verdict}** in this run{paper_note}: {measured}.")
+
+
+def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path | None = None) -> Path:
+    """Write the Markdown results: our Table 4 beside the paper's, how the run was made, the timings.
+
+    Args:
+        path: The Markdown file.
+        config: The run's :class:`~davis_ag.workflows.reproduce.ReproduceConfig`.
+        state: The run's ``state.json``: ``results`` (per scenario), ``stages`` (seconds, notes,
+            code) and ``scene_folders`` (per group).
+        out: The work folder, for the scene and training records.
+
+    Returns:
+        ``path``.
+    """
+    from davis_ag.atomic_files import write_text_atomic
+    from davis_ag.scene.specs import crop_spec, scenario_spec
+    from davis_ag.scene.view_grid import views_per_scene
+
+    strawberry, vine = crop_spec("strawberry"), crop_spec("vine")
+    sp_views = views_per_scene(scenario_spec("sp", strawberry), strawberry)
+    mp_views = views_per_scene(scenario_spec("mp", vine), vine)
+    mp_grid = (f"{config.mp_extent[0]:g} x {config.mp_extent[1]:g} m around the middle vine"
+               if config.mp_extent else f"Table 2's 7 x 3 m, {mp_views} views each")
+    lines = [
+        "# Table 4 reproduction",
+        "",
+        "Written by `davis-ag reproduce` from the run's own records; do not edit by hand. Every number in "
+        "the *ours* columns was measured by the run described here; the *paper* columns are Table 4 of "
+        "the paper.",
+        "",
+        f"- **Configuration** `{config.name}`: {config.sp_scenes} SP strawberry scene(s) (Table 2's "
+        f"grid, {sp_views} views each) and {config.mp_scenes} MP vine scene(s) (grid {mp_grid}, 0.5 m "
+        f"step, 12 headings, 2 altitudes) at {config.size[0]}x{config.size[1]}, dataset seed "
+        f"{config.seed}; box thresholds scaled by image area; A2C (SB3 defaults, the paper's "
+        f"network of section V-B, {config.n_envs} environments) for {config.sp_timesteps:,} (SP) and "
+        f"{config.mp_timesteps:,} (MP) environment steps; evaluation {config.sessions} sessions x "
+        f"{config.episodes} episodes, seed {config.seed}, A2C deterministic.",
+        "- **Paper**: 86 SP strawberry and 44 MP vine scenes at 1280x720 (Table 3), A2C for 300K "
+        "steps, 3 sessions x 200 episodes on the test split.",
+        f"- **Machine**: {machine_description()}.",
+        "",
+    ]
+    for scenario in ("sp", "mp"):
+        lines += [f"## {TITLES[scenario]}", ""]
+        result = state.get("results", {}).get(scenario)
+        if not result:
+            lines += ["Not run (yet): the run stopped before this benchmark.", ""]
+            continue
+        protocol, policies = result["protocol"], result["policies"]
+        lines += [f"Split `{protocol['split']}` ({len(protocol.get('scenes', []))} scene(s)), "
+                  f"tau = {protocol['tau']}; ours: mean ± std over {protocol['sessions']} "
+                  f"sessions of {protocol['episodes']} episodes.", "",
+                  "| Policy | OER_tau ours | OER_tau paper | Cum. reward ours | Cum. reward paper "
+                  "| Ep. length ours | Ep. length paper |", "|---|---|---|---|---|---|---|"]
+        for name in ("A2C", "LRD", "UDD", "Rand", "Oracle"):
+            if name not in policies:
+                continue
+            cells = [name]
+            for metric in ("oer_tau", "reward", "length"):
+                stat = policies[name][metric]
+                cells.append(f"{_cell(stat['mean'])} ± {_cell(stat['std'])}")
+                paper_mean = PAPER_TABLE4[scenario][metric].get(name)
+                cells.append(_cell(paper_mean) if paper_mean is None
+                             else f"{_cell(paper_mean)} ± {_cell(PAPER_TABLE4_STD[scenario][metric][name])}")
+            lines.append("| " + " | ".join(cells) + " |")
+        lines += ["", _comparison(scenario, policies)]
+        if "oer_0" in policies.get("LRD", {}):
+            lines += ["", f"Mean start OER (OER_0) of these episodes: {_cell(policies['LRD']['oer_0']['mean'])}."]
+        lines.append("")
+    lines += ["## Notes", ""] + [f"- {note}" for note in _notes(config, state, out)] + [""]
+    lines += _how_made(state, out)
+    lines += ["## Wall time per stage", "", "| Stage | Seconds | Note |", "|---|---|---|"]
+    total = 0.0
+    for stage, entry in state.get("stages", {}).items():
+        total += entry["seconds"]
+        lines.append(f"| {stage} | {entry['seconds']:.0f} | {entry['note']} |")
+    lines += [f"| total | {total:.0f} | |", ""]
+    return write_text_atomic(path, "\n".join(lines) + "\n")

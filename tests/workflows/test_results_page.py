@@ -1,0 +1,73 @@
+"""docs/results.md is written from the run's records: the orderings, the scenes' code, the sittings."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from davis_ag.workflows.reproduce import CONFIGS
+from davis_ag.workflows.results_page import (
+    PAPER_ORDERINGS,
+    PAPER_TABLE4,
+    PAPER_TABLE4_STD,
+    ordering_holds,
+    write_results_md,
+)
+
+
+def paper_stats(scenario: str) -> dict:
+    return {name: {"oer_tau": {"mean": mean, "std": PAPER_TABLE4_STD[scenario]["oer_tau"][name]}}
+            for name, mean in PAPER_TABLE4[scenario]["oer_tau"].items()}
+
+
+@pytest.mark.parametrize("scenario", ["sp", "mp"])
+def test_table_4_meets_the_orderings_section_vi_reads_from_it(scenario: str) -> None:
+    # Table 4: SP .520 (A2C) > .438 ± .101 (Rand) ~ .433 ± .007 (LRD) > .371 (UDD);
+    # MP .369 > .340 (Rand) > .316 ± .008 (LRD) ~ .313 ± .006 (UDD).
+    assert ordering_holds(PAPER_ORDERINGS[scenario], paper_stats(scenario)) is True
+
+
+def test_an_ordering_fails_where_a_step_is_reversed_or_apart() -> None:
+    stats = paper_stats("sp")
+    stats["A2C"]["oer_tau"]["mean"] = 0.40  # below Rand
+    assert ordering_holds(PAPER_ORDERINGS["sp"], stats) is False
+    stats = paper_stats("mp")
+    stats["UDD"]["oer_tau"]["mean"] = 0.2  # LRD ~ UDD no longer: .116 apart, stds .014
+    assert ordering_holds(PAPER_ORDERINGS["mp"], stats) is False
+    del stats["A2C"]
+    assert ordering_holds(PAPER_ORDERINGS["mp"], stats) is None
+
+
+def write_scene(root: Path, folder: str, version: str) -> None:
+    scene = root / "dataset" / folder
+    scene.mkdir(parents=True)
+    meta = {"generator": {"version": version}, "camera": {"width": 640, "height": 360},
+            "renderer": {"name": "opengl", "look": "default", "antialiasing": "4x multisampled colour"}}
+    (scene / "scene.json").write_text(json.dumps(meta))
+
+
+def test_a_run_resumed_across_code_changes_says_so(tmp_path: Path) -> None:
+    folders = ["Single-Strawberry/000", "Single-Strawberry/001"]
+    write_scene(tmp_path, folders[0], "0.1.0+aaaa")
+    write_scene(tmp_path, folders[1], "0.1.0+bbbb")
+    (tmp_path / "models").mkdir()
+    record = {"timesteps": 300_000, "seconds": 7200.0, "steps_per_second": 41.7, "arch": "paper", "n_envs": 8,
+              "sittings": [{"code": "0.1.0+aaaa", "from_step": 0, "to_step": 120_000, "seconds": 3000.0},
+                           {"code": "0.1.0+bbbb", "from_step": 120_000, "to_step": 300_000, "seconds": 4200.0}]}
+    (tmp_path / "models" / "a2c_sp-strawberry.training.json").write_text(json.dumps(record))
+    stat = {"mean": 0.5, "std": 0.01}
+    state = {"scene_folders": {"sp-strawberry": folders},
+             "results": {"sp": {"protocol": {"split": "test", "tau": 3, "sessions": 3, "episodes": 200,
+                                             "scenes": folders[1:]},
+                                "policies": {name: {"oer_tau": dict(stat, mean=m), "reward": stat, "length": stat}
+                                             for name, m in (("A2C", .6), ("Rand", .45), ("LRD", .44),
+                                                             ("UDD", .3))}}},
+             "stages": {"sp-strawberry: generate": {"seconds": 12.0, "note": "2 scenes", "code": "0.1.0+aaaa"}}}
+    text = write_results_md(tmp_path / "results.md", CONFIGS["medium"], state, tmp_path).read_text()
+    assert "0.1.0+aaaa (1 scene); 0.1.0+bbbb (1 scene) — made by more than one version of the code" in text
+    assert "300,000 steps in 2 sitting(s)" in text and "the code changed between sittings" in text
+    assert "**holds** in this run" in text  # .6 > .45 ~ .44 > .3
+    assert "under-trained" not in text  # 300K steps: the paper's count
+    assert "do not edit by hand" in text and "How this run was made" in text
