@@ -17,7 +17,8 @@ import gymnasium as gym
 import numpy as np
 
 from davis_ag.atomic_files import atomic_output, prove_writable_file, write_or_rescue
-from davis_ag.benchmark.training import ARCHITECTURES, model_path, save_model
+from davis_ag.benchmark.networks import ARCHITECTURES
+from davis_ag.benchmark.training import model_path, save_model
 from davis_ag.errors import UserError
 
 
