@@ -104,7 +104,7 @@ def pools_for(command: str, out: str) -> tuple[list[str], dict[str, st.SearchStr
                  "--sessions", "1"]
         return first, {"--dataset": ANY, "--scenario": ANY, "--crop": ANY, "--split": ANY,
                        "--model": st.sampled_from(["missing.zip", "a-file", "data", f"{out}/none.zip"]),
-                       "--policies": ANY, "--stochastic": FLAG, "--episodes": small, "--sessions": small,
+                       "--policies": ANY, "--stochastic": FLAG, "--env": st.sampled_from(["grid", "continuous", "x"]), "--episodes": small, "--sessions": small,
                        "--seed": ANY, "--cache-dir": cache, "--out": out_or_bad,
                        "--plot": st.sampled_from([f"{out}/p.png", "/proc/x/p.png", "data", f"{out}/r.json"])}, []
     if command == "validate":

@@ -24,6 +24,7 @@ STAGES: tuple[tuple[str, ...], ...] = (
     ("generate",),
     ("data",),
     ("benchmark",),
+    ("live",),  # regrows and renders: after the benchmark, which knows nothing of Helios
     ("detection",),
     ("figures",),
     ("workflows",),

@@ -14,7 +14,9 @@ For each crop (a single-plant strawberry and a single goblet vine, dataset seed 
   ``writeImageBoundingBoxes`` and ``writeImageSegmentationMasks``, fruit labelled with object data;
 - floor: our renderer's draw and read-back alone (colour, ids, depth), nothing else.
 
-Per path the median over repetitions of the mean seconds per view is reported. Then the hours the
+Per path the median over repetitions of the mean seconds per view is reported. With strawberry,
+also the grid environment's steps/s and TVMContinuous-v0's at 224x224 (``--only continuous``
+measures only the latter, in about a minute). Then the hours the
 ``paper`` preset would take on one machine like this one and on a Ray cluster of such machines.
 With ``--doc docs/performance.md`` the tables are written into that file between its
 ``<!-- bench:start -->`` and ``<!-- bench:end -->`` markers.
@@ -195,6 +197,100 @@ def env_speed(dataset: Path, steps: int = 20_000) -> dict:
     return {"steps_per_second": round(rate), "steps": steps, "target_min": 5000}
 
 
+#: TVMContinuous-v0's rate target at 224x224 on this 2-core machine (issue 14).
+CONTINUOUS_TARGET = 50.0
+
+
+def continuous_scene(root: Path) -> Path:
+    """A single-plant strawberry scene (seed 0, scene 0, the crop's full grid area) with one view
+    drawn and its geometry cached from the growth, so that reopening it live grows nothing."""
+    from davis_ag.live.reopen import CACHE_FILE, assets_from_model, read_settings, save_cache
+    from davis_ag.scene.specs import scenario_spec
+
+    crop = CROPS["strawberry"]
+    request = SceneRequest(scenario_spec("sp", crop), crop, 0, SEED, Camera(320, 180))
+    model, grid = grow_scene(request)
+    scene_dir, _ = draw_scene(request, model, grid, root / "continuous", views=list(grid.viewpoints[:1]))
+    save_cache(scene_dir / CACHE_FILE, read_settings(scene_dir).cache_key, assets_from_model(model, grid))
+    return scene_dir
+
+
+def continuous_env_speed(scratch: Path, steps: int = 600) -> dict:
+    """Steps per second of TVMContinuous-v0 at 224x224 on a single-plant strawberry scene (the
+    crop's full grid area; one view drawn, the geometry cached from the growth, so nothing
+    regrows), random actions, resets included; and the time one 224x224 render takes."""
+    from davis_ag.live.scene import merge_ground
+    from davis_ag.live.tvm_continuous import TVMContinuousEnv, steps_per_second
+
+    scene_dir = continuous_scene(scratch)
+    started = time.perf_counter()
+    env = TVMContinuousEnv(scene_dir, "sp")
+    env.reset(seed=SEED)  # the renderer's set-up (textures, shadow map) is paid here
+    setup_s = time.perf_counter() - started
+    try:
+        view = env.scene.aimed_pose(1.0, -1.0, 0.4)
+        env.scene.render(view, 224, 224, antialiasing="none", fractions=False, fast_ground=True)
+        begun = time.perf_counter()
+        for _ in range(50):
+            env.scene.render(view, 224, 224, antialiasing="none", fractions=False, fast_ground=True)
+        render_ms = (time.perf_counter() - begun) / 50 * 1000
+        rate = steps_per_second(env, steps, seed=SEED)
+    finally:
+        env.close()
+    return {"steps_per_second": round(rate["steps_per_second"], 1), "cpu_ms_per_step": round(rate["cpu_ms_per_step"], 1),
+            "steps": steps, "resets": rate["resets"],
+            "refused_share": round(rate["refused"], 3), "render_and_label_ms": round(render_ms, 1),
+            "open_and_first_reset_s": round(setup_s, 2), "target_min": CONTINUOUS_TARGET,
+            "triangles": int(env.scenes[0].assets.geometry.triangle_count),
+            "triangles_drawn": int(merge_ground(env.scenes[0].assets.geometry).triangle_count)}
+
+
+def continuous_table(result: dict, load: tuple[float, float]) -> str:
+    """The TVMContinuous-v0 rate as Markdown."""
+    met = "meets" if result["steps_per_second"] >= result["target_min"] else "misses"
+    return (f"224x224 observations, single-plant strawberry (seed {SEED}, scene 0, {result['triangles']:,} triangles, "
+            f"{result['triangles_drawn']:,} with the soil merged), "
+            f"uniformly random actions, resets included; load average {load[0]:.2f} at the start, "
+            f"{load[1]:.2f} at the end, {os.cpu_count()} CPUs.\n\n"
+            "| steps timed | resets | refused moves | render + labels, ms | open + first reset, s | CPU ms/step | "
+            "steps/s | target |\n"
+            "|---|---|---|---|---|---|---|---|\n"
+            f"| {result['steps']} | {result['resets']} | {result['refused_share']:.0%} | "
+            f"{result['render_and_label_ms']} | {result['open_and_first_reset_s']} | {result['cpu_ms_per_step']} | "
+            f"**{result['steps_per_second']}** | >= {result['target_min']:.0f} ({met}) |")
+
+
+def continuous_line(result: dict) -> str:
+    """The rate in one sentence, for the README."""
+    return (f"Measured by `make bench` on this 2-core machine (shared, load average in docs/performance.md): "
+            f"**{result['steps_per_second']} steps/s** at 224x224 with random actions, resets included "
+            f"({result['render_and_label_ms']} ms to draw and label a view, {result['cpu_ms_per_step']} ms of CPU "
+            f"per step; target >= {result['target_min']:.0f}).")
+
+
+def write_continuous(result: dict, load: tuple[float, float], doc: Path | None) -> None:
+    """Write the TVMContinuous-v0 rate into the doc and, beside its folder, the README."""
+    if doc:
+        write_section(doc, "bench-continuous", continuous_table(result, load))
+        readme = doc.absolute().parent.parent / "README.md"
+        if readme.is_file() and "<!-- continuous-rate:start -->" in readme.read_text():
+            write_section(readme, "continuous-rate", continuous_line(result))
+
+
+def run_continuous(out: Path, doc: Path | None) -> dict:
+    """Only the TVMContinuous-v0 measurement (``--only continuous``): JSON, the doc's section and
+    the README's line."""
+    start = os.getloadavg()[0]
+    with tempfile.TemporaryDirectory(prefix="davis-ag-bench-") as scratch:
+        result = continuous_env_speed(Path(scratch))
+    load = (start, os.getloadavg()[0])
+    print(continuous_table(result, load))
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(json.dumps({"continuous_env": result}, indent=1) + "\n")
+    write_continuous(result, load, doc)
+    return result
+
+
 def run(out: Path, crops: list[str], repeats: int, antialiasing: str = "fxaa") -> dict:
     """Run every measurement; return the JSON report."""
     load_start = os.getloadavg()
@@ -216,6 +312,7 @@ def run(out: Path, crops: list[str], repeats: int, antialiasing: str = "fxaa") -
             grow[crop] = result["grow_s"]
         if "strawberry" in crops:
             report["env_steps_per_second"] = env_speed(Path(scratch) / "strawberry-ours-0")
+            report["continuous_env"] = continuous_env_speed(Path(scratch))
     for name in CROPS:  # a crop not measured this time: assume the slowest one measured
         for measured in (per_view, overhead, floor, grow):
             measured.setdefault(name, max(measured.values()))
@@ -289,7 +386,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--antialiasing", choices=("fxaa", "msaa", "none"), default="fxaa",
                         help="our renderer's colour samples per pixel (default 4)")
     parser.add_argument("--doc", type=Path, help="write the tables into this Markdown file's bench section")
+    parser.add_argument("--only", choices=("all", "continuous"), default="all",
+                        help="continuous: only TVMContinuous-v0's steps/s (about a minute)")
     args = parser.parse_args(argv)
+    if args.only == "continuous":
+        run_continuous(args.out, args.doc)
+        print(f"written {args.out}" + (f" and {args.doc}" if args.doc else ""))
+        return 0
     crops = [c for c in args.crops.split(",") if c]
     for name in crops:
         if name not in CROPS:
@@ -301,6 +404,9 @@ def main(argv: list[str] | None = None) -> int:
     print(text)
     if args.doc:
         write_section(args.doc, "bench", text)
+        if "continuous_env" in report:
+            load = report["machine"]["load_average"]
+            write_continuous(report["continuous_env"], (load["start"][0], load["end"][0]), args.doc)
         print(f"written {args.doc}")
     print(f"written {args.out}")
     return 0

@@ -121,7 +121,7 @@ def test_commands(sp_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture[s
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["--policies", "LRD,Greedy"], "unknown name 'Greedy'"),  # refused as parsed
+    (["--policies", "LRD,Bogus"], "unknown name 'Bogus'"),  # refused as parsed
     (["--episodes", "0"], "argument --episodes"),
 ])
 def test_evaluate_bad_values_are_refused_as_parsed(sp_root: Path, tmp_path: Path, argv: list[str], message: str,
@@ -130,6 +130,14 @@ def test_evaluate_bad_values_are_refused_as_parsed(sp_root: Path, tmp_path: Path
         _parser().parse_args(["evaluate", "--dataset", str(sp_root), "--scenario", "sp",
                               "--out", str(tmp_path / "r.json"), *argv])
     assert exit_.value.code == 2 and message in capsys.readouterr().err
+
+
+def test_a_continuous_policy_on_the_grid_is_refused(sp_root: Path, tmp_path: Path) -> None:
+    args = _parser().parse_args(["evaluate", "--dataset", str(sp_root), "--scenario", "sp",
+                                 "--out", str(tmp_path / "r.json"), "--policies", "LRD,Greedy"])
+    with pytest.raises(UserError, match="not a policy of --env grid"):
+        args.func(args)
+    assert not (tmp_path / "r.json").exists()
 
 
 def test_evaluate_missing_model(sp_root: Path, tmp_path: Path) -> None:

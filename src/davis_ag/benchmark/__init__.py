@@ -4,6 +4,10 @@ Importing this package registers the environment::
 
     import gymnasium, davis_ag.benchmark
     env = gymnasium.make("davis_ag/TVM-v0", dataset="data/", scenario="sp", split="train")
+
+Beside it, ``davis_ag/TVMContinuous-v0`` (:mod:`davis_ag.live.tvm_continuous`): the same task with
+a continuous camera pose, drawn live from regrown scenes. It is registered here by name only, so
+nothing of it (Helios, the renderer) loads until it is made.
 """
 
 from __future__ import annotations
@@ -19,13 +23,17 @@ from davis_ag.benchmark.tvm import MAX_START_OER, TVMEnv
 
 #: The id every davis-ag environment is registered under.
 TVM_ID = "davis_ag/TVM-v0"
-#: All ids this package registers (tests parametrize over it).
+#: All grid environments this package registers (tests parametrize over it).
 ENV_IDS: tuple[str, ...] = (TVM_ID,)
+#: The continuous-pose environment (a later stage, :mod:`davis_ag.live`, implements it).
+CONTINUOUS_ID = "davis_ag/TVMContinuous-v0"
 
 if TVM_ID not in registry:
     # No max_episode_steps: the environment ends its own episodes at tau with terminated=True
     # (a TimeLimit would report truncated and make learners bootstrap past the final reward).
     register(id=TVM_ID, entry_point="davis_ag.benchmark.tvm:TVMEnv")
+if CONTINUOUS_ID not in registry:
+    register(id=CONTINUOUS_ID, entry_point="davis_ag.live.tvm_continuous:TVMContinuousEnv")
 
 
 def benchmark_steps(env: gym.Env, n: int = 20_000, seed: int = 0) -> float:
@@ -52,5 +60,5 @@ def benchmark_steps(env: gym.Env, n: int = 20_000, seed: int = 0) -> float:
     return n / (time.perf_counter() - start)
 
 
-__all__ = ["ENV_IDS", "MAX_START_OER", "OBS_SIZE", "TVM_ID", "SceneCache", "TVMEnv",
+__all__ = ["CONTINUOUS_ID", "ENV_IDS", "MAX_START_OER", "OBS_SIZE", "TVM_ID", "SceneCache", "TVMEnv",
            "benchmark_steps", "load_scene_cache"]

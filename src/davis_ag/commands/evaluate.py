@@ -1,4 +1,5 @@
-"""``davis-ag evaluate``: the section V-C benchmark (Table 4) on a dataset's test split."""
+"""``davis-ag evaluate``: the section V-C benchmark (Table 4) on a dataset's test split, on the grid
+(TVM-v0) or with continuous camera poses (``--env continuous``, TVMContinuous-v0)."""
 
 from __future__ import annotations
 
@@ -8,8 +9,10 @@ from davis_ag.atomic_files import write_or_rescue
 from davis_ag.commands import arguments
 from davis_ag.errors import UserError
 
-#: What --policies accepts (A2C needs --model too).
+#: What --policies accepts on the grid (A2C needs --model too).
 POLICIES = ("LRD", "UDD", "Rand", "Oracle", "A2C")
+#: What --policies accepts with --env continuous (Model needs --model: a PPO or SAC .zip).
+CONTINUOUS_POLICIES = ("LR", "UD", "Rand", "Greedy", "Model")
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -29,10 +32,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help="scenes to evaluate on (default: test)")
     parser.add_argument("--model", type=arguments.path, default=None, metavar="MODEL.zip",
                         help="trained A2C model; adds the A2C column")
-    parser.add_argument("--policies", type=arguments.name_list(POLICIES), default="LRD,UDD,Rand,Oracle",
-                        help="comma-separated baselines (default: LRD,UDD,Rand,Oracle)")
+    parser.add_argument("--env", default="grid", choices=["grid", "continuous"],
+                        help="grid: the dataset's views (TVM-v0, default); continuous: any pose, drawn live "
+                             "from regrown scenes (TVMContinuous-v0; scenes made by davis-ag generate)")
+    parser.add_argument("--policies", type=arguments.name_list(tuple(dict.fromkeys(POLICIES + CONTINUOUS_POLICIES))),
+                        default=None, help="comma-separated baselines (grid default: LRD,UDD,Rand,Oracle; "
+                                           "continuous: LR,UD,Rand,Greedy)")
     parser.add_argument("--stochastic", action="store_true",
-                        help="let A2C sample its actions instead of taking the most likely one")
+                        help="let A2C (or the continuous Model) sample its actions instead of taking the most likely one")
     parser.add_argument("--episodes", type=arguments.bounded(1, 10**6), default=200,
                         help="episodes per session (200)")
     parser.add_argument("--sessions", type=arguments.bounded(1, 1000), default=3, help="sessions (3)")
@@ -47,24 +54,45 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Evaluate, print the table, write JSON and PNG."""
-    from davis_ag.benchmark import TVMEnv
-    from davis_ag.benchmark.agents import build_agents
-    from davis_ag.benchmark.evaluation import evaluate_agents, format_table, plot_results, write_json
+    from davis_ag.benchmark.evaluation import format_table, plot_results, write_json
 
-    names = list(args.policies)
-    if args.model and "A2C" not in names:
-        names.append("A2C")
+    continuous = args.env == "continuous"
+    allowed = CONTINUOUS_POLICIES if continuous else POLICIES
+    names = list(args.policies or (("LR", "UD", "Rand", "Greedy") if continuous else ("LRD", "UDD", "Rand", "Oracle")))
+    wrong = [n for n in names if n not in allowed]
+    if wrong:
+        raise UserError(f"--policies {wrong[0]} is not a policy of --env {args.env}: choose from {', '.join(allowed)}")
+    model_name = "Model" if continuous else "A2C"
+    if args.model and model_name not in names:
+        names.append(model_name)
     out = arguments.prove_writable_file(args.out)
     plot = arguments.prove_writable_file(args.plot or out.with_suffix(".png"), "--plot")
     if plot == out:
         raise UserError(f"--plot and --out are both {out}: give the chart another name")
     if args.cache_dir is not None:
         arguments.prove_writable_folder(args.cache_dir, "--cache-dir")
-    agents = build_agents(names, model=args.model, deterministic=not args.stochastic)
-    env = TVMEnv(args.dataset, scenario=args.scenario, split=args.split, crop=args.crop,
-                 cache_dir=args.cache_dir)
-    results = evaluate_agents(env, agents, episodes=args.episodes, sessions=args.sessions,
-                              seed=args.seed, keep_episodes=True)
+    if continuous:
+        from davis_ag.live.evaluation import evaluate_continuous
+        from davis_ag.live.policies import build_policies
+        from davis_ag.live.tvm_continuous import TVMContinuousEnv
+
+        agents = build_policies(names, model=args.model, deterministic=not args.stochastic)
+        env = TVMContinuousEnv(args.dataset, scenario=args.scenario, split=args.split, crop=args.crop)
+        try:
+            results = evaluate_continuous(env, agents, episodes=args.episodes, sessions=args.sessions,
+                                          seed=args.seed, keep_episodes=True)
+        finally:
+            env.close()
+    else:
+        from davis_ag.benchmark import TVMEnv
+        from davis_ag.benchmark.agents import build_agents
+        from davis_ag.benchmark.evaluation import evaluate_agents
+
+        agents = build_agents(names, model=args.model, deterministic=not args.stochastic)
+        env = TVMEnv(args.dataset, scenario=args.scenario, split=args.split, crop=args.crop,
+                     cache_dir=args.cache_dir)
+        results = evaluate_agents(env, agents, episodes=args.episodes, sessions=args.sessions,
+                                  seed=args.seed, keep_episodes=True)
     print(format_table(results))
     # The JSON is the result: keep it somewhere even when --out fails at the end.
     write_or_rescue(out, lambda path: write_json(results, path), "the results")

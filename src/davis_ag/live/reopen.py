@@ -1,0 +1,288 @@
+"""Reopen a generated scene: regrow it from its scene.json, or load its cached geometry.
+
+A scene made by ``davis-ag generate`` records its seed and settings in scene.json. Growing it
+again from them (:func:`davis_ag.generate.one_scene.grow_scene`) gives the same plants, bit for
+bit, and the same slipped grid; both are checked against what scene.json stored (the fruit
+registry, the plants and every view's pose) before anything is used.
+
+Growing takes 20-60 s per plant, so the extracted geometry (every triangle, the fruit's
+primitives, the exact grid poses) is cached in ``live_geometry.npz`` inside the scene folder,
+written atomically and keyed by everything that shapes it (scene.json's seed and settings,
+generator and pyhelios versions). A cache with another key is ignored and rewritten; a scene
+folder that cannot be written is reopened uncached, with one line on stderr.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import json
+import sys
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from davis_ag.atomic_files import atomic_output
+from davis_ag.errors import UserError
+from davis_ag.scene.camera import Camera
+from davis_ag.scene.lighting import Lighting
+from davis_ag.scene.specs import CropSpec, ScenarioSpec, crop_spec, scenario_spec
+from davis_ag.scene.view_grid import Viewpoint
+
+CACHE_FILE = "live_geometry.npz"
+#: Bump when the cache's content changes.
+CACHE_VERSION = 1
+_GEOMETRY_FIELDS = ("positions", "uvs", "normals", "uuids", "colours", "texture", "mode", "caster", "patch")
+
+
+@dataclass
+class SceneSettings:
+    """What scene.json says about how a scene was made.
+
+    Attributes:
+        folder: The scene folder.
+        metadata: scene.json as read.
+        scenario, crop: The scene's grid (as generated, reduced grids included) and crop.
+        index, seed, dataset_seed: Which scene.
+        camera: The camera its views were drawn with.
+        renderer, look, antialiasing: How its views were drawn.
+    """
+
+    folder: Path
+    metadata: dict
+    scenario: ScenarioSpec
+    crop: CropSpec
+    index: int
+    seed: int
+    dataset_seed: int
+    camera: Camera
+    renderer: str
+    look: str
+    antialiasing: str
+
+    @property
+    def cache_key(self) -> str:
+        """Digest of everything that shapes the grown geometry and the grid."""
+        meta = self.metadata
+        keyed = {"version": CACHE_VERSION, "seed": self.seed, "dataset_seed": self.dataset_seed,
+                 "scenario": meta["scenario"], "crop": meta["crop"], "scene": meta["scene"],
+                 "grid": meta["grid"], "generator": meta["generator"]}
+        return hashlib.sha256(json.dumps(keyed, sort_keys=True).encode()).hexdigest()[:20]
+
+
+def antialiasing_of(renderer: dict) -> str:
+    """The antialiasing mode a scene.json's renderer entry names: its description (as
+    :data:`~davis_ag.render.backends.ANTIALIASING_DESCRIPTIONS` writes it), Helios's Visualizer
+    (4x multisampling), or an earlier version's 4x / 1x wording."""
+    from davis_ag.render.backends import ANTIALIASING_DESCRIPTIONS
+
+    text = str(renderer.get("antialiasing", ""))
+    by_description = {description: mode for mode, description in ANTIALIASING_DESCRIPTIONS.items()}
+    if text in by_description:
+        return by_description[text]
+    return "msaa" if text.startswith("4x") or renderer.get("name") == "helios" else "none"
+
+
+def read_settings(scene_dir: str | Path) -> SceneSettings:
+    """Read and check a scene's scene.json.
+
+    Raises:
+        UserError: when the folder holds no scene made by davis-ag generate, or scene.json is damaged.
+    """
+    from davis_ag.generate.one_scene import SCENE_FORMAT
+
+    folder = Path(scene_dir)
+    path = folder / "scene.json"
+    try:
+        metadata = json.loads(path.read_text())
+    except FileNotFoundError:
+        raise UserError(f"{path}: missing; only scenes made by `davis-ag generate` can be reopened live") from None
+    except (OSError, ValueError) as error:
+        raise UserError(f"{path}: cannot be read ({error}); generate the scene again") from None
+    generator = metadata.get("generator") if isinstance(metadata, dict) else None
+    if not (isinstance(generator, dict) and generator.get("name") == "davis-ag"
+            and metadata.get("format") == SCENE_FORMAT):
+        raise UserError(f"{path}: not a scene.json written by `davis-ag generate` ({SCENE_FORMAT}); "
+                        "only our own scenes can be regrown")
+    try:
+        crop = crop_spec(metadata["crop"])
+        grid = metadata["grid"]
+        levels = tuple(crop.altitudes.index(a) for a in grid["altitudes_m"])
+        scenario = replace(scenario_spec(metadata["scenario"], crop), extent=tuple(grid["extent_m"]),
+                           step=float(grid["step_m"]), altitude_levels=levels)
+        camera_info = metadata["camera"]
+        camera = Camera(int(camera_info["width"]), int(camera_info["height"]), float(camera_info["vfov_deg"]))
+        renderer = metadata["renderer"]
+        antialiasing = antialiasing_of(renderer)
+        settings = SceneSettings(folder, metadata, scenario, crop, int(metadata["scene"].rsplit("/", 1)[1]),
+                                 int(metadata["seed"]), int(metadata["dataset_seed"]), camera,
+                                 str(renderer["name"]), str(renderer["look"]),
+                                 antialiasing)
+    except (KeyError, ValueError, TypeError, IndexError, AttributeError) as error:
+        raise UserError(f"{path}: lacks or mangles a setting needed to regrow the scene ({error!r}); "
+                        "generate the scene again") from None
+    return settings
+
+
+@dataclass
+class SceneAssets:
+    """A reopened scene's drawable content.
+
+    Attributes:
+        geometry: Every triangle (:class:`davis_ag.render.scene_geometry.SceneGeometry`).
+        fruit_uuids: Each fruit id's primitive UUIDs.
+        uuid_count: One more than the largest primitive UUID.
+        lighting: Sun and sky.
+        aim_height: Height single-plant cameras aim at, m.
+        grid_views: The grid's exact viewpoints (unrounded slip), in image order.
+        from_cache: Whether this came from the cache (False: regrown just now).
+    """
+
+    geometry: object
+    fruit_uuids: dict[int, np.ndarray]
+    uuid_count: int
+    lighting: Lighting
+    aim_height: float
+    grid_views: list[Viewpoint]
+    from_cache: bool
+
+
+def _pyhelios_root() -> Path | None:
+    spec = importlib.util.find_spec("pyhelios")
+    return Path(spec.origin).parent if spec and spec.origin else None
+
+
+def _portable(path: str, root: Path | None) -> str:
+    """Texture paths under pyhelios's install relative to it, so a cache survives another venv."""
+    if root is not None and Path(path).is_relative_to(root):
+        return "pyhelios:" + Path(path).relative_to(root).as_posix()
+    return path
+
+
+def _resolve(path: str, root: Path | None) -> str:
+    if path.startswith("pyhelios:") and root is not None:
+        return str(root / path[len("pyhelios:"):])
+    return path
+
+
+def regrow(settings: SceneSettings) -> SceneAssets:
+    """Grow a scene again from its seed and settings and check it against scene.json.
+
+    Raises:
+        UserError: when the regrown plants, fruit or grid poses differ from the stored ones
+            (another pyhelios or davis-ag version grows differently).
+    """
+    from davis_ag.generate.one_scene import SceneRequest, grow_scene
+
+    request = SceneRequest(settings.scenario, settings.crop, settings.index, settings.dataset_seed,
+                           settings.camera, renderer=settings.renderer, look=settings.look)
+    if request.seed != settings.seed:
+        raise UserError(f"{settings.folder}/scene.json: seed {settings.seed} does not follow from dataset seed "
+                        f"{settings.dataset_seed} and scene {settings.metadata['scene']}; the file was edited")
+    model, grid = grow_scene(request)
+    stored = settings.metadata
+    version = f"pyhelios3d {stored['generator'].get('pyhelios3d')}, davis-ag {stored['generator'].get('version')}"
+    regrown_fruit = json.loads(json.dumps([f.summary() for f in model.fruits]))
+    regrown_plants = json.loads(json.dumps([p.summary() for p in model.plants]))
+    if regrown_fruit != stored.get("fruits") or regrown_plants != stored.get("plants"):
+        raise UserError(f"{settings.folder}: regrowing from the seed gave other plants than scene.json records "
+                        f"(made with {version}); reopen it with those versions")
+    check_grid(settings, list(grid.viewpoints))
+    return assets_from_model(model, grid)
+
+
+def assets_from_model(model, grid) -> SceneAssets:
+    """A grown scene's drawable content (:func:`davis_ag.generate.one_scene.grow_scene`'s output)."""
+    from davis_ag.render.scene_geometry import read_scene_geometry
+
+    return SceneAssets(read_scene_geometry(model.context), {f.id: np.asarray(f.uuids, dtype=np.int64)
+                                                            for f in model.fruits},
+                       model.uuid_count, model.lighting, float(model.aim_height), list(grid.viewpoints), False)
+
+
+def check_grid(settings: SceneSettings, views: list[Viewpoint]) -> None:
+    """The grid's views must be the stored ones: same names, same poses as annotations.json."""
+    path = settings.folder / "annotations.json"
+    try:
+        annotations = json.loads(path.read_text())
+    except (OSError, ValueError) as error:
+        raise UserError(f"{path}: cannot be read ({error})") from None
+    poses = {v.image_name: [round(x, 5) for x in v.pose] for v in views}
+    for name, entry in annotations.items():
+        if poses.get(name) != entry.get("pose"):
+            raise UserError(f"{path}: view {name} has pose {entry.get('pose')}, the regrown grid "
+                            f"{poses.get(name)}; the scene cannot be reopened as it was drawn")
+
+
+def save_cache(path: Path, key: str, assets: SceneAssets) -> None:
+    """Write the assets atomically (an uncompressed npz loads in a fraction of a second)."""
+    root = _pyhelios_root()
+    geometry = assets.geometry
+    fruit_ids = sorted(assets.fruit_uuids)
+    uuids = [assets.fruit_uuids[f] for f in fruit_ids]
+    views = assets.grid_views
+    arrays = {name: getattr(geometry, name) for name in _GEOMETRY_FIELDS}
+    arrays.update(
+        key=np.array(key), texture_files=np.array([_portable(f, root) for f in geometry.texture_files], dtype=str),
+        fruit_ids=np.array(fruit_ids, dtype=np.int64), fruit_offsets=np.cumsum([0] + [len(u) for u in uuids]),
+        fruit_uuids=np.concatenate(uuids + [np.zeros(0, np.int64)]).astype(np.int64),
+        uuid_count=np.array(assets.uuid_count), aim_height=np.array(assets.aim_height),
+        sun=np.array([assets.lighting.sun_elevation, assets.lighting.sun_azimuth]),
+        sky=np.array(assets.lighting.sky_texture or ""),
+        view_grid=np.array([[v.ix, v.iy, v.level, v.heading] for v in views], dtype=np.int64).reshape(-1, 4),
+        view_nominal=np.array([v.nominal for v in views], dtype=np.float64).reshape(-1, 3),
+        view_position=np.array([v.position for v in views], dtype=np.float64).reshape(-1, 3),
+        view_angles=np.array([(v.yaw, v.pitch) for v in views], dtype=np.float64).reshape(-1, 2))
+    with atomic_output(path) as handle:
+        np.savez(handle, **arrays)
+
+
+def load_cache(path: Path, key: str) -> SceneAssets | None:
+    """The cached assets, or None when missing, unreadable or made for other settings."""
+    from davis_ag.render.scene_geometry import SceneGeometry
+
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            if str(data["key"]) != key:
+                return None
+            root = _pyhelios_root()
+            files = [_resolve(str(f), root) for f in data["texture_files"]]
+            if not all(Path(f).is_file() for f in files):
+                return None
+            geometry = SceneGeometry(**{name: data[name] for name in _GEOMETRY_FIELDS}, texture_files=files)
+            offsets = data["fruit_offsets"]
+            fruit_uuids = {int(f): data["fruit_uuids"][offsets[k]:offsets[k + 1]]
+                           for k, f in enumerate(data["fruit_ids"])}
+            sun = data["sun"]
+            views = [Viewpoint(k, int(g[0]), int(g[1]), int(g[2]), int(g[3]), tuple(map(float, n)),
+                               tuple(map(float, p)), float(a[0]), float(a[1]))
+                     for k, (g, n, p, a) in enumerate(zip(data["view_grid"], data["view_nominal"],
+                                                          data["view_position"], data["view_angles"]))]
+            return SceneAssets(geometry, fruit_uuids, int(data["uuid_count"]),
+                               Lighting(float(sun[0]), float(sun[1]), str(data["sky"]) or None),
+                               float(data["aim_height"]), views, True)
+    except (OSError, ValueError, KeyError, IndexError, TypeError):
+        return None
+
+
+def reopen_assets(settings: SceneSettings, use_cache: bool = True) -> SceneAssets:
+    """The scene's assets from its cache if current, else regrown (and cached where possible).
+
+    Args:
+        settings: From :func:`read_settings`.
+        use_cache: False regrows even when a current cache exists (and rewrites it).
+    """
+    path = settings.folder / CACHE_FILE
+    key = settings.cache_key
+    if use_cache:
+        cached = load_cache(path, key)
+        if cached is not None:
+            return cached
+    assets = regrow(settings)
+    try:
+        save_cache(path, key, assets)
+    except OSError as error:
+        print(f"davis-ag: cannot cache the scene's geometry in {path} ({error.strerror or error}); "
+              "the next reopening will grow it again", file=sys.stderr)
+    return assets
