@@ -22,3 +22,9 @@ def test_the_grow_and_draw_bound_is_below_the_whole_cost() -> None:
                       {c: 20.0 for c in CROPS})
     assert 0 < ours["hours_one_machine_grow_and_draw_only"] < ours["hours_one_machine"]
     assert "hours_one_machine_grow_and_draw_only" not in projection({c: 0.5 for c in CROPS}, {c: 30.0 for c in CROPS})
+
+
+def test_a_measured_pool_gain_replaces_the_helios_one() -> None:
+    costs = ({c: 1.0 for c in CROPS}, {c: 0.0 for c in CROPS})
+    assert projection(*costs, gain=2.0)["hours_one_machine"] == pytest.approx(502_542 / 3600 / 2, abs=0.1)
+    assert "measured by this bench" in projection(*costs, gain=2.0)["assumptions"]
