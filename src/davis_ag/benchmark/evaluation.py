@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -103,18 +103,7 @@ def evaluate_agents(env: TVMEnv, agents: list[Agent], episodes: int = 200, sessi
         "policies": {},
     }
     for agent in agents:
-        per_session: dict[str, list[float]] = {k: [] for k in (*METRICS, "oer_0")}
-        records = []
-        for session in range(sessions):
-            env_seeds, agent_seeds = episode_seeds(seed, session, episodes)
-            runs = [run_episode(env, agent, r, a) for r, a in zip(env_seeds, agent_seeds)]
-            for key in per_session:
-                per_session[key].append(float(np.mean([run[key] for run in runs])))
-            records.extend({"session": session, **run} for run in runs)
-        summary: dict[str, Any] = {
-            key: {"mean": float(np.mean(values)), "std": float(np.std(values)),
-                  "sessions": values}
-            for key, values in per_session.items()}
+        summary, records = play_sessions(env, agent, run_episode, (*METRICS, "oer_0"), seed, sessions, episodes)
         chosen = np.bincount([a for r in records for a in r["actions"]],
                              minlength=len(inner.action_names))
         summary["action_counts"] = {n: int(c) for n, c in zip(inner.action_names, chosen)}
@@ -122,6 +111,32 @@ def evaluate_agents(env: TVMEnv, agents: list[Agent], episodes: int = 200, sessi
             summary["episodes"] = records
         results["policies"][agent.name] = summary
     return results
+
+
+def play_sessions(env: Any, agent: Any, play: Callable[..., dict[str, Any]], keys: tuple[str, ...], seed: int,
+                  sessions: int, episodes: int) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    """Play ``sessions`` x ``episodes`` seeded episodes (the same for every policy) and summarise.
+
+    Args:
+        env, agent: The environment and the policy.
+        play: ``play(env, agent, reset_seed, agent_seed) -> record`` for one episode.
+        keys: The record's numbers to average per session.
+        seed, sessions, episodes: The protocol.
+
+    Returns:
+        Per key the mean, std and per-session values over sessions; and every episode's record.
+    """
+    per_session: dict[str, list[float]] = {k: [] for k in keys}
+    records = []
+    for session in range(sessions):
+        env_seeds, agent_seeds = episode_seeds(seed, session, episodes)
+        runs = [play(env, agent, r, a) for r, a in zip(env_seeds, agent_seeds)]
+        for key in per_session:
+            per_session[key].append(float(np.mean([run[key] for run in runs])))
+        records.extend({"session": session, **run} for run in runs)
+    summary = {key: {"mean": float(np.mean(v)), "std": float(np.std(v)), "sessions": v}
+               for key, v in per_session.items()}
+    return summary, records
 
 
 def _number(value: float) -> str:

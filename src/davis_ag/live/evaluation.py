@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from davis_ag.benchmark.evaluation import METRICS, episode_seeds
+from davis_ag.benchmark.evaluation import METRICS, play_sessions
 from davis_ag.live.policies import continuous
 
 
@@ -68,16 +68,8 @@ def evaluate_continuous(env: Any, agents: list[Any], episodes: int = 200, sessio
         "policies": {},
     }
     for agent in agents:
-        per_session: dict[str, list[float]] = {k: [] for k in (*METRICS, "oer_0", "refused")}
-        records = []
-        for session in range(sessions):
-            env_seeds, agent_seeds = episode_seeds(seed, session, episodes)
-            runs = [run_episode(env, agent, r, a) for r, a in zip(env_seeds, agent_seeds)]
-            for key in per_session:
-                per_session[key].append(float(np.mean([run[key] for run in runs])))
-            records.extend({"session": session, **run} for run in runs)
-        summary: dict[str, Any] = {key: {"mean": float(np.mean(v)), "std": float(np.std(v)), "sessions": v}
-                                   for key, v in per_session.items()}
+        summary, records = play_sessions(env, agent, run_episode, (*METRICS, "oer_0", "refused"), seed, sessions,
+                                         episodes)
         moves = np.abs(np.array([a for r in records for a in r["actions"]], dtype=np.float64))
         summary["mean_abs_action"] = dict(zip(results["protocol"]["actions"], moves.mean(axis=0).round(4).tolist()))
         if keep_episodes:
