@@ -8,7 +8,9 @@ two small SP strawberry scenes are generated first) and times every update's par
 rollout (the environments' steps and, apart, the rest: the policy's forward passes and SB3's
 bookkeeping) and the update itself (``train()``: forward, backward, RMSprop step). The floor is
 the network alone on observations of the same shape: five forward passes of a batch of 8 and one
-forward, backward and optimiser step of 40, timed in the same process after the run. With
+forward, backward and optimiser step of 40, timed in the same process after the run, both layouts in turn. The same
+training with the convolutions in the plain NCHW layout (before they ran channels-last) is timed
+alongside, alternating, as the "before". With
 ``--doc`` the table is written between the file's ``<!-- a2c:start -->`` and ``<!-- a2c:end -->``.
 """
 
@@ -21,7 +23,6 @@ import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
 import torch
 from stable_baselines3 import A2C
 from stable_baselines3.common.vec_env import VecEnvWrapper
@@ -68,27 +69,31 @@ class TimedA2C(A2C):
         self.update_s.append(time.perf_counter() - start)
 
 
-def network_floor(model: A2C, repeats: int = 10) -> float:
-    """Median seconds of the network's share of one update: 5 rollout forwards of 8, one update of 40."""
-    policy = model.policy
-    shape = model.observation_space.shape
-    small = torch.randint(0, 256, (N_ENVS, *shape), dtype=torch.uint8)
-    batch = torch.randint(0, 256, (N_ENVS * model.n_steps, *shape), dtype=torch.uint8)
-    actions = torch.randint(0, model.action_space.n, (len(batch),))
-    times = []
+def network_floors(models: list[A2C], repeats: int = 10) -> list[float]:
+    """Median seconds of each model's network share of one update, the models timed in turn.
+
+    One repetition is 5 rollout forward passes of 8 and one update of 40 on random observations.
+    """
+    times: list[list[float]] = [[] for _ in models]
     for _ in range(repeats + 1):
-        start = time.perf_counter()
-        with torch.no_grad():
-            for _ in range(model.n_steps):
-                policy(small)
-        values, log_prob, entropy = policy.evaluate_actions(batch, actions)
-        loss = -log_prob.mean() + 0.5 * values.pow(2).mean() - 0.0 * entropy.mean()
-        policy.optimizer.zero_grad()
-        loss.backward()
-        torch.nn.utils.clip_grad_norm_(policy.parameters(), model.max_grad_norm)
-        policy.optimizer.step()
-        times.append(time.perf_counter() - start)
-    return statistics.median(times[1:])
+        for model, spent in zip(models, times):
+            policy = model.policy
+            shape = model.observation_space.shape
+            small = torch.randint(0, 256, (N_ENVS, *shape), dtype=torch.uint8)
+            batch = torch.randint(0, 256, (N_ENVS * model.n_steps, *shape), dtype=torch.uint8)
+            actions = torch.randint(0, model.action_space.n, (len(batch),))
+            start = time.perf_counter()
+            with torch.no_grad():
+                for _ in range(model.n_steps):
+                    policy(small)
+            values, log_prob, entropy = policy.evaluate_actions(batch, actions)
+            loss = -log_prob.mean() + 0.5 * values.pow(2).mean() - 0.0 * entropy.mean()
+            policy.optimizer.zero_grad()
+            loss.backward()
+            torch.nn.utils.clip_grad_norm_(policy.parameters(), model.max_grad_norm)
+            policy.optimizer.step()
+            spent.append(time.perf_counter() - start)
+    return [statistics.median(spent[1:]) for spent in times]
 
 
 def small_dataset(folder: Path) -> Path:
@@ -106,24 +111,41 @@ def small_dataset(folder: Path) -> Path:
     return folder
 
 
-def measure(dataset: Path, steps: int) -> dict:
-    """Train for ``steps`` steps with timers; return the per-update times and the floor."""
-    env = TimedSteps(make_vec_tvm(dataset, "sp", N_ENVS, 0, "all"))
-    model = TimedA2C("CnnPolicy", env, seed=0, device="cpu", policy_kwargs=dict(ARCHITECTURES["paper"]))
-    model.rollout_s, model.update_s = [], []
-    model.learn(N_ENVS * model.n_steps * 5)  # warm-up: caches, allocator, oneDNN kernels
-    model.rollout_s, model.update_s, env.seconds = [], [], 0.0
-    start = time.perf_counter()
-    model.learn(steps, reset_num_timesteps=False)
-    wall = time.perf_counter() - start
-    updates = len(model.update_s)
-    floor = network_floor(model)
-    env.close()
-    per_update = {"rollout": sum(model.rollout_s) / updates, "env": env.seconds / updates,
-                  "update": sum(model.update_s) / updates}
-    return {"steps": updates * N_ENVS * model.n_steps, "wall_s": wall, "updates": updates,
-            "steps_per_second": updates * N_ENVS * model.n_steps / wall, "per_update_s": per_update,
-            "floor_s": floor, "threads": torch.get_num_threads()}
+def measure(dataset: Path, steps: int, chunks: int = 5) -> dict:
+    """Train for ``steps`` steps with timers; return the per-update times and the floor.
+
+    The same training is run twice in this process, the convolutions in the shipped
+    channels-last layout and in the plain NCHW one (before the layout change), alternating in
+    ``chunks`` pieces so that both see the same machine; the floor is taken for each.
+    """
+    runs = {}
+    for layout in (True, False):
+        env = TimedSteps(make_vec_tvm(dataset, "sp", N_ENVS, 0, "all"))
+        kwargs = {**ARCHITECTURES["paper"], "features_extractor_kwargs": {"channels_last": layout}}
+        model = TimedA2C("CnnPolicy", env, seed=0, device="cpu", policy_kwargs=kwargs)
+        model.rollout_s, model.update_s = [], []
+        model.learn(N_ENVS * model.n_steps * 5)  # warm-up: caches, allocator, oneDNN kernels
+        model.rollout_s, model.update_s, env.seconds = [], [], 0.0
+        runs[layout] = {"model": model, "env": env, "wall": 0.0}
+    for _ in range(chunks):
+        for run in runs.values():
+            start = time.perf_counter()
+            run["model"].learn(steps // chunks, reset_num_timesteps=False)
+            run["wall"] += time.perf_counter() - start
+    floors = dict(zip(runs, network_floors([run["model"] for run in runs.values()])))
+    results = {}
+    for layout, run in runs.items():
+        model, env = run["model"], run["env"]
+        updates = len(model.update_s)
+        per_update = {"rollout": sum(model.rollout_s) / updates, "env": env.seconds / updates,
+                      "update": sum(model.update_s) / updates}
+        results[layout] = {"steps": updates * N_ENVS * model.n_steps, "wall_s": run["wall"], "updates": updates,
+                           "steps_per_second": updates * N_ENVS * model.n_steps / run["wall"],
+                           "per_update_s": per_update, "floor_s": floors[layout],
+                           "threads": torch.get_num_threads()}
+        env.close()
+    return {**results[True], "nchw_steps_per_second": results[False]["steps_per_second"],
+            "nchw_floor_s": results[False]["floor_s"]}
 
 
 def table(result: dict) -> str:
@@ -143,7 +165,11 @@ def table(result: dict) -> str:
               f"The network alone (five forward passes of 8, one forward, backward and RMSprop step of 40, "
               f"random observations): {1000 * result['floor_s']:.0f} ms per update, "
               f"{N_ENVS * 5 / result['floor_s']:.1f} steps/s; training runs at "
-              f"{result['floor_s'] / whole:.0%} of that floor."]
+              f"{result['floor_s'] / whole:.0%} of that floor.", "",
+              f"Before the convolutions ran channels-last (the plain NCHW layout, trained alongside in "
+              f"the same process): **{result['nchw_steps_per_second']:.1f} steps/s**, the network alone "
+              f"{1000 * result['nchw_floor_s']:.0f} ms per update; channels-last is "
+              f"{result['steps_per_second'] / result['nchw_steps_per_second']:.2f}x that."]
     return "\n".join(lines)
 
 

@@ -60,3 +60,16 @@ def test_natures_first_stride_differs_from_the_papers() -> None:
     nature = policy("nature").features_extractor
     first = next(m for m in nature.modules() if isinstance(m, nn.Conv2d))
     assert (first.kernel_size[0], first.stride[0]) == (8, 4) != PAPER_KERNELS_STRIDES[0]
+
+
+def test_channels_last_layout_gives_the_same_features_and_loads_either_way() -> None:
+    space = gym.spaces.Box(0, 255, (4, 224, 224), dtype=np.uint8)
+    torch.manual_seed(0)
+    fast = PaperCNN(space)
+    plain = PaperCNN(space, channels_last=False)
+    plain.load_state_dict(fast.state_dict())
+    x = torch.rand(3, 4, 224, 224)
+    assert torch.allclose(fast(x), plain(x), atol=1e-5)
+    # A checkpoint saved in one layout loads into the other and gives the same features.
+    fast.load_state_dict(plain.state_dict())
+    assert torch.allclose(fast(x), plain(x), atol=1e-5)

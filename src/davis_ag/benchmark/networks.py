@@ -30,10 +30,15 @@ class PaperCNN(BaseFeaturesExtractor):
     On the 224x224x4 observation the maps are 73x73, 35x35 and 33x33.
     """
 
-    def __init__(self, observation_space: gym.spaces.Box, features_dim: int = PAPER_FEATURES) -> None:
+    def __init__(self, observation_space: gym.spaces.Box, features_dim: int = PAPER_FEATURES,
+                 channels_last: bool = True) -> None:
         """Args:
             observation_space: Channels-first image space (SB3 transposes ours to it).
             features_dim: Size of the feature vector (512 in the paper).
+            channels_last: Run the convolutions on channels-last (NHWC) tensors. The same
+                network and numbers to float rounding; oneDNN's NHWC kernels made an A2C update
+                faster on this CPU (tools/a2c_speed.py, docs/performance.md). Off gives the
+                plain NCHW layout the measurement compares with.
         """
         super().__init__(observation_space, features_dim)
         layers: list[nn.Module] = []
@@ -45,10 +50,13 @@ class PaperCNN(BaseFeaturesExtractor):
         with torch.no_grad():
             n_flatten = self.cnn(torch.zeros(1, *observation_space.shape)).shape[1]
         self.linear = nn.Sequential(nn.Linear(n_flatten, features_dim), nn.ReLU())
+        self.memory_format = torch.channels_last if channels_last else torch.contiguous_format
 
     def forward(self, observations: torch.Tensor) -> torch.Tensor:
         """Features of a batch of (already 0-1 scaled) observations."""
-        return self.linear(self.cnn(observations))
+        # Flatten reads the maps in logical (C, H, W) order whatever the layout, so the linear
+        # layer sees the same features either way.
+        return self.linear(self.cnn(observations.contiguous(memory_format=self.memory_format)))
 
 
 class PooledFeatures(BaseFeaturesExtractor):
