@@ -14,6 +14,7 @@ when another is refreshed; docs/scenes.md is rewritten from whichever exist:
 Run: ``python tools/scene_stats.py views``, ``... plants 10 [tomato,vine]``,
 ``... findings 3 192x108 [0.5]`` (the last argument: the grid step, default the paper's 0.25 m;
 one file per image size, docs/scenes-findings-WxH.json, since the OER share depends on it).
+With no argument it only rewrites docs/scenes.md, e.g. after ``tools/strawberry_recipes.py``.
 """
 
 from __future__ import annotations
@@ -216,6 +217,33 @@ def findings_lines(data: dict) -> list[str]:
     return lines
 
 
+def recipes_table() -> list[str]:
+    """Markdown: the strawberry recipes tried for Fig. 2 and the OER share (tools/strawberry_recipes.py)."""
+    path = DOCS / "scenes-strawberry-recipes.json"
+    if not path.exists():
+        return []
+    data = json.loads(path.read_text())
+    lines = [f"Scenes {', '.join(str(i) for i in data['scenes'])} of dataset seed 0, grown under each recipe and "
+             f"drawn at {data['size'][0]}x{data['size'][1]} on the grid every {data['step']:g} m, at both "
+             f"strawberry altitude sets (`tools/strawberry_recipes.py`; {data['machine']}). \"hidden by fruit\": "
+             "of the box pixels that are not the target in boxes with OER < 0.4, the share covered by other fruit.",
+             "", "| recipe | altitudes | visible per view: min / median / max | views < 5 | views >= 16 | "
+             "scenes meeting Fig. 2 (< 5 and >= 16 somewhere) | OER < 0.4 | in 2-8 % | hidden by fruit | visible fraction of those fruit (median) |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    for row in data["recipes"]:
+        visible = np.concatenate([s["visible"] for s in row["scenes"]])
+        oer = np.concatenate([s["box_oer"] for s in row["scenes"]])
+        share = float((oer < 0.4).mean())
+        fig2 = sum(min(s["visible"]) < 5 and max(s["visible"]) >= 16 for s in row["scenes"])
+        by_fruit = [s["low_hidden_by_fruit"] for s in row["scenes"] if s["low_hidden_by_fruit"] is not None]
+        low_vf = [s["low_visible_fraction"] for s in row["scenes"] if s["low_visible_fraction"] is not None]
+        lines.append(f"| {row['recipe']}: {row['idea']} | {row['altitudes']} | {visible.min()} / "
+                     f"{np.median(visible):g} / {visible.max()} | {(visible < 5).sum()} | {(visible >= 16).sum()} | "
+                     f"{fig2} of {len(row['scenes'])} | {share:.1%} | {'yes' if 0.02 <= share <= 0.08 else 'no'} | "
+                     f"{np.mean(by_fruit):.0%} | {np.median(low_vf):.2f} |")
+    return lines + [""]
+
+
 def skewness(values: np.ndarray) -> float:
     """Sample skewness (third standardised moment): negative when the tail points to low values."""
     centred = np.asarray(values, dtype=float) - np.mean(values)
@@ -233,6 +261,8 @@ def render_markdown() -> str:
         lines += ["## Fruit per plant", "", *plants, ""]
     if findings := findings_table():
         lines += ["## The paper's findings on single-plant strawberry scenes", "", *findings]
+    if recipes := recipes_table():
+        lines += ["## Strawberry recipes tried for Fig. 2 and the OER share together", "", *recipes]
     return "\n".join(lines)
 
 
