@@ -55,8 +55,6 @@ EXPOSURE = 1.0
 SHADOW_MAP_SIZE = 4096
 #: Depth offset of the shadow test, in the map's [0, 1] depth (besides a polygon offset).
 SHADOW_BIAS = 1e-4
-#: The default look's shadow box: every point maps to its middle, so shadows fall everywhere.
-EVERYWHERE = np.array([[0, 0, 0, 0.5], [0, 0, 0, 0.5], [0, 0, 0, 0.5], [0, 0, 0, 1.0]])
 #: Default look: one copy of a ground texture covers this many metres of soil. The Context's own
 #: texture coordinates stretch one soil image over a whole 12 m tile (Helios shows its texels as
 #: 2 cm blocks); the default look lays the image at this size instead, with mipmaps.
@@ -127,18 +125,18 @@ class OpenGLRenderer:
 
         ctx = self.ctx
         helios = self.look == "helios"
+        look = ("HELIOS_LOOK",) if helios else ()
         self._programs = {
-            "scene": ctx.program(vertex_shader=_shader("scene.vert"), fragment_shader=_fragment("scene.frag")),
+            "scene": ctx.program(vertex_shader=_shader("scene.vert"), fragment_shader=_fragment("scene.frag", look)),
             "ids": ctx.program(vertex_shader=_shader("scene.vert"),
-                               fragment_shader=_fragment("scene.frag", ("IDS_ONLY",))),
-            "shadow": ctx.program(vertex_shader=_shader("shadow.vert"), fragment_shader=_fragment("shadow.frag")),
-            "sky": ctx.program(vertex_shader=_shader("sky.vert"), fragment_shader=_fragment("sky.frag")),
+                               fragment_shader=_fragment("scene.frag", ("IDS_ONLY", *look))),
+            "shadow": ctx.program(vertex_shader=_shader("shadow.vert"), fragment_shader=_fragment("shadow.frag", look)),
+            "sky": ctx.program(vertex_shader=_shader("sky.vert"), fragment_shader=_fragment("sky.frag", look)),
         }
         if self.antialiasing == "fxaa":
             self._programs["fxaa"] = ctx.program(vertex_shader=_shader("sky.vert"), fragment_shader=_shader("fxaa.frag"))
-        # Samplers and the look first: the shadow pass below samples leaf textures already.
+        # Samplers first: the shadow pass below samples leaf textures already.
         for program in self._programs.values():
-            self._set(program, "helios_look", int(helios))
             self._set(program, "textures", 0)
             self._set(program, "shadow_map", 1)
             self._set(program, "sky", 2)
@@ -298,19 +296,18 @@ class OpenGLRenderer:
 
     def _view_uniforms(self, view: Viewpoint) -> None:
         eye = np.asarray(view.position, dtype=np.float64)
-        target = np.asarray(view.look_at(1.0), dtype=np.float64)
         view_matrix, projection = camera_matrices(self.camera, view)
         view_projection = matmul32(projection, view_matrix)
         rotation = view_matrix.astype(np.float64)
         rotation[:3, 3] = 0.0
-        # Helios computes shadows only inside a box around its camera's view volume.
-        box = helios_shadow_box(self.camera, eye, target, self.lighting.direction) if self.look == "helios" \
-            else EVERYWHERE
         for program in (self._programs["scene"], self._programs["ids"]):
             self._set(program, "view_projection", gl_matrix(view_projection))
             self._set(program, "view", gl_matrix(view_matrix))
         self._set(self._programs["scene"], "eye", tuple(eye))
-        self._set(self._programs["scene"], "shadow_box", gl_matrix(box))
+        if self.look == "helios":  # Helios computes shadows only inside a box around its camera's view volume
+            target = np.asarray(view.look_at(1.0), dtype=np.float64)
+            box = helios_shadow_box(self.camera, eye, target, self.lighting.direction)
+            self._set(self._programs["scene"], "shadow_box", gl_matrix(box))
         self._set(self._programs["sky"], "inverse_rotation_projection",
                   gl_matrix(np.linalg.inv(projection.astype(np.float64) @ rotation)))
 
