@@ -1,5 +1,6 @@
 // davis-ag: shading of scene triangles. Outputs colour, primitive id (UUID + 1) and the depth
-// along the optical axis in one pass; the id-only variant (IDS_ONLY) skips the lighting.
+// along the optical axis in one pass; the id-only variant (IDS_ONLY) skips the lighting, the
+// NO_DEPTH variant the depth (for callers that do not need it: one output and one value less).
 
 uniform sampler2D shadow_map;
 uniform vec3 sun;               // unit vector towards the sun
@@ -28,7 +29,9 @@ layout(location = 1) out float out_depth;
 #else
 layout(location = 0) out vec4 out_colour;
 layout(location = 1) out uint out_id;
+#ifndef NO_DEPTH
 layout(location = 2) out float out_depth;
+#endif
 #endif
 
 // Helios computes shadows only inside a box around its camera's view volume (shadow_box); the
@@ -76,7 +79,9 @@ void main() {
         discard;
     }
     out_id = primitive_id;
+#ifndef NO_DEPTH
     out_depth = view_depth;
+#endif
 #ifndef IDS_ONLY
     vec3 normal = normalize(vertex_normal);
     vec3 to_eye = normalize(eye - world_position);
