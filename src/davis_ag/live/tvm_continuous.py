@@ -187,8 +187,8 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         return self.scene.pose(*position, yaw, float(np.clip(pitch, *PITCH_RANGE)))
 
     def _draw(self, view: Viewpoint) -> LiveView:
-        # No depth: the task never looks at it, and leaving it out makes each draw cheaper.
         self.draws += 1
+        # No depth: the task never looks at it, and leaving it out makes each draw cheaper.
         return self.scene.render(view, self.size, self.size, antialiasing=self.antialiasing, fractions=False,
                                  fast_ground=True, depth=False)
 

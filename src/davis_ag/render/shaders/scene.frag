@@ -69,8 +69,8 @@ float sunlit(vec3 normal) {
 void main() {
     // Colours arrive linear: vertex colours boosted and decoded once per scene, texels decoded
     // when the textures were made.
-    // One look-up serves both textured modes: llvmpipe would run a look-up written in each branch.
     vec4 albedo = colour;
+    // One look-up serves both textured modes: llvmpipe would run a look-up written in each branch.
     vec4 texel = sample_layer(uv, texture_layer);
     if (texture_mode == 1) {
         albedo = texel;
