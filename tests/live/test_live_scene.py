@@ -94,6 +94,28 @@ def test_any_pose_at_any_size(live_scene: LiveScene) -> None:
     assert away.boxes == [] and (away.segmentation == 255).all()
 
 
+def test_a_view_without_depth_is_the_same_view(live_scene: LiveScene) -> None:
+    """As TVMContinuous-v0 draws (224x224, no antialiasing, merged soil, no depth): the same colour,
+    labels and OER as with the depth, for poses aimed at the plant and poses that put fruit at the
+    frame's edge or out of it."""
+    aimed = live_scene.aimed_pose(0.9, -0.6, 0.33)
+    poses = [aimed, live_scene.aimed_pose(-0.5, 0.4, 0.5), live_scene.aimed_pose(0.3, 0.35, 0.2),
+             *(live_scene.pose(0.9, -0.6, 0.33, yaw=aimed.yaw + turn, pitch=aimed.pitch + tilt)
+               for turn, tilt in ((14, 0), (-16, 4), (0, 15), (25, -10), (180, 0)))]
+    boxes_at_the_edge = 0
+    for pose in poses:
+        with_depth = live_scene.render(pose, 224, 224, antialiasing="none", fractions=False, fast_ground=True)
+        without = live_scene.render(pose, 224, 224, antialiasing="none", fractions=False, fast_ground=True,
+                                    depth=False)
+        assert without.depth is None and with_depth.depth.shape == (224, 224)
+        assert np.array_equal(without.colour, with_depth.colour)
+        assert np.array_equal(without.segmentation, with_depth.segmentation)
+        assert without.boxes == with_depth.boxes and without.oer == with_depth.oer
+        boxes_at_the_edge += sum(x0 == 0 or y0 == 0 or x0 + w == 224 or y0 + h == 224
+                                 for x0, y0, w, h, _, _ in without.boxes)
+    assert boxes_at_the_edge > 0
+
+
 def test_merged_soil_draws_the_same_image(live_scene: LiveScene) -> None:
     geometry = live_scene.assets.geometry
     assert merge_ground(geometry).triangle_count < geometry.triangle_count - 10_000

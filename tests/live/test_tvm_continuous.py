@@ -16,7 +16,7 @@ from davis_ag.errors import UserError
 from davis_ag.live.evaluation import evaluate_continuous
 from davis_ag.live.policies import Greedy, ModelAgent, RandomAxes, build_policies
 from davis_ag.live.training import plot_training_curve, train_continuous
-from davis_ag.live.tvm_continuous import TVMContinuousEnv
+from davis_ag.live.tvm_continuous import TVMContinuousEnv, steps_per_second
 from davis_ag.scene.specs import SLIP_SIGMA
 
 
@@ -93,6 +93,28 @@ def _start(env: TVMContinuousEnv, x: float, y: float, z: float, yaw: float = 0.0
     _, info = env.reset(seed=0, options={"pose": [x, y, z, view.yaw if yaw == 0 else yaw, view.pitch],
                                          "target": target})
     return info
+
+
+def test_the_rate_counts_the_views_the_episodes_draw(env: TVMContinuousEnv) -> None:
+    """steps_per_second's draw counts are those of the same seeded episodes played again: one view
+    per random start tried, one per step whose move is not refused before drawing."""
+    steps = 8
+    rate = steps_per_second(env, n=steps, seed=5)
+    actions = np.random.default_rng(5).uniform(-1, 1, size=(steps, 3)).astype(np.float32)
+    env.reset(seed=5)
+    first = env.draws
+    drawn_moves = reset_draws = resets = 0
+    for action in actions:
+        _, _, terminated, _, info = env.step(action)
+        drawn_moves += info["refused"] not in ("bounds", "collision")
+        if terminated:
+            before = env.draws
+            env.reset()
+            reset_draws, resets = reset_draws + env.draws - before, resets + 1
+    assert env.draws - first == drawn_moves + reset_draws
+    assert rate["draws_per_step"] == pytest.approx((env.draws - first) / steps)
+    assert rate["resets"] == resets == 2 and rate["draws_per_reset"] == pytest.approx(reset_draws / resets)
+    assert reset_draws >= resets  # every start is drawn at least once
 
 
 def test_moves_out_of_the_grid_or_through_the_plant_are_refused(free_env: TVMContinuousEnv) -> None:

@@ -143,6 +143,20 @@ def test_fxaa_touches_only_silhouettes(frames: dict) -> None:
     assert not (changed & ~edge).any()
 
 
+@pytest.mark.parametrize("look,antialiasing", [("helios", "none"), ("default", "none"), ("default", "fxaa")])
+def test_without_depth_colour_and_ids_are_the_same(frames: dict, look: str, antialiasing: str) -> None:
+    """render(depth=False) returns no depth, and the same colour and ids (with antialiasing none
+    it draws with a shader that writes no depth)."""
+    model = frames["model"]
+    with open_renderer("opengl", model.context, CAMERA, model.lighting, look, antialiasing) as renderer:
+        for view in frames["views"]:
+            colour, ids, depth = renderer.render(view)
+            colour2, ids2, none = renderer.render(view, depth=False)
+            assert none is None and depth is not None
+            assert np.array_equal(colour, colour2) and np.array_equal(ids, ids2)
+            assert (ids > 0).any() and (ids == 0).any()  # plant, soil and sky in the frame
+
+
 def test_renderer_and_look_choices() -> None:
     from davis_ag.errors import UserError
 

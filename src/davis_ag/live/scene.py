@@ -44,7 +44,8 @@ class LiveView:
         visible_pixels: Visible pixels of each boxed fruit.
         oer: Object exposure rate (eq. 1, section IV-A) of each boxed fruit.
         visible_fraction: Visible over unoccluded pixels of each boxed fruit (None when not asked).
-        depth: (height, width) float32, metres along the optical axis, 0 where nothing is hit.
+        depth: (height, width) float32, metres along the optical axis, 0 where nothing is hit (None
+            when not asked).
     """
 
     pose: list[float]
@@ -54,7 +55,7 @@ class LiveView:
     visible_pixels: dict[int, int]
     oer: dict[int, float]
     visible_fraction: dict[int, float] | None
-    depth: np.ndarray
+    depth: np.ndarray | None
 
     def box(self, fruit_id: int) -> list[int] | None:
         """The fruit's box in this view, or None."""
@@ -187,7 +188,7 @@ class LiveScene:
 
     def render(self, view: Viewpoint, width: int | None = None, height: int | None = None,
                vfov: float | None = None, antialiasing: str | None = None, fractions: bool = True,
-               fast_ground: bool = False) -> LiveView:
+               fast_ground: bool = False, depth: bool = True) -> LiveView:
         """Draw and label one pose.
 
         Args:
@@ -198,6 +199,8 @@ class LiveScene:
             fractions: Also count each boxed fruit's unoccluded pixels (one small pass per fruit).
             fast_ground: Draw the soil as one quad (:func:`merge_ground`): the same image for
                 fewer triangles; off by default so that a grid pose redraws exactly as stored.
+            depth: Also return the depth image (False: ``depth`` is None, and with antialiasing
+                ``none`` the renderer skips drawing it; colour and labels are the same).
 
         Returns:
             The :class:`LiveView`.
@@ -205,7 +208,7 @@ class LiveScene:
         width = int(width or self.settings.camera.width)
         height = int(height or self.settings.camera.height)
         renderer = self.renderer(width, height, vfov, antialiasing, fast_ground)
-        colour, ids, depth = renderer.render(view)
+        colour, ids, depth_image = renderer.render(view, depth=depth)
         labels = label_view(ids, self.lookup, min_pixels_for(self.settings, width, height))
         visible = None
         if fractions:
@@ -213,7 +216,7 @@ class LiveScene:
             visible = visible_fractions(renderer.camera, view, labels, {},
                                         lambda fruit: renderer.silhouette_pixels(view, fruit, uuids[fruit]))
         return LiveView([*view.position, view.yaw, view.pitch], colour, labels.segmentation, labels.boxes,
-                        labels.visible_pixels, exposure_rates(labels.boxes, labels.visible_pixels), visible, depth)
+                        labels.visible_pixels, exposure_rates(labels.boxes, labels.visible_pixels), visible, depth_image)
 
     def close(self) -> None:
         """Release every renderer."""

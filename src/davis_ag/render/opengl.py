@@ -33,12 +33,11 @@ from __future__ import annotations
 from importlib import resources
 
 import numpy as np
-from PIL import Image
 
 from davis_ag.render.egl_context import create_context, egl_current, egl_restore
 from davis_ag.render.projection import camera_matrices, gl_matrix, helios_shadow_box, light_matrix, matmul32
 from davis_ag.render.scene_geometry import SceneGeometry, read_scene_geometry
-from davis_ag.render.textures import default_sky_texture, load_texture
+from davis_ag.render.textures import decode_srgb, default_sky_texture, load_texture, texture_layers
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.lighting import Lighting
 from davis_ag.scene.view_grid import Viewpoint
@@ -55,20 +54,10 @@ EXPOSURE = 1.0
 SHADOW_MAP_SIZE = 4096
 #: Depth offset of the shadow test, in the map's [0, 1] depth (besides a polygon offset).
 SHADOW_BIAS = 1e-4
-#: The default look's shadow box: every point maps to its middle, so shadows fall everywhere.
-EVERYWHERE = np.array([[0, 0, 0, 0.5], [0, 0, 0, 0.5], [0, 0, 0, 0.5], [0, 0, 0, 1.0]])
 #: Default look: one copy of a ground texture covers this many metres of soil. The Context's own
 #: texture coordinates stretch one soil image over a whole 12 m tile (Helios shows its texels as
 #: 2 cm blocks); the default look lays the image at this size instead, with mipmaps.
 GROUND_REPEAT = 0.5
-#: Largest side of a texture layer in the default look (the array is one size for all layers).
-MAX_LAYER = 4096
-
-
-def decode_srgb(values: np.ndarray) -> np.ndarray:
-    """sRGB-encoded values in [0, 1] to linear light (IEC 61966-2-1)."""
-    values = np.asarray(values, dtype=np.float64)
-    return np.where(values <= 0.04045, values / 12.92, ((values + 0.055) / 1.055) ** 2.4)
 
 
 def linear_albedo(colours: np.ndarray) -> np.ndarray:
@@ -127,18 +116,23 @@ class OpenGLRenderer:
 
         ctx = self.ctx
         helios = self.look == "helios"
+        look = ("HELIOS_LOOK",) if helios else ()
         self._programs = {
-            "scene": ctx.program(vertex_shader=_shader("scene.vert"), fragment_shader=_fragment("scene.frag")),
+            "scene": ctx.program(vertex_shader=_shader("scene.vert"), fragment_shader=_fragment("scene.frag", look)),
             "ids": ctx.program(vertex_shader=_shader("scene.vert"),
-                               fragment_shader=_fragment("scene.frag", ("IDS_ONLY",))),
-            "shadow": ctx.program(vertex_shader=_shader("shadow.vert"), fragment_shader=_fragment("shadow.frag")),
-            "sky": ctx.program(vertex_shader=_shader("sky.vert"), fragment_shader=_fragment("sky.frag")),
+                               fragment_shader=_fragment("scene.frag", ("IDS_ONLY", *look))),
+            "shadow": ctx.program(vertex_shader=_shader("shadow.vert"), fragment_shader=_fragment("shadow.frag", look)),
+            "sky": ctx.program(vertex_shader=_shader("sky.vert"), fragment_shader=_fragment("sky.frag", look)),
         }
         if self.antialiasing == "fxaa":
             self._programs["fxaa"] = ctx.program(vertex_shader=_shader("sky.vert"), fragment_shader=_shader("fxaa.frag"))
-        # Samplers and the look first: the shadow pass below samples leaf textures already.
+        if self.antialiasing == "none":  # colour and ids without the depth output, for render(depth=False)
+            self._programs["no_depth"] = ctx.program(vertex_shader=_shader("scene.vert"),
+                                                     fragment_shader=_fragment("scene.frag", ("NO_DEPTH", *look)))
+        # The programs that shade the scene: the same uniforms for each.
+        self._shading = [self._programs[k] for k in ("scene", "no_depth") if k in self._programs]
+        # Samplers first: the shadow pass below samples leaf textures already.
         for program in self._programs.values():
-            self._set(program, "helios_look", int(helios))
             self._set(program, "textures", 0)
             self._set(program, "shadow_map", 1)
             self._set(program, "sky", 2)
@@ -168,6 +162,9 @@ class OpenGLRenderer:
         names = ["in_position", "in_uv", "in_normal", "in_colour", "in_id", "in_texture", "in_mode"]
         self._scene = ctx.vertex_array(self._programs["scene"], [(self._vbo, layout, *names)], skip_errors=True)
         self._ids = ctx.vertex_array(self._programs["ids"], [(self._vbo, layout, *names)], skip_errors=True)
+        if "no_depth" in self._programs:
+            self._no_depth = ctx.vertex_array(self._programs["no_depth"], [(self._vbo, layout, *names)],
+                                              skip_errors=True)
         shadow_layout = "3f 2f 12x 16x 4x 1i 1i"
         self._shadow = ctx.vertex_array(self._programs["shadow"], [
             (self._vbo, shadow_layout, "in_position", "in_uv", "in_texture", "in_mode")], skip_errors=True)
@@ -203,9 +200,11 @@ class OpenGLRenderer:
         self._colour = ctx.texture((w, h), 4)
         self._id_buffer = ctx.renderbuffer((w, h), 1, dtype="u4")
         self._depth_buffer = ctx.texture((w, h), 1, dtype="f4")
-        self._fbo = ctx.framebuffer([self._colour, self._id_buffer, self._depth_buffer],
-                                    ctx.depth_renderbuffer((w, h)))
+        depth_test = ctx.depth_renderbuffer((w, h))
+        self._fbo = ctx.framebuffer([self._colour, self._id_buffer, self._depth_buffer], depth_test)
         self._colour_fbo = self._fbo  # where the finished colour is read from
+        if self.antialiasing == "none":
+            self._no_depth_fbo = ctx.framebuffer([self._colour, self._id_buffer], depth_test)
         if self.antialiasing == "fxaa":
             self._colour.filter = (moderngl.LINEAR, moderngl.LINEAR)
             self._colour.repeat_x = self._colour.repeat_y = False
@@ -223,43 +222,24 @@ class OpenGLRenderer:
             self._ids_fbo = ctx.framebuffer([self._id_buffer, self._depth_buffer], ctx.depth_renderbuffer((w, h)))
 
         # Uniforms that hold for every view.
-        scene = self._programs["scene"]
-        for program in (scene, self._programs["ids"]):
+        for program in (*self._shading, self._programs["ids"]):
             self._set(program, "light_projection", gl_matrix(self._light))
         self._set(self._programs["sky"], "exposure", EXPOSURE)
-        self._set(scene, "light_depth_range", float(1.0 / np.linalg.norm(self._light[2, :3])))
         for name, value in (("sun", self.lighting.direction), ("exposure", EXPOSURE),
                             ("sky_ambient", SKY_AMBIENT),
                             ("ground_ambient", GROUND_AMBIENT), ("material", MATERIAL),
-                            ("shadow_bias", SHADOW_BIAS)):
-            self._set(scene, name, value)
+                            ("shadow_bias", SHADOW_BIAS),
+                            ("light_depth_range", float(1.0 / np.linalg.norm(self._light[2, :3])))):
+            for program in self._shading:
+                self._set(program, name, value)
+
     def _upload_textures(self, geometry: SceneGeometry) -> None:
         import moderngl
 
         ctx = self.ctx
         helios = self.look == "helios"
-        files = geometry.texture_files or []
-        if helios:
-            images = [load_texture(f, "helios") for f in files]
-            width = max([i.shape[1] for i in images] + [1])
-            height = max([i.shape[0] for i in images] + [1])
-        else:
-            sizes = []
-            for f in files:
-                with Image.open(f) as image:
-                    sizes.append(image.size)
-            width = min(MAX_LAYER, max([s[0] for s in sizes] + [1]))
-            height = min(MAX_LAYER, max([s[1] for s in sizes] + [1]))
-            images = [load_texture(f, "default", (width, height)) for f in files]
-        layers = max(1, len(images))
-        # Half floats in linear light: the shader samples colours it need not decode.
-        data = np.zeros((layers, height, width, 4), dtype=np.float16)
-        scale = np.ones((64, 2), dtype=np.float32)
-        for k, image in enumerate(images):
-            texels = image.astype(np.float64) / 255.0
-            texels[..., :3] = decode_srgb(texels[..., :3])
-            data[k, : image.shape[0], : image.shape[1]] = texels
-            scale[k] = (image.shape[1] / width, image.shape[0] / height)
+        data, scale = texture_layers(geometry.texture_files or [], self.look)
+        layers, height, width = data.shape[:3]
         self._textures = ctx.texture_array((width, height, layers), 4, data.tobytes(), dtype="f2")
         if helios:
             self._textures.filter = (moderngl.NEAREST, moderngl.NEAREST)
@@ -298,24 +278,25 @@ class OpenGLRenderer:
 
     def _view_uniforms(self, view: Viewpoint) -> None:
         eye = np.asarray(view.position, dtype=np.float64)
-        target = np.asarray(view.look_at(1.0), dtype=np.float64)
         view_matrix, projection = camera_matrices(self.camera, view)
         view_projection = matmul32(projection, view_matrix)
         rotation = view_matrix.astype(np.float64)
         rotation[:3, 3] = 0.0
-        # Helios computes shadows only inside a box around its camera's view volume.
-        box = helios_shadow_box(self.camera, eye, target, self.lighting.direction) if self.look == "helios" \
-            else EVERYWHERE
-        for program in (self._programs["scene"], self._programs["ids"]):
+        for program in (*self._shading, self._programs["ids"]):
             self._set(program, "view_projection", gl_matrix(view_projection))
             self._set(program, "view", gl_matrix(view_matrix))
-        self._set(self._programs["scene"], "eye", tuple(eye))
-        self._set(self._programs["scene"], "shadow_box", gl_matrix(box))
+            self._set(program, "eye", tuple(eye))
+        if self.look == "helios":  # Helios computes shadows only inside a box around its camera's view volume
+            target = np.asarray(view.look_at(1.0), dtype=np.float64)
+            box = helios_shadow_box(self.camera, eye, target, self.lighting.direction)
+            for program in self._shading:
+                self._set(program, "shadow_box", gl_matrix(box))
         self._set(self._programs["sky"], "inverse_rotation_projection",
                   gl_matrix(np.linalg.inv(projection.astype(np.float64) @ rotation)))
 
-    def draw(self, view: Viewpoint) -> None:
-        """Draw a view into the renderer's buffers (read them with :meth:`read`)."""
+    def draw(self, view: Viewpoint, depth: bool = True) -> None:
+        """Draw a view into the renderer's buffers (read them with :meth:`read`); without
+        ``depth``, antialiasing ``none`` leaves the depth image out (FXAA needs it)."""
         import moderngl
 
         ctx = self.ctx
@@ -330,6 +311,8 @@ class OpenGLRenderer:
             self._ids_fbo.use()
             self._ids_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
             self._ids.render(moderngl.TRIANGLES)
+        elif not depth and self.antialiasing == "none":
+            self._pass(self._no_depth_fbo, self._no_depth)
         else:
             self._pass(self._fbo, self._scene)
         if self.antialiasing == "fxaa":
@@ -351,27 +334,31 @@ class OpenGLRenderer:
         self._sky.render(moderngl.TRIANGLES, vertices=3)
         self.ctx.polygon_offset = (1.0, 1.0)
 
-    def read(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The last view drawn: colour, primitive ids and depth (see :meth:`render`)."""
+    def read(self, depth: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+        """The last view drawn: colour, primitive ids and depth (None without ``depth``; see :meth:`render`)."""
         w, h = self.camera.width, self.camera.height
         colour = np.frombuffer(self._colour_fbo.read(components=3, attachment=0), dtype=np.uint8).reshape(h, w, 3)
         ids = np.frombuffer(self._fbo.read(components=1, attachment=1, dtype="u4"), dtype=np.uint32).reshape(h, w)
-        depth = np.frombuffer(self._fbo.read(components=1, attachment=2, dtype="f4"), dtype=np.float32).reshape(h, w)
-        return colour[::-1].copy(), ids[::-1].copy(), depth[::-1].copy()
+        if not depth:
+            return colour[::-1].copy(), ids[::-1].copy(), None
+        values = np.frombuffer(self._fbo.read(components=1, attachment=2, dtype="f4"), dtype=np.float32)
+        return colour[::-1].copy(), ids[::-1].copy(), values.reshape(h, w)[::-1].copy()
 
-    def render(self, view: Viewpoint, depth: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Draw one view (the depth comes from the same pass as the ids, so ``depth`` changes nothing).
+    def render(self, view: Viewpoint, depth: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+        """Draw one view; without ``depth`` the depth image is neither returned nor, with
+        antialiasing ``none``, drawn (one fragment output and one interpolated value less).
 
         Returns:
             Colour (height, width, 3) uint8; primitive ids (height, width) uint32, UUID + 1 of the
             primitive seen at each pixel centre, 0 for none; depth (height, width) float32, metres
-            along the optical axis, 0 where nothing is hit. Row 0 is the top of the image.
+            along the optical axis, 0 where nothing is hit, or None without ``depth``. Row 0 is the
+            top of the image. Colour and ids are the same with and without ``depth``.
         """
         previous = egl_current()
         try:
             with self.ctx:
-                self.draw(view)
-                return self.read()
+                self.draw(view, depth)
+                return self.read(depth)
         finally:
             egl_restore(previous)
 

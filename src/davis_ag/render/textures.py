@@ -75,3 +75,49 @@ def load_texture(path: str, look: str, size: tuple[int, int] | None = None) -> n
     return data
 
 
+#: Largest side of a texture layer in the default look (the array is one size for all layers).
+MAX_LAYER = 4096
+
+
+def decode_srgb(values: np.ndarray) -> np.ndarray:
+    """sRGB-encoded values in [0, 1] to linear light (IEC 61966-2-1)."""
+    values = np.asarray(values, dtype=np.float64)
+    return np.where(values <= 0.04045, values / 12.92, ((values + 0.055) / 1.055) ** 2.4)
+
+
+def texture_layers(files: list[str], look: str) -> tuple[np.ndarray, np.ndarray]:
+    """The scene's textures as one array of layers, in linear light, for our renderer.
+
+    Args:
+        files: The texture images, by index.
+        look: ``"helios"`` (Helios's reduced copies, each at its own size in a layer as large as
+            the largest) or ``"default"`` (every image resized to the largest, at most
+            :data:`MAX_LAYER` a side).
+
+    Returns:
+        (layers, height, width, 4) float16 texels, at least one layer; (64, 2) float32, the used
+        part of each layer (width, height fractions).
+    """
+    from PIL import Image
+
+    if look == "helios":
+        images = [load_texture(f, "helios") for f in files]
+        width = max([i.shape[1] for i in images] + [1])
+        height = max([i.shape[0] for i in images] + [1])
+    else:
+        sizes = []
+        for f in files:
+            with Image.open(f) as image:
+                sizes.append(image.size)
+        width = min(MAX_LAYER, max([s[0] for s in sizes] + [1]))
+        height = min(MAX_LAYER, max([s[1] for s in sizes] + [1]))
+        images = [load_texture(f, "default", (width, height)) for f in files]
+    # Half floats in linear light: the shader samples colours it need not decode.
+    data = np.zeros((max(1, len(images)), height, width, 4), dtype=np.float16)
+    scale = np.ones((64, 2), dtype=np.float32)
+    for k, image in enumerate(images):
+        texels = image.astype(np.float64) / 255.0
+        texels[..., :3] = decode_srgb(texels[..., :3])
+        data[k, : image.shape[0], : image.shape[1]] = texels
+        scale[k] = (image.shape[1] / width, image.shape[0] / height)
+    return data, scale

@@ -2,18 +2,21 @@
 // Written for davis-ag from the lighting model Helios's Visualizer documents (Blinn-Phong with a sky
 // and ground ambient, a shadow map, sRGB decoding, an ACES-fitted tone curve); no Helios shader text.
 
+// The look is chosen when the program is compiled (HELIOS_LOOK defined: Helios's texture handling,
+// wrap by fract, nearest texel), not by a uniform: llvmpipe runs both sides of every branch under
+// a mask, so a branch on a uniform would sample the textures of both looks for every fragment.
 uniform sampler2DArray textures;
 uniform vec2 layer_scale[64];   // used part of each layer (Helios look: images keep their own size)
-uniform int helios_look;        // 1: Helios's texture handling (wrap by fract, nearest texel)
 
 vec4 sample_layer(vec2 coordinate, int layer) {
-    if (helios_look == 1) {
-        return texture(textures, vec3(fract(coordinate) * layer_scale[layer], float(layer)));
-    }
+#ifdef HELIOS_LOOK
+    return texture(textures, vec3(fract(coordinate) * layer_scale[layer], float(layer)));
+#else
     // Colour trilinear from the mipmaps; alpha from the full-resolution image, so a leaf keeps its
     // outline at a distance (averaged alpha would thin it below the 0.5 threshold).
     vec3 at = vec3(coordinate, float(layer));
     return vec4(texture(textures, at).rgb, textureLod(textures, at, 0.0).a);
+#endif
 }
 
 vec3 decode_srgb(vec3 c) {

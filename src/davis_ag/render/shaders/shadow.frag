@@ -9,9 +9,9 @@ void main() {
     if (texture_mode == 0) {
         return;
     }
-    if (helios_look == 1) {
-        if (texture(textures, vec3(uv * layer_scale[texture_layer], float(texture_layer))).a < 0.05) discard;
-    } else if (sample_layer(uv, texture_layer).a < 0.5) {
-        discard;
-    }
+#ifdef HELIOS_LOOK
+    if (texture(textures, vec3(uv * layer_scale[texture_layer], float(texture_layer))).a < 0.05) discard;
+#else
+    if (sample_layer(uv, texture_layer).a < 0.5) discard;
+#endif
 }

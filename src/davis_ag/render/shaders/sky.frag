@@ -18,12 +18,11 @@ void main() {
     vec3 d = normalize(far.xyz / far.w);
     // Longitude measured as Helios's sky dome maps it, latitude linear in the height of the direction.
     vec2 coordinate = vec2(0.5 - atan(d.x, -d.y) / (2.0 * PI), 0.5 * d.z + 0.5);
-    vec3 c;
-    if (helios_look == 1) {
-        c = texture(sky, fract(coordinate) * sky_scale).rgb;
-    } else {
-        c = textureLod(sky, vec2(fract(coordinate.x), coordinate.y), 0.0).rgb;
-    }
+#ifdef HELIOS_LOOK
+    vec3 c = texture(sky, fract(coordinate) * sky_scale).rgb;
+#else
+    vec3 c = textureLod(sky, vec2(fract(coordinate.x), coordinate.y), 0.0).rgb;
+#endif
     out_colour = vec4(encode_srgb(tone_curve(decode_srgb(c) * exposure)), 1.0);
     out_id = 0u;
     out_depth = 0.0;
