@@ -6,12 +6,12 @@ Trains the benchmark's A2C (SB3's defaults, the paper's network of section V-B, 
 so one update every 8 x 5 = 40 environment steps) on the SP scenes of ``--dataset`` (without one,
 two small SP strawberry scenes are generated first) and times every update's parts: collecting the
 rollout (the environments' steps and, apart, the rest: the policy's forward passes and SB3's
-bookkeeping) and the update itself (``train()``: forward, backward, RMSprop step). The floor is
-the network alone on observations of the same shape: five forward passes of a batch of 8 and one
-forward, backward and optimiser step of 40, timed in the same process after the run, both layouts in turn. The same
+bookkeeping) and the update itself (``train()``: forward, backward, RMSprop step). The same
 training with the convolutions in the plain NCHW layout (before they ran channels-last) is timed
-alongside, alternating, as the "before". With
-``--doc`` the table is written between the file's ``<!-- a2c:start -->`` and ``<!-- a2c:end -->``.
+alongside, alternating, as the "before". The floor is the network alone on observations of the
+same shape: five forward passes of a batch of 8 and one forward, backward and optimiser step of
+40, timed after the runs, both layouts in turn. With ``--doc`` the table is written between the
+file's ``<!-- a2c:start -->`` and ``<!-- a2c:end -->``.
 """
 
 from __future__ import annotations
