@@ -130,6 +130,48 @@ def test_the_same_request_gives_the_same_scene(generated: tuple[Path, Path, dict
         assert image.read_bytes() == (second / "images" / image.name).read_bytes(), image.name
 
 
+def same_scene(first: Path, second: Path) -> None:
+    """Two scene folders hold the same files with the same bytes (scene.json: but its timings)."""
+    assert (first / "annotations.json").read_bytes() == (second / "annotations.json").read_bytes()
+    meta = [json.loads((d / "scene.json").read_text()) for d in (first, second)]
+    for m in meta:
+        del m["timing_s"]
+    assert meta[0] == meta[1]
+    assert sorted(p.name for p in first.rglob("*")) == sorted(p.name for p in second.rglob("*"))
+    for image in sorted((first / "images").iterdir()):
+        assert image.read_bytes() == (second / "images" / image.name).read_bytes(), image.name
+
+
+def test_a_scene_stopped_mid_way_resumes_to_the_same_scene(generated: tuple[Path, Path, dict],
+                                                           tmp_path: Path) -> None:
+    def stop_after_9(done: int, total: int) -> None:
+        if done == 9:
+            raise KeyboardInterrupt  # Ctrl-C; a kill -9 leaves the same folder without a word
+
+    with pytest.raises(KeyboardInterrupt):
+        generate_scene(REQUEST, tmp_path, on_view=stop_after_9)
+    partial = tmp_path / "Single-Strawberry" / ".000.partial"
+    assert not (tmp_path / REQUEST.folder).exists() and partial.is_dir()
+    drawn: list[int] = []
+    scene_dir, _ = generate_scene(REQUEST, tmp_path, on_view=lambda done, total: drawn.append(done))
+    assert drawn == list(range(1, VIEWS + 1)) and not partial.exists()
+    # The views written before the stop were kept, not drawn again.
+    assert json.loads((scene_dir / "scene.json").read_text())["timing_s"]["views_from_an_earlier_run"] == 9
+    same_scene(generated[1], scene_dir)
+
+
+def test_a_partial_scene_of_another_request_is_cleared(generated: tuple[Path, Path, dict], tmp_path: Path) -> None:
+    partial = tmp_path / "Single-Strawberry" / ".000.partial"
+    (partial / "images").mkdir(parents=True)
+    (partial / "resume.json").write_text(json.dumps({"request": "another one"}))
+    (partial / "views.jsonl").write_text(json.dumps({"name": "0001.jpeg", "entry": {}, "extras": {},
+                                                     "files": ["0001.jpeg"]}) + "\n")
+    (partial / "images" / "0001.jpeg").write_bytes(b"not this scene's view")
+    scene_dir, _ = generate_scene(REQUEST, tmp_path)
+    assert json.loads((scene_dir / "scene.json").read_text())["timing_s"]["views_from_an_earlier_run"] == 0
+    same_scene(generated[1], scene_dir)
+
+
 # ---------------------------------------------------------------------------------------------
 # The command line
 

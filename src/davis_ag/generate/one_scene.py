@@ -10,7 +10,7 @@ from __future__ import annotations
 import json
 import platform
 import time
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Callable
 
@@ -19,7 +19,7 @@ import numpy as np
 from davis_ag.provenance import code_version
 from davis_ag.atomic_files import PROBE_PREFIX, prove_writable_folder
 from davis_ag.errors import UserError
-from davis_ag.generate.scene_writer import SceneWriter, partial_dir
+from davis_ag.generate.scene_writer import SceneWriter
 from davis_ag.labels.fruit_labels import fruit_lookup, label_view, visible_fractions
 from davis_ag.render.backends import ANTIALIASING_DESCRIPTIONS, DEFAULT_RENDERER, open_renderer, resolve_look
 from davis_ag.scene.build import build_scene
@@ -176,13 +176,18 @@ def draw_scene(request: SceneRequest, model, grid, root: Path, on_view: Callable
     fruit_uuids = {f.id: f.uuids for f in model.fruits}
     camera = request.camera
     scene_dir = root / request.folder
-    writer = SceneWriter(scene_dir)
-    visible: dict[str, dict[str, float]] = {}
+    writer = SceneWriter(scene_dir, resume_key(request, viewpoints))
+    # Views a crashed run of this same request left on disk are kept, not drawn again.
+    visible: dict[str, dict[str, float]] = {name: record["extras"]["visible"] for name, record in writer.done.items()}
     try:
         look = resolve_look(request.renderer, request.look)
         with open_renderer(request.renderer, model.context, camera, model.lighting, look,
                            request.antialiasing) as renderer:
             for done, view in enumerate(viewpoints, 1):
+                if view.image_name in writer.done:
+                    if on_view:
+                        on_view(done, len(viewpoints))
+                    continue
                 colour, primitive_ids, depth = renderer.render(view, depth=request.depth)
                 labels = label_view(primitive_ids, lookup, request.min_fruit_pixels)
                 draw_silhouette = getattr(renderer, "silhouette_pixels", None)
@@ -191,22 +196,36 @@ def draw_scene(request: SceneRequest, model, grid, root: Path, on_view: Callable
                 fractions = visible_fractions(camera, view, labels, polygons, silhouette)
                 entry = {"bounding_boxes": labels.boxes, "pose": [round(v, 5) for v in view.pose]}
                 entry.update(grid.pointers(view.index))
-                writer.add_view(view.image_name, colour, labels.segmentation, entry,
-                                depth if request.depth else None)
                 visible[view.image_name] = {str(k): v for k, v in fractions.items()}
+                writer.add_view(view.image_name, colour, labels.segmentation, entry,
+                                depth if request.depth else None, {"visible": visible[view.image_name]})
                 if on_view:
                     on_view(done, len(viewpoints))
             writer.wait()  # every image written before the Visualizer's teardown moves the cwd
         drawn = time.perf_counter()
         metadata = scene_metadata(request, model, grid, visible)
-        metadata["timing_s"] = {"grow": round(grow_s, 3), "draw_and_label": round(drawn - grown, 3)}
+        metadata["timing_s"] = {"grow": round(grow_s, 3), "draw_and_label": round(drawn - grown, 3),
+                                "views_from_an_earlier_run": len(writer.done)}
         writer.finish(metadata)
+    except Exception:
+        writer.abort()  # an error (a full disk, a bug): give the space back; the next run redoes it
+        raise
     except BaseException:
-        writer.abort()
+        writer.abort(keep=True)  # a stop (Ctrl-C): the next run resumes from the views written
         raise
     stats = {"views": len(viewpoints), "grow_s": grow_s, "views_s": drawn - grown,
              "total_s": grow_s + time.perf_counter() - grown}
     return scene_dir, stats
+
+
+def resume_key(request: SceneRequest, viewpoints: list) -> dict:
+    """What a scene's views are drawn from: a crashed run's views are reused only when it matches.
+
+    The request, the views asked for and the code version (a changed generator or renderer may
+    draw differently, so its views are not mixed with this one's).
+    """
+    return json.loads(json.dumps({"request": asdict(request), "seed": request.seed, "code": code_version(),
+                                  "views": [view.image_name for view in viewpoints]}, default=str))
 
 
 def scene_metadata(request: SceneRequest, model, grid, visible: dict) -> dict:
@@ -292,9 +311,3 @@ def check_scene_slot(root: Path, request: SceneRequest) -> bool:
         return True
     return False
 
-
-def remove_stale_partial(root: Path, request: SceneRequest) -> None:
-    """Drop what a crashed run left of a scene."""
-    import shutil
-
-    shutil.rmtree(partial_dir(root / request.folder), ignore_errors=True)

@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Any, Sequence
 
 from davis_ag.errors import UserError
-from davis_ag.generate.one_scene import SceneRequest, generate_scene, remove_stale_partial
+from davis_ag.generate.one_scene import SceneRequest, generate_scene
 from davis_ag.generate.run_progress import Progress, RunOptions, RunReport, record_failure
 
 
@@ -74,7 +74,6 @@ def run_on_pool(todo: Sequence[SceneRequest], root: Path, options: RunOptions, p
                         elif tries.setdefault(request.folder, 0) < options.max_retries:
                             tries[request.folder] += 1
                             progress.write(f"{request.folder}: its worker process died; trying again")
-                            remove_stale_partial(root, request)
                             pending.append(request)
                         else:
                             record_failure(report, progress, request, UserError(
@@ -88,7 +87,7 @@ def run_on_pool(todo: Sequence[SceneRequest], root: Path, options: RunOptions, p
             _drain(events, progress, started)
         except BaseException:
             # Ctrl-C or a bug here: stop the scenes now rather than wait for them (what they
-            # leave is a hidden partial folder, cleared by the next run).
+            # leave is a hidden partial folder, resumed by the next run).
             for process in list(getattr(pool, "_processes", {}).values()):
                 process.kill()
             raise

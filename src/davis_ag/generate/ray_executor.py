@@ -131,7 +131,7 @@ def run_on_ray(todo: Sequence[SceneRequest], root: Path, options: RunOptions, pr
                     report.stats[request.folder] = stats
                     progress.finished(request, stats)
     except BaseException:
-        for ref in refs:  # a killed task leaves only a hidden partial folder, cleared next run
+        for ref in refs:  # a killed task leaves only a hidden partial folder, resumed next run
             ray.cancel(ref, force=True)
         raise
     finally:

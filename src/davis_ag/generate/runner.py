@@ -4,8 +4,10 @@ A run is safe to kill at any moment and to start again with the same command:
 
 - scenes are written atomically (:mod:`davis_ag.generate.scene_writer`), so a scene folder is whole or absent;
   finished scenes are skipped (:func:`davis_ag.generate.one_scene.check_scene_slot`) and what a killed run
-  left of a scene (its hidden ``.NNN.partial`` folder) is removed before the scene is redone;
-- every scene is fully determined by its seed, so a redone scene equals the one that was lost;
+  left of a scene (its hidden ``.NNN.partial`` folder) is resumed: the views it wrote are kept and
+  only the rest are drawn, unless the request or the code changed, when it is cleared and redone;
+- every scene is fully determined by its seed, so a resumed or redone scene equals the one an
+  uninterrupted run writes;
 - ``dataset.json`` (seed, image size, each group's grid) is written before any scene and checked
   on every later run, so one folder never mixes scenes made with different settings; temporary
   files a kill left beside it are removed under the lock;
@@ -42,7 +44,6 @@ from davis_ag.generate.one_scene import (
     check_output_root,
     check_scene_slot,
     generate_scene,
-    remove_stale_partial,
 )
 from davis_ag.generate.run_progress import (  # noqa: F401
     DEFAULT_MAX_RETRIES,
@@ -139,8 +140,6 @@ def run_dataset(requests: Sequence[SceneRequest], root: Path, options: RunOption
             else:
                 todo.append(request)
         write_json_atomic(root / DATASET_FILE, settings)
-        for request in todo:
-            remove_stale_partial(root, request)
         progress = Progress(todo, options.progress)
         if report.skipped:
             progress.write(f"{len(report.skipped)} of {len(requests)} scenes already complete in {root}: skipped")

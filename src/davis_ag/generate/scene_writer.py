@@ -1,16 +1,25 @@
-"""Write one scene in the published DAVIS-Ag layout, atomically.
+"""Write one scene in the published DAVIS-Ag layout, atomically, resuming a crashed scene.
 
 A scene is written into a hidden sibling folder and renamed into place only once every file is
 complete, so a crash never leaves a half-written scene where a reader would look: a scene folder
 either is whole or does not exist.
+
+A multi-plant scene takes most of an hour, so the hidden folder also keeps a journal: one line
+per view whose files are all on disk, with its annotations entry and extras. A run that finds
+the folder of the same request (``resume_key``: the request and the code version) draws only the
+views the journal lacks; generation is deterministic (same seed, same plants, same draws), so
+the finished scene is the one an uninterrupted run writes. Any other folder is cleared. The
+journal and key are removed before the scene is published.
 """
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from PIL import Image
@@ -21,6 +30,9 @@ JPEG_QUALITY = 95
 #: Depth images: uint16 millimetres along the optical axis, 0 where nothing is hit; farther
 #: surfaces than this many millimetres are stored as this value.
 DEPTH_MAX_MM = 65535
+#: In the hidden folder only: the views written so far (JSON lines) and what they were made for.
+JOURNAL = "views.jsonl"
+RESUME_KEY = "resume.json"
 
 
 def depth_png(depth: np.ndarray) -> np.ndarray:
@@ -39,26 +51,41 @@ class SceneWriter:
 
     Image encoding runs on a small thread pool (Pillow releases the GIL while encoding), so it
     overlaps with drawing the next view.
-
-    Args:
-        scene_dir: Where the finished scene will be.
     """
 
-    def __init__(self, scene_dir: Path) -> None:
+    def __init__(self, scene_dir: Path, resume_key: dict[str, Any] | None = None) -> None:
+        """Args:
+            scene_dir: Where the finished scene will be.
+            resume_key: What the scene is made from (JSON-ready); a hidden folder left with the
+                same key is resumed (:attr:`done`), any other is cleared. None: never resume.
+        """
         # Absolute from the start: pyhelios changes the process's working directory while a
         # Visualizer or PlantArchitecture is built or destroyed, and our encoder threads may
         # still be writing then.
         self.scene_dir = Path(scene_dir).absolute()
         self.tmp_dir = partial_dir(self.scene_dir)
+        self.resume_key = resume_key
+        #: Views already on disk from a crashed run: image name -> its journal record.
+        self.done: dict[str, dict[str, Any]] = {}
         if self.tmp_dir.exists():  # left by a run that crashed mid-scene
-            shutil.rmtree(self.tmp_dir)
-        (self.tmp_dir / "images").mkdir(parents=True)
-        self.annotations: dict[str, dict] = {}
+            if resume_key is not None and _read_key(self.tmp_dir) == resume_key:
+                self.done = _read_journal(self.tmp_dir)
+            else:
+                shutil.rmtree(self.tmp_dir)
+        (self.tmp_dir / "images").mkdir(parents=True, exist_ok=True)
+        if resume_key is not None:
+            write_json_atomic(self.tmp_dir / RESUME_KEY, resume_key)
+            # Rewritten with only the views kept, so a torn last line does not stay in the middle.
+            lines = "".join(json.dumps(record) + "\n" for record in self.done.values())
+            (self.tmp_dir / JOURNAL).write_text(lines)
+        self.annotations: dict[str, dict] = {name: record["entry"] for name, record in self.done.items()}
+        self._journal = open(self.tmp_dir / JOURNAL, "a") if resume_key is not None else None
         self._pool = ThreadPoolExecutor(max_workers=2)
-        self._pending: list[Future] = []
+        # Per queued view: its name, its files' futures and its journal record.
+        self._pending: list[tuple[str, list[Future], dict[str, Any]]] = []
 
     def add_view(self, name: str, colour: np.ndarray, segmentation: np.ndarray, entry: dict,
-                 depth: np.ndarray | None = None) -> None:
+                 depth: np.ndarray | None = None, extras: dict[str, Any] | None = None) -> None:
         """Queue one view's image, segmentation, depth and annotations entry.
 
         Args:
@@ -68,23 +95,33 @@ class SceneWriter:
             entry: Its annotations.json entry.
             depth: (height, width) metres along the optical axis, 0 where nothing is hit; written
                 as ``NNNN_depth.png`` (uint16 millimetres) unless None.
+            extras: JSON-ready data of the view the caller wants back when the scene is resumed
+                (``done[name]["extras"]``).
         """
         stem = name.rsplit(".", 1)[0]
         images = self.tmp_dir / "images"
-        self._pending.append(self._pool.submit(
-            lambda: Image.fromarray(colour).save(images / name, quality=JPEG_QUALITY)))
-        self._pending.append(self._pool.submit(
-            lambda: Image.fromarray(segmentation, mode="L").save(images / f"{stem}_seg.png", compress_level=1)))
+        files = [self._pool.submit(lambda: Image.fromarray(colour).save(images / name, quality=JPEG_QUALITY)),
+                 self._pool.submit(lambda: Image.fromarray(segmentation, mode="L").save(
+                     images / f"{stem}_seg.png", compress_level=1))]
         if depth is not None:
-            self._pending.append(self._pool.submit(
+            files.append(self._pool.submit(
                 lambda: Image.fromarray(depth_png(depth)).save(images / f"{stem}_depth.png", compress_level=1)))
+        self._pending.append((name, files, {"name": name, "entry": entry, "extras": extras or {},
+                                            "files": [name, f"{stem}_seg.png"]
+                                            + ([f"{stem}_depth.png"] if depth is not None else [])}))
         self.annotations[name] = entry
-        if len(self._pending) > 24:
-            self._drain(keep=12)
+        if len(self._pending) > 8:
+            self._drain(keep=4)
 
     def _drain(self, keep: int = 0) -> None:
+        """Wait for the oldest views' files, then journal those views, in order."""
         while len(self._pending) > keep:
-            self._pending.pop(0).result()
+            _, files, record = self._pending.pop(0)
+            for future in files:
+                future.result()
+            if self._journal is not None:
+                self._journal.write(json.dumps(record) + "\n")
+                self._journal.flush()
 
     def wait(self) -> None:
         """Block until every queued image is on disk (call before a renderer is closed)."""
@@ -98,6 +135,10 @@ class SceneWriter:
         """
         self._drain()
         self._pool.shutdown()
+        if self._journal is not None:
+            self._journal.close()
+        (self.tmp_dir / JOURNAL).unlink(missing_ok=True)  # not part of the published layout
+        (self.tmp_dir / RESUME_KEY).unlink(missing_ok=True)
         write_json_atomic(self.tmp_dir / "annotations.json", self.annotations)
         write_json_atomic(self.tmp_dir / "scene.json", scene_metadata)
         _fsync_dir(self.tmp_dir / "images")
@@ -105,10 +146,51 @@ class SceneWriter:
         _fsync_dir(self.scene_dir.parent)
         return self.scene_dir
 
-    def abort(self) -> None:
-        """Drop the partial scene."""
-        self._pool.shutdown(cancel_futures=True)
-        shutil.rmtree(self.tmp_dir, ignore_errors=True)
+    def abort(self, keep: bool = False) -> None:
+        """Stop writing the scene.
+
+        Args:
+            keep: Keep the hidden folder, its finished views journalled, for the next run to
+                resume (a stop: Ctrl-C); otherwise drop it (an error such as a full disk, whose
+                space the user wants back). Only a writer with a ``resume_key`` keeps anything.
+        """
+        if not keep or self._journal is None:
+            self._pool.shutdown(cancel_futures=True)
+            if self._journal is not None:
+                self._journal.close()
+            shutil.rmtree(self.tmp_dir, ignore_errors=True)
+            return
+        try:
+            self._drain()  # views already queued are a few encodings from being kept
+        except Exception:  # noqa: BLE001 - a view that cannot be written is simply not kept
+            pass
+        finally:
+            self._pool.shutdown(cancel_futures=True)
+            self._journal.close()
+
+
+def _read_key(folder: Path) -> Any:
+    try:
+        return json.loads((folder / RESUME_KEY).read_text())
+    except (OSError, ValueError):
+        return None
+
+
+def _read_journal(folder: Path) -> dict[str, dict[str, Any]]:
+    """The journalled views whose files are all there; a torn last line (a crash) is skipped."""
+    done: dict[str, dict[str, Any]] = {}
+    try:
+        lines = (folder / JOURNAL).read_text().splitlines()
+    except OSError:
+        return done
+    for line in lines:
+        try:
+            record = json.loads(line)
+        except ValueError:
+            break
+        if all((folder / "images" / name).is_file() for name in record["files"]):
+            done[record["name"]] = record
+    return done
 
 
 def _fsync_dir(path: Path) -> None:
