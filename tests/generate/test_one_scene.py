@@ -160,6 +160,21 @@ def test_a_scene_stopped_mid_way_resumes_to_the_same_scene(generated: tuple[Path
     same_scene(generated[1], scene_dir)
 
 
+def test_a_view_cut_short_and_those_after_it_are_drawn_again(generated: tuple[Path, Path, dict],
+                                                           tmp_path: Path) -> None:
+    def stop_after_9(done: int, total: int) -> None:
+        if done == 9:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        generate_scene(REQUEST, tmp_path, on_view=stop_after_9)
+    cut = tmp_path / "Single-Strawberry" / ".000.partial" / "images" / "0005_seg.png"
+    cut.write_bytes(cut.read_bytes()[:-20])  # what a power loss can leave of a file
+    scene_dir, _ = generate_scene(REQUEST, tmp_path)
+    assert json.loads((scene_dir / "scene.json").read_text())["timing_s"]["views_from_an_earlier_run"] == 4
+    same_scene(generated[1], scene_dir)
+
+
 def test_a_partial_scene_of_another_request_is_cleared(generated: tuple[Path, Path, dict], tmp_path: Path) -> None:
     partial = tmp_path / "Single-Strawberry" / ".000.partial"
     (partial / "images").mkdir(parents=True)

@@ -177,7 +177,13 @@ def _read_key(folder: Path) -> Any:
 
 
 def _read_journal(folder: Path) -> dict[str, dict[str, Any]]:
-    """The journalled views whose files are all there; a torn last line (a crash) is skipped."""
+    """The journalled views, in order, up to the first one torn or with a file not whole.
+
+    Stopping there keeps the views a prefix of the scene's, so annotations.json comes out in the
+    same order as an uninterrupted run's. A torn last line is what a crash mid-write leaves; a
+    file cut short, what a power loss can (the journal is written after its views' files, but
+    neither is synced to disk).
+    """
     done: dict[str, dict[str, Any]] = {}
     try:
         lines = (folder / JOURNAL).read_text().splitlines()
@@ -188,9 +194,27 @@ def _read_journal(folder: Path) -> dict[str, dict[str, Any]]:
             record = json.loads(line)
         except ValueError:
             break
-        if all((folder / "images" / name).is_file() for name in record["files"]):
-            done[record["name"]] = record
+        if not all(_whole(folder / "images" / name) for name in record["files"]):
+            break
+        done[record["name"]] = record
     return done
+
+
+#: How our image files end: JPEG's end-of-image marker and PNG's IEND chunk (with its CRC).
+_FILE_ENDS = {".jpeg": b"\xff\xd9", ".png": b"IEND\xaeB`\x82"}
+
+
+def _whole(path: Path) -> bool:
+    """Whether an image file is there and ends as a complete JPEG or PNG does."""
+    end = _FILE_ENDS.get(path.suffix, b"")
+    try:
+        with open(path, "rb") as file:
+            file.seek(0, os.SEEK_END)
+            size = file.tell()
+            file.seek(max(0, size - len(end)))
+            return size > len(end) and file.read() == end
+    except OSError:
+        return False
 
 
 def _fsync_dir(path: Path) -> None:
