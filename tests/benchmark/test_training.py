@@ -64,6 +64,36 @@ def test_a_killed_run_resumes_from_its_checkpoint(tmp_path: Path, one_thread: No
     assert record["timesteps"] == 240 and record["seconds"] == pytest.approx(sum(s["seconds"] for s in sittings), abs=0.2)
 
 
+def test_a_checkpoint_of_another_dataset_is_not_resumed(tmp_path: Path, one_thread: None,
+                                                         capsys: pytest.CaptureFixture[str]) -> None:
+    first = write_tiny_dataset(tmp_path / "first", "sp", "strawberry", scenes=2)
+    second = write_tiny_dataset(tmp_path / "second", "sp", "strawberry", scenes=2)
+    out = tmp_path / "a2c.zip"
+    with pytest.raises(KeyboardInterrupt):
+        train_a2c(first, "sp", total_timesteps=200, seed=1, out_path=out, n_envs=2, arch="pooled",
+                  device="cpu", checkpoint_every=20, callback=_Kill(60))
+    saved = json.loads(checkpoint_paths(out)[1].read_text())
+    assert saved["dataset"] == str(Path(first).absolute())
+    train_a2c(second, "sp", total_timesteps=100, seed=1, out_path=out, n_envs=2, arch="pooled",
+              device="cpu", checkpoint_every=20)
+    assert "resuming" not in capsys.readouterr().out
+
+
+def test_a_checkpoint_from_before_datasets_were_recorded_still_resumes(
+        tmp_path: Path, one_thread: None, capsys: pytest.CaptureFixture[str]) -> None:
+    root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2)
+    out = tmp_path / "a2c.zip"
+    with pytest.raises(KeyboardInterrupt):
+        train_a2c(root, "sp", total_timesteps=200, seed=1, out_path=out, n_envs=2, arch="pooled",
+                  device="cpu", checkpoint_every=20, callback=_Kill(60))
+    settings_file = checkpoint_paths(out)[1]
+    saved = json.loads(settings_file.read_text())
+    settings_file.write_text(json.dumps({**saved, "dataset": "/"}))  # as earlier versions wrote it
+    train_a2c(root, "sp", total_timesteps=200, seed=1, out_path=out, n_envs=2, arch="pooled",
+              device="cpu", checkpoint_every=20)
+    assert "resuming" in capsys.readouterr().out
+
+
 def test_other_settings_never_resume_a_checkpoint(tmp_path: Path, one_thread: None,
                                                   capsys: pytest.CaptureFixture[str]) -> None:
     root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2)

@@ -128,6 +128,10 @@ def _resumable(settings_file: Path, model_file: Path, settings: dict[str, Any]) 
         return None
     done = saved.pop("timesteps_done", None)
     sittings = saved.pop("sittings", [])
+    if saved.get("dataset") == "/":
+        # Checkpoints before this version recorded Path.root ("/") for any dataset given as a
+        # path; they are taken as they were then, for whatever dataset the run names.
+        saved["dataset"] = settings["dataset"]
     if saved != settings or not isinstance(done, int) or not isinstance(sittings, list):
         return None
     return done, sittings
@@ -182,7 +186,9 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
     final = model_path(Path(out_path).expanduser().absolute())
     prove_writable_file(final)  # before hours of training, not after
     model_file, settings_file = checkpoint_paths(final)
-    settings = {"dataset": str(getattr(dataset, "root", dataset)), "scenario": scenario, "crop": crop,
+    # A path names the dataset itself (a Path's own .root would be "/"); a reader's dataset, its root.
+    root = dataset if isinstance(dataset, (str, os.PathLike)) else getattr(dataset, "root", dataset)
+    settings = {"dataset": str(Path(root).expanduser().absolute()), "scenario": scenario, "crop": crop,
                 "seed": seed, "n_envs": n_envs, "arch": arch, "algorithm": "A2C"}
     env = make_vec_tvm(dataset, scenario, n_envs, seed, "train", crop, cache_dir)
     resumed = _resumable(settings_file, model_file, settings)
