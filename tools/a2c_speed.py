@@ -27,7 +27,7 @@ import torch
 from stable_baselines3 import A2C
 from stable_baselines3.common.vec_env import VecEnvWrapper
 
-from davis_ag.bench import write_section
+from davis_ag.atomic_files import write_marked_section
 from davis_ag.benchmark.networks import ARCHITECTURES
 from davis_ag.benchmark.training import make_vec_tvm
 
@@ -185,7 +185,7 @@ def main() -> int:
     text = table(result)
     print(text)
     if args.doc:
-        write_section(args.doc, "a2c", text)
+        write_marked_section(args.doc, "a2c", text)
         print(f"written {args.doc}")
     return 0
 

@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from davis_ag.bench import write_section
+from davis_ag.atomic_files import write_marked_section
 from davis_ag.generate.one_scene import SceneRequest, grow_scene
 from davis_ag.labels.fruit_labels import fruit_lookup, label_view
 from davis_ag.render.helios import HeliosRenderer
@@ -188,7 +188,7 @@ def main() -> int:
     text = table(rows, camera)
     print(text)
     if args.doc:
-        write_section(args.doc, "antialiasing", text)
+        write_marked_section(args.doc, "antialiasing", text)
     return 0
 
 

@@ -21,7 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from davis_ag.bench import continuous_scene, write_section
+from davis_ag.atomic_files import write_marked_section
+from davis_ag.bench import continuous_scene
 from davis_ag.benchmark.evaluation import format_table
 from davis_ag.live.evaluation import evaluate_continuous
 from davis_ag.live.policies import ModelAgent, build_policies
@@ -65,7 +66,7 @@ def main() -> None:
             f"![training curve]({os.path.relpath(args.png, args.doc.parent) if args.doc else args.png})")
     print(text)
     if args.doc:
-        write_section(args.doc, "continuous-training", text)
+        write_marked_section(args.doc, "continuous-training", text)
 
 
 if __name__ == "__main__":

@@ -67,6 +67,50 @@ def write_json_atomic(path: str | os.PathLike[str], data: Any, indent: int = 1) 
     return write_text_atomic(path, json.dumps(data, indent=indent) + "\n")
 
 
+def save_figure_atomic(figure: Any, path: str | os.PathLike[str], dpi: float | None = None) -> Path:
+    """Save a matplotlib figure atomically, in the format the path's suffix names (PNG when none).
+
+    Args:
+        figure: A matplotlib ``Figure``.
+        path: The file to write.
+        dpi: Dots per inch; ``None`` keeps the figure's own.
+
+    Returns:
+        The path.
+
+    Raises:
+        UserError: when the file cannot be written (a folder in the way, no permission).
+    """
+    out = Path(path)
+    fmt = out.suffix.lstrip(".").lower() or "png"
+    try:
+        with atomic_output(out, "wb") as handle:
+            figure.savefig(handle, format=fmt, **({} if dpi is None else {"dpi": dpi}))
+    except OSError as error:
+        raise UserError(f"{out}: cannot write the figure ({error.strerror or error}); choose "
+                        "another output path") from None
+    return out
+
+
+def write_marked_section(doc: str | os.PathLike[str], marker: str, text: str) -> None:
+    """Replace what lies between ``<!-- MARKER:start -->`` and ``<!-- MARKER:end -->`` in a file.
+
+    This is how measured numbers reach Markdown pages: the code that measured them writes them
+    between markers, and the rest of the page stays as written.
+
+    Raises:
+        UserError: when the file lacks either marker.
+    """
+    doc = Path(doc)
+    content = doc.read_text()
+    start, end = f"<!-- {marker}:start -->", f"<!-- {marker}:end -->"
+    if start not in content or end not in content:
+        raise UserError(f"{doc} has no {start} ... {end} section to write into")
+    head, rest = content.split(start, 1)
+    _, tail = rest.split(end, 1)
+    write_text_atomic(doc, f"{head}{start}\n{text}\n{end}{tail}")
+
+
 # ---------------------------------------------------------------------------------------------
 # Proving an output path writable, and keeping a result whose final write failed
 

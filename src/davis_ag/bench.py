@@ -35,6 +35,7 @@ import time
 from pathlib import Path
 from typing import Callable
 
+from davis_ag.atomic_files import write_marked_section
 from davis_ag.errors import UserError
 from davis_ag.generate.one_scene import SceneRequest, draw_scene, grow_scene
 from davis_ag.generate.run_config import load_dataset_config
@@ -296,10 +297,10 @@ def continuous_line(result: dict) -> str:
 def write_continuous(result: dict, load: tuple[float, float], doc: Path | None) -> None:
     """Write the TVMContinuous-v0 rate into the doc and, beside its folder, the README."""
     if doc:
-        write_section(doc, "bench-continuous", continuous_table(result, load))
+        write_marked_section(doc, "bench-continuous", continuous_table(result, load))
         readme = doc.absolute().parent.parent / "README.md"
         if readme.is_file() and "<!-- continuous-rate:start -->" in readme.read_text():
-            write_section(readme, "continuous-rate", continuous_line(result))
+            write_marked_section(readme, "continuous-rate", continuous_line(result))
 
 
 def run_continuous(out: Path, doc: Path | None) -> dict:
@@ -393,19 +394,6 @@ def table(report: dict) -> str:
     return "\n".join(lines)
 
 
-def write_section(doc: Path, marker: str, text: str) -> None:
-    """Replace what lies between ``<!-- MARKER:start -->`` and ``<!-- MARKER:end -->`` in a file."""
-    from davis_ag.atomic_files import write_text_atomic
-
-    content = doc.read_text()
-    start, end = f"<!-- {marker}:start -->", f"<!-- {marker}:end -->"
-    if start not in content or end not in content:
-        raise UserError(f"{doc} has no {start} ... {end} section to write into")
-    head, rest = content.split(start, 1)
-    _, tail = rest.split(end, 1)
-    write_text_atomic(doc, f"{head}{start}\n{text}\n{end}{tail}")
-
-
 def main(argv: list[str] | None = None) -> int:
     """Command line: ``python -m davis_ag.bench --out out/bench.json [--doc docs/performance.md]``."""
     parser = argparse.ArgumentParser(prog="python -m davis_ag.bench", description=__doc__,
@@ -434,7 +422,7 @@ def main(argv: list[str] | None = None) -> int:
     text = table(report)
     print(text)
     if args.doc:
-        write_section(args.doc, "bench", text)
+        write_marked_section(args.doc, "bench", text)
         if "continuous_env" in report:
             load = report["machine"]["load_average"]
             write_continuous(report["continuous_env"], (load["start"][0], load["end"][0]), args.doc)

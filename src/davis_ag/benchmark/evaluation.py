@@ -17,7 +17,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from davis_ag.atomic_files import atomic_output, write_json_atomic
+from davis_ag.atomic_files import save_figure_atomic, write_json_atomic
 from davis_ag.benchmark import TVMEnv
 from davis_ag.benchmark.agents import Agent
 
@@ -206,10 +206,7 @@ def plot_results(results: dict[str, Any], path: str | os.PathLike[str]) -> Path:
     fig.suptitle(f"{protocol['scenario'].upper()} {protocol['split']}: {protocol['sessions']} x "
                  f"{protocol['episodes']} episodes")
     fig.tight_layout()
-    out = Path(path)
     try:
-        with atomic_output(out) as handle:
-            fig.savefig(handle, format="png", dpi=120)
+        return save_figure_atomic(fig, path, dpi=120)
     finally:
         plt.close(fig)
-    return out

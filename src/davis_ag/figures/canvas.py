@@ -7,8 +7,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from davis_ag.atomic_files import atomic_output
-from davis_ag.errors import UserError
+from davis_ag.atomic_files import save_figure_atomic as save_figure  # noqa: F401 (the figures' saver)
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -22,23 +21,6 @@ def new_figure(width: float, height: float) -> Figure:
     figure = Figure(figsize=(width, height), dpi=100)
     FigureCanvasAgg(figure)
     return figure
-
-
-def save_figure(figure: Figure, out_path: str | Path) -> Path:
-    """Save ``figure`` to ``out_path`` atomically (format from the suffix; PNG when there is none).
-
-    Raises:
-        UserError: when the file cannot be written (a folder in the way, no permission).
-    """
-    out = Path(out_path)
-    fmt = out.suffix.lstrip(".").lower() or "png"
-    try:
-        with atomic_output(out, "wb") as handle:
-            figure.savefig(handle, format=fmt)
-    except OSError as error:
-        raise UserError(f"{out}: cannot write the figure ({error.strerror or error}); choose "
-                        "another output path") from None
-    return out
 
 
 #: Formats ``davis-ag plot`` writes by default.

@@ -16,7 +16,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from davis_ag.atomic_files import atomic_output, prove_writable_file, write_or_rescue
+from davis_ag.atomic_files import prove_writable_file, save_figure_atomic, write_or_rescue
 from davis_ag.benchmark.networks import ARCHITECTURES
 from davis_ag.benchmark.training import model_path, save_model
 from davis_ag.errors import UserError
@@ -150,10 +150,7 @@ def plot_training_curve(records: list[dict], path: str | os.PathLike[str], title
         ax.set_title(label)
     fig.suptitle(title)
     fig.tight_layout()
-    out = Path(path)
     try:
-        with atomic_output(out) as handle:
-            fig.savefig(handle, format="png", dpi=110)
+        return save_figure_atomic(fig, path, dpi=110)
     finally:
         plt.close(fig)
-    return out
