@@ -71,3 +71,28 @@ def test_a_run_resumed_across_code_changes_says_so(tmp_path: Path) -> None:
     assert "**holds** in this run" in text  # .6 > .45 ~ .44 > .3
     assert "under-trained" not in text  # 300K steps: the paper's count
     assert "do not edit by hand" in text and "How this run was made" in text
+
+
+def test_the_readme_block_beside_docs_is_rewritten_from_the_run(tmp_path: Path) -> None:
+    # A results page in a project's docs/ writes the README's block too: no number copied by hand.
+    (tmp_path / "docs").mkdir()
+    readme = tmp_path / "README.md"
+    readme.write_text("# p\n\nbefore\n<!-- results-table4:start -->\nstale .999\n<!-- results-table4:end -->\nafter\n")
+    stat = {"mean": 0.5, "std": 0.01}
+    policies = {name: {"oer_tau": dict(stat, mean=m), "reward": stat, "length": stat}
+                for name, m in (("A2C", .6), ("Rand", .45), ("LRD", .44), ("UDD", .3))}
+    state = {"results": {"sp": {"protocol": {"split": "test", "tau": 3, "sessions": 3, "episodes": 200,
+                                             "scenes": ["Single-Strawberry/003", "Single-Strawberry/007"]},
+                                "policies": policies}}}
+    write_results_md(tmp_path / "docs" / "results.md", CONFIGS["medium"], state, tmp_path)
+    text = readme.read_text()
+    assert "stale" not in text and text.startswith("# p\n\nbefore\n") and text.endswith("after\n")
+    assert "| SP strawberry, ours (2 test scenes) | .600 ± .010 | .440 ± .010 | .300 ± .010 | .450 ± .010 | – |" in text
+    assert "| SP strawberry, paper (Table 4) | .520 ± .004 | .433 ± .007 | .371 ± .008 | .438 ± .101 | - |" in text
+    assert "| MP vine, ours | not run |" in text and "| MP vine, paper (Table 4) | .369 ± .009 |" in text
+    assert "SP strawberry: A2C > Rand ~ LRD > UDD **holds**." in text
+    # A page written elsewhere (a work folder beside the README) leaves the README alone.
+    other = tmp_path / "work"
+    other.mkdir()
+    write_results_md(other / "results.md", CONFIGS["medium"], {"results": {}}, other)
+    assert readme.read_text() == text

@@ -212,6 +212,51 @@ def _comparison(scenario: str, policies: dict[str, dict[str, Any]]) -> str:
             f"deviations added), **{verdict}** in this run{paper_note}: {measured}.")
 
 
+#: The README's block that holds the run's OER_tau beside Table 4's (see :func:`readme_block`).
+README_MARKER = "results-table4"
+
+
+def readme_block(config: Any, state: dict[str, Any]) -> str:
+    """The README's short Table 4: OER_tau, ours beside the paper's, and whether the orderings hold.
+
+    Args:
+        config: The run's :class:`~davis_ag.workflows.reproduce.ReproduceConfig`.
+        state: The run's ``state.json`` (its ``results``).
+
+    Returns:
+        Markdown: a line on the run, a table, a line per ordering.
+    """
+    results = state.get("results", {})
+    head = (f"`{config.name}` run (docs/results.md): {config.sp_scenes} SP strawberry and {config.mp_scenes} "
+            f"MP vine scenes at {config.size[0]}x{config.size[1]}, A2C {config.sp_timesteps:,} (SP) and "
+            f"{config.mp_timesteps:,} (MP) steps; OER_tau, mean ± std over {config.sessions} sessions of "
+            f"{config.episodes} episodes on the test split. Table 4's rows are the paper's.")
+    lines = [head, "", "| | A2C | LRD | UDD | Rand | Oracle (ours only) |", "|---|---|---|---|---|---|"]
+    verdicts = []
+    for scenario in ("sp", "mp"):
+        result = results.get(scenario)
+        if result:
+            policies = result["policies"]
+            scenes = len(result["protocol"].get("scenes", []))
+            cells = [f"{_cell(policies[n]['oer_tau']['mean'])} ± {_cell(policies[n]['oer_tau']['std'])}"
+                     if n in policies else "–" for n in ("A2C", "LRD", "UDD", "Rand", "Oracle")]
+            lines.append(f"| {TITLES[scenario]}, ours ({scenes} test scene{'s' if scenes != 1 else ''}) | "
+                         + " | ".join(cells) + " |")
+            holds = ordering_holds(PAPER_ORDERINGS[scenario], policies)
+            verdicts.append(f"{TITLES[scenario]}: {' '.join(PAPER_ORDERINGS[scenario])} "
+                            + {True: "**holds**", False: "**does not hold**", None: "not checked"}[holds] + ".")
+        else:
+            lines.append(f"| {TITLES[scenario]}, ours | not run | | | | |")
+        paper = PAPER_TABLE4[scenario]["oer_tau"]
+        lines.append(f"| {TITLES[scenario]}, paper (Table 4) | "
+                     + " | ".join(f"{_cell(paper[n])} ± {_cell(PAPER_TABLE4_STD[scenario]['oer_tau'][n])}"
+                                  for n in ("A2C", "LRD", "UDD", "Rand")) + " | - |")
+    if verdicts:
+        lines += ["", "The paper's orderings in this run (`~`: means within their two standard deviations "
+                  "added): " + " ".join(verdicts)]
+    return "\n".join(lines)
+
+
 def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path | None = None) -> Path:
     """Write the Markdown results: our Table 4 beside the paper's, how the run was made, the timings.
 
@@ -225,7 +270,7 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
     Returns:
         ``path``.
     """
-    from davis_ag.atomic_files import write_text_atomic
+    from davis_ag.atomic_files import write_marked_section, write_text_atomic
     from davis_ag.scene.specs import crop_spec, scenario_spec
     from davis_ag.scene.view_grid import views_per_scene
 
@@ -288,4 +333,11 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
         total += entry["seconds"]
         lines.append(f"| {stage} | {entry['seconds']:.0f} | {entry['note']} |")
     lines += [f"| total | {total:.0f} | |", ""]
-    return write_text_atomic(path, "\n".join(lines) + "\n")
+    written = write_text_atomic(path, "\n".join(lines) + "\n")
+    # A page in a project's docs/ also updates the README's block beside it, so the README's
+    # numbers are the run's, never copied by hand.
+    folder = Path(path).absolute().parent
+    readme = folder.parent / "README.md"
+    if folder.name == "docs" and readme.is_file() and f"<!-- {README_MARKER}:start -->" in readme.read_text():
+        write_marked_section(readme, README_MARKER, readme_block(config, state))
+    return written
