@@ -64,13 +64,22 @@ def test_a_run_resumed_across_code_changes_says_so(tmp_path: Path) -> None:
                                 "policies": {name: {"oer_tau": dict(stat, mean=m), "reward": stat, "length": stat}
                                              for name, m in (("A2C", .6), ("Rand", .45), ("LRD", .44),
                                                              ("UDD", .3))}}},
-             "stages": {"sp-strawberry: generate": {"seconds": 12.0, "note": "2 scenes", "code": "0.1.0+aaaa"}}}
+             # What a resuming sitting (code bbbb) leaves in state.json: it re-records the generate
+             # stage it only skipped, and times only its own part of the training.
+             "stages": {"sp-strawberry: generate": {"seconds": 12.0, "note": "2 scenes", "code": "0.1.0+bbbb"},
+                        "sp-strawberry: train A2C": {"seconds": 4200.0, "note": "300000 steps, 71.4 steps/s",
+                                                     "code": "0.1.0+bbbb"}}}
     text = write_results_md(tmp_path / "results.md", CONFIGS["medium"], state, tmp_path).read_text()
     assert "0.1.0+aaaa (1 scene); 0.1.0+bbbb (1 scene) — made by more than one version of the code" in text
     assert "300,000 steps in 2 sitting(s)" in text and "the code changed between sittings" in text
     assert "**holds** in this run" in text  # .6 > .45 ~ .44 > .3
     assert "under-trained" not in text  # 300K steps: the paper's count
     assert "do not edit by hand" in text and "How this run was made" in text
+    # The stage table takes each stage's code from what did the work: the scenes, the sittings.
+    assert "| sp-strawberry: generate | 12 | 0.1.0+aaaa (1 scene); 0.1.0+bbbb (1 scene) | 2 scenes |" in text
+    assert ("| sp-strawberry: train A2C | 7200 | 0.1.0+aaaa, 0.1.0+bbbb | 300,000 steps in 2 sitting(s), "
+            "41.7 steps/s over the sittings' wall time |") in text
+    assert "71.4" not in text and "| total | 7212 | | |" in text
 
 
 def test_the_readme_block_beside_docs_is_rewritten_from_the_run(tmp_path: Path) -> None:

@@ -189,11 +189,38 @@ def _how_made(state: dict[str, Any], out: Path | None) -> list[str]:
         record = _load(training_record_path(out / "models" / f"a2c_{key}.zip"))
         if record:
             lines.append(f"  - A2C: {training_provenance(record)}")
-    stage_codes = Counter(entry.get("code", "unrecorded") for entry in state.get("stages", {}).values())
-    if stage_codes:
-        lines.append(f"- Stages run by code {', '.join(stage_codes)}"
-                     + (" (more than one version)" if len(stage_codes) > 1 else "") + ".")
     return lines + [""]
+
+
+def stage_rows(state: dict[str, Any], out: Path | None) -> list[tuple[str, float, str, str]]:
+    """The wall time per stage, each with the code that did its work and a note.
+
+    A stage's entry in ``state.json`` is rewritten by every sitting that passes it, even one that
+    only skipped finished scenes or resumed a training run. So the code of a generate stage is read
+    from its scenes' ``scene.json``, and a training stage's time, rate and code from the model's
+    training record (every sitting), where those exist.
+
+    Returns:
+        ``(stage, seconds, code, note)`` rows in the run's order.
+    """
+    from davis_ag.benchmark.training import training_record_path
+
+    rows = []
+    for stage, entry in state.get("stages", {}).items():
+        key, _, step = stage.partition(": ")
+        seconds, code, note = entry["seconds"], entry.get("code", "unrecorded"), entry["note"]
+        if out is not None and step == "generate" and state.get("scene_folders", {}).get(key):
+            code = _counted(Counter(_load(out / "dataset" / scene / "scene.json").get("generator", {})
+                                    .get("version", "unrecorded") for scene in state["scene_folders"][key]))
+        record = _load(training_record_path(out / "models" / f"a2c_{key}.zip")) if out is not None else {}
+        if step == "train A2C" and record.get("sittings"):
+            sittings = record["sittings"]
+            seconds = record.get("seconds", seconds)
+            code = ", ".join(dict.fromkeys(s.get("code", "unrecorded") for s in sittings))
+            note = (f"{record.get('timesteps', 0):,} steps in {len(sittings)} sitting(s), "
+                    f"{record.get('steps_per_second', 0):.1f} steps/s over the sittings' wall time")
+        rows.append((stage, seconds, code, note))
+    return rows
 
 
 def _comparison(scenario: str, policies: dict[str, dict[str, Any]]) -> str:
@@ -327,12 +354,12 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
         lines.append("")
     lines += ["## Notes", ""] + [f"- {note}" for note in _notes(config, state, out)] + [""]
     lines += _how_made(state, out)
-    lines += ["## Wall time per stage", "", "| Stage | Seconds | Note |", "|---|---|---|"]
+    lines += ["## Wall time per stage", "", "| Stage | Seconds | Code | Note |", "|---|---|---|---|"]
     total = 0.0
-    for stage, entry in state.get("stages", {}).items():
-        total += entry["seconds"]
-        lines.append(f"| {stage} | {entry['seconds']:.0f} | {entry['note']} |")
-    lines += [f"| total | {total:.0f} | |", ""]
+    for stage, seconds, code, note in stage_rows(state, out):
+        total += seconds
+        lines.append(f"| {stage} | {seconds:.0f} | {code} | {note} |")
+    lines += [f"| total | {total:.0f} | | |", ""]
     written = write_text_atomic(path, "\n".join(lines) + "\n")
     # A page in a project's docs/ also updates the README's block beside it, so the README's
     # numbers are the run's, never copied by hand.
