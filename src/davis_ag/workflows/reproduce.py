@@ -211,8 +211,10 @@ def _progress_callback(total: int, label: str) -> Any:
     class Progress(BaseCallback):
         # A bar on a terminal; in a log (not a terminal), a line a minute instead of a redrawn bar.
         def _on_training_start(self) -> None:
-            self.bar = tqdm(total=total, desc=f"A2C {label}", unit="step", mininterval=5, disable=None)
-            self.steps, self.last = 0, time.monotonic()
+            # A run resumed from a checkpoint starts at the checkpoint's step count, not at 0.
+            self.steps, self.last = int(self.model.num_timesteps), time.monotonic()
+            self.bar = tqdm(total=total, initial=self.steps, desc=f"A2C {label}", unit="step",
+                            mininterval=5, disable=None)
 
         def _on_step(self) -> bool:
             self.bar.update(self.training_env.num_envs)
