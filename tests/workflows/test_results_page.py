@@ -12,6 +12,7 @@ from davis_ag.workflows.results_page import (
     PAPER_ORDERINGS,
     PAPER_TABLE4,
     PAPER_TABLE4_STD,
+    ordering_failures,
     ordering_holds,
     write_results_md,
 )
@@ -72,7 +73,8 @@ def test_a_run_resumed_across_code_changes_says_so(tmp_path: Path) -> None:
     text = write_results_md(tmp_path / "results.md", CONFIGS["medium"], state, tmp_path).read_text()
     assert "0.1.0+aaaa (1 scene); 0.1.0+bbbb (1 scene) — made by more than one version of the code" in text
     assert "300,000 steps in 2 sitting(s)" in text and "the code changed between sittings" in text
-    assert "**holds** in this run" in text  # .6 > .45 ~ .44 > .3
+    assert "**holds** in this run:" in text  # .6 > .45 ~ .44 > .3
+    assert "nor does it hold in Table 4's own numbers" not in text  # Table 4 meets its own ordering
     assert "under-trained" not in text  # 300K steps: the paper's count
     assert "do not edit by hand" in text and "How this run was made" in text
     # The stage table takes each stage's code from what did the work: the scenes, the sittings.
@@ -105,3 +107,14 @@ def test_the_readme_block_beside_docs_is_rewritten_from_the_run(tmp_path: Path) 
     other.mkdir()
     write_results_md(other / "results.md", CONFIGS["medium"], {"results": {}}, other)
     assert readme.read_text() == text
+
+
+def test_a_broken_ordering_names_the_steps_that_break() -> None:
+    # Our medium run's SP numbers: A2C .405 > Rand .388, but Rand and LRD are .030 apart with
+    # stds .003 and .002, and UDD .360 is above LRD .358.
+    stats = {name: {"oer_tau": {"mean": m, "std": sd}} for name, m, sd in
+             (("A2C", .405, .002), ("Rand", .388, .003), ("LRD", .358, .002), ("UDD", .360, .005))}
+    assert ordering_failures(PAPER_ORDERINGS["sp"], stats) == [
+        "Rand ~ LRD fails: .388 and .358 are .030 apart, more than their stds added (.005)",
+        "LRD > UDD fails: .358 is not above .360"]
+    assert ordering_failures(PAPER_ORDERINGS["mp"], stats) == []  # A2C > Rand > LRD ~ UDD

@@ -63,27 +63,42 @@ def machine_description() -> str:
             f"torch {torch.__version__}, {platform.system()} {platform.release()}")
 
 
-def ordering_holds(order: tuple[str, ...], policies: dict[str, dict[str, Any]],
-                   metric: str = "oer_tau") -> bool | None:
-    """Whether an ordering such as ``A2C > Rand ~ LRD > UDD`` holds for measured means and stds.
+def ordering_failures(order: tuple[str, ...], policies: dict[str, dict[str, Any]],
+                      metric: str = "oer_tau") -> list[str] | None:
+    """The steps of an ordering such as ``A2C > Rand ~ LRD > UDD`` that measured means and stds break.
 
     ``a > b`` holds when a's mean exceeds b's; ``a ~ b`` when the means differ by no more than the
     two standard deviations (over sessions) added.
 
     Returns:
-        True or False; None when a policy in the ordering was not measured.
+        One sentence per broken step (empty when the ordering holds); None when a policy in the
+        ordering was not measured.
     """
     try:
         stats = {name: policies[name][metric] for name in order[::2]}
     except KeyError:
         return None
+    failures = []
     for left, relation, right in zip(order[0::2], order[1::2], order[2::2]):
         a, b = stats[left], stats[right]
         if relation == ">" and not a["mean"] > b["mean"]:
-            return False
-        if relation == "~" and abs(a["mean"] - b["mean"]) > a["std"] + b["std"]:
-            return False
-    return True
+            failures.append(f"{left} > {right} fails: {_cell(a['mean'])} is not above {_cell(b['mean'])}")
+        gap, spread = abs(a["mean"] - b["mean"]), a["std"] + b["std"]
+        if relation == "~" and gap > spread:
+            failures.append(f"{left} ~ {right} fails: {_cell(a['mean'])} and {_cell(b['mean'])} are "
+                            f"{_cell(gap)} apart, more than their stds added ({_cell(spread)})")
+    return failures
+
+
+def ordering_holds(order: tuple[str, ...], policies: dict[str, dict[str, Any]],
+                   metric: str = "oer_tau") -> bool | None:
+    """Whether an ordering holds for measured means and stds (:func:`ordering_failures`).
+
+    Returns:
+        True or False; None when a policy in the ordering was not measured.
+    """
+    failures = ordering_failures(order, policies, metric)
+    return None if failures is None else not failures
 
 
 def _cell(value: float | None) -> str:
@@ -225,18 +240,19 @@ def stage_rows(state: dict[str, Any], out: Path | None) -> list[tuple[str, float
 
 def _comparison(scenario: str, policies: dict[str, dict[str, Any]]) -> str:
     order = PAPER_ORDERINGS[scenario]
-    paper = {name: {"mean": value, "std": PAPER_TABLE4_STD[scenario]["oer_tau"][name]}
+    paper = {name: {"oer_tau": {"mean": value, "std": PAPER_TABLE4_STD[scenario]["oer_tau"][name]}}
              for name, value in PAPER_TABLE4[scenario]["oer_tau"].items()}
-    holds = ordering_holds(order, policies)
+    failures = ordering_failures(order, policies)
     text = " ".join(order)
-    if holds is None:
+    if failures is None:
         return f"The paper's ordering of OER_tau, {text}, cannot be checked: a policy was not run."
     measured = ", ".join(f"{name} {_cell(policies[name]['oer_tau']['mean'])} ± {_cell(policies[name]['oer_tau']['std'])}"
                          for name in order[::2])
-    verdict = "holds" if holds else "does not hold"
+    verdict = "holds" if not failures else "does not hold"
     paper_note = "" if ordering_holds(order, paper) else " (nor does it hold in Table 4's own numbers)"
+    where = "" if not failures else " " + "; ".join(failures) + "."
     return (f"The paper's ordering of OER_tau, {text} (`>`: higher mean; `~`: means within the two standard "
-            f"deviations added), **{verdict}** in this run{paper_note}: {measured}.")
+            f"deviations added), **{verdict}** in this run{paper_note}: {measured}.{where}")
 
 
 #: The README's block that holds the run's OER_tau beside Table 4's (see :func:`readme_block`).
@@ -269,9 +285,10 @@ def readme_block(config: Any, state: dict[str, Any]) -> str:
                      if n in policies else "–" for n in ("A2C", "LRD", "UDD", "Rand", "Oracle")]
             lines.append(f"| {TITLES[scenario]}, ours ({scenes} test scene{'s' if scenes != 1 else ''}) | "
                          + " | ".join(cells) + " |")
-            holds = ordering_holds(PAPER_ORDERINGS[scenario], policies)
-            verdicts.append(f"{TITLES[scenario]}: {' '.join(PAPER_ORDERINGS[scenario])} "
-                            + {True: "**holds**", False: "**does not hold**", None: "not checked"}[holds] + ".")
+            failures = ordering_failures(PAPER_ORDERINGS[scenario], policies)
+            verdict = ("not checked" if failures is None else "**holds**" if not failures
+                       else "**does not hold** (" + "; ".join(failures) + ")")
+            verdicts.append(f"{TITLES[scenario]}: {' '.join(PAPER_ORDERINGS[scenario])} {verdict}.")
         else:
             lines.append(f"| {TITLES[scenario]}, ours | not run | | | | |")
         paper = PAPER_TABLE4[scenario]["oer_tau"]
