@@ -273,17 +273,17 @@ def readme_block(config: Any, state: dict[str, Any]) -> str:
     head = (f"`{config.name}` run (docs/results.md): {config.sp_scenes} SP strawberry and {config.mp_scenes} "
             f"MP vine scenes at {config.size[0]}x{config.size[1]}, A2C {config.sp_timesteps:,} (SP) and "
             f"{config.mp_timesteps:,} (MP) steps; OER_tau, mean ± std over {config.sessions} sessions of "
-            f"{config.episodes} episodes on the test split. Table 4's rows are the paper's.")
+            f"{config.episodes} episodes on the split each row names. Table 4's rows are the paper's.")
     lines = [head, "", "| | A2C | LRD | UDD | Rand | Oracle (ours only) |", "|---|---|---|---|---|---|"]
     verdicts = []
     for scenario in ("sp", "mp"):
         result = results.get(scenario)
         if result:
             policies = result["policies"]
-            scenes = len(result["protocol"].get("scenes", []))
+            scenes, split = len(result["protocol"].get("scenes", [])), result["protocol"]["split"]
             cells = [f"{_cell(policies[n]['oer_tau']['mean'])} ± {_cell(policies[n]['oer_tau']['std'])}"
                      if n in policies else "–" for n in ("A2C", "LRD", "UDD", "Rand", "Oracle")]
-            lines.append(f"| {TITLES[scenario]}, ours ({scenes} test scene{'s' if scenes != 1 else ''}) | "
+            lines.append(f"| {TITLES[scenario]}, ours ({scenes} {split} scene{'s' if scenes != 1 else ''}) | "
                          + " | ".join(cells) + " |")
             failures = ordering_failures(PAPER_ORDERINGS[scenario], policies)
             verdict = ("not checked" if failures is None else "**holds**" if not failures
