@@ -6,25 +6,12 @@ import json
 from pathlib import Path
 
 import pytest
+from kill_callback import KillAfter
 from layout_factory import write_tiny_dataset
 from stable_baselines3 import A2C
-from stable_baselines3.common.callbacks import BaseCallback
 
 from davis_ag.benchmark.training import checkpoint_paths, train_a2c, training_record_path
 from davis_ag.provenance import code_version
-
-
-class _Kill(BaseCallback):
-    """Stands in for a kill: stops the process's training with an exception after ``at`` steps."""
-
-    def __init__(self, at: int) -> None:
-        super().__init__()
-        self.at = at
-
-    def _on_step(self) -> bool:
-        if self.model.num_timesteps >= self.at:
-            raise KeyboardInterrupt
-        return True
 
 
 @pytest.fixture()
@@ -44,7 +31,7 @@ def test_a_killed_run_resumes_from_its_checkpoint(tmp_path: Path, one_thread: No
     kwargs = dict(total_timesteps=240, seed=1, out_path=out, n_envs=2, arch="pooled", device="cpu",
                   checkpoint_every=40)
     with pytest.raises(KeyboardInterrupt):
-        train_a2c(root, "sp", callback=_Kill(130), **kwargs)
+        train_a2c(root, "sp", callback=KillAfter(130), **kwargs)
     model_file, settings_file = checkpoint_paths(out)
     saved = json.loads(settings_file.read_text())
     assert 80 <= saved["timesteps_done"] <= 130 and model_file.is_file()
@@ -71,7 +58,7 @@ def test_a_checkpoint_of_another_dataset_is_not_resumed(tmp_path: Path, one_thre
     out = tmp_path / "a2c.zip"
     with pytest.raises(KeyboardInterrupt):
         train_a2c(first, "sp", total_timesteps=200, seed=1, out_path=out, n_envs=2, arch="pooled",
-                  device="cpu", checkpoint_every=20, callback=_Kill(60))
+                  device="cpu", checkpoint_every=20, callback=KillAfter(60))
     saved = json.loads(checkpoint_paths(out)[1].read_text())
     assert saved["dataset"] == str(Path(first).absolute())
     train_a2c(second, "sp", total_timesteps=100, seed=1, out_path=out, n_envs=2, arch="pooled",
@@ -85,7 +72,7 @@ def test_a_checkpoint_from_before_datasets_were_recorded_still_resumes(
     out = tmp_path / "a2c.zip"
     with pytest.raises(KeyboardInterrupt):
         train_a2c(root, "sp", total_timesteps=200, seed=1, out_path=out, n_envs=2, arch="pooled",
-                  device="cpu", checkpoint_every=20, callback=_Kill(60))
+                  device="cpu", checkpoint_every=20, callback=KillAfter(60))
     settings_file = checkpoint_paths(out)[1]
     saved = json.loads(settings_file.read_text())
     settings_file.write_text(json.dumps({**saved, "dataset": "/"}))  # as earlier versions wrote it
@@ -100,7 +87,7 @@ def test_other_settings_never_resume_a_checkpoint(tmp_path: Path, one_thread: No
     out = tmp_path / "a2c.zip"
     with pytest.raises(KeyboardInterrupt):
         train_a2c(root, "sp", total_timesteps=200, seed=1, out_path=out, n_envs=2, arch="pooled",
-                  device="cpu", checkpoint_every=20, callback=_Kill(60))
+                  device="cpu", checkpoint_every=20, callback=KillAfter(60))
     path = train_a2c(root, "sp", total_timesteps=100, seed=2, out_path=out, n_envs=2, arch="pooled",
                      device="cpu", checkpoint_every=20)
     assert "resuming" not in capsys.readouterr().out

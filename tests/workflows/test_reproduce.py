@@ -6,24 +6,12 @@ from pathlib import Path
 
 import pytest
 import torch
+from kill_callback import KillAfter
 from layout_factory import write_tiny_dataset
-from stable_baselines3.common.callbacks import BaseCallback, CallbackList
+from stable_baselines3.common.callbacks import CallbackList
 
 from davis_ag.benchmark.training import train_a2c
 from davis_ag.workflows.reproduce import _progress_callback
-
-
-class _Kill(BaseCallback):
-    """Stands in for a kill after ``at`` steps."""
-
-    def __init__(self, at: int) -> None:
-        super().__init__()
-        self.at = at
-
-    def _on_step(self) -> bool:
-        if self.model.num_timesteps >= self.at:
-            raise KeyboardInterrupt
-        return True
 
 
 def test_progress_of_a_resumed_run_starts_at_its_checkpoint(tmp_path: Path) -> None:
@@ -34,7 +22,7 @@ def test_progress_of_a_resumed_run_starts_at_its_checkpoint(tmp_path: Path) -> N
         kwargs = dict(total_timesteps=160, seed=1, out_path=tmp_path / "a2c", n_envs=2, arch="pooled",
                       device="cpu", checkpoint_every=40)
         with pytest.raises(KeyboardInterrupt):
-            train_a2c(root, "sp", callback=CallbackList([_progress_callback(160, "t"), _Kill(90)]), **kwargs)
+            train_a2c(root, "sp", callback=CallbackList([_progress_callback(160, "t"), KillAfter(90)]), **kwargs)
         resumed = _progress_callback(160, "t")
         train_a2c(root, "sp", callback=resumed, **kwargs)
     finally:
