@@ -7,9 +7,10 @@ when another is refreshed; docs/scenes.md is rewritten from whichever exist:
 - ``plants N``: fruit per plant and the measured phenotype of N single plants per crop, grown as
   ``davis-ag generate`` grows them (scene seeds of dataset seed 0, indices 0..N-1).
 - ``findings N WxH``: N single-plant strawberry scenes generated at WxH (dataset seed 0), and the
-  paper's section IV and V-C findings measured on them: visible fruit per position (the views
-  that box a fruit), whether any view sees every fruit, how often changing altitude at a fixed
-  position loses or gains fruit (Fig. 3), and the share of boxes with OER below 0.4.
+  paper's section IV and V-C findings measured on them: visible fruit per position (fruit that
+  Helios's Synthetic Annotation plug-in would box: ``specs.SEEABLE_FRUIT_PIXELS``), whether any
+  view sees every fruit, how often changing altitude at a fixed position loses or gains fruit
+  (Fig. 3), and the share of the published boxes (the crop's 210 pixels) with OER below 0.4.
 
 Run: ``python tools/scene_stats.py views``, ``... plants 10 [tomato,vine]``,
 ``... findings 3 192x108 [0.5]`` (the last argument: the grid step, default the paper's 0.25 m;
@@ -31,7 +32,12 @@ from pathlib import Path
 import numpy as np
 
 from davis_ag.atomic_files import write_json_atomic, write_text_atomic
-from davis_ag.scene.specs import CROPS, PHENOTYPE_SPREAD, scenario_spec
+from davis_ag.scene.specs import (
+    CROPS,
+    PHENOTYPE_SPREAD,
+    SEEABLE_FRUIT_PIXELS,
+    scenario_spec,
+)
 from davis_ag.scene.view_grid import views_per_scene
 
 DOCS = Path(__file__).resolve().parent.parent / "docs"
@@ -82,7 +88,6 @@ def measure_findings(count: int, size: tuple[int, int], step: float) -> dict:
     Returns:
         JSON-ready measurements.
     """
-    from davis_ag.benchmark.cache import load_scene_cache
     from davis_ag.data.reader import open_dataset
     from davis_ag.generate.one_scene import SceneRequest, generate_scene
     from davis_ag.scene.camera import Camera
@@ -93,13 +98,34 @@ def measure_findings(count: int, size: tuple[int, int], step: float) -> dict:
     with tempfile.TemporaryDirectory() as folder:
         root = Path(folder)
         for index in range(count):
-            scene_dir, stats = generate_scene(SceneRequest(scenario, crop, index, 0, Camera(*size)), root)
+            request = SceneRequest(scenario, seeable(crop), index, 0, Camera(*size))
+            scene_dir, stats = generate_scene(request, root)
             scene = open_dataset(root).scene(f"Single-Strawberry/{index:03d}")
             scenes.append({**visibility_findings(scene, json.loads((scene_dir / "scene.json").read_text())),
-                           "box_oer": [round(float(v), 4) for v in load_scene_cache(scene, root).box_oer],
+                           "box_oer": published_oer(scene, root, request),
                            "seconds": round(stats["total_s"], 1)})
             print(f"scene {index}: {scenes[-1]['fruit']} fruit", file=sys.stderr, flush=True)
     return {"size": list(size), "step": step, "scenes": scenes}
+
+
+def seeable(crop):
+    """The crop with every fruit that the Synthetic Annotation plug-in would box boxed (Fig. 2)."""
+    return dataclasses.replace(crop, min_fruit_pixels=SEEABLE_FRUIT_PIXELS)
+
+
+def published_oer(scene, root: Path, request) -> list[float]:
+    """OER of a scene's boxes that the published dataset keeps: the crop's 210 pixels, scaled.
+
+    Args:
+        scene: A scene generated with :func:`seeable`'s threshold.
+        root: The dataset folder it lies in.
+        request: Its request; the threshold is its crop's, ``CROPS``' own, scaled to its image.
+    """
+    from davis_ag.benchmark.cache import load_scene_cache
+
+    cache = load_scene_cache(scene, root)
+    threshold = dataclasses.replace(request, crop=CROPS[request.crop.name]).min_fruit_pixels
+    return [round(float(v), 4) for v in cache.box_oer[cache.box_pixels >= threshold]]
 
 
 def visibility_findings(scene, meta: dict) -> dict:
@@ -110,7 +136,8 @@ def visibility_findings(scene, meta: dict) -> dict:
         meta: Its scene.json.
 
     Returns:
-        Fruit count, boxed fruit per view (``visible``), views that box every fruit, and the
+        Fruit count, boxed fruit per view (``visible``; generated with :func:`seeable`, the fruit
+        the Synthetic Annotation plug-in would box), views that box every fruit, and the
         (position, altitude) pairs where moving up loses and gains fruit.
     """
     seen: dict[tuple[int, int, int], set[int]] = {}
@@ -193,7 +220,9 @@ def findings_lines(data: dict) -> list[str]:
     oer = np.concatenate([s["box_oer"] for s in scenes])
     lines = [f"{len(scenes)} scenes (dataset seed 0, scenes 0-{len(scenes) - 1}) generated at "
               f"{data['size'][0]}x{data['size'][1]} on the grid every {data.get('step', 0.25):g} m "
-              "(the paper's: 0.25 m), box threshold scaled with the image area; "
+              "(the paper's: 0.25 m); a fruit is visible when the Synthetic Annotation plug-in would box "
+              f"it ({SEEABLE_FRUIT_PIXELS} pixels at 1280x720), the boxes are those of at least 210 "
+              "pixels (both scaled with the image area); "
               f"{data['machine']}. Section IV: one plant with 24 fruit; visible fruit from fewer than 5 "
               "to 16 or more across positions; no view sees all 24; Fig. 3: changing altitude at a "
               "position both loses and gains fruit. Section V-C: 4 % of boxes have OER < 0.4.", "",

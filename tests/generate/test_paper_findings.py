@@ -1,12 +1,17 @@
 """The paper's findings on a generated single-plant strawberry scene (sections IV and V-C).
 
 One real scene: real Helios plants, the paper's grid thinned to every 0.5 m (90 of its 285
-views, every altitude kept), drawn small.
+views, every altitude kept), drawn at the paper's 1280x720.
 Section IV (Fig. 2) shows one strawberry plant with 24 fruit whose visible-fruit count ranges
 from fewer than 5 to 16 or more across positions, no view seeing all 24; Fig. 3 shows that
 changing altitude at a fixed position both loses and gains fruit. Section V-C: the OER of SP
 strawberry boxes is right-skewed, 4 % of them below 0.4 (tools/scene_stats.py measures this
 over several scenes; docs/scenes.md has the result).
+
+Fig. 2 counts a fruit as visible when Helios's Synthetic Annotation plug-in would box it (10
+pixels, ``specs.SEEABLE_FRUIT_PIXELS``); the OER share is over the published boxes, those of at
+least the crop's 210 pixels (section III-C). The scene is generated once with the lower
+threshold and its boxes are split by their visible pixels.
 """
 
 from __future__ import annotations
@@ -21,16 +26,17 @@ import pytest
 from davis_ag.errors import UserError
 from davis_ag.generate.one_scene import SceneRequest, generate_scene
 from davis_ag.scene.camera import Camera
-from davis_ag.scene.specs import CROPS, scenario_spec
+from davis_ag.scene.specs import CROPS, SEEABLE_FRUIT_PIXELS, scenario_spec
 
-#: Small, so that the views draw in about a minute; boxes need the crop's 210 pixels scaled by
-#: the image area (5 here).
-CAMERA = Camera(192, 108)
+#: The paper's image size: a strawberry 2.5 cm wide covers a few hundred pixels at a metre.
+CAMERA = Camera(1280, 720)
+STRAWBERRY = CROPS["strawberry"]
 #: Scene 3 of dataset seed 0, as `davis-ag generate --crop strawberry` grows it: the first scene
 #: whose plant carries the paper's 24 fruit (section IV; scenes 0-2 carry 21, 30 and 22). On the
-#: paper's 2.5 x 2.5 m lattice every 0.5 m: 30 positions at each of the three altitudes.
-GRID = replace(scenario_spec("sp", CROPS["strawberry"]), step=0.5)
-REQUEST = SceneRequest(GRID, CROPS["strawberry"], 3, 0, CAMERA)
+#: paper's 2.5 x 2.5 m lattice every 0.5 m: 30 positions at each of the three altitudes. Every
+#: fruit the plug-in would box is boxed.
+GRID = replace(scenario_spec("sp", STRAWBERRY), step=0.5)
+REQUEST = SceneRequest(GRID, replace(STRAWBERRY, min_fruit_pixels=SEEABLE_FRUIT_PIXELS), 3, 0, CAMERA)
 #: Section IV: the showcase plant's fruit.
 PAPER_FRUIT = 24
 POSITIONS = 30
@@ -52,8 +58,10 @@ def scene(tmp_path_factory: pytest.TempPathFactory) -> dict:
     meta = json.loads((scene_dir / "scene.json").read_text())
     opened = open_dataset(root).scene(REQUEST.folder)
     seen = {tuple(meta["views"][v.name]["grid"][:3]): {b.fruit_id for b in v.boxes} for v in opened}
+    cache = load_scene_cache(opened, Path(root))
+    published = cache.box_pixels >= STRAWBERRY.min_fruit_pixels
     return {"seen": seen, "fruit": len(meta["fruits"]), "plants": meta["plants"],
-            "oer": np.asarray(load_scene_cache(opened, Path(root)).box_oer, dtype=float)}
+            "oer": np.asarray(cache.box_oer[published], dtype=float)}
 
 
 def test_the_plant_carries_as_many_fruit_as_the_papers(scene: dict) -> None:
@@ -86,11 +94,10 @@ def test_changing_altitude_both_loses_and_gains_fruit(scene: dict) -> None:
 
 def test_oer_is_right_skewed_with_few_boxes_below_0_4(scene: dict) -> None:
     oer = scene["oer"]
-    assert len(oer) > 500  # enough boxes for a share of a few per cent to mean something
+    assert len(oer) > 150  # enough published boxes for a share of a few per cent to mean something
     # Section V-C: right-skewed, 4 % below 0.4. One scene varies more than several
-    # (tools/scene_stats.py measures those): 1-10 % here, 2-8 % over several scenes. At this
-    # size only: at 640x360 the share is higher (docs/scenes.md; the README says so).
-    assert 0.01 <= (oer < 0.4).mean() <= 0.10
+    # (tools/scene_stats.py measures those, 2-8 % asked): 1-8 % here.
+    assert 0.01 <= (oer < 0.4).mean() <= 0.08
     # Right-skewed as the paper uses it: the mass at high OER with a tail towards 0, i.e. a
     # negative third standardised moment (median against mean, the proxy used before, differs by
     # less than 0.01 on these distributions and so decides nothing: docs/scenes.md).

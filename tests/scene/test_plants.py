@@ -15,10 +15,12 @@ from davis_ag.scene.plants import (
     TOLERANCE,
     GrownPlant,
     Phenotype,
+    fruit_body_uuids,
     helios_seed,
     in_table_range,
     leaf_groups,
     primitive_vertices,
+    principal_extents,
     quiet_stdout,
     relative_error,
     require_native_helios,
@@ -196,6 +198,12 @@ def test_grown_plant_matches_its_target_within_table_1(crop: str, seed: int) -> 
         assert fruit[:, 2].max() < plant.measured.plant_height / 2
         fruit_reach = np.hypot(*(fruit[:, :2] - position).T).max()
         assert np.percentile(np.hypot(*(leaves[:, :2] - position).T), 90) > fruit_reach + 0.05
+        # Table 1's 2.5 cm "fruit radius" is the Canopy Generator's parameter, whose strawberry is
+        # a tube half that radius at its widest: fruit about as wide as the radius (+- 20 %), half
+        # the width a sphere of that radius would have.
+        widths = [np.median(principal_extents(np.concatenate(primitive_vertices(context, fruit_body_uuids(context, f))))[1:])
+                  for f in plant.fruit_objects]
+        assert 0.75 * spec.fruit_radius < np.median(widths) < 1.3 * spec.fruit_radius
 
     summary = plant.summary()
     assert summary["phenotype_measured"] == asdict(plant.measured)

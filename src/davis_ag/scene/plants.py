@@ -9,9 +9,11 @@ What is measured (metres):
 
 - height: top of the plant above the ground (strawberry, tomato); for the vine, the trunk height.
 - fruit radius: per fruit, half the mean extent of its body's vertices along their principal
-  axes (the body: the fruit object without its green calyx and stalk); for the vine, the radius
-  of single berries (a cluster is one fruit object, split into berries by mesh connectivity).
-  The plant's value is the median over fruit.
+  axes (the body: the fruit object without its green calyx and stalk), divided by the crop's
+  ``fruit_size_per_radius`` to put it in Table 1's terms (the Canopy Generator's parameter; a
+  strawberry of Table 1's 2.5 cm is 2.5 cm wide, see ``specs.CropSpec``); for the vine, the
+  radius of single berries (a cluster is one fruit object, split into berries by mesh
+  connectivity). The plant's value is the median over fruit.
 - leaf length: per leaf (every blade on one petiole: seven leaflets for tomato, one for the vine;
   each strawberry leaflet, see ``LEAF_UNIT``), the extent of its blades along their principal
   axis; the plant's value is the median over leaves. Helios numbers a leaf's blades
@@ -168,7 +170,7 @@ def measure_plant(
         radii = np.array([
             fruit_radius(np.concatenate(primitive_vertices(context, fruit_body_uuids(context, f))))
             for f in fruit_ids
-        ])
+        ]) / crop.fruit_size_per_radius
     blades = plant_architecture.getPlantLeafObjectIDs(plant_id)
     lengths = np.array([
         leaf_length(np.concatenate([object_vertices(context, b) for b in group]))
@@ -254,7 +256,8 @@ def _lift_to_ground(context, plant_architecture, plant_id: int) -> None:
 #: Measured height ~ a + b * knob for our plants (fitted on a few seeds), used only for
 #: the first build's guess; later builds correct it by the secant through the last two builds.
 HEIGHT_MODEL = {"strawberry": (-0.07, 0.43), "tomato": (0.505, 0.68)}
-#: Fruit radius and leaf length of the library models as built, for the first build's guess.
+#: Fruit size (half the mean principal extent) and leaf length of the library models as built,
+#: for the first build's guess.
 DEFAULT_SIZES = {"strawberry": (0.037, 0.139), "tomato": (0.016, 0.205)}
 #: Blades measured as one leaf where not all of a petiole's: Table 1's strawberry leaf length is
 #: a leaflet's, as ``leaf_length`` is in the Canopy Generator that made the original's plants.
@@ -395,7 +398,7 @@ def grow_library_plant(
     intercept, slope = HEIGHT_MODEL[crop.name]
     first_knobs = {
         "plant_height": max(0.2, (target.plant_height - intercept) / slope),
-        "fruit_radius": target.fruit_radius / DEFAULT_SIZES[crop.name][0],
+        "fruit_radius": target.fruit_radius * crop.fruit_size_per_radius / DEFAULT_SIZES[crop.name][0],
         "leaf_length": target.leaf_length / DEFAULT_SIZES[crop.name][1],
     }
     blades = LEAF_UNIT.get(crop.name, blades_per_leaf(shoot_defaults))

@@ -37,7 +37,14 @@ class CropSpec:
         name: Short name used on the command line (``strawberry``, ``tomato``, ``vine``).
         title: Capitalised name in published folder names (``Strawberry``...).
         plant_height: Plant height, or trunk height for the vine (Table 1), m.
-        fruit_radius: Fruit radius, or single-berry radius for the vine (Table 1), m.
+        fruit_radius: Fruit radius, or single-berry radius for the vine (Table 1), m: the Canopy
+            Generator's ``fruit_radius`` parameter, whose defaults Table 1 lists.
+        fruit_size_per_radius: Half the mean principal extent of a fruit body (what
+            :mod:`davis_ag.scene.plants` measures) per unit of ``fruit_radius``, as the Canopy
+            Generator builds it. Its tomato fruit and grape berries are spheres of that radius
+            (1.0); its strawberry is a tube whose widest radius is half ``fruit_radius`` and whose
+            length is 1.1 ``fruit_radius``, so (0.5 + 0.5 + 0.55) / 3 (``strawberry.cpp`` of
+            Helios's canopygenerator plug-in): Table 1's 2.5 cm makes a strawberry 2.5 cm wide.
         leaf_length: Leaf length (Table 1), m.
         altitudes: The three camera altitudes, low to high (Table 1), m.
         min_fruit_pixels: Visible pixels a fruit needs to get a box (section III-C).
@@ -70,6 +77,7 @@ class CropSpec:
     age_days: float
     sp_extent: tuple[float, float] = (3.0, 3.0)
     mp_extent: tuple[float, float] = (7.0, 3.0)
+    fruit_size_per_radius: float = 1.0
 
 
 # Why the grids differ by crop. Table 2 gives 3 x 3 m (SP) and 7 x 3 m (MP) grids, but Table 3's
@@ -86,6 +94,7 @@ CROPS: dict[str, CropSpec] = {
         leaf_length=0.10, altitudes=(0.25, 0.40, 0.55), min_fruit_pixels=210,
         exclusion_radius=0.75, centre_height=0.20, mp_plants=5, mp_spacing=0.30, min_fruit=4,
         helios_model="strawberry", age_days=90.0, sp_extent=(2.5, 2.5), mp_extent=(4.0, 3.0),
+        fruit_size_per_radius=(0.5 + 0.5 + 0.55) / 3,
     ),
     "tomato": CropSpec(
         name="tomato", title="Tomato", plant_height=1.00, fruit_radius=0.030,
@@ -100,6 +109,14 @@ CROPS: dict[str, CropSpec] = {
         helios_model="grapevine_VSP", age_days=95.0,
     ),
 }
+
+#: Visible pixels (at 1280x720) from which Helios's Synthetic Annotation plug-in, which labelled
+#: the original, boxes a fruit: its ``labelminpixels``, fixed at 10 in ``render()``. The paper then
+#: dropped boxes below ``min_fruit_pixels`` (section III-C). Its Fig. 2 counts "visible
+#: strawberries" at positions up to 1.8 m from the plant, where a whole Table 1 strawberry (2.5 cm
+#: wide) covers about 110 pixels, so those counts cannot be of 210-pixel boxes: we read them as
+#: the plug-in's boxes, of at least this many pixels (our inference, not the paper's words).
+SEEABLE_FRUIT_PIXELS = 10
 
 #: Strawberry camera altitudes, m. The paper disagrees with itself: Table 1 gives 25/40/55 cm (our
 #: default), the Fig. 2 caption and the dataset's README 0.50/0.75/1.00 m.
