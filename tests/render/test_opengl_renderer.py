@@ -19,10 +19,15 @@ from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import CROPS, SCENARIOS, plant_centres
 from davis_ag.scene.view_grid import build_view_grid
 
-CAMERA = Camera(640, 360)
+#: The size datasets are drawn at (the paper's). At 640x360 the far soil near the horizon, its
+#: texture minified several times over, is sampled differently by the two: a median of 2.1/255 in
+#: mean colour over every ninth view of this scene (47), 38 of them above 2/255; at 1280x720 a
+#: median of 1.0/255 and at most 1.2 (measured 2026-11-23).
+CAMERA = Camera(1280, 720)
 #: Views of the scene's grid: low, middle and high altitude, different sides of the plant.
 VIEW_INDICES = (40, 150, 260)
-MIN_FRUIT_PIXELS = 60
+#: The crop's box threshold (section III-C): the fruit a dataset boxes.
+MIN_FRUIT_PIXELS = CROPS["strawberry"].min_fruit_pixels
 
 
 @pytest.fixture(scope="module")
@@ -172,14 +177,14 @@ def test_drawn_silhouettes_match_the_projected_ones(frames: dict) -> None:
     from davis_ag.labels.fruit_labels import silhouette_pixels
 
     model = frames["model"]
-    view = frames["views"][1]
     with open_renderer("opengl", model.context, CAMERA, model.lighting, "helios") as renderer:
         checked = 0
-        for fruit in model.fruits:
-            projected = silhouette_pixels(CAMERA, view, fruit.polygons)
-            if projected < MIN_FRUIT_PIXELS:
-                continue
-            drawn = renderer.silhouette_pixels(view, fruit.id, fruit.uuids)
-            assert abs(drawn - projected) <= max(3, 0.01 * projected), (fruit.id, drawn, projected)
-            checked += 1
-    assert checked >= 1
+        for view in frames["views"]:
+            for fruit in model.fruits:
+                projected = silhouette_pixels(CAMERA, view, fruit.polygons)
+                if projected < MIN_FRUIT_PIXELS:
+                    continue
+                drawn = renderer.silhouette_pixels(view, fruit.id, fruit.uuids)
+                assert abs(drawn - projected) <= max(3, 0.01 * projected), (fruit.id, drawn, projected)
+                checked += 1
+    assert checked >= 3
