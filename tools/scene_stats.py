@@ -13,7 +13,7 @@ when another is refreshed; docs/scenes.md is rewritten from whichever exist:
   (Fig. 3), and the share of the published boxes (the crop's 210 pixels) with OER below 0.4.
 
 Run: ``python tools/scene_stats.py views``, ``... plants 10 [tomato,vine]``,
-``... findings 3 192x108 [0.5]`` (the last argument: the grid step, default the paper's 0.25 m;
+``... findings 10 1280x720 [0.5]`` (the last argument: the grid step, default the paper's 0.25 m;
 one file per image size, docs/scenes-findings-WxH.json, since the OER share depends on it).
 With no argument it only rewrites docs/scenes.md, e.g. after ``tools/strawberry_recipes.py``.
 """
