@@ -227,8 +227,10 @@ def stage_rows(state: dict[str, Any], out: Path | None) -> list[tuple[str, float
         if out is not None and step == "generate" and state.get("scene_folders", {}).get(key):
             code = _counted(Counter(_load(out / "dataset" / scene / "scene.json").get("generator", {})
                                     .get("version", "unrecorded") for scene in state["scene_folders"][key]))
-        record = _load(training_record_path(out / "models" / f"a2c_{key}.zip")) if out is not None else {}
-        if step == "train A2C" and record.get("sittings"):
+        record: dict[str, Any] = {}
+        if step == "train A2C" and out is not None:  # only a training stage has a record
+            record = _load(training_record_path(out / "models" / f"a2c_{key}.zip"))
+        if record.get("sittings"):
             sittings = record["sittings"]
             seconds = record.get("seconds", seconds)
             code = ", ".join(dict.fromkeys(s.get("code", "unrecorded") for s in sittings))
