@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -18,3 +19,17 @@ def sp_root(tmp_path_factory: pytest.TempPathFactory) -> Path:
 def mp_root(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """Two multi-plant strawberry scenes."""
     return write_tiny_dataset(tmp_path_factory.mktemp("mp"), "mp", "strawberry", scenes=2)
+
+
+@pytest.fixture()
+def one_thread() -> Iterator[None]:
+    """Torch on one thread for the test. Tiny tensors on shared cores: torch's thread pool spins
+    and runs several times slower than one thread."""
+    import torch
+
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(threads)

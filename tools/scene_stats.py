@@ -113,19 +113,24 @@ def seeable(crop):
     return dataclasses.replace(crop, min_fruit_pixels=SEEABLE_FRUIT_PIXELS)
 
 
+def published_pixels(request) -> int:
+    """The box threshold a published dataset keeps for a request's crop: its 210 pixels (strawberry),
+    ``CROPS``' own whatever :func:`seeable` lowered, scaled to the request's image."""
+    return dataclasses.replace(request, crop=CROPS[request.crop.name]).min_fruit_pixels
+
+
 def published_oer(scene, root: Path, request) -> list[float]:
-    """OER of a scene's boxes that the published dataset keeps: the crop's 210 pixels, scaled.
+    """OER of a scene's boxes that the published dataset keeps (:func:`published_pixels`).
 
     Args:
         scene: A scene generated with :func:`seeable`'s threshold.
         root: The dataset folder it lies in.
-        request: Its request; the threshold is its crop's, ``CROPS``' own, scaled to its image.
+        request: Its request.
     """
     from davis_ag.benchmark.cache import load_scene_cache
 
     cache = load_scene_cache(scene, root)
-    threshold = dataclasses.replace(request, crop=CROPS[request.crop.name]).min_fruit_pixels
-    return [round(float(v), 4) for v in cache.box_oer[cache.box_pixels >= threshold]]
+    return [round(float(v), 4) for v in cache.box_oer[cache.box_pixels >= published_pixels(request)]]
 
 
 def visibility_findings(scene, meta: dict) -> dict:

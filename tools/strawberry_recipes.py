@@ -76,7 +76,7 @@ def measure_scene(index: int, size: tuple[int, int], altitudes: str) -> dict:
         JSON-ready measurements of the scene.
     """
     sys.path.insert(0, str(Path(__file__).resolve().parent))
-    from scene_stats import published_oer, seeable, visibility_findings
+    from scene_stats import published_oer, published_pixels, seeable, visibility_findings
 
     from davis_ag.data.reader import open_dataset
     from davis_ag.generate.one_scene import SceneRequest, generate_scene
@@ -88,7 +88,7 @@ def measure_scene(index: int, size: tuple[int, int], altitudes: str) -> dict:
     with tempfile.TemporaryDirectory() as folder:
         root = Path(folder)
         request = SceneRequest(grid, seeable(crop), index, 0, Camera(*size))
-        threshold = dataclasses.replace(request, crop=crop).min_fruit_pixels
+        threshold = published_pixels(request)
         scene_dir, _ = generate_scene(request, root)
         meta = json.loads((scene_dir / "scene.json").read_text())
         scene = open_dataset(root).scene(f"Single-Strawberry/{index:03d}")

@@ -106,20 +106,12 @@ def test_build_agents_errors() -> None:
     assert isinstance(build_agents(["udd"])[0], HeuristicAgent)
 
 
-def test_short_a2c_run_beats_random(sp_root: Path, tmp_path: Path) -> None:
+def test_short_a2c_run_beats_random(sp_root: Path, tmp_path: Path, one_thread: None) -> None:
     """3,000 steps with the small network on the train scene: the greedy policy must earn more
     than Rand on the same training episodes. Untrained (5 steps) it earns 0.04-0.08 against
-    Rand's 0.086 for seeds 0-3; trained, every seed reaches 0.114."""
-    import torch
-
-    # Tiny tensors: with other processes on the cores, torch's thread pool spins and runs ~8x
-    # slower than one thread.
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    try:
-        _short_a2c_run(sp_root, tmp_path)
-    finally:
-        torch.set_num_threads(threads)
+    Rand's 0.086 for seeds 0-3; trained, every seed reaches 0.114. (``one_thread``: with other
+    processes on the cores, torch's thread pool spins and runs ~8x slower than one thread.)"""
+    _short_a2c_run(sp_root, tmp_path)
 
 
 def _short_a2c_run(sp_root: Path, tmp_path: Path) -> None:

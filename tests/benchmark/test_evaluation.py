@@ -95,25 +95,18 @@ def test_table_json_and_plot(sp_root: Path, tmp_path: Path) -> None:
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
-def test_commands(sp_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    import torch
-
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)  # tiny tensors on shared cores: see test_agents
-    try:
-        model = tmp_path / "model.zip"
-        args = _parser().parse_args(
-            ["train", "--dataset", str(sp_root), "--scenario", "sp", "--timesteps", "40",
-             "--n-envs", "2", "--arch", "pooled", "--device", "cpu", "--verbose", "0",
-             "--out", str(model)])
-        assert args.func(args) == 0 and model.is_file()
-        out = tmp_path / "results.json"
-        args = _parser().parse_args(
-            ["evaluate", "--dataset", str(sp_root), "--scenario", "sp", "--model", str(model),
-             "--episodes", "5", "--sessions", "2", "--out", str(out)])
-        assert args.func(args) == 0
-    finally:
-        torch.set_num_threads(threads)
+def test_commands(sp_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], one_thread: None) -> None:
+    model = tmp_path / "model.zip"
+    args = _parser().parse_args(
+        ["train", "--dataset", str(sp_root), "--scenario", "sp", "--timesteps", "40",
+         "--n-envs", "2", "--arch", "pooled", "--device", "cpu", "--verbose", "0",
+         "--out", str(model)])
+    assert args.func(args) == 0 and model.is_file()
+    out = tmp_path / "results.json"
+    args = _parser().parse_args(
+        ["evaluate", "--dataset", str(sp_root), "--scenario", "sp", "--model", str(model),
+         "--episodes", "5", "--sessions", "2", "--out", str(out)])
+    assert args.func(args) == 0
     printed = capsys.readouterr().out
     assert "A2C" in printed and "Oracle" in printed and "OER_tau" in printed
     assert set(json.loads(out.read_text())["policies"]) == {"LRD", "UDD", "Rand", "Oracle", "A2C"}

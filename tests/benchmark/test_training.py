@@ -14,16 +14,6 @@ from davis_ag.benchmark.training import checkpoint_paths, train_a2c, training_re
 from davis_ag.provenance import code_version
 
 
-@pytest.fixture()
-def one_thread() -> None:
-    import torch
-
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)  # tiny tensors: a spinning thread pool is slower on a busy machine
-    yield
-    torch.set_num_threads(threads)
-
-
 def test_a_killed_run_resumes_from_its_checkpoint(tmp_path: Path, one_thread: None,
                                                   capsys: pytest.CaptureFixture[str]) -> None:
     root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2)
