@@ -13,6 +13,7 @@ import numpy as np
 
 from davis_ag.errors import UserError
 from davis_ag.scene.lighting import Lighting
+from davis_ag.scene.organs import ORGAN_DATA
 from davis_ag.scene.plants import (
     GrownPlant,
     fruit_body_uuids,
@@ -81,6 +82,24 @@ class SceneModel:
     def uuid_count(self) -> int:
         """One more than the largest primitive UUID."""
         return int(max(self.context.getAllUUIDs())) + 1
+
+    def organ_of_uuid(self) -> np.ndarray:
+        """Organ class (:mod:`davis_ag.scene.organs`) of every primitive, indexed by UUID.
+
+        Returns:
+            uint8 array of length :attr:`uuid_count`; primitives without organ data read 0 (sky).
+        """
+        uuids = list(self.context.getAllUUIDs())
+        table = np.zeros(self.uuid_count, dtype=np.uint8)
+        try:  # one bulk call when every primitive is labelled, as in scenes built here
+            table[np.asarray(uuids)] = np.asarray(self.context.getPrimitiveDataArray(uuids, ORGAN_DATA))
+            return table
+        except (RuntimeError, ValueError):
+            pass
+        labelled = [u for u in uuids if self.context.doesPrimitiveDataExist(u, ORGAN_DATA)]
+        if labelled:
+            table[np.asarray(labelled)] = np.asarray(self.context.getPrimitiveDataArray(labelled, ORGAN_DATA))
+        return table
 
 
 def helios_texture(name: str) -> str:
