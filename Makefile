@@ -26,7 +26,7 @@ test: $(STAMP)
 	$(BIN)/python -m pytest -q
 
 bench: $(STAMP)
-	$(BIN)/python -m davis_ag.bench --out $(OUT)/bench.json --doc docs/performance.md
+	$(BIN)/python tools/bench.py --out $(OUT)/bench.json --doc docs/performance.md
 
 reproduce: $(STAMP)
 	$(BIN)/davis-ag reproduce --out $(OUT)/reproduce --results docs/results.md

@@ -1,7 +1,7 @@
 """The package's layout is its pipeline: stages import only earlier stages, with no import cycles.
 
 Every import counts, at module level or inside a function: a late import still ties a stage to a
-later one. The order is the README's "Layout" section.
+later one. The order is docs/architecture.md's "Layout" section.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ STAGES: tuple[tuple[str, ...], ...] = (
     ("detection",),
     ("figures",),
     ("workflows",),
-    ("commands", "cli", "bench"),
+    ("commands", "cli"),
 )
 RANK = {name: rank for rank, names in enumerate(STAGES) for name in names}
 #: Stages that must import without Helios or a renderer: they are pure geometry and reading.
@@ -73,7 +73,7 @@ def test_every_module_belongs_to_a_stage_and_says_what_it_is() -> None:
     for name, path in MODULES.items():
         if name == "davis_ag":
             continue
-        assert stage(name) in RANK, f"{name}: add its stage to STAGES (and to the README's Layout)"
+        assert stage(name) in RANK, f"{name}: add its stage to STAGES (and to docs/architecture.md's Layout)"
         doc = ast.get_docstring(ast.parse(path.read_text()))
         assert doc and len(doc.splitlines()[0]) > 10, f"{path}: its first line should say what it is"
 

@@ -321,20 +321,22 @@ def main(argv: list[str]) -> None:
         write_json_atomic(findings_file(size),
                           {**measure_findings(int(argv[1]), size, step), "machine": machine}, indent=1)
     write_text_atomic(DOCS / "scenes.md", render_markdown())
-    update_readme({"views": views_table(), "plants": plants_table(), "findings": findings_table()})
+    update_docs_pages({"views": views_table(), "plants": plants_table(), "findings": findings_table()})
 
 
-def update_readme(blocks: dict[str, list[str]]) -> None:
-    """Replace the README's ``<!-- scene-stats:NAME -->`` blocks with the measured tables."""
-    readme = DOCS.parent / "README.md"
-    text = readme.read_text()
-    for name, lines in blocks.items():
-        begin, end = f"<!-- scene-stats:{name} -->", f"<!-- /scene-stats:{name} -->"
-        if lines and begin in text and end in text:
-            head, _, tail = text.partition(begin)
-            _, _, tail = tail.partition(end)
-            text = head + begin + "\n" + "\n".join(lines) + "\n" + end + tail
-    write_text_atomic(readme, text)
+def update_docs_pages(blocks: dict[str, list[str]]) -> None:
+    """Replace the ``<!-- scene-stats:NAME -->`` blocks of the docs pages that hold them
+    (docs/dataset-format.md: views; docs/plants.md: plants, findings) with the measured tables."""
+    for page in sorted(DOCS.glob("*.md")):
+        text = original = page.read_text()
+        for name, lines in blocks.items():
+            begin, end = f"<!-- scene-stats:{name} -->", f"<!-- /scene-stats:{name} -->"
+            if lines and begin in text and end in text:
+                head, _, tail = text.partition(begin)
+                _, _, tail = tail.partition(end)
+                text = head + begin + "\n" + "\n".join(lines) + "\n" + end + tail
+        if text != original:
+            write_text_atomic(page, text)
 
 
 if __name__ == "__main__":

@@ -1,4 +1,4 @@
-"""``python -m davis_ag.bench``: what a labelled view costs with our renderer, against pyhelios's
+"""``python tools/bench.py``: what a labelled view costs with our renderer, against pyhelios's
 documented path on a stock Helios Visualizer, and what the paper-scale dataset would take.
 
 For each crop (a single-plant strawberry and a single goblet vine, dataset seed 0, scene 0, at
@@ -287,7 +287,7 @@ def continuous_table(result: dict, load: tuple[float, float]) -> str:
 
 
 def continuous_line(result: dict) -> str:
-    """The rate in one sentence, for the README."""
+    """The rate in one sentence, for docs/views-on-demand.md."""
     return (f"Measured by `make bench` on this 2-core machine (shared, load average in docs/performance.md): "
             f"**{result['steps_per_second']} steps/s** at 224x224 with random actions, resets included "
             f"({result['render_and_label_ms']} ms to draw and label a view, {result['cpu_ms_per_step']} ms of CPU "
@@ -295,17 +295,17 @@ def continuous_line(result: dict) -> str:
 
 
 def write_continuous(result: dict, load: tuple[float, float], doc: Path | None) -> None:
-    """Write the TVMContinuous-v0 rate into the doc and, beside its folder, the README."""
+    """Write the TVMContinuous-v0 rate into the doc and, beside it, docs/views-on-demand.md."""
     if doc:
         write_marked_section(doc, "bench-continuous", continuous_table(result, load))
-        readme = doc.absolute().parent.parent / "README.md"
-        if readme.is_file() and "<!-- continuous-rate:start -->" in readme.read_text():
-            write_marked_section(readme, "continuous-rate", continuous_line(result))
+        page = doc.absolute().parent / "views-on-demand.md"
+        if page.is_file() and "<!-- continuous-rate:start -->" in page.read_text():
+            write_marked_section(page, "continuous-rate", continuous_line(result))
 
 
 def run_continuous(out: Path, doc: Path | None) -> dict:
     """Only the TVMContinuous-v0 measurement (``--only continuous``): JSON, the doc's section and
-    the README's line."""
+    docs/views-on-demand.md's line."""
     start = os.getloadavg()[0]
     with tempfile.TemporaryDirectory(prefix="davis-ag-bench-") as scratch:
         result = continuous_env_speed(Path(scratch))
@@ -395,8 +395,8 @@ def table(report: dict) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Command line: ``python -m davis_ag.bench --out out/bench.json [--doc docs/performance.md]``."""
-    parser = argparse.ArgumentParser(prog="python -m davis_ag.bench", description=__doc__,
+    """Command line: ``python tools/bench.py --out out/bench.json [--doc docs/performance.md]``."""
+    parser = argparse.ArgumentParser(prog="python tools/bench.py", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--out", type=Path, default=Path("out/bench.json"), help="JSON report")
     parser.add_argument("--crops", default="strawberry,tomato,vine",
