@@ -17,7 +17,7 @@ PACKAGE = Path(davis_ag.__file__).parent
 
 #: The pipeline, earliest first; a module may import its own stage and those before it.
 STAGES: tuple[tuple[str, ...], ...] = (
-    ("errors", "atomic_files", "stage_timer", "provenance"),  # helpers every stage may use
+    ("errors", "atomic_files", "stage_timer", "provenance", "dataset_layout"),  # helpers every stage may use
     ("scene",),
     ("render",),
     ("labels",),

@@ -35,6 +35,7 @@ import numpy as np
 from PIL import Image
 
 from davis_ag.data.safe_read import check_inside
+from davis_ag.dataset_layout import ANNOTATIONS
 from davis_ag.errors import UserError
 from davis_ag.scene.specs import ALL_ACTIONS
 
@@ -120,7 +121,7 @@ def scene_fingerprint(scene: Any, root: Path) -> str:
 def annotations_path(scene: Any, root: Path) -> Path:
     """The scene's annotations.json: the reader's ``path`` if it has one, else root/id."""
     path = getattr(scene, "annotations_path", None)
-    return Path(path) if path is not None else Path(root) / scene.id / "annotations.json"
+    return Path(path) if path is not None else Path(root) / scene.id / ANNOTATIONS
 
 
 def scaled_box(xmin: int, ymin: int, width: int, height: int,

@@ -32,6 +32,8 @@ from davis_ag.data.annotation_schema import (
     parse_pose,
 )
 from davis_ag.data.safe_read import check_inside, load_pixels, read_json
+from davis_ag.dataset_layout import ANNOTATIONS, IMAGES, SCENE_METADATA, read_depth, view_file, view_stem
+from davis_ag.dataset_layout import SPLITS_FILE as SPLITS
 from davis_ag.errors import UserError
 from davis_ag.scene import specs as config
 
@@ -41,9 +43,6 @@ __all__ = [
     "parse_box", "parse_entry", "parse_pose", "read_json",
 ]
 
-ANNOTATIONS = "annotations.json"
-SCENE_METADATA = "scene.json"
-SPLITS = "splits.json"
 
 
 class NotFoundError(UserError, KeyError):
@@ -54,7 +53,7 @@ class NotFoundError(UserError, KeyError):
 
 
 def _view_order(name: str) -> tuple[int, str]:
-    stem = name.removesuffix(".jpeg")
+    stem = view_stem(name)
     return (int(stem), name) if stem.isdigit() else (1 << 62, name)
 
 
@@ -79,17 +78,17 @@ class View:
     @property
     def image_path(self) -> Path:
         """Where the RGB image is (``images/0001.jpeg``)."""
-        return self.scene.path / "images" / self.name
+        return self.scene.path / IMAGES / self.name
 
     @property
     def mask_path(self) -> Path:
         """Where the instance mask is (``images/0001_seg.png``), whether or not it exists."""
-        return self.scene.path / "images" / f"{self.name.removesuffix('.jpeg')}_seg.png"
+        return view_file(self.scene.path, self.name, "mask")
 
     @property
     def depth_path(self) -> Path:
         """Where the depth image is (``images/0001_depth.png``), whether or not it exists."""
-        return self.scene.path / "images" / f"{self.name.removesuffix('.jpeg')}_depth.png"
+        return view_file(self.scene.path, self.name, "depth")
 
     @property
     def depth(self) -> np.ndarray | None:
@@ -99,18 +98,9 @@ class View:
         Raises:
             UserError: when the file exists but cannot be read or is not 16-bit.
         """
-        from PIL import Image, UnidentifiedImageError
-
         if not self.depth_path.is_file():
             return None
-        try:
-            with Image.open(self.depth_path) as im:
-                millimetres = np.asarray(im)
-        except (OSError, UnidentifiedImageError, ValueError) as error:
-            raise UserError(f"{self.depth_path}: cannot decode ({error}); regenerate the scene") from None
-        if millimetres.dtype != np.uint16 or millimetres.ndim != 2:
-            raise UserError(f"{self.depth_path}: a depth image must be a 16-bit single-channel PNG")
-        return millimetres.astype(np.float32) / 1000.0
+        return read_depth(check_inside(self.depth_path, self.scene.root))
 
     def next(self, action: str) -> View | None:
         """The view an action leads to.

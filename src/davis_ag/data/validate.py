@@ -36,6 +36,7 @@ from davis_ag.data.reader import (
     parse_entry,
 )
 from davis_ag.data.safe_read import check_inside
+from davis_ag.dataset_layout import IMAGES, read_depth_millimetres, view_file, view_of_file
 from davis_ag.errors import UserError
 
 
@@ -153,7 +154,7 @@ def validate_scene(scene: Scene, quick: bool = False, box_tolerance: int | None 
         records[record.name] = record
     report.views += len(raw)
 
-    images = scene.path / "images"
+    images = scene.path / IMAGES
     for record in records.values():
         for action, target in record.pointers.items():
             if target and target not in names:
@@ -161,7 +162,7 @@ def validate_scene(scene: Scene, quick: bool = False, box_tolerance: int | None 
         report.boxes += len(record.boxes)
         for problem in _box_schema_problems(record):
             flag(ann_path, problem)
-        image, mask = images / record.name, images / f"{record.name.removesuffix('.jpeg')}_seg.png"
+        image, mask = images / record.name, view_file(scene.path, record.name, "mask")
         has_image, has_mask = image.is_file(), mask.is_file()
         for path, present in ((image, has_image), (mask, has_mask)):
             if present and (outside := _outside(path, scene.root)):
@@ -173,7 +174,7 @@ def validate_scene(scene: Scene, quick: bool = False, box_tolerance: int | None 
             flag(image, f"missing: annotations.json has an entry {record.name} for it")
         if not mask.is_file():
             flag(mask, f"missing: the instance mask of {record.name}")
-        depth = images / f"{record.name.removesuffix('.jpeg')}_depth.png"
+        depth = view_file(scene.path, record.name, "depth")
         if isinstance(metadata, dict) and metadata.get("depth") and not depth.is_file():
             flag(depth, f"missing: scene.json records depth images but {record.name} has none")
         if quick:
@@ -191,9 +192,8 @@ def validate_scene(scene: Scene, quick: bool = False, box_tolerance: int | None 
 
     if images.is_dir():
         for path in sorted(images.iterdir()):
-            stem = next((path.name.removesuffix(end) for end in ("_seg.png", "_depth.png") if path.name.endswith(end)),
-                        path.stem)
-            if path.suffix.lower() in (".jpeg", ".jpg", ".png") and f"{stem}.jpeg" not in names:
+            view = view_of_file(path.name)
+            if view is not None and view[0] not in names:
                 flag(path, "has no entry in annotations.json")
     return report
 
@@ -313,12 +313,9 @@ def depth_problems(record: ViewRecord, depth_path: Path, mask_path: Path | None,
     from PIL import Image
 
     try:
-        with Image.open(depth_path) as im:
-            depth = np.asarray(im)
-    except Exception as error:  # Pillow raises many types for a damaged file
-        return [f"cannot decode ({error})"]
-    if depth.dtype != np.uint16 or depth.ndim != 2:
-        return [f"must be a uint16 single-channel PNG (millimetres), got {depth.dtype} {depth.shape}"]
+        depth = read_depth_millimetres(depth_path)
+    except UserError as error:  # the reason, without the path the report already names
+        return [str(error).removeprefix(f"{depth_path}: ").removesuffix("; regenerate the scene")]
     problems = []
     size = _camera_size(metadata)
     if size and depth.shape[::-1] != size:

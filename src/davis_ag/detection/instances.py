@@ -35,11 +35,6 @@ def category_id(crop: str | None) -> int:
     return CATEGORIES.index(crop) + 1
 
 
-def depth_path(view: View) -> Path:
-    """Where a view's optional depth image lies (``images/NNNN_depth.png``, uint16 millimetres)."""
-    return view.image_path.with_name(f"{view.name.removesuffix('.jpeg')}_depth.png")
-
-
 def scenes_by_split(dataset: Dataset) -> dict[str, list[Scene]]:
     """The dataset's scenes per split.
 
@@ -145,7 +140,7 @@ def label_view(view: View, with_masks: bool = True) -> LabelledView:
         fraction = fractions.get(str(box.fruit_id))
         instances.append(Instance(box, category, None if fraction is None else float(fraction),
                                   None if seg is None else seg == box.fruit_id))
-    depth = depth_path(view)
+    depth = view.depth_path
     return LabelledView(view, width, height, tuple(instances), depth if depth.is_file() else None)
 
 

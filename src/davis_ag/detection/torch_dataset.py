@@ -27,6 +27,7 @@ import numpy as np
 import torch
 
 from davis_ag.data.reader import open_dataset
+from davis_ag.dataset_layout import read_depth
 from davis_ag.detection.instances import label_view, scenes_by_split
 from davis_ag.errors import UserError
 
@@ -98,17 +99,11 @@ class DavisAgDetection(torch.utils.data.Dataset):
 
 
 def _depth_metres(path: Path, shape: tuple[int, int]) -> torch.Tensor:
-    from PIL import Image
-
-    try:
-        with Image.open(path) as im:
-            millimetres = np.asarray(im).astype(np.float32)
-    except OSError as error:
-        raise UserError(f"{path}: cannot read the depth image ({error}); regenerate the scene") from None
-    if millimetres.shape != shape:
-        raise UserError(f"{path}: depth is {millimetres.shape[1]}x{millimetres.shape[0]}, "
+    metres = read_depth(path)
+    if metres.shape != shape:
+        raise UserError(f"{path}: depth is {metres.shape[1]}x{metres.shape[0]}, "
                         f"image {shape[1]}x{shape[0]}; regenerate the scene")
-    return torch.from_numpy(millimetres / 1000.0).unsqueeze(0)
+    return torch.from_numpy(metres).unsqueeze(0)
 
 
 def collate(batch: list[tuple[torch.Tensor, Target]]) -> tuple[list[torch.Tensor], list[Target]]:

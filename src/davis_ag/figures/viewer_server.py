@@ -32,19 +32,16 @@ from urllib.parse import parse_qs, unquote, urlsplit
 import numpy as np
 
 from davis_ag.data.reader import NO_FRUIT, Dataset, Scene, open_dataset
+from davis_ag.dataset_layout import IMAGES, VIEW_FILES, read_depth_millimetres
 from davis_ag.errors import UserError
 from davis_ag.figures.scene_numbers import altitudes
 from davis_ag.figures.visibility_plots import plant_xy
 
 #: The only file names served: an image, its mask or its depth image.
-FILE_NAME = re.compile(r"\d{1,6}(\.jpeg|\.jpg|\.png|_seg\.png|_depth\.png)")
+FILE_NAME = re.compile(r"\d{1,6}(" + "|".join(re.escape(end) for end in sorted(
+    {".jpg", ".png", *(suffix for suffix, _ in VIEW_FILES.values())})) + ")")
 HOST = "127.0.0.1"
 _TYPES = {".jpeg": "image/jpeg", ".jpg": "image/jpeg", ".png": "image/png"}
-
-
-def depth_path(scene: Scene, view_name: str) -> Path:
-    """Where a view's depth image would be (``images/NNNN_depth.png``, uint16 millimetres)."""
-    return scene.path / "images" / f"{view_name.removesuffix('.jpeg')}_depth.png"
 
 
 def scene_payload(scene: Scene) -> dict[str, Any]:
@@ -64,7 +61,7 @@ def scene_payload(scene: Scene) -> dict[str, Any]:
             "boxes": [[b.xmin, b.ymin, b.width, b.height, b.fruit_id] for b in view.boxes],
             "pointers": dict(view.pointers),
             "mask": view.mask_path.is_file(),
-            "depth": depth_path(scene, name).is_file(),
+            "depth": view.depth_path.is_file(),
         }
     camera = (scene.metadata or {}).get("camera") or {}
     size = [camera.get("width"), camera.get("height")] if camera.get("width") else None
@@ -139,7 +136,7 @@ class Viewer:
         followed, really lies in that folder; else ``None``."""
         if not FILE_NAME.fullmatch(name):
             return None
-        folder = (scene.path / "images").resolve()
+        folder = (scene.path / IMAGES).resolve()
         try:
             real = (folder / name).resolve(strict=True)
         except (OSError, RuntimeError):
@@ -220,13 +217,13 @@ def make_handler(viewer: Viewer, page: bytes) -> type[BaseHTTPRequestHandler]:
                 if mask is None:
                     return self._missing("no mask")
                 return self._send(HTTPStatus.OK, mask_overlay(mask), "image/png", cache=True)
-            path = viewer.file(scene, depth_path(scene, view.name).name)
+            path = viewer.file(scene, view.depth_path.name)
             if path is None:
                 return self._missing("no depth")
-            from PIL import Image
-
-            with Image.open(path) as im:
-                depth = np.asarray(im).astype(np.uint16)
+            try:
+                depth = read_depth_millimetres(path)
+            except UserError:
+                return self._missing("damaged depth")
             self._send(HTTPStatus.OK, depth_picture(depth), "image/png", cache=True)
 
     return Handler

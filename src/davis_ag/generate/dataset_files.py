@@ -22,9 +22,8 @@ from davis_ag.generate.one_scene import SceneRequest
 from davis_ag.generate.run_config import grid_settings
 from davis_ag.render.backends import resolve_look
 from davis_ag.scene.specs import CROPS, SCENARIOS, parse_group_name
+from davis_ag.dataset_layout import ANNOTATIONS, DATASET_FILE, SPLITS_FILE
 
-DATASET_FILE = "dataset.json"
-SPLITS_FILE = "splits.json"
 DATASET_FORMAT = "davis-ag-dataset/1"
 #: Share of each group's scenes in the training split (section V-C).
 TRAIN_FRACTION = 0.7
@@ -57,7 +56,7 @@ def complete_scenes(root: Path) -> list[str]:
     return sorted(f"{group.name}/{scene.name}" for group in root.iterdir()
                   if group.is_dir() and parse_group_name(group.name)
                   for scene in group.iterdir()
-                  if scene.is_dir() and not scene.name.startswith(".") and (scene / "annotations.json").is_file())
+                  if scene.is_dir() and not scene.name.startswith(".") and (scene / ANNOTATIONS).is_file())
 
 
 def reconcile_settings(root: Path, wanted: dict[str, Any]) -> dict[str, Any]:

@@ -16,6 +16,7 @@ from typing import Callable
 
 import numpy as np
 
+from davis_ag.dataset_layout import SCENE_METADATA
 from davis_ag.provenance import code_version
 from davis_ag.atomic_files import PROBE_PREFIX, prove_writable_folder
 from davis_ag.errors import UserError
@@ -103,7 +104,7 @@ def scene_seed(dataset_seed: int, scenario: ScenarioSpec, crop: CropSpec, index:
 def read_scene_seed(scene_dir: Path) -> int | None:
     """The seed a finished scene was made with, or None when it carries no scene.json of ours."""
     try:
-        with open(scene_dir / "scene.json") as handle:
+        with open(scene_dir / SCENE_METADATA) as handle:
             return int(json.load(handle)["seed"])
     except (OSError, ValueError, KeyError, TypeError):
         return None
@@ -112,7 +113,7 @@ def read_scene_seed(scene_dir: Path) -> int | None:
 def read_scene_size(scene_dir: Path) -> tuple[int, int] | None:
     """The image size a finished scene was drawn at, or None when its scene.json does not say."""
     try:
-        with open(scene_dir / "scene.json") as handle:
+        with open(scene_dir / SCENE_METADATA) as handle:
             camera = json.load(handle)["camera"]
         return int(camera["width"]), int(camera["height"])
     except (OSError, ValueError, KeyError, TypeError):

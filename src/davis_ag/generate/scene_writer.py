@@ -22,23 +22,13 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from PIL import Image
 
 from davis_ag.atomic_files import write_json_atomic
+from davis_ag.dataset_layout import ANNOTATIONS, IMAGES, SCENE_METADATA, view_file_name, write_view_files
 
-JPEG_QUALITY = 95
-#: Depth images: uint16 millimetres along the optical axis, 0 where nothing is hit; farther
-#: surfaces than this many millimetres are stored as this value.
-DEPTH_MAX_MM = 65535
 #: In the hidden folder only: the views written so far (JSON lines) and what they were made for.
 JOURNAL = "views.jsonl"
 RESUME_KEY = "resume.json"
-
-
-def depth_png(depth: np.ndarray) -> np.ndarray:
-    """Metres (0 = nothing hit) to the uint16 millimetres of ``NNNN_depth.png``."""
-    millimetres = np.rint(np.asarray(depth, dtype=np.float64) * 1000.0)
-    return np.clip(millimetres, 0, DEPTH_MAX_MM).astype(np.uint16)
 
 
 def partial_dir(scene_dir: Path) -> Path:
@@ -72,7 +62,7 @@ class SceneWriter:
                 self.done = _read_journal(self.tmp_dir)
             else:
                 shutil.rmtree(self.tmp_dir)
-        (self.tmp_dir / "images").mkdir(parents=True, exist_ok=True)
+        (self.tmp_dir / IMAGES).mkdir(parents=True, exist_ok=True)
         if resume_key is not None:
             write_json_atomic(self.tmp_dir / RESUME_KEY, resume_key)
             # Rewritten with only the views kept, so a torn last line does not stay in the middle.
@@ -98,17 +88,14 @@ class SceneWriter:
             extras: JSON-ready data of the view the caller wants back when the scene is resumed
                 (``done[name]["extras"]``).
         """
-        stem = name.rsplit(".", 1)[0]
-        images = self.tmp_dir / "images"
-        files = [self._pool.submit(lambda: Image.fromarray(colour).save(images / name, quality=JPEG_QUALITY)),
-                 self._pool.submit(lambda: Image.fromarray(segmentation, mode="L").save(
-                     images / f"{stem}_seg.png", compress_level=1))]
+        images = self.tmp_dir / IMAGES
+        files = [self._pool.submit(write_view_files, images, name, colour=colour),
+                 self._pool.submit(write_view_files, images, name, segmentation=segmentation)]
         if depth is not None:
-            files.append(self._pool.submit(
-                lambda: Image.fromarray(depth_png(depth)).save(images / f"{stem}_depth.png", compress_level=1)))
+            files.append(self._pool.submit(write_view_files, images, name, depth=depth))
         self._pending.append((name, files, {"name": name, "entry": entry, "extras": extras or {},
-                                            "files": [name, f"{stem}_seg.png"]
-                                            + ([f"{stem}_depth.png"] if depth is not None else [])}))
+                                            "files": [name, view_file_name(name, "mask")]
+                                            + ([view_file_name(name, "depth")] if depth is not None else [])}))
         self.annotations[name] = entry
         if len(self._pending) > 8:
             self._drain(keep=4)
@@ -139,9 +126,9 @@ class SceneWriter:
             self._journal.close()
         (self.tmp_dir / JOURNAL).unlink(missing_ok=True)  # not part of the published layout
         (self.tmp_dir / RESUME_KEY).unlink(missing_ok=True)
-        write_json_atomic(self.tmp_dir / "annotations.json", self.annotations)
-        write_json_atomic(self.tmp_dir / "scene.json", scene_metadata)
-        _fsync_dir(self.tmp_dir / "images")
+        write_json_atomic(self.tmp_dir / ANNOTATIONS, self.annotations)
+        write_json_atomic(self.tmp_dir / SCENE_METADATA, scene_metadata)
+        _fsync_dir(self.tmp_dir / IMAGES)
         os.replace(self.tmp_dir, self.scene_dir)
         _fsync_dir(self.scene_dir.parent)
         return self.scene_dir
@@ -194,7 +181,7 @@ def _read_journal(folder: Path) -> dict[str, dict[str, Any]]:
             record = json.loads(line)
         except ValueError:
             break
-        if not all(_whole(folder / "images" / name) for name in record["files"]):
+        if not all(_whole(folder / IMAGES / name) for name in record["files"]):
             break
         done[record["name"]] = record
     return done

@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from davis_ag.atomic_files import atomic_output
+from davis_ag.dataset_layout import ANNOTATIONS, SCENE_METADATA
 from davis_ag.errors import UserError
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.lighting import Lighting
@@ -93,7 +94,7 @@ def read_settings(scene_dir: str | Path) -> SceneSettings:
     from davis_ag.generate.one_scene import SCENE_FORMAT
 
     folder = Path(scene_dir)
-    path = folder / "scene.json"
+    path = folder / SCENE_METADATA
     try:
         metadata = json.loads(path.read_text())
     except FileNotFoundError:
@@ -203,7 +204,7 @@ def assets_from_model(model, grid) -> SceneAssets:
 
 def check_grid(settings: SceneSettings, views: list[Viewpoint]) -> None:
     """The grid's views must be the stored ones: same names, same poses as annotations.json."""
-    path = settings.folder / "annotations.json"
+    path = settings.folder / ANNOTATIONS
     try:
         annotations = json.loads(path.read_text())
     except (OSError, ValueError) as error:

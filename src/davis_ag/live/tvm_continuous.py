@@ -44,6 +44,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from davis_ag.dataset_layout import ANNOTATIONS, SCENE_METADATA
 from davis_ag.errors import UserError
 from davis_ag.live.scene import LiveScene, LiveView, open_live_scene
 from davis_ag.scene.specs import SLIP_SIGMA, scenario_spec
@@ -63,7 +64,7 @@ def scene_folders(source: str | os.PathLike[str], scenario: str, split: str, cro
     """The scene folders an environment opens: ``source`` itself when it is a scene folder, else
     the dataset's scenes of the scenario and split (:func:`davis_ag.benchmark.splits.select_scenes`)."""
     path = Path(os.fspath(source))
-    if (path / "scene.json").is_file() and (path / "annotations.json").is_file():
+    if (path / SCENE_METADATA).is_file() and (path / ANNOTATIONS).is_file():
         return [path]
     from davis_ag.benchmark.splits import select_scenes
     from davis_ag.benchmark.tvm import as_dataset

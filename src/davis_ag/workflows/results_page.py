@@ -16,6 +16,8 @@ from collections import Counter
 from pathlib import Path
 from typing import Any
 
+from davis_ag.dataset_layout import SCENE_METADATA
+
 #: Table 4 of the paper: scenario -> metric -> policy -> value.
 PAPER_TABLE4: dict[str, dict[str, dict[str, float]]] = {
     "sp": {"oer_tau": {"A2C": .520, "LRD": .433, "UDD": .371, "Rand": .438},
@@ -124,7 +126,7 @@ def scene_provenance(dataset: Path, scenes: list[str]) -> list[str]:
     """One line per fact about how a group's scenes were made, from their scene.json files."""
     versions, renderers, sizes = Counter(), Counter(), Counter()
     for scene in scenes:
-        meta = _load(dataset / scene / "scene.json")
+        meta = _load(dataset / scene / SCENE_METADATA)
         versions[meta.get("generator", {}).get("version", "unrecorded")] += 1
         renderer = meta.get("renderer", {})
         renderers[f"{renderer.get('name', '?')} renderer, {renderer.get('look', '?')} look, antialiasing: "
@@ -225,7 +227,7 @@ def stage_rows(state: dict[str, Any], out: Path | None) -> list[tuple[str, float
         key, _, step = stage.partition(": ")
         seconds, code, note = entry["seconds"], entry.get("code", "unrecorded"), entry["note"]
         if out is not None and step == "generate" and state.get("scene_folders", {}).get(key):
-            code = _counted(Counter(_load(out / "dataset" / scene / "scene.json").get("generator", {})
+            code = _counted(Counter(_load(out / "dataset" / scene / SCENE_METADATA).get("generator", {})
                                     .get("version", "unrecorded") for scene in state["scene_folders"][key]))
         record: dict[str, Any] = {}
         if step == "train A2C" and out is not None:  # only a training stage has a record
