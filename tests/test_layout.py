@@ -17,8 +17,9 @@ PACKAGE = Path(davis_ag.__file__).parent
 
 #: The pipeline, earliest first; a module may import its own stage and those before it.
 STAGES: tuple[tuple[str, ...], ...] = (
-    ("errors", "atomic_files", "stage_timer", "provenance", "dataset_layout"),  # helpers every stage may use
+    ("errors", "atomic_files", "stage_timer", "provenance"),  # helpers every stage may use
     ("scene",),
+    ("formats",),  # the dataset's files, split rule and schemas: shared by writer, reader and benchmark
     ("render",),
     ("labels",),
     ("generate",),
@@ -32,7 +33,7 @@ STAGES: tuple[tuple[str, ...], ...] = (
 )
 RANK = {name: rank for rank, names in enumerate(STAGES) for name in names}
 #: Stages that must import without Helios or a renderer: they are pure geometry and reading.
-NO_HELIOS_AT_IMPORT = ("scene", "data", "benchmark", "detection")
+NO_HELIOS_AT_IMPORT = ("scene", "formats", "data", "benchmark", "detection")
 
 
 def module_name(path: Path) -> str:

@@ -186,15 +186,29 @@ def test_original_layout_without_splits(tmp_path: Path) -> None:
         TVMEnv(missing, "sp", "all")
 
 
-def test_fallback_split_is_seeded_70_30() -> None:
-    from davis_ag.benchmark.splits import fallback_split
+def test_a_dataset_without_splits_json_splits_as_the_generator_would(sp_root: Path, tmp_path: Path) -> None:
+    """One split rule: the benchmark's fallback is the generator's, with dataset.json's seed."""
+    import shutil
 
-    ids = [f"Single-Tomato/{i:03d}" for i in range(10)]
-    split = fallback_split(list(reversed(ids)))
-    assert split == fallback_split(ids)  # order of discovery does not matter
-    assert len(split["train"]) == 7 and len(split["test"]) == 3
-    assert sorted(split["train"] + split["test"]) == ids
-    assert fallback_split(ids[:2])["test"] and fallback_split(ids[:1])["train"] == ids[:1]
+    from davis_ag.benchmark.splits import dataset_splits, select_scenes
+    from davis_ag.data.reader import open_dataset
+    from davis_ag.formats.splits import split_scenes
+
+    ids = [f"Single-Tomato/{i:03d}" for i in range(10)] + [f"Multi-Vine/{i:03d}" for i in range(4)]
+    split = split_scenes(list(reversed(ids)), 0)
+    assert split == split_scenes(ids, 0)  # order of discovery does not matter
+    assert sum(s.startswith("Single") for s in split["train"]) == 7 and len(split["test"]) == 3 + 1
+    assert sorted(split["train"] + split["test"]) == sorted(ids)
+
+    root = tmp_path / "copy"
+    shutil.copytree(sp_root, root)
+    (root / "splits.json").unlink(missing_ok=True)
+    data = open_dataset(root)
+    every = [s.id for s in data.scenes]
+    assert dataset_splits(data) == split_scenes(every, 0)
+    (root / "dataset.json").write_text('{"seed": 5}')
+    assert dataset_splits(open_dataset(root)) == split_scenes(every, 5)
+    assert [s.id for s in select_scenes(open_dataset(root), "sp", "test")] == split_scenes(every, 5)["test"]
 
 
 def test_stable_baselines3_accepts_the_env(sp_root: Path) -> None:

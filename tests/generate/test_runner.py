@@ -20,7 +20,8 @@ import pytest
 
 from davis_ag.cli import main
 from davis_ag.errors import UserError
-from davis_ag.generate.dataset_files import split_group, write_splits
+from davis_ag.formats.splits import split_group
+from davis_ag.generate.dataset_files import write_splits
 from davis_ag.generate.run_config import load_dataset_config
 from davis_ag.generate.run_progress import RunOptions
 from davis_ag.generate.runner import LOCK_FILE, DatasetLock, run_dataset

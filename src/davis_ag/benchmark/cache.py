@@ -35,7 +35,7 @@ import numpy as np
 from PIL import Image
 
 from davis_ag.data.safe_read import check_inside
-from davis_ag.dataset_layout import ANNOTATIONS
+from davis_ag.formats.layout import ANNOTATIONS
 from davis_ag.errors import UserError
 from davis_ag.scene.specs import ALL_ACTIONS
 

@@ -1,29 +1,21 @@
 """Which scenes an environment uses: scenario and crop filter, then the train/test split.
 
-Split rule (section V-C: 70 % of the data trains, 30 % tests):
-
-- If the dataset has a ``splits.json`` (``Dataset.splits``), its ``train`` and ``test`` lists
-  are used as they are; scenes in neither list are only used by ``split="all"``.
-- Otherwise (e.g. the original download, which ships none) the split is drawn per group
-  (scenario and crop, i.e. per published folder such as ``Single-Strawberry``): the group's
-  scene ids are sorted, shuffled with ``numpy.random.default_rng(0)``, and the first
-  ``round(0.7 n)`` are train, the rest test, keeping at least one scene on each side when the
-  group has two or more. The same dataset therefore always splits the same way.
+Split (section V-C: 70 % of the data trains, 30 % tests): the dataset's ``splits.json``
+(``Dataset.splits``) where it has one, its lists used as they are (scenes in neither list are
+only used by ``split="all"``); otherwise (e.g. the original download, which ships none) the
+generator's own rule, :mod:`davis_ag.formats.splits`, with the seed of the dataset's
+``dataset.json`` (0 without one). The same dataset therefore always splits the same way, and as
+the generator would have split it.
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-import numpy as np
-
 from davis_ag.errors import UserError
+from davis_ag.formats.splits import recorded_seed, split_scenes
 from davis_ag.scene.specs import crop_spec, parse_group_name, scenario_spec
 
-#: Share of each group's scenes that train when the dataset has no splits.json.
-TRAIN_FRACTION = 0.7
-#: Seed of the fallback split.
-SPLIT_SEED = 0
 SPLITS = ("train", "test", "all")
 
 
@@ -48,23 +40,19 @@ def scene_crop(scene: Any) -> str | None:
     return parsed[1].name if parsed else None
 
 
-def fallback_split(scene_ids: list[str]) -> dict[str, list[str]]:
-    """The seeded 70/30 split of one group's scenes (see the module docstring).
+def dataset_splits(dataset: Any) -> dict[str, list[str]]:
+    """The train and test scene ids of a dataset (see the module docstring).
 
     Args:
-        scene_ids: The group's scene ids, any order.
+        dataset: An opened dataset (``davis_ag.data.reader.Dataset``).
 
     Returns:
-        ``{"train": [...], "test": [...]}``, each sorted.
+        ``{"train": [...], "test": [...]}``.
     """
-    ids = sorted(scene_ids)
-    order = np.random.default_rng(SPLIT_SEED).permutation(len(ids))
-    n_train = int(round(TRAIN_FRACTION * len(ids)))
-    if len(ids) >= 2:
-        n_train = min(max(n_train, 1), len(ids) - 1)
-    train = sorted(ids[i] for i in order[:n_train])
-    test = sorted(ids[i] for i in order[n_train:])
-    return {"train": train, "test": test}
+    splits = getattr(dataset, "splits", None)
+    if splits:
+        return {split: [str(i) for i in splits.get(split, [])] for split in ("train", "test")}
+    return split_scenes((s.id for s in dataset.scenes), recorded_seed(dataset.root))
 
 
 def select_scenes(dataset: Any, scenario: str, split: str, crop: str | None = None) -> list[Any]:
@@ -93,14 +81,7 @@ def select_scenes(dataset: Any, scenario: str, split: str, crop: str | None = No
         raise UserError(f"no {where}: pick a scenario/crop the dataset has")
     if split == "all":
         return sorted(scenes, key=lambda s: s.id)
-    splits = getattr(dataset, "splits", None)
-    if splits:
-        keep = {str(i) for i in splits.get(split, [])}
-    else:
-        groups: dict[tuple[str | None, str | None], list[str]] = {}
-        for s in scenes:
-            groups.setdefault((scene_scenario(s), scene_crop(s)), []).append(s.id)
-        keep = {i for ids in groups.values() for i in fallback_split(ids)[split]}
+    keep = set(dataset_splits(dataset)[split])
     chosen = sorted((s for s in scenes if s.id in keep), key=lambda s: s.id)
     if not chosen:
         raise UserError(f"the {split} split has none of the {len(scenes)} {where}: use "

@@ -32,8 +32,8 @@ from davis_ag.data.annotation_schema import (
     parse_pose,
 )
 from davis_ag.data.safe_read import check_inside, load_pixels, read_json
-from davis_ag.dataset_layout import ANNOTATIONS, IMAGES, SCENE_METADATA, read_depth, view_file, view_stem
-from davis_ag.dataset_layout import SPLITS_FILE as SPLITS
+from davis_ag.formats.layout import ANNOTATIONS, IMAGES, SCENE_METADATA, read_depth, view_file, view_stem
+from davis_ag.formats.layout import SPLITS_FILE as SPLITS
 from davis_ag.errors import UserError
 from davis_ag.scene import specs as config
 

@@ -36,7 +36,7 @@ from davis_ag.data.reader import (
     parse_entry,
 )
 from davis_ag.data.safe_read import check_inside
-from davis_ag.dataset_layout import IMAGES, read_depth_millimetres, view_file, view_of_file
+from davis_ag.formats.layout import IMAGES, read_depth_millimetres, view_file, view_of_file
 from davis_ag.errors import UserError
 
 

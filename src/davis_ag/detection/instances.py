@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from davis_ag.benchmark.splits import fallback_split, scene_crop, scene_scenario
+from davis_ag.benchmark.splits import dataset_splits
 from davis_ag.data.reader import Box, Dataset, Scene, View
 from davis_ag.errors import UserError
 
@@ -39,22 +39,14 @@ def scenes_by_split(dataset: Dataset) -> dict[str, list[Scene]]:
     """The dataset's scenes per split.
 
     ``splits.json`` where the dataset has one (scenes in neither list are left out), else the
-    benchmark's seeded 70/30 split by scene within each group
-    (:func:`davis_ag.benchmark.splits.fallback_split`), so exports and the benchmark agree.
+    the generator's seeded 70/30 split by scene within each group
+    (:func:`davis_ag.benchmark.splits.dataset_splits`), so exports and the benchmark agree.
 
     Returns:
         ``{"train": [...], "test": [...]}``, each sorted by scene id.
     """
-    if dataset.splits:
-        keep = {split: {str(i) for i in dataset.splits.get(split, [])} for split in EXPORT_SPLITS}
-    else:
-        groups: dict[tuple[str | None, str | None], list[str]] = {}
-        for scene in dataset.scenes:
-            groups.setdefault((scene_scenario(scene), scene_crop(scene)), []).append(scene.id)
-        keep = {split: set() for split in EXPORT_SPLITS}
-        for ids in groups.values():
-            for split, chosen in fallback_split(ids).items():
-                keep[split] |= set(chosen)
+    splits = dataset_splits(dataset)
+    keep = {split: set(splits[split]) for split in EXPORT_SPLITS}
     return {split: [s for s in dataset.scenes if s.id in keep[split]] for split in EXPORT_SPLITS}
 
 

@@ -32,7 +32,7 @@ from urllib.parse import parse_qs, unquote, urlsplit
 import numpy as np
 
 from davis_ag.data.reader import NO_FRUIT, Dataset, Scene, open_dataset
-from davis_ag.dataset_layout import IMAGES, VIEW_FILES, read_depth_millimetres
+from davis_ag.formats.layout import IMAGES, VIEW_FILES, read_depth_millimetres
 from davis_ag.errors import UserError
 from davis_ag.figures.scene_numbers import altitudes
 from davis_ag.figures.visibility_plots import plant_xy

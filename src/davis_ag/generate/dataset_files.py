@@ -4,8 +4,9 @@
   field of view, each group's viewpoint grid); a run checks it before touching anything, so one
   folder never mixes scenes made with different settings.
 - ``splits.json`` is the 70/30 train/test split by scene of section V-C,
-  ``{"seed": int, "train": [scene ids], "test": [scene ids]}``, drawn per group from the dataset
-  seed; it depends only on the seed and the scenes on disk, so a resumed run writes the same one.
+  ``{"seed": int, "train": [scene ids], "test": [scene ids]}``, drawn by
+  :mod:`davis_ag.formats.splits` from the dataset seed; it depends only on the seed and the scenes
+  on disk, so a resumed run writes the same one.
 """
 
 from __future__ import annotations
@@ -14,19 +15,16 @@ import json
 from pathlib import Path
 from typing import Any, Sequence
 
-import numpy as np
-
 from davis_ag.atomic_files import write_json_atomic
 from davis_ag.errors import UserError
 from davis_ag.generate.one_scene import SceneRequest
 from davis_ag.generate.run_config import grid_settings
 from davis_ag.render.backends import resolve_look
-from davis_ag.scene.specs import CROPS, SCENARIOS, parse_group_name
-from davis_ag.dataset_layout import ANNOTATIONS, DATASET_FILE, SPLITS_FILE
+from davis_ag.scene.specs import parse_group_name
+from davis_ag.formats.layout import ANNOTATIONS, DATASET_FILE, SPLITS_FILE
+from davis_ag.formats.splits import recorded_seed, split_scenes
 
 DATASET_FORMAT = "davis-ag-dataset/1"
-#: Share of each group's scenes in the training split (section V-C).
-TRAIN_FRACTION = 0.7
 
 
 def dataset_settings(requests: Sequence[SceneRequest]) -> dict[str, Any]:
@@ -111,31 +109,6 @@ def _shown(value: Any) -> str:
 # splits.json
 
 
-def split_group(scene_ids: Sequence[str], seed: int) -> dict[str, list[str]]:
-    """The seeded 70/30 train/test split of one group's scenes.
-
-    The group's ids are sorted and shuffled with a generator seeded by the dataset seed and the
-    group (scenario, crop), and the first ``round(0.7 n)`` train, keeping a scene on each side
-    when the group has two or more. The split depends only on the seed and the set of ids.
-
-    Args:
-        scene_ids: Ids of one group, e.g. ``Single-Strawberry/003``.
-        seed: The dataset seed.
-
-    Returns:
-        ``{"train": [...], "test": [...]}``, each sorted.
-    """
-    ids = sorted(scene_ids)
-    parsed = parse_group_name(ids[0].split("/")[0]) if ids else None
-    stream = [list(SCENARIOS).index(parsed[0].name), list(CROPS).index(parsed[1].name)] if parsed else [0, 0]
-    # A stream of its own (the trailing 1) so the split never correlates with any scene seed.
-    order = np.random.default_rng(np.random.SeedSequence([seed, *stream, 1])).permutation(len(ids))
-    n_train = int(round(TRAIN_FRACTION * len(ids)))
-    if len(ids) >= 2:
-        n_train = min(max(n_train, 1), len(ids) - 1)
-    return {"train": sorted(ids[i] for i in order[:n_train]), "test": sorted(ids[i] for i in order[n_train:])}
-
-
 def write_splits(root: Path, seed: int | None = None) -> Path:
     """Write ``<root>/splits.json`` atomically from the complete scenes on disk.
 
@@ -148,19 +121,7 @@ def write_splits(root: Path, seed: int | None = None) -> Path:
     """
     root = Path(root)
     if seed is None:
-        try:
-            seed = int(json.loads((root / DATASET_FILE).read_text())["seed"])
-        except (OSError, ValueError, KeyError, TypeError):
-            seed = 0
-    groups: dict[str, list[str]] = {}
-    for scene_id in complete_scenes(root):
-        groups.setdefault(scene_id.split("/")[0], []).append(scene_id)
-    train: list[str] = []
-    test: list[str] = []
-    for ids in groups.values():
-        split = split_group(ids, seed)
-        train += split["train"]
-        test += split["test"]
+        seed = recorded_seed(root)
     path = root / SPLITS_FILE
-    write_json_atomic(path, {"seed": seed, "train": sorted(train), "test": sorted(test)})
+    write_json_atomic(path, {"seed": seed, **split_scenes(complete_scenes(root), seed)})
     return path

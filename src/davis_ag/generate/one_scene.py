@@ -16,7 +16,7 @@ from typing import Callable
 
 import numpy as np
 
-from davis_ag.dataset_layout import SCENE_METADATA
+from davis_ag.formats.layout import SCENE_METADATA
 from davis_ag.provenance import code_version
 from davis_ag.atomic_files import PROBE_PREFIX, prove_writable_folder
 from davis_ag.errors import UserError

@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from davis_ag.atomic_files import write_json_atomic
-from davis_ag.dataset_layout import ANNOTATIONS, IMAGES, SCENE_METADATA, view_file_name, write_view_files
+from davis_ag.formats.layout import ANNOTATIONS, IMAGES, SCENE_METADATA, view_file_name, write_view_files
 
 #: In the hidden folder only: the views written so far (JSON lines) and what they were made for.
 JOURNAL = "views.jsonl"

@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from davis_ag.atomic_files import atomic_output
-from davis_ag.dataset_layout import ANNOTATIONS, SCENE_METADATA
+from davis_ag.formats.layout import ANNOTATIONS, SCENE_METADATA
 from davis_ag.errors import UserError
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.lighting import Lighting

@@ -44,7 +44,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from davis_ag.dataset_layout import ANNOTATIONS, SCENE_METADATA
+from davis_ag.formats.layout import ANNOTATIONS, SCENE_METADATA
 from davis_ag.errors import UserError
 from davis_ag.live.scene import LiveScene, LiveView, open_live_scene
 from davis_ag.scene.specs import SLIP_SIGMA, scenario_spec

@@ -16,7 +16,7 @@ from collections import Counter
 from pathlib import Path
 from typing import Any
 
-from davis_ag.dataset_layout import SCENE_METADATA
+from davis_ag.formats.layout import SCENE_METADATA
 
 #: Table 4 of the paper: scenario -> metric -> policy -> value.
 PAPER_TABLE4: dict[str, dict[str, dict[str, float]]] = {
