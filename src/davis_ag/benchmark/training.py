@@ -23,6 +23,7 @@ from davis_ag.atomic_files import atomic_output, prove_writable_file, write_json
 from davis_ag.benchmark import TVMEnv
 from davis_ag.benchmark.networks import ARCHITECTURES
 from davis_ag.errors import UserError
+from davis_ag.formats.models import check_seed
 from davis_ag.provenance import code_version
 
 #: Steps between checkpoints by default: about a minute of training on a 2-core CPU.
@@ -180,8 +181,7 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
         raise UserError(f"unknown network {arch!r}: choose one of {', '.join(ARCHITECTURES)}")
     if total_timesteps < 1 or n_envs < 1 or checkpoint_every < 0:
         raise UserError("--timesteps and --n-envs must be positive, --checkpoint-every from 0")
-    if not 0 <= seed < 2**32:
-        raise UserError(f"--seed {seed}: use a whole number from 0 to {2**32 - 1}")
+    check_seed(seed, "--seed")
     check_device(device)
     final = model_path(Path(out_path).expanduser().absolute())
     prove_writable_file(final)  # before hours of training, not after

@@ -9,22 +9,20 @@ those create a temporary file where the output will go, the only test that holds
 from __future__ import annotations
 
 import argparse
-import re
 from pathlib import Path
 from typing import Callable
 
 from davis_ag.atomic_files import prove_writable_file, prove_writable_folder  # noqa: F401 - shared
-
-#: Largest seed: NumPy's legacy seeding, Gymnasium and Stable-Baselines3 take 32-bit seeds.
-MAX_SEED = 2**32 - 1
+from davis_ag.errors import UserError
+from davis_ag.formats.models import MAX_SEED, check_image_size, check_seed
 
 
 def image_size(text: str) -> tuple[int, int]:
-    """Parse ``WIDTHxHEIGHT``."""
-    match = re.fullmatch(r"(\d+)x(\d+)", text.strip())
-    if not match or min(int(match[1]), int(match[2])) < 16:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an image size like 1280x720 (16 pixels at least)")
-    return int(match[1]), int(match[2])
+    """Parse ``WIDTHxHEIGHT`` by the one image-size rule (:func:`davis_ag.formats.models.check_image_size`)."""
+    try:
+        return check_image_size(text.strip(), "")
+    except UserError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
 
 
 def _digits(text: str) -> int | None:
@@ -64,11 +62,12 @@ def bounded(low: int, high: int) -> Callable[[str], int]:
 
 
 def seed(text: str) -> int:
-    """Parse a seed: a whole number from 0 to 2**32 - 1."""
+    """Parse a seed by the one seed rule (:func:`davis_ag.formats.models.check_seed`)."""
     value = _digits(text)
-    if value is None or value > MAX_SEED:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a seed: use a whole number from 0 to {MAX_SEED}")
-    return value
+    try:
+        return check_seed(value if value is not None else text)
+    except UserError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a seed: use a whole number from 0 to {MAX_SEED}") from None
 
 
 def name_list(choices: tuple[str, ...]) -> Callable[[str], list[str]]:

@@ -3,8 +3,8 @@
 Format (every key but ``groups`` is optional)::
 
     name: paper                  # a label; defaults to the file name
-    seed: 0                      # dataset seed, a whole number from 0 (default 0)
-    image_size: 1280x720         # WIDTHxHEIGHT or [WIDTH, HEIGHT] (default 1280x720)
+    seed: 0                      # dataset seed, a whole number from 0 to 2**32 - 1 (default 0)
+    image_size: 1280x720         # WIDTHxHEIGHT or [WIDTH, HEIGHT], 16 to 8192 a side (default 1280x720)
     renderer: opengl             # opengl (ours, default) or helios (pyhelios's Visualizer)
     look: default                # default or helios (Helios's texture handling); helios renderer: helios
     depth: true                  # write images/NNNN_depth.png (uint16 mm) for every view
@@ -33,16 +33,17 @@ single-plant scenes, minutes on a laptop). ``--config`` takes a preset name or a
 from __future__ import annotations
 
 import dataclasses
-import math
-import re
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 from typing import Any
 
+from pydantic import ValidationError
+
 from davis_ag.errors import UserError
+from davis_ag.formats.models import MAX_SCENES, DatasetConfigFile, check_image_size, check_seed, one_line
 from davis_ag.generate.one_scene import SceneRequest
-from davis_ag.render.backends import DEFAULT_RENDERER, resolve_antialiasing, resolve_look
+from davis_ag.render.backends import DEFAULT_RENDERER, resolve_look
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import (
     CropSpec,
@@ -53,14 +54,6 @@ from davis_ag.scene.specs import (
     with_strawberry_altitudes,
 )
 
-#: Smallest image side accepted, pixels.
-MIN_IMAGE_SIDE = 16
-#: Scene folders are numbered NNN.
-MAX_SCENES = 1000
-TOP_KEYS = ("name", "seed", "image_size", "renderer", "look", "depth", "antialiasing", "strawberry_altitudes",
-            "grid", "groups")
-GROUP_KEYS = ("scenario", "crop", "scenes", "first", "grid")
-GRID_KEYS = ("extent", "step", "altitude_levels", "headings")
 
 
 @dataclass(frozen=True)
@@ -170,8 +163,8 @@ def single_group_config(scenario: str, crop: str, scenes: int, first: int, seed:
     group = GroupConfig(scenario_spec(scenario, crop_settings), crop_settings, scenes, first)
     if first < 0 or first + scenes > MAX_SCENES:
         raise UserError(f"scene indices {first}..{first + scenes - 1} do not fit 000..{MAX_SCENES - 1}")
-    if seed < 0:
-        raise UserError(f"--seed {seed} is negative: use a whole number from 0")
+    check_seed(seed, "--seed")
+    size = check_image_size(size, "--size")
     resolve_look(renderer, look)
     return DatasetConfig("command line", seed, Camera(*size), (group,), "the command line", renderer, look, depth,
                          antialiasing)
@@ -219,7 +212,7 @@ def load_dataset_config(name_or_path: str | Path) -> DatasetConfig:
 
 
 def parse_dataset_config(text: str, source: str, default_name: str = "dataset") -> DatasetConfig:
-    """Validate the YAML text of a dataset config.
+    """Validate the YAML text of a dataset config (:class:`~davis_ag.formats.models.DatasetConfigFile`).
 
     Args:
         text: The YAML.
@@ -230,7 +223,8 @@ def parse_dataset_config(text: str, source: str, default_name: str = "dataset") 
         The config.
 
     Raises:
-        UserError: naming the source, the key and what is wrong.
+        UserError: one line naming the source, the key's path (``groups.0.crop``) and what is
+            allowed.
     """
     import yaml
 
@@ -241,46 +235,21 @@ def parse_dataset_config(text: str, source: str, default_name: str = "dataset") 
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
         problem = getattr(error, "problem", None) or "not valid YAML"
         raise UserError(f"{source}: not valid YAML{where}: {problem}") from None
-    check = _Checker(source)
     if not isinstance(data, dict):
-        check.fail("", "must be a mapping with at least a 'groups' list")
-    check.keys(data, "", TOP_KEYS)
-    name = data.get("name", default_name)
-    if not isinstance(name, str) or not name.strip():
-        check.fail("name", f"must be a non-empty text, not {name!r}")
-    seed = check.whole(data.get("seed", 0), "seed", minimum=0)
-    camera = Camera(*check.image_size(data.get("image_size", "1280x720"), "image_size"))
-    renderer, look = data.get("renderer", DEFAULT_RENDERER), data.get("look")
+        raise UserError(f"{source}: must be a mapping with at least a 'groups' list")
     try:
-        resolve_look(renderer, look)
-    except UserError as error:
-        check.fail("renderer" if renderer not in ("opengl", "helios") else "look", str(error))
-    depth = data.get("depth", True)
-    if not isinstance(depth, bool):
-        check.fail("depth", f"must be true or false, not {depth!r}")
-    try:
-        antialiasing = resolve_antialiasing(data.get("antialiasing"))
-    except UserError as error:
-        check.fail("antialiasing", str(error))
-    top_grid = check.grid_mapping(data.get("grid", {}), "grid")
-    groups_data = data.get("groups")
-    if not isinstance(groups_data, list) or not groups_data:
-        check.fail("groups", "must be a non-empty list of {scenario, crop, scenes} entries")
-    groups: list[GroupConfig] = []
-    for position, item in enumerate(groups_data):
-        groups.append(check.group(item, f"groups[{position}]", top_grid))
-    seen: dict[str, int] = {}
-    for position, group in enumerate(groups):
-        if group.name in seen:
-            check.fail(f"groups[{position}]", f"{group.name} is already groups[{seen[group.name]}]: "
-                                              "give each scenario and crop once")
-        seen[group.name] = position
-    altitudes = data.get("strawberry_altitudes", "table1")
-    try:
-        groups = [dataclasses.replace(g, crop=with_strawberry_altitudes(g.crop, str(altitudes))) for g in groups]
-    except UserError as error:
-        check.fail("strawberry_altitudes", str(error))
-    return DatasetConfig(name.strip(), seed, camera, tuple(groups), source, renderer, look, depth, antialiasing)
+        model = DatasetConfigFile.model_validate(data)
+    except ValidationError as error:
+        raise UserError(one_line(error, source)) from None
+    groups = []
+    for position, entry in enumerate(model.groups):
+        crop = with_strawberry_altitudes(crop_spec(entry.crop), model.strawberry_altitudes)
+        scenario = scenario_spec(entry.scenario, crop)  # the crop's grid (Table 3's counts)
+        where = f"{source}: groups.{position}.grid" if entry.grid else f"{source}: grid"
+        changes = {**(model.grid.changes() if model.grid else {}), **(entry.grid.changes() if entry.grid else {})}
+        groups.append(GroupConfig(apply_grid(scenario, changes, where), crop, entry.scenes, entry.first))
+    return DatasetConfig((model.name or default_name).strip(), model.seed, Camera(*model.image_size), tuple(groups),
+                         source, model.renderer, model.look, model.depth, model.antialiasing)
 
 
 def use_strawberry_altitudes(config: DatasetConfig, choice: str) -> DatasetConfig:
@@ -300,118 +269,23 @@ def use_strawberry_altitudes(config: DatasetConfig, choice: str) -> DatasetConfi
     return dataclasses.replace(config, groups=groups)
 
 
-class _Checker:
-    """Raises UserErrors that name the file and the key."""
+def apply_grid(scenario: ScenarioSpec, changes: dict[str, Any], where: str) -> ScenarioSpec:
+    """The scenario with a grid override (already checked field by field) applied, and checked
+    against the scenario.
 
-    def __init__(self, source: str) -> None:
-        self.source = source
-
-    def fail(self, key: str, what: str) -> None:
-        """Raise the error for ``key``."""
-        raise UserError(f"{self.source}: {key + ': ' if key else ''}{what}")
-
-    def keys(self, data: dict, where: str, known: tuple[str, ...]) -> None:
-        """Reject keys this format does not know (a typo would otherwise be silently ignored)."""
-        for key in data:
-            if key not in known:
-                self.fail(f"{where}.{key}".lstrip("."), f"unknown key (known: {', '.join(known)})")
-
-    def whole(self, value: Any, key: str, minimum: int, maximum: int | None = None) -> int:
-        """A whole number in range."""
-        if isinstance(value, bool) or not isinstance(value, int):
-            self.fail(key, f"must be a whole number, not {value!r}")
-        if value < minimum or (maximum is not None and value > maximum):
-            upper = f" to {maximum}" if maximum is not None else ""
-            self.fail(key, f"must be from {minimum}{upper}, not {value}")
-        return value
-
-    def number(self, value: Any, key: str) -> float:
-        """A positive finite number."""
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
-                or value <= 0:
-            self.fail(key, f"must be a positive number (metres), not {value!r}")
-        return float(value)
-
-    def image_size(self, value: Any, key: str) -> tuple[int, int]:
-        """``WIDTHxHEIGHT`` or ``[WIDTH, HEIGHT]``."""
-        if isinstance(value, str) and (match := re.fullmatch(r"\s*(\d+)\s*x\s*(\d+)\s*", value)):
-            size = (int(match[1]), int(match[2]))
-        elif isinstance(value, list) and len(value) == 2 and all(
-                isinstance(v, int) and not isinstance(v, bool) for v in value):
-            size = (value[0], value[1])
-        else:
-            self.fail(key, f"must be WIDTHxHEIGHT like 1280x720, not {value!r}")
-        if min(size) < MIN_IMAGE_SIDE:
-            self.fail(key, f"{size[0]}x{size[1]} is too small: {MIN_IMAGE_SIDE} pixels a side at least")
-        return size
-
-    def grid_mapping(self, value: Any, key: str) -> dict[str, Any]:
-        """A grid override's raw mapping (checked against the scenario later)."""
-        if value is None:
-            return {}
-        if not isinstance(value, dict):
-            self.fail(key, f"must be a mapping of {', '.join(GRID_KEYS)}, not {value!r}")
-        self.keys(value, key, GRID_KEYS)
-        return dict(value)
-
-    def group(self, item: Any, where: str, top_grid: dict[str, Any]) -> GroupConfig:
-        """One groups[] entry."""
-        if not isinstance(item, dict):
-            self.fail(where, f"must be a mapping with scenario, crop and scenes, not {item!r}")
-        self.keys(item, where, GROUP_KEYS)
-        for key in ("scenario", "crop", "scenes"):
-            if key not in item:
-                self.fail(f"{where}.{key}", "missing")
-        specs: list[Any] = []
-        for key, lookup in (("scenario", scenario_spec), ("crop", crop_spec)):
-            if not isinstance(item[key], str):
-                self.fail(f"{where}.{key}", f"must be a name, not {item[key]!r}")
-            try:
-                specs.append(lookup(item[key]))
-            except UserError as error:
-                self.fail(f"{where}.{key}", str(error))
-        scenario, crop = specs
-        scenario = scenario_spec(scenario.name, crop)  # the crop's grid (Table 3's counts)
-        scenes = self.whole(item["scenes"], f"{where}.scenes", minimum=1, maximum=MAX_SCENES)
-        first = self.whole(item.get("first", 0), f"{where}.first", minimum=0, maximum=MAX_SCENES - 1)
-        if first + scenes > MAX_SCENES:
-            self.fail(where, f"scenes {first}..{first + scenes - 1} do not fit 000..{MAX_SCENES - 1}")
-        grid = {**top_grid, **self.grid_mapping(item.get("grid", {}), f"{where}.grid")}
-        scenario = self.apply_grid(scenario, grid, f"{where}.grid" if item.get("grid") else "grid")
-        return GroupConfig(scenario, crop, scenes, first)
-
-    def apply_grid(self, scenario: ScenarioSpec, grid: dict[str, Any], where: str) -> ScenarioSpec:
-        """The scenario with a grid override applied and checked."""
-        if not grid:
-            return scenario
-        changes: dict[str, Any] = {}
-        if "extent" in grid:
-            extent = grid["extent"]
-            if not isinstance(extent, list) or len(extent) != 2:
-                self.fail(f"{where}.extent", f"must be [x, y] in metres, not {extent!r}")
-            changes["extent"] = tuple(self.number(v, f"{where}.extent") for v in extent)
-        if "step" in grid:
-            changes["step"] = self.number(grid["step"], f"{where}.step")
-        extent, step = changes.get("extent", scenario.extent), changes.get("step", scenario.step)
-        if min(extent) < step:
-            self.fail(where, f"step {step} m is larger than the extent {list(extent)}: no position fits")
-        if "altitude_levels" in grid:
-            levels = grid["altitude_levels"]
-            if not isinstance(levels, list) or not levels or any(
-                    isinstance(v, bool) or v not in (0, 1, 2) for v in levels) or levels != sorted(set(levels)):
-                self.fail(f"{where}.altitude_levels",
-                          f"must list distinct levels from 0 (low) to 2 (high) in increasing order, not {levels!r}")
-            changes["altitude_levels"] = tuple(levels)
-        if "headings" in grid:
-            headings = self.whole(grid["headings"], f"{where}.headings", minimum=1, maximum=360)
-            if scenario.headings == 1 and headings != 1:
-                self.fail(f"{where}.headings", "the single-plant camera always faces the plant: only 1")
-            # Forward moves along the grid axis nearest the heading: a diagonal would be a tie.
-            diagonal = any(math.isclose((k * 360 / headings) % 90, 45) for k in range(headings))
-            if scenario.headings > 1 and (headings < 2 or diagonal or 360 % headings):
-                self.fail(f"{where}.headings", f"{headings} does not work for multi plant: use 2, 3, 4, 6 or 12")
-            changes["headings"] = headings
-        return dataclasses.replace(scenario, **changes)
+    Raises:
+        UserError: ``where`` and what does not fit.
+    """
+    if not changes:
+        return scenario
+    extent, step = changes.get("extent", scenario.extent), changes.get("step", scenario.step)
+    if min(extent) < step:
+        raise UserError(f"{where}: step {step} m is larger than the extent {list(extent)}: no position fits")
+    if scenario.headings == 1 and changes.get("headings", 1) != 1:
+        raise UserError(f"{where}.headings: the single-plant camera always faces the plant: only 1")
+    if scenario.headings > 1 and changes.get("headings", 2) < 2:
+        raise UserError(f"{where}.headings: multi plant needs 2, 3, 4, 6 or 12")
+    return dataclasses.replace(scenario, **changes)
 
 
 def grid_settings(scenario: ScenarioSpec, crop: CropSpec | None = None) -> dict[str, Any]:

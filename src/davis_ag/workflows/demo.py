@@ -19,7 +19,8 @@ from tqdm import tqdm
 
 from davis_ag.atomic_files import prove_writable_folder, write_or_rescue
 from davis_ag.errors import UserError
-from davis_ag.generate.dataset_files import SPLITS_FILE
+from davis_ag.formats.models import check_image_size, check_seed
+from davis_ag.formats.layout import SPLITS_FILE
 from davis_ag.generate.one_scene import SceneRequest
 from davis_ag.generate.run_progress import RunOptions, default_workers
 from davis_ag.generate.runner import run_dataset
@@ -142,8 +143,8 @@ def run_demo(out: Path, scenes: int = 2, size: tuple[int, int] = DEMO_SIZE, seed
     from davis_ag.data.validate import validate_dataset
     from davis_ag.figures.report import write_report
 
-    if isinstance(seed, bool) or not 0 <= seed < 2**32:
-        raise UserError(f"--seed {seed}: use a whole number from 0 to {2**32 - 1}")
+    check_seed(seed, "--seed")
+    size = check_image_size(size, "--size")
     if scenes < 1 or scenes > 1000:
         raise UserError(f"--scenes {scenes}: choose 1 to 1000")
     if episodes < 1 or sessions < 1:
