@@ -26,7 +26,8 @@ from davis_ag.bench import continuous_scene
 from davis_ag.benchmark.evaluation import format_table
 from davis_ag.live.evaluation import evaluate_continuous
 from davis_ag.live.policies import ModelAgent, build_policies
-from davis_ag.live.training import plot_training_curve, train_continuous
+from davis_ag.figures.result_charts import plot_training_curve
+from davis_ag.live.training import train_continuous
 from davis_ag.live.tvm_continuous import TVMContinuousEnv
 
 

@@ -15,13 +15,13 @@ from davis_ag.benchmark.evaluation import (
     episode_seeds,
     evaluate_agents,
     format_table,
-    plot_results,
     run_episode,
     write_json,
 )
 from davis_ag.commands import evaluate as evaluate_command
 from davis_ag.commands import train as train_command
 from davis_ag.errors import UserError
+from davis_ag.figures.result_charts import plot_results
 
 
 def _parser() -> argparse.ArgumentParser:

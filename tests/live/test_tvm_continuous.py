@@ -15,7 +15,8 @@ from davis_ag.benchmark import CONTINUOUS_ID
 from davis_ag.errors import UserError
 from davis_ag.live.evaluation import evaluate_continuous
 from davis_ag.live.policies import Greedy, ModelAgent, RandomAxes, build_policies
-from davis_ag.live.training import plot_training_curve, train_continuous
+from davis_ag.figures.result_charts import plot_training_curve
+from davis_ag.live.training import train_continuous
 from davis_ag.live.tvm_continuous import TVMContinuousEnv, steps_per_second
 from davis_ag.scene.specs import SLIP_SIGMA
 

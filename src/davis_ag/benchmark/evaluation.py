@@ -17,7 +17,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from davis_ag.atomic_files import save_figure_atomic, write_json_atomic
+from davis_ag.atomic_files import write_json_atomic
 from davis_ag.benchmark import TVMEnv
 from davis_ag.benchmark.agents import Agent
 
@@ -175,38 +175,3 @@ def format_table(results: dict[str, Any]) -> str:
 def write_json(results: dict[str, Any], path: str | os.PathLike[str]) -> Path:
     """Write the results as indented JSON (atomically: temp file then rename)."""
     return write_json_atomic(path, results, indent=2)
-
-
-def plot_results(results: dict[str, Any], path: str | os.PathLike[str]) -> Path:
-    """Bar chart of the three Table 4 metrics per policy, with the std over sessions as error
-    bars, saved as PNG.
-
-    Args:
-        results: What :func:`evaluate_agents` returned.
-        path: The PNG to write.
-
-    Returns:
-        ``path``.
-    """
-    import matplotlib
-
-    matplotlib.use("Agg")  # files only: no display on servers
-    import matplotlib.pyplot as plt
-
-    policies = results["policies"]
-    names = list(policies)
-    fig, axes = plt.subplots(1, len(METRICS), figsize=(4 * len(METRICS), 3.2))
-    for ax, (key, title) in zip(axes, METRICS.items()):
-        means = [policies[n][key]["mean"] for n in names]
-        stds = [policies[n][key]["std"] for n in names]
-        ax.bar(names, means, yerr=stds, capsize=4, color=[f"C{i}" for i in range(len(names))])
-        ax.set_title(title)
-        ax.tick_params(axis="x", labelrotation=30)
-    protocol = results["protocol"]
-    fig.suptitle(f"{protocol['scenario'].upper()} {protocol['split']}: {protocol['sessions']} x "
-                 f"{protocol['episodes']} episodes")
-    fig.tight_layout()
-    try:
-        return save_figure_atomic(fig, path, dpi=120)
-    finally:
-        plt.close(fig)

@@ -46,6 +46,17 @@ from davis_ag.scene.specs import ALL_ACTIONS, crop_spec, scenario_spec
 
 #: Section V-C: an episode starts on a target with OER below this.
 MAX_START_OER = 0.4
+
+
+def can_start(oer: Any, max_start_oer: float = MAX_START_OER) -> Any:
+    """Section V-C's start rule: a fruit may be an episode's target when its OER is below the
+    limit (a float, or an array of them); the grid and the continuous environments share it."""
+    return oer < max_start_oer
+
+
+def episode_reward(oer_0: float, oer_end: float) -> float:
+    """Section IV-C's reward at an episode's end: ``max(OER_end - OER_0, 0) ** 2``."""
+    return float(max(oer_end - oer_0, 0.0) ** 2)
 #: Image area that the crops' ``min_fruit_pixels`` (section III-C) refer to.
 REFERENCE_PIXELS = 1280 * 720
 
@@ -146,7 +157,7 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
     @staticmethod
     def _eligible(cache: SceneCache, min_pixels: float, max_oer: float) -> _Starts:
         """Boxes a scene's episodes may start from (OER and visible-pixel filters)."""
-        ok = (cache.box_oer < max_oer) & (cache.box_pixels >= min_pixels)
+        ok = can_start(cache.box_oer, max_oer) & (cache.box_pixels >= min_pixels)
         boxes = np.flatnonzero(ok).astype(np.int32)
         # Rows were written view by view, so a stable sort by view keeps each view's boxes
         # together in annotation order.
@@ -251,8 +262,8 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
 
     @staticmethod
     def reward(oer_0: float, oer_end: float) -> float:
-        """Section IV-C: ``max(OER_end - OER_0, 0) ** 2``."""
-        return float(max(oer_end - oer_0, 0.0) ** 2)
+        """Section IV-C: ``max(OER_end - OER_0, 0) ** 2`` (:func:`episode_reward`)."""
+        return episode_reward(oer_0, oer_end)
 
     # ----------------------------------------------------------------------------- state
 

@@ -54,7 +54,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Evaluate, print the table, write JSON and PNG."""
-    from davis_ag.benchmark.evaluation import format_table, plot_results, write_json
+    from davis_ag.benchmark.evaluation import format_table, write_json
+    from davis_ag.figures.result_charts import plot_results
 
     continuous = args.env == "continuous"
     allowed = CONTINUOUS_POLICIES if continuous else POLICIES

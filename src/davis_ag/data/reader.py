@@ -32,8 +32,11 @@ from davis_ag.data.annotation_schema import (
     parse_pose,
 )
 from davis_ag.data.safe_read import check_inside, load_pixels, read_json
+from pydantic import ValidationError
+
 from davis_ag.formats.layout import ANNOTATIONS, IMAGES, SCENE_METADATA, read_depth, view_file, view_stem
 from davis_ag.formats.layout import SPLITS_FILE as SPLITS
+from davis_ag.formats.models import SplitsFile, one_line
 from davis_ag.errors import UserError
 from davis_ag.scene import specs as config
 
@@ -313,14 +316,11 @@ class Dataset:
         if not path.is_file():
             return None
         data = read_json(check_inside(path, self.root), "splits")
-        if not isinstance(data, dict):
-            raise UserError(f"{path}: must hold a JSON object with train and test lists; fix or delete it")
-        for name in ("train", "test"):
-            ids = data.get(name, [])
-            if not isinstance(ids, list) or not all(isinstance(i, str) for i in ids):
-                raise UserError(f"{path}: {name!r} must be a list of scene ids like \"Single-Strawberry/000\"; "
-                                "fix or delete it")
-        return data
+        try:
+            return SplitsFile.model_validate(data).to_json()
+        except ValidationError as error:
+            raise UserError(f"{one_line(error, str(path))}; fix or delete it (a list of scene ids like "
+                            "\"Single-Strawberry/000\" for train and for test)") from None
 
     def __len__(self) -> int:
         return len(self.scenes)

@@ -20,6 +20,9 @@ from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
+
+from pydantic import BaseModel, ValidationError
 
 from davis_ag.data.reader import (
     ANNOTATIONS,
@@ -36,7 +39,8 @@ from davis_ag.data.reader import (
     parse_entry,
 )
 from davis_ag.data.safe_read import check_inside
-from davis_ag.formats.layout import IMAGES, read_depth_millimetres, view_file, view_of_file
+from davis_ag.formats.layout import DATASET_FILE, IMAGES, read_depth_millimetres, view_file, view_of_file
+from davis_ag.formats.models import AnnotationEntry, DatasetFile, SplitsFile, one_line
 from davis_ag.errors import UserError
 
 
@@ -141,6 +145,7 @@ def validate_scene(scene: Scene, quick: bool = False, box_tolerance: int | None 
     tolerance = box_tolerance if box_tolerance is not None else (0 if metadata is not None else 1)
 
     records: dict[str, ViewRecord] = {}
+    keys: dict[str, str] = {}  # each record's key in annotations.json
     # Names of every entry, readable or not, so a broken entry does not also orphan its files.
     names = {_name_or_key(key) for key in raw}
     for key, entry in raw.items():
@@ -152,6 +157,7 @@ def validate_scene(scene: Scene, quick: bool = False, box_tolerance: int | None 
         if record.name in records:
             flag(ann_path, f"entry {key!r}: names the same image as another entry")
         records[record.name] = record
+        keys[record.name] = key
     report.views += len(raw)
 
     images = scene.path / IMAGES
@@ -160,8 +166,14 @@ def validate_scene(scene: Scene, quick: bool = False, box_tolerance: int | None 
             if target and target not in names:
                 flag(ann_path, f"{record.name}: {action} points to {target}, which is not a view of this scene")
         report.boxes += len(record.boxes)
-        for problem in _box_schema_problems(record):
+        box_problems = _box_schema_problems(record)
+        for problem in box_problems:
             flag(ann_path, problem)
+        if metadata is not None and not box_problems:  # ours: held to the entry we write
+            try:
+                AnnotationEntry.model_validate(raw[keys[record.name]])
+            except ValidationError as error:
+                flag(ann_path, one_line(error, f"entry {keys[record.name]!r}"))
         image, mask = images / record.name, view_file(scene.path, record.name, "mask")
         has_image, has_mask = image.is_file(), mask.is_file()
         for path, present in ((image, has_image), (mask, has_mask)):
@@ -360,29 +372,38 @@ def _close(box: Box, extent: Box, tolerance: int) -> bool:
 
 def _check_splits(dataset: Dataset, whole: bool) -> list[Problem]:
     path = dataset.root / SPLITS
+    splits, problems = _read_root_file(dataset, SPLITS, SplitsFile)
+    if splits is None:
+        return problems
+    known = {scene.id for scene in dataset.scenes}
+    # Only scenes under the opened path are known; a group or scene opened alone sees a subset.
+    problems = [Problem(path, f"{name} lists {i}, which is not a scene here")
+                for name, ids in (("train", splits.train), ("test", splits.test)) for i in ids
+                if whole and i not in known]
+    if both := splits.in_both():
+        problems.append(Problem(path, f"{len(both)} scene(s) in both train and test, e.g. {both[0]}"))
+    return problems
+
+
+def _read_root_file(dataset: Dataset, name: str, model: type[BaseModel]) -> tuple[Any, list[Problem]]:
+    """A JSON file at the dataset's root read through its model: ``(model or None, problems)``;
+    ``(None, [])`` where the file is absent."""
+    path = dataset.root / name
     if not path.is_file():
-        return []
+        return None, []
     outside = _outside(path, dataset.root)
     data, error = (None, outside) if outside else _read_json(path)
     if error:
-        return [Problem(path, error)]
-    if not isinstance(data, dict):
-        return [Problem(path, "must hold a JSON object with train and test lists")]
-    problems = []
-    known = {scene.id for scene in dataset.scenes}
-    lists = {}
-    for name in ("train", "test"):
-        ids = data.get(name)
-        if not isinstance(ids, list) or not all(isinstance(i, str) for i in ids):
-            problems.append(Problem(path, f"{name!r} must be a list of scene ids like \"Single-Strawberry/000\""))
-            continue
-        lists[name] = set(ids)
-        # Only scenes under the opened path are known; a group or scene opened alone sees a subset.
-        if whole:
-            problems += [Problem(path, f"{name} lists {i}, which is not a scene here") for i in ids if i not in known]
-    if len(lists) == 2 and (both := sorted(lists["train"] & lists["test"])):
-        problems.append(Problem(path, f"{len(both)} scene(s) in both train and test, e.g. {both[0]}"))
-    return problems
+        return None, [Problem(path, error)]
+    try:
+        return model.model_validate(data), []
+    except ValidationError as invalid:
+        return None, [Problem(path, one_line(invalid))]
+
+
+def _check_dataset_file(dataset: Dataset) -> list[Problem]:
+    """dataset.json (ours), where the root has one: the settings its scenes share."""
+    return _read_root_file(dataset, DATASET_FILE, DatasetFile)[1]
 
 
 def _check_counts(dataset: Dataset, counts: dict[str, int]) -> list[Problem]:
@@ -431,7 +452,7 @@ def validate_dataset(path: str | Path, quick: bool = False, box_tolerance: int |
             on_problem(problem)
 
     whole = Path(path).expanduser().absolute() == dataset.root
-    for problem in _check_splits(dataset, whole):
+    for problem in _check_splits(dataset, whole) + (_check_dataset_file(dataset) if whole else []):
         emit(problem)
     bar = tqdm(dataset.scenes, desc="validate", unit="scene", file=sys.stderr,
                disable=None if progress and len(dataset.scenes) > 1 else True)

@@ -7,7 +7,7 @@ Figures (matplotlib Agg, each file written through a temporary file and a rename
   :func:`davis_ag.figures.visibility_plots.plot_visibility`);
 - every other figure of the paper the data allows (:func:`davis_ag.figures.plots.paper_figures`,
   PNG and SVG under ``figures/``): altitude changes, OER, actions, an episode, phenotypes;
-- the Table 4 bar chart (:func:`davis_ag.benchmark.evaluation.plot_results`).
+- the Table 4 bar chart (:func:`davis_ag.figures.result_charts.plot_results`).
 
 ``index.html`` links everything with relative paths, so the report folder can be moved.
 """
@@ -115,7 +115,8 @@ def write_report(root: Path, out_dir: Path, results: dict[str, Any] | None = Non
     Raises:
         UserError: when ``root`` holds no dataset.
     """
-    from davis_ag.benchmark.evaluation import format_table, plot_results
+    from davis_ag.benchmark.evaluation import format_table
+    from davis_ag.figures.result_charts import plot_results
 
     dataset = open_dataset(root)
     scenes = dataset.scenes

@@ -28,6 +28,7 @@ from pydantic import (
     StrictInt,
     TypeAdapter,
     ValidationError,
+    ValidationInfo,
     field_validator,
     model_validator,
 )
@@ -193,19 +194,12 @@ class GroupEntry(_Model):
     first: whole(0, MAX_SCENES - 1) = 0
     grid: GridOverride | None = None
 
-    @field_validator("scenario")
+    @field_validator("scenario", "crop")
     @classmethod
-    def _known_scenario(cls, name: str) -> str:
+    def _known_name(cls, name: str, info: ValidationInfo) -> str:
+        """The canonical name (``single`` -> ``sp``, ``grape`` -> ``vine``); the error lists the choices."""
         try:
-            return scenario_spec(name).name
-        except UserError as error:
-            raise ValueError(str(error)) from None
-
-    @field_validator("crop")
-    @classmethod
-    def _known_crop(cls, name: str) -> str:
-        try:
-            return crop_spec(name).name
+            return (scenario_spec if info.field_name == "scenario" else crop_spec)(name).name
         except UserError as error:
             raise ValueError(str(error)) from None
 
@@ -305,12 +299,9 @@ class SplitsFile(_Model):
     train: list[str]
     test: list[str]
 
-    @model_validator(mode="after")
-    def _disjoint(self) -> SplitsFile:
-        both = sorted(set(self.train) & set(self.test))
-        if both:
-            raise ValueError(f"{len(both)} scene(s) in both train and test, e.g. {both[0]}")
-        return self
+    def in_both(self) -> list[str]:
+        """Scene ids listed for train and for test (a damaged file; the validator reports them)."""
+        return sorted(set(self.train) & set(self.test))
 
 
 # ---------------------------------------------------------------------------------------------

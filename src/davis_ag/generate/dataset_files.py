@@ -21,7 +21,10 @@ from davis_ag.generate.one_scene import SceneRequest
 from davis_ag.generate.run_config import grid_settings
 from davis_ag.render.backends import resolve_look
 from davis_ag.scene.specs import parse_group_name
+from pydantic import ValidationError
+
 from davis_ag.formats.layout import ANNOTATIONS, DATASET_FILE, SPLITS_FILE
+from davis_ag.formats.models import DatasetFile, SplitsFile, one_line
 from davis_ag.formats.splits import recorded_seed, split_scenes
 
 DATASET_FORMAT = "davis-ag-dataset/1"
@@ -42,9 +45,9 @@ def dataset_settings(requests: Sequence[SceneRequest]) -> dict[str, Any]:
     groups: dict[str, Any] = {}
     for request in requests:
         groups[request.folder.split("/")[0]] = {"grid": grid_settings(request.scenario, request.crop)}
-    return {"format": DATASET_FORMAT, "seed": first.dataset_seed,
-            "image_size": [first.camera.width, first.camera.height], "vfov_deg": first.camera.vfov,
-            "renderer": first.renderer, "look": resolve_look(first.renderer, first.look), "groups": groups}
+    return DatasetFile(format=DATASET_FORMAT, seed=first.dataset_seed,
+                       image_size=(first.camera.width, first.camera.height), vfov_deg=first.camera.vfov,
+                       renderer=first.renderer, look=resolve_look(first.renderer, first.look), groups=groups).to_json()
 
 
 def complete_scenes(root: Path) -> list[str]:
@@ -74,15 +77,15 @@ def reconcile_settings(root: Path, wanted: dict[str, Any]) -> dict[str, Any]:
     if not path.is_file():
         return wanted
     try:
-        old = json.loads(path.read_text())
-        assert isinstance(old, dict) and isinstance(old.get("groups"), dict)
-    except (OSError, ValueError, AssertionError):
-        raise UserError(f"{path} is unreadable: move it away if the folder holds no scenes of ours") from None
+        old = DatasetFile.model_validate_json(path.read_bytes()).to_json()
+    except OSError as error:
+        raise UserError(f"{path} is unreadable ({error.strerror}): move it away if the folder holds no scenes of "
+                        "ours") from None
+    except ValidationError as error:
+        raise UserError(f"{one_line(error, str(path))}: move it away if the folder holds no scenes of ours") from None
     present = complete_scenes(root)
     if not present:  # nothing was finished with the old settings: they may change freely
         return wanted
-    # Datasets from before the choice of renderer were drawn by Helios.
-    old = {"renderer": "helios", "look": "helios", **old}
     for key, flag in (("seed", "--seed"), ("image_size", "--size"), ("vfov_deg", "the field of view"),
                       ("renderer", "--renderer"), ("look", "--look")):
         if old.get(key) != wanted[key]:
@@ -123,5 +126,5 @@ def write_splits(root: Path, seed: int | None = None) -> Path:
     if seed is None:
         seed = recorded_seed(root)
     path = root / SPLITS_FILE
-    write_json_atomic(path, {"seed": seed, **split_scenes(complete_scenes(root), seed)})
+    write_json_atomic(path, SplitsFile(seed=seed, **split_scenes(complete_scenes(root), seed)).to_json())
     return path

@@ -17,6 +17,7 @@ from typing import Callable
 import numpy as np
 
 from davis_ag.formats.layout import SCENE_METADATA
+from davis_ag.formats.models import AnnotationEntry
 from davis_ag.provenance import code_version
 from davis_ag.atomic_files import PROBE_PREFIX, prove_writable_folder
 from davis_ag.errors import UserError
@@ -195,8 +196,8 @@ def draw_scene(request: SceneRequest, model, grid, root: Path, on_view: Callable
                 silhouette = (lambda fruit_id, view=view: draw_silhouette(view, fruit_id, fruit_uuids[fruit_id])) \
                     if draw_silhouette else None
                 fractions = visible_fractions(camera, view, labels, polygons, silhouette)
-                entry = {"bounding_boxes": labels.boxes, "pose": [round(v, 5) for v in view.pose]}
-                entry.update(grid.pointers(view.index))
+                entry = AnnotationEntry(bounding_boxes=labels.boxes, pose=[round(v, 5) for v in view.pose],
+                                        **grid.pointers(view.index)).to_json()
                 visible[view.image_name] = {str(k): v for k, v in fractions.items()}
                 writer.add_view(view.image_name, colour, labels.segmentation, entry,
                                 depth if request.depth else None, {"visible": visible[view.image_name]})

@@ -1,4 +1,4 @@
-"""Train PPO (Stable-Baselines3) on TVMContinuous-v0 and draw its training curve.
+"""Train PPO (Stable-Baselines3) on TVMContinuous-v0 (its training curve: :mod:`davis_ag.figures.result_charts`).
 
 PPO, not A2C: the action is continuous, and PPO is SB3's on-policy method for it that behaves
 well on short runs; SAC (off-policy, replay buffer) would keep every 224x224x4 observation in
@@ -16,7 +16,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from davis_ag.atomic_files import prove_writable_file, save_figure_atomic, write_or_rescue
+from davis_ag.atomic_files import prove_writable_file, write_or_rescue
 from davis_ag.benchmark.networks import ARCHITECTURES
 from davis_ag.benchmark.training import model_path, save_model
 from davis_ag.errors import UserError
@@ -118,39 +118,3 @@ def train_continuous(dataset: Any, scenario: str = "sp", total_timesteps: int = 
     records = list(log.records)
     saved = write_or_rescue(final, lambda path: save_model(model, path), "the trained model")
     return saved, records
-
-
-def plot_training_curve(records: list[dict], path: str | os.PathLike[str], title: str, window: int = 50) -> Path:
-    """Reward and final OER per episode against environment steps, with a moving mean, as PNG.
-
-    Args:
-        records: What :func:`train_continuous` returned.
-        path: The PNG.
-        title: The figure's title.
-        window: Episodes in the moving mean.
-
-    Returns:
-        ``path``.
-    """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    steps = np.array([r["timestep"] for r in records])
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.2))
-    for ax, key, label in ((axes[0], "reward", "episode reward"), (axes[1], "gain", "OER_tau - OER_0")):
-        values = np.array([r["reward"] if key == "reward" else r["oer_tau"] - r["oer_0"] for r in records])
-        ax.plot(steps, values, ".", ms=2, alpha=0.3, color="C0")
-        if len(values) >= window:
-            mean = np.convolve(values, np.ones(window) / window, mode="valid")
-            ax.plot(steps[window - 1:], mean, color="C1", label=f"mean of {window} episodes")
-            ax.legend(loc="upper left", fontsize=8)
-        ax.set_xlabel("environment steps")
-        ax.set_title(label)
-    fig.suptitle(title)
-    fig.tight_layout()
-    try:
-        return save_figure_atomic(fig, path, dpi=110)
-    finally:
-        plt.close(fig)

@@ -44,16 +44,14 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from davis_ag.formats.layout import ANNOTATIONS, SCENE_METADATA
+from davis_ag.benchmark.cache import OBS_SIZE
+from davis_ag.benchmark.tvm import MAX_START_OER, can_start, episode_reward
 from davis_ag.errors import UserError
+from davis_ag.formats.layout import ANNOTATIONS, SCENE_METADATA
 from davis_ag.live.scene import LiveScene, LiveView, open_live_scene
 from davis_ag.scene.specs import SLIP_SIGMA, scenario_spec
 from davis_ag.scene.view_grid import Viewpoint, excluded
 
-#: Observation side, pixels (section IV-C).
-OBS_SIZE = 224
-#: Section V-C: an episode starts on a target with OER below this.
-MAX_START_OER = 0.4
 #: Random poses tried per reset before giving up on a scene.
 START_TRIES = 200
 #: Pitch limits of a free camera, degrees above the horizon.
@@ -244,7 +242,7 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
             pitch = math.degrees(math.atan2(aim_z - position[2], math.hypot(dx, dy)))
             view = self._pose(position, yaw, pitch)
             labels = self._draw(view)
-            eligible = [f for f, oer in labels.oer.items() if oer < self.max_start_oer]
+            eligible = [f for f, oer in labels.oer.items() if can_start(oer, self.max_start_oer)]
             if eligible:
                 self._view, self._labels = view, labels
                 self._target = int(eligible[int(rng.integers(len(eligible)))])
@@ -300,7 +298,7 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         reward = 0.0
         if terminated:
             self._over = True
-            reward = float(max(self.oer - self._oer_0, 0.0) ** 2)
+            reward = episode_reward(self._oer_0, self.oer)
         return self._observation(), reward, terminated, False, self._info()
 
     # ----------------------------------------------------------------------------- state

@@ -86,7 +86,8 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
         0 on success, 1 when a dataset failed validation.
     """
     from davis_ag.atomic_files import prove_writable_file, prove_writable_folder, write_or_rescue
-    from davis_ag.benchmark.evaluation import format_table, plot_results, write_json
+    from davis_ag.benchmark.evaluation import format_table, write_json
+    from davis_ag.figures.result_charts import plot_results
     from davis_ag.benchmark.training import train_a2c
     from davis_ag.data.validate import validate_dataset
     from davis_ag.generate.one_scene import SceneRequest
