@@ -6,8 +6,9 @@ the phenotype drawn for it; what was built is then measured back from the Contex
 
 - height: top of the plant's tallest stem (strawberry: the highest point of its stems, which
   lean and bend, so below the drawn height; tomato: the main stem's top; vine: the trunk's top);
-- fruit radius in Table 1's terms: half the mean principal extent of each fruit body over the
-  crop's ``fruit_size_per_radius`` (for the vine, of each berry), median over fruit;
+- fruit radius in Table 1's terms: for the strawberry, half the mean principal extent of each
+  fruit over the crop's ``fruit_size_per_radius``; a tomato or a grape berry is a sphere, and its
+  radius the mean distance of its vertices from their centre; median over fruit (berries);
 - leaf length: the largest leaf's size (the largest distance between two of its vertices) over
   that of the crop's unit leaf, the shape every leaf is a scaled copy of.
 """
@@ -101,6 +102,11 @@ def add_parts(context, parts: PlantParts) -> PlacedPlant:
     return PlacedPlant(uuids, fruits, fruit_parts, leaves, stems)
 
 
+def _sphere_radius(points: np.ndarray) -> float:
+    points = np.unique(np.round(points, 7), axis=0)
+    return float(np.linalg.norm(points - points.mean(axis=0), axis=1).mean())
+
+
 def _diameter(points: np.ndarray) -> float:
     points = np.unique(np.round(points, 7), axis=0)
     return float(np.sqrt(((points[:, None, :] - points[None, :, :]) ** 2).sum(-1)).max())
@@ -110,8 +116,10 @@ def measure_placed(context, placed: PlacedPlant, crop: CropSpec) -> Phenotype:
     """Measure height, fruit radius and leaf length of a placed plant (see the module docstring)."""
     frame = placed.stems if crop.name == "strawberry" else placed.stems[:1]  # tomato: main stem; vine: trunk
     height = float(max(v[:, 2].max() for s in frame for v in primitive_vertices(context, s)))
-    pieces = [piece for fruit in placed.fruit_parts for piece in fruit]
-    radii = [fruit_radius(np.concatenate(primitive_vertices(context, piece))) for piece in pieces]
+    pieces = [np.concatenate(primitive_vertices(context, piece)) for fruit in placed.fruit_parts for piece in fruit]
+    # A tomato or a berry is a sphere: every vertex lies at its radius from the centre (half its
+    # principal extent would read a coarsely tessellated sphere a few per cent small).
+    radii = [_sphere_radius(p) if crop.name != "strawberry" else fruit_radius(p) for p in pieces]
     radius = float(np.median(radii)) / crop.fruit_size_per_radius if radii else float("nan")
     unit = UNIT_LEAVES[crop.name]()
     unit_size = _diameter(unit.triangles.reshape(-1, 3))
