@@ -34,7 +34,7 @@ from pydantic import (
 )
 
 from davis_ag.errors import UserError
-from davis_ag.scene.specs import ALL_ACTIONS, crop_spec, group_name, scenario_spec
+from davis_ag.scene.specs import ALL_ACTIONS, DEFAULT_PLANTS, PLANT_GENERATORS, crop_spec, group_name, scenario_spec
 
 #: Largest seed: NumPy's legacy seeding, Gymnasium and Stable-Baselines3 take 32-bit seeds.
 MAX_SEED = 2**32 - 1
@@ -228,6 +228,7 @@ class DatasetConfigFile(_Model):
     look: Literal["default", "helios"] | None = None
     depth: StrictBool = True
     antialiasing: Annotated[Literal["fxaa", "msaa", "none"], BeforeValidator(_antialiasing)] = "fxaa"
+    plants: Literal[PLANT_GENERATORS] = DEFAULT_PLANTS  # type: ignore[valid-type]
     strawberry_altitudes: Literal["table1", "readme"] = "table1"
     grid: GridOverride | None = None
     groups: list[GroupEntry]
@@ -288,6 +289,8 @@ class DatasetFile(_Model):
     # Datasets from before the choice of renderer were drawn by Helios.
     renderer: Literal["opengl", "helios"] = "helios"
     look: Literal["default", "helios"] = "helios"
+    # Datasets from before the choice of plants grew PlantArchitecture plants.
+    plants: Literal[PLANT_GENERATORS] = "architecture"  # type: ignore[valid-type]
     groups: dict[str, DatasetGroup]
 
 

@@ -9,6 +9,7 @@ Format (every key but ``groups`` is optional)::
     look: default                # default or helios (Helios's texture handling); helios renderer: helios
     depth: true                  # write images/NNNN_depth.png (uint16 mm) for every view
     antialiasing: fxaa           # our renderer's: fxaa (default), msaa (4x samples, slower) or none
+    plants: canopy               # canopy (Helios's Canopy Generator, default) or architecture
     strawberry_altitudes: table1 # table1 (25/40/55 cm, default) or readme (0.50/0.75/1.00 m)
     grid:                        # overrides the scenario's Table 2 grid for every group
       extent: [3.0, 3.0]         #   grid size along x and y, m
@@ -46,8 +47,10 @@ from davis_ag.generate.one_scene import SceneRequest
 from davis_ag.render.backends import DEFAULT_RENDERER, resolve_look
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import (
+    DEFAULT_PLANTS,
     CropSpec,
     ScenarioSpec,
+    check_plants,
     crop_spec,
     group_name,
     scenario_spec,
@@ -97,6 +100,7 @@ class DatasetConfig:
         look: ``default`` or ``helios``; None for the renderer's own.
         depth: Whether every view gets a depth image.
         antialiasing: Our renderer's antialiasing: ``fxaa``, ``msaa`` or ``none``.
+        plants: The plant generator: ``canopy`` (default) or ``architecture``.
     """
 
     name: str
@@ -108,6 +112,7 @@ class DatasetConfig:
     look: str | None = None
     depth: bool = True
     antialiasing: str = "fxaa"
+    plants: str = DEFAULT_PLANTS
 
     def requests(self, only: list[str] | None = None) -> list[SceneRequest]:
         """Every scene to make, in group order, optionally narrowed to some groups or scenes.
@@ -124,7 +129,7 @@ class DatasetConfig:
         """
         look = resolve_look(self.renderer, self.look)
         everything = [SceneRequest(g.scenario, g.crop, i, self.seed, self.camera, self.renderer, look, self.depth,
-                                   self.antialiasing)
+                                   self.antialiasing, self.plants)
                       for g in self.groups for i in g.indices]
         if not only:
             return everything
@@ -150,7 +155,7 @@ def _normalise_scene_id(text: str) -> str:
 
 def single_group_config(scenario: str, crop: str, scenes: int, first: int, seed: int,
                         size: tuple[int, int], renderer: str = DEFAULT_RENDERER, look: str | None = None,
-                        depth: bool = True, antialiasing: str = "fxaa") -> DatasetConfig:
+                        depth: bool = True, antialiasing: str = "fxaa", plants: str = DEFAULT_PLANTS) -> DatasetConfig:
     """The dataset the classic flags (--scenario --crop --scenes --first) describe.
 
     Returns:
@@ -167,7 +172,7 @@ def single_group_config(scenario: str, crop: str, scenes: int, first: int, seed:
     size = check_image_size(size, "--size")
     resolve_look(renderer, look)
     return DatasetConfig("command line", seed, Camera(*size), (group,), "the command line", renderer, look, depth,
-                         antialiasing)
+                         antialiasing, check_plants(plants))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -249,7 +254,8 @@ def parse_dataset_config(text: str, source: str, default_name: str = "dataset") 
         changes = {**(model.grid.changes() if model.grid else {}), **(entry.grid.changes() if entry.grid else {})}
         groups.append(GroupConfig(apply_grid(scenario, changes, where), crop, entry.scenes, entry.first))
     return DatasetConfig((model.name or default_name).strip(), model.seed, Camera(*model.image_size), tuple(groups),
-                         source, model.renderer, model.look, model.depth, model.antialiasing)
+                         source, model.renderer, model.look, model.depth, model.antialiasing,
+                         model.plants)
 
 
 def use_strawberry_altitudes(config: DatasetConfig, choice: str) -> DatasetConfig:
