@@ -71,7 +71,8 @@ def test_unwritable_outputs_are_refused_before_any_work(capsys: pytest.CaptureFi
 @pytest.mark.parametrize("argv", [
     ["preview", "--seed", "-1"], ["preview", "--views", "0"], ["preview", "--views", "1,x"],
     ["preview", "--views", "100000"], ["preview", "--index", "-2"], ["preview", "--crop", "banana"],
-    ["preview", "--size", "0x0"],
+    ["preview", "--size", "0x0"], ["preview", "--size", "99999x99999"],
+    ["generate", "--size", "99999x99999"], ["generate", "--seed", "4294967296"], ["demo", "--size", "8193x16"],
     ["generate", "--seed", "-1"], ["generate", "--scenes", "0"], ["generate", "--first", "-1"],
     ["generate", "--crop", "banana"], ["generate", "--config", "nope.yaml"],
     ["demo", "--seed", "-1"], ["demo", "--scenes", "0"], ["demo", "--episodes", "0"],
@@ -82,6 +83,19 @@ def test_bad_values_of_commands_that_make_scenes(argv: list[str], capsys: pytest
                                                  tmp_path: Path, never_grow: None) -> None:
     line = refused(capsys, *argv, "--out", str(tmp_path / "out"))
     assert argv[1] in line or "banana" in line or "nope" in line or "view" in line, line
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_config_the_renderer_cannot_draw_is_refused_before_any_plant_grows(
+        capsys: pytest.CaptureFixture[str], tmp_path: Path, never_grow: None) -> None:
+    config = tmp_path / "huge.yaml"
+    config.write_text("image_size: 99999x99999\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n")
+    line = refused(capsys, "generate", "--config", str(config), "--out", str(tmp_path / "out"))
+    assert line.endswith(f"{config}: image_size: 99999x99999: each side must be from 16 to 8192 pixels "
+                         "(the renderer's limit)"), line
+    config.write_text("groups: [{scenario: sp, crop: banana, scenes: 1}]\n")
+    line = refused(capsys, "generate", "--config", str(config), "--out", str(tmp_path / "out"))
+    assert line.endswith("groups.0.crop: unknown crop 'banana': choose one of strawberry, tomato, vine"), line
     assert not (tmp_path / "out").exists()
 
 
@@ -97,6 +111,19 @@ def test_bad_values_of_evaluate(extra: list[str], message: str, capsys: pytest.C
     argv = ["evaluate", "--dataset", str(sp_root), "--scenario", "sp", "--out", str(tmp_path / "r.json"), *extra]
     assert message in refused(capsys, *argv)
     assert not list(tmp_path.iterdir())
+
+
+def test_a_config_the_renderer_cannot_draw_is_refused_before_any_plant_grows(
+        capsys: pytest.CaptureFixture[str], tmp_path: Path, never_grow: None) -> None:
+    config = tmp_path / "huge.yaml"
+    config.write_text("image_size: 99999x99999\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n")
+    line = refused(capsys, "generate", "--config", str(config), "--out", str(tmp_path / "out"))
+    assert line.endswith(f"{config}: image_size: 99999x99999: each side must be from 16 to 8192 pixels "
+                         "(the renderer's limit)"), line
+    config.write_text("groups: [{scenario: sp, crop: banana, scenes: 1}]\n")
+    line = refused(capsys, "generate", "--config", str(config), "--out", str(tmp_path / "out"))
+    assert line.endswith("groups.0.crop: unknown crop 'banana': choose one of strawberry, tomato, vine"), line
+    assert not (tmp_path / "out").exists()
 
 
 @pytest.mark.parametrize("extra, message", [
