@@ -4,7 +4,7 @@
         [--doc docs/performance.md]
 
 The scene is the bench's (single-plant strawberry, dataset seed 0, scene 0, the crop's full grid
-area; :func:`davis_ag.bench.continuous_scene`). PPO (:func:`davis_ag.live.training.train_continuous`)
+area; :func:`tools/bench.py continuous_scene`). PPO (:func:`davis_ag.live.training.train_continuous`)
 trains on it from seed 0; then PPO (deterministic), LR, UD, Rand and Greedy play the same 3 x 50
 starts (:func:`davis_ag.live.evaluation.evaluate_continuous`). The curve is drawn from every
 training episode; with ``--doc`` the numbers are written between the file's
@@ -22,13 +22,14 @@ from pathlib import Path
 import numpy as np
 
 from davis_ag.atomic_files import write_marked_section
-from davis_ag.bench import continuous_scene
 from davis_ag.benchmark.evaluation import format_table
 from davis_ag.live.evaluation import evaluate_continuous
-from davis_ag.live.policies import ModelAgent, build_policies
 from davis_ag.figures.result_charts import plot_training_curve
+from davis_ag.live.policies import ModelAgent, build_policies
 from davis_ag.live.training import train_continuous
 from davis_ag.live.tvm_continuous import TVMContinuousEnv
+
+from bench import continuous_scene  # tools/bench.py: this script runs beside it
 
 
 def main() -> None:
