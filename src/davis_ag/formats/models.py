@@ -40,14 +40,15 @@ from davis_ag.scene.specs import ALL_ACTIONS, DEFAULT_PLANTS, PLANT_GENERATORS, 
 MAX_SEED = 2**32 - 1
 #: Smallest image side, pixels: below it no fruit passes a box threshold.
 MIN_IMAGE_SIDE = 16
-#: Largest image side, pixels. Mesa's llvmpipe and current GPUs draw at most 16384 a side, but at
-#: that size one frame's colour, id, depth and multisampled buffers take several GB; 8192 keeps a
-#: frame near 1 GB, and is 6.4 times the paper's 1280.
+#: Largest image side, pixels. Mesa's llvmpipe (GL_MAX_RENDERBUFFER_SIZE) and current GPUs draw at
+#: most 16384 a side, but at that size one frame's colour, id, depth and multisampled buffers take
+#: about 7 GB; at 8192 under 2 GB, and 8192 is 6.4 times the paper's 1280.
 MAX_IMAGE_SIDE = 8192
 #: Scene folders are numbered NNN.
 MAX_SCENES = 1000
 #: Fruit ids fit the uint8 mask, whose 255 means no fruit.
 MAX_FRUIT_ID = 254
+
 
 def whole(low: int, high: int) -> Any:
     """A whole number from ``low`` to ``high``, whose error names the range."""
