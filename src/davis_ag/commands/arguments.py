@@ -22,7 +22,7 @@ def image_size(text: str) -> tuple[int, int]:
     try:
         return check_image_size(text.strip(), "")
     except UserError as error:
-        raise argparse.ArgumentTypeError(str(error)) from None
+        raise argparse.ArgumentTypeError(f"not an image size: {error}") from None
 
 
 def _digits(text: str) -> int | None:
@@ -111,7 +111,6 @@ def path(text: str) -> Path:
         return Path(text).expanduser().absolute()
     except RuntimeError:  # expanduser of ~name for a user that does not exist
         raise argparse.ArgumentTypeError(f"{text!r}: no such user's home folder") from None
-
 
 
 def antialiasing_mode(text: str) -> str:
