@@ -55,7 +55,7 @@ EGL_DEVICE_VARIABLE = "DAVIS_AG_EGL_DEVICE"
 def create_context():
     """A headless OpenGL 3.3+ context through EGL: the default EGL display (a GPU's driver where one
     is installed and chosen by libglvnd, else Mesa's llvmpipe), or EGL device number
-    ``$DAVIS_AG_EGL_DEVICE`` where that is set (README, "Rendering")."""
+    ``$DAVIS_AG_EGL_DEVICE`` where that is set (docs/rendering.md)."""
     import os
 
     import moderngl

@@ -25,7 +25,7 @@ and the depth image.
   filtering.
 
 Where a GPU with an EGL driver is present, the same code draws on it; which EGL device is used
-follows the EGL vendor library's choice (``__EGL_VENDOR_LIBRARY_FILENAMES``); see the README.
+follows the EGL vendor library's choice (``__EGL_VENDOR_LIBRARY_FILENAMES``); see docs/rendering.md.
 """
 
 from __future__ import annotations
