@@ -62,3 +62,15 @@ def test_annotation_entries_as_we_write_them() -> None:
         with pytest.raises(ValidationError) as caught:
             AnnotationEntry.model_validate({**entry, **change})
         assert one_line(caught.value).startswith(f"{path}: "), one_line(caught.value)
+
+
+def test_a_bad_config_is_one_line_naming_the_key_and_what_is_allowed() -> None:
+    from davis_ag.formats.models import DatasetConfigFile
+
+    for data, line in (({"groups": [{"scenario": "sp", "crop": "tomato", "scenes": 1, "sceens": 2}]},
+                        "groups.0.sceens: unknown key"),
+                       ({"plants": "bonsai", "groups": [{"scenario": "sp", "crop": "tomato", "scenes": 1}]},
+                        "plants: must be 'canopy' or 'architecture', not 'bonsai'")):
+        with pytest.raises(ValidationError) as caught:
+            DatasetConfigFile.model_validate(data)
+        assert one_line(caught.value, "c.yaml") == f"c.yaml: {line}"

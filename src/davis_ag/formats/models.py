@@ -109,10 +109,9 @@ def one_line(error: ValidationError, source: str = "") -> str:
     path = ".".join(str(part) for part in first["loc"])
     message = str(first["msg"]).removeprefix("Value error, ").removeprefix("Assertion failed, ")
     message = _MESSAGES.get(first["type"], message).replace("Input should be", "must be")
-    if first["type"] in _MESSAGES and first["type"] not in ("missing", "extra_forbidden"):
-        message = f"{message}, not {first.get('input')!r}"
-    elif "input" in first and first["type"] not in ("value_error", "assertion_error") \
-            and not isinstance(first["input"], (dict, list)):
+    # Our own checks name the value already; a missing or unknown key has none worth showing.
+    if first["type"] not in ("missing", "extra_forbidden", "value_error", "assertion_error") \
+            and "input" in first and not isinstance(first["input"], (dict, list)):
         message = f"{message}, not {first['input']!r}"
     more = f" (and {len(problems) - 1} more problem{'s' if len(problems) > 2 else ''})" if len(problems) > 1 else ""
     return ": ".join(part for part in (source, path, message) if part) + more
