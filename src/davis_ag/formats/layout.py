@@ -123,12 +123,14 @@ def read_depth_millimetres(path: Path) -> np.ndarray:
     Raises:
         UserError: naming the file when it cannot be decoded or is not a 16-bit single-channel PNG.
     """
-    from PIL import Image, UnidentifiedImageError
+    from PIL import Image
 
     try:
         with Image.open(path) as im:
             millimetres = np.asarray(im)
-    except (OSError, UnidentifiedImageError, ValueError, SyntaxError) as error:
+    except Exception as error:  # Pillow, and plug-ins patched into it (ultralytics' HEIF), raise many types
+        if isinstance(error, MemoryError):
+            raise
         raise UserError(f"{path}: cannot decode ({error}); regenerate the scene") from None
     if millimetres.dtype != np.uint16 or millimetres.ndim != 2:
         raise UserError(f"{path}: a depth image must be a uint16 single-channel PNG (millimetres), "
