@@ -109,7 +109,10 @@ def test_commands(sp_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture[s
     assert args.func(args) == 0
     printed = capsys.readouterr().out
     assert "A2C" in printed and "Oracle" in printed and "OER_tau" in printed
-    assert set(json.loads(out.read_text())["policies"]) == {"LRD", "UDD", "Rand", "Oracle", "A2C"}
+    saved = json.loads(out.read_text())
+    assert set(saved["policies"]) == {"LRD", "UDD", "Rand", "Oracle", "A2C", "Best fixed action"}
+    assert saved["policies"]["A2C"]["play"] == "deterministic"  # the command's default; --stochastic samples
+    assert "Best fixed action: always" in printed and "OER_tau exact" in printed
     assert out.with_suffix(".png").is_file()
 
 

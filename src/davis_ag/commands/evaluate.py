@@ -22,7 +22,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="benchmark LRD, UDD, Rand, Oracle (and a trained A2C) as in Table 4",
         description="Run every policy on the same episodes of the test split (sessions x "
                     "episodes, fixed seeds), print a Table 4 style summary, write it as JSON and "
-                    "a PNG bar chart.",
+                    "a PNG bar chart. On the grid the row 'Best fixed action' (the best policy that "
+                    "always plays one action) is added, and the image-blind policies get their "
+                    "exact expectations beside the sampled means.",
     )
     parser.add_argument("--dataset", type=arguments.path, required=True, metavar="DIR", help="dataset root")
     parser.add_argument("--scenario", required=True, choices=["sp", "mp"],
@@ -92,7 +94,7 @@ def run(args: argparse.Namespace) -> int:
         env = TVMEnv(args.dataset, scenario=args.scenario, split=args.split, crop=args.crop,
                      cache_dir=args.cache_dir)
         results = evaluate_agents(env, agents, episodes=args.episodes, sessions=args.sessions,
-                                  seed=args.seed, keep_episodes=True)
+                                  seed=args.seed, keep_episodes=True, best_fixed_action=True)
     print(format_table(results))
     # The JSON is the result: keep it somewhere even when --out fails at the end.
     write_or_rescue(out, lambda path: write_json(results, path), "the results")
