@@ -71,7 +71,7 @@ def measure_plants(count: int, crops: list[str]) -> dict:
             model = build_scene(scenario, crop, np.random.default_rng(seed))
             plant = model.plants[0]
             plants.append({**plant.summary(), "scene_seed": seed, "grow_s": round(time.perf_counter() - started, 1)})
-            print(f"{crop.name} {index}: {len(plant.fruit_objects)} fruit", file=sys.stderr, flush=True)
+            print(f"{crop.name} {index}: {plant.fruit_count} fruit", file=sys.stderr, flush=True)
             del model
         out["crops"][crop.name] = plants
     return out

@@ -39,15 +39,16 @@ def dataset_settings(requests: Sequence[SceneRequest]) -> dict[str, Any]:
     first = requests[0]
     for request in requests:
         if request.dataset_seed != first.dataset_seed or request.camera != first.camera \
-                or (request.renderer, request.look) != (first.renderer, first.look):
-            raise UserError("the scenes of one run must share the dataset seed, the image size, the renderer "
-                            "and the look")
+                or (request.renderer, request.look, request.plants) != (first.renderer, first.look, first.plants):
+            raise UserError("the scenes of one run must share the dataset seed, the image size, the renderer, "
+                            "the look and the plant generator")
     groups: dict[str, Any] = {}
     for request in requests:
         groups[request.folder.split("/")[0]] = {"grid": grid_settings(request.scenario, request.crop)}
     return {"format": DATASET_FORMAT, "seed": first.dataset_seed,
             "image_size": [first.camera.width, first.camera.height], "vfov_deg": first.camera.vfov,
-            "renderer": first.renderer, "look": resolve_look(first.renderer, first.look), "groups": groups}
+            "renderer": first.renderer, "look": resolve_look(first.renderer, first.look),
+            "plants": first.plants, "groups": groups}
 
 
 def complete_scenes(root: Path) -> list[str]:
@@ -85,9 +86,10 @@ def reconcile_settings(root: Path, wanted: dict[str, Any]) -> dict[str, Any]:
     if not present:  # nothing was finished with the old settings: they may change freely
         return wanted
     # Datasets from before the choice of renderer were drawn by Helios.
-    old = {"renderer": "helios", "look": "helios", **old}
+    # Datasets from before the choice of plants grew PlantArchitecture plants.
+    old = {"renderer": "helios", "look": "helios", "plants": "architecture", **old}
     for key, flag in (("seed", "--seed"), ("image_size", "--size"), ("vfov_deg", "the field of view"),
-                      ("renderer", "--renderer"), ("look", "--look")):
+                      ("renderer", "--renderer"), ("look", "--look"), ("plants", "--plants")):
         if old.get(key) != wanted[key]:
             shown = [_shown(old.get(key)), _shown(wanted[key])]
             raise UserError(f"{root} holds scenes made with {key} {shown[0]}, not {shown[1]}: "

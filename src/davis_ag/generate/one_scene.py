@@ -24,7 +24,15 @@ from davis_ag.labels.fruit_labels import fruit_lookup, label_view, visible_fract
 from davis_ag.render.backends import ANTIALIASING_DESCRIPTIONS, DEFAULT_RENDERER, open_renderer, resolve_look
 from davis_ag.scene.build import build_scene
 from davis_ag.scene.camera import Camera
-from davis_ag.scene.specs import CROPS, SCENARIOS, CropSpec, ScenarioSpec, group_name, plant_centres
+from davis_ag.scene.specs import (
+    CROPS,
+    DEFAULT_PLANTS,
+    SCENARIOS,
+    CropSpec,
+    ScenarioSpec,
+    group_name,
+    plant_centres,
+)
 from davis_ag.scene.view_grid import build_view_grid
 
 SCENE_FORMAT = "davis-ag-scene/1"
@@ -65,6 +73,7 @@ class SceneRequest:
             renderer's own (``default`` for ours, ``helios`` for Helios).
         depth: Write ``images/NNNN_depth.png`` for every view.
         antialiasing: Our renderer's antialiasing: ``fxaa``, ``msaa`` or ``none``.
+        plants: The plant generator: ``canopy`` (default) or ``architecture``.
     """
 
     scenario: ScenarioSpec
@@ -76,6 +85,7 @@ class SceneRequest:
     look: str | None = None
     depth: bool = True
     antialiasing: str = "fxaa"
+    plants: str = DEFAULT_PLANTS
 
     @property
     def seed(self) -> int:
@@ -147,7 +157,7 @@ def grow_scene(request: SceneRequest):
         The :class:`~davis_ag.scene.build.SceneModel` and its view grid.
     """
     rng = np.random.default_rng(request.seed)
-    model = build_scene(request.scenario, request.crop, rng)
+    model = build_scene(request.scenario, request.crop, rng, request.plants)
     grid = build_view_grid(request.scenario, request.crop, plant_centres(request.scenario, request.crop),
                            model.aim_height, rng)
     return model, grid
@@ -241,6 +251,7 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict) -> dict:
         "scenario": request.scenario.name,
         "crop": request.crop.name,
         "scene": request.folder,
+        "plant_generator": model.plant_generator,
         "conventions": CONVENTIONS,
         "camera": request.camera.intrinsics(),
         "renderer": {"name": request.renderer, "look": resolve_look(request.renderer, request.look),
