@@ -44,6 +44,25 @@ def summary(results: dict) -> dict:
             for name, p in results["policies"].items()}
 
 
+def policy_at_starts(model: object, env: TVMEnv) -> dict:
+    """The policy's action probabilities at every start of the split: their mean, the mean of the
+    largest, and how many starts each action is the most likely at (one action everywhere: a
+    deterministic player is a fixed action)."""
+    import numpy as np
+    import torch
+
+    observations = []
+    for scene, box in env.starts:
+        cache = env.caches[scene]
+        start = (env.scenes[scene].id, cache.view_names[cache.box_view[box]], int(cache.fruit_ids[cache.box_fruit[box]]))
+        observations.append(env.reset(options={"start": start})[0])
+    tensor, _ = model.policy.obs_to_tensor(np.stack(observations))
+    with torch.no_grad():
+        probs = model.policy.get_distribution(tensor).distribution.probs.cpu().numpy()
+    return {"mean_probs": [round(float(p), 3) for p in probs.mean(0)], "mean_max_prob": round(float(probs.max(1).mean()), 3),
+            "argmax_counts": np.bincount(probs.argmax(1), minlength=probs.shape[1]).tolist()}
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--dataset", type=Path, required=True)
@@ -77,14 +96,16 @@ def main() -> int:
             agents += [FixedActionAgent(a) for a in env.action_names]
         results = evaluate_agents(env, agents, episodes=200, sessions=3, seed=args.seed)
         record = json.loads(training_record_path(model).read_text())
+        start_policy = policy_at_starts(deterministic.model, env)
         out = {"trial": name, "settings": record["a2c_settings"], "timesteps": args.timesteps,
                "train_seconds": round(seconds, 1), "split": "train", "policies": summary(results),
-               "curve": record.get("curve", [])}
+               "policy_at_starts": start_policy, "curve": record.get("curve", [])}
         (args.out / f"{name}.json").write_text(json.dumps(out, indent=1))
         for policy, stats in out["policies"].items():
             print(f"{name:10s} {policy:18s} OER {stats['oer_tau'][0]:.3f}±{stats['oer_tau'][1]:.3f} "
                   f"reward {stats['reward'][0]:.4f} length {stats['length'][0]:.2f} {stats['actions']}",
                   flush=True)
+        print(f"{name:10s} at the split's starts: {start_policy}", flush=True)
     return 0
 
 

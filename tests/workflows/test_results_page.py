@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from davis_ag.workflows.reproduce import CONFIGS
@@ -140,14 +141,17 @@ def test_the_page_shows_what_each_policy_does(tmp_path: Path, sp_root: Path, one
     assert best["action"] in results["protocol"]["actions"] and policies["A2C"]["play"] == "sampled"
     assert "| Best fixed action |" in text and f"(always `{best['action']}`)" in text
     assert "A2C **beats** it" in text or "A2C **does not beat** it" in text
-    assert "ent_coef=0.01, normalize_advantage=True" in text and "plays actions sampled from the policy" in text
-    assert A2C_SETTINGS == {"ent_coef": 0.01, "normalize_advantage": True}
+    assert ", ".join(f"{k}={v}" for k, v in A2C_SETTINGS.items()) in text
+    assert "plays actions sampled from the policy" in text
     assert "uniform over every eligible (view, target) pair" in text
     # Exact beside sampled, and each policy's action shares.
     lrd = policies["LRD"]
     assert (f"| LRD | {_c(lrd['oer_tau']['mean'])} ± {_c(lrd['oer_tau']['sem'])} | {_c(lrd['exact']['oer_tau'])} |"
             in text)
     assert "| Policy | forward | backward | left | right | up | down | done |" in text
+    # Played as the benchmark plays it (sampled), the trained A2C is not one move repeated.
+    shares = np.array(list(policies["A2C"]["action_counts"].values())) / sum(policies["A2C"]["action_counts"].values())
+    assert (shares >= 0.05).sum() >= 2, policies["A2C"]["action_counts"]
     counts = best["action_counts"]
     assert f"| Best fixed action | " + " | ".join("100" if a == best["action"] else "0" for a in counts) + " |" in text
     for picture in ("results-sp-strawberry-actions.png", "results-learning-curve.png"):
