@@ -31,13 +31,15 @@ CHECKPOINT_EVERY = 10_000
 CURVE_EVERY = 1_000
 
 #: The A2C settings we train with, on top of Stable-Baselines3's defaults (the paper gives none).
-#: With SB3's defaults alone (``ent_coef=0``, raw advantages) the policy collapsed to one move:
-#: the reward is ``max(OER_tau - OER_0, 0)**2``, about .02 on average, so advantages are tiny,
-#: and without an entropy bonus the first move that pays a little on average ("down") takes
-#: all the probability. ``normalize_advantage`` scales each update's advantages to unit
-#: variance (the reward's scale stops mattering) and ``ent_coef=0.01`` keeps the policy from
-#: becoming one move before it has learnt from the image; chosen on the train split
-#: (tools/a2c_trials.py).
+#: ``normalize_advantage`` scales each update's advantages to unit variance, so the size of the
+#: reward (``max(OER_tau - OER_0, 0)**2``, about .02 on average) stops setting the step size;
+#: ``ent_coef=0.01`` is then the usual entropy bonus, which keeps the policy from turning into a
+#: point mass on one move over a long run. Measured on the train split only
+#: (tools/a2c_trials.py): after enough steps A2C learns policies whose most likely move differs
+#: from start to start with these settings, with SB3's defaults and with the bonus alone (which
+#: left the flattest policy and the lowest sampled score); these learnt a little faster early on.
+#: What made the evaluated A2C a fixed action was chiefly too little training played
+#: deterministically (see ``A2C_DETERMINISTIC`` in agents.py).
 A2C_SETTINGS: dict[str, Any] = {"ent_coef": 0.01, "normalize_advantage": True}
 #: Stable-Baselines3's own A2C defaults for the settings above (what ``--a2c-settings sb3`` trains).
 SB3_DEFAULT_SETTINGS: dict[str, Any] = {"ent_coef": 0.0, "normalize_advantage": False}
