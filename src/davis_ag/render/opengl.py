@@ -224,8 +224,13 @@ class OpenGLRenderer:
         # Uniforms that hold for every view.
         for program in (*self._shading, self._programs["ids"]):
             self._set(program, "light_projection", gl_matrix(self._light))
-        self._set(self._programs["sky"], "exposure", EXPOSURE)
-        for name, value in (("sun", self.lighting.direction), ("exposure", EXPOSURE),
+        exposure = EXPOSURE * self.lighting.exposure
+        white_balance = tuple(float(v) for v in self.lighting.white_balance)
+        self._set(self._programs["sky"], "exposure", exposure)
+        self._set(self._programs["sky"], "white_balance", white_balance)
+        for name, value in (("sun", self.lighting.direction), ("exposure", exposure),
+                            ("sun_strength", float(self.lighting.sun_strength)),
+                            ("white_balance", white_balance),
                             ("sky_ambient", SKY_AMBIENT),
                             ("ground_ambient", GROUND_AMBIENT), ("material", MATERIAL),
                             ("shadow_bias", SHADOW_BIAS),

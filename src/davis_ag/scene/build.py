@@ -112,8 +112,11 @@ def helios_texture(name: str) -> str:
     return str(path)
 
 
-def add_ground(context) -> None:
+def add_ground(context, soil_texture: str = "dirt.jpg") -> None:
     """Textured soil at z = 0: fine patches under the grid, a coarse ring out to the horizon.
+
+    Every soil primitive is labelled with the organ class ``soil``. ``soil_texture`` is an image
+    shipped with Helios (:func:`helios_texture`); randomised appearance picks others.
 
     Helios keeps textures at a low resolution, so a texture stretched over metres turns into a
     checkerboard of blocks; one texture per ``NEAR_PATCH`` patch keeps the soil's grain. The far
@@ -122,10 +125,12 @@ def add_ground(context) -> None:
     """
     from pyhelios.types import int2, vec2, vec3
 
-    texture = helios_texture("dirt.jpg")
+    from davis_ag.scene.organ_labels import label_soil
+
+    texture = helios_texture(soil_texture)
     patches = int(round(NEAR_SIZE / NEAR_PATCH))
-    context.addTileObject(center=vec3(0.0, 0.0, 0.0), size=vec2(NEAR_SIZE, NEAR_SIZE),
-                          subdiv=int2(patches, patches), texturefile=texture)
+    tiles = [context.addTileObject(center=vec3(0.0, 0.0, 0.0), size=vec2(NEAR_SIZE, NEAR_SIZE),
+                                   subdiv=int2(patches, patches), texturefile=texture)]
     band = (GROUND_SIZE - NEAR_SIZE) / 2
     offset = (NEAR_SIZE + band) / 2
     strips = [  # (centre x, centre y, size x, size y): north, south, east, west
@@ -134,8 +139,9 @@ def add_ground(context) -> None:
     ]
     for x, y, width, depth in strips:
         repeats = int2(max(1, round(width / FAR_REPEAT)), max(1, round(depth / FAR_REPEAT)))
-        context.addTileObject(center=vec3(x, y, 0.0), size=vec2(width, depth), subdiv=int2(1, 1),
-                              texturefile=texture, texture_repeat=repeats)
+        tiles.append(context.addTileObject(center=vec3(x, y, 0.0), size=vec2(width, depth), subdiv=int2(1, 1),
+                                           texturefile=texture, texture_repeat=repeats))
+    label_soil(context, tiles)
 
 
 def _fruit(context, fruit_id: int, plant: int, object_id: int) -> Fruit:
@@ -151,13 +157,15 @@ def _fruit(context, fruit_id: int, plant: int, object_id: int) -> Fruit:
                  tuple(float(v) for v in (lo + hi) / 2), tuple(float(v) for v in hi - lo))
 
 
-def build_scene(scenario: ScenarioSpec, crop: CropSpec, rng: np.random.Generator) -> SceneModel:
+def build_scene(scenario: ScenarioSpec, crop: CropSpec, rng: np.random.Generator,
+                soil_texture: str = "dirt.jpg") -> SceneModel:
     """Grow a scene's plants on soil, choose the sun and number the fruit.
 
     Args:
         scenario: Single or multi plant.
         crop: The crop.
         rng: The scene's only source of randomness.
+        soil_texture: The soil's image (:func:`add_ground`).
 
     Returns:
         The :class:`SceneModel`.
@@ -185,7 +193,7 @@ def build_scene(scenario: ScenarioSpec, crop: CropSpec, rng: np.random.Generator
         seed = helios_seed(rng)
         grow = grow_goblet_vine if crop.name == "vine" else grow_library_plant
         plants.append(grow(context, plant_architecture, shoot_defaults, crop, index, position, target, seed))
-    add_ground(context)
+    add_ground(context, soil_texture)
 
     fruits: list[Fruit] = []
     for plant in plants:
