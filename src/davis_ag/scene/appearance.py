@@ -99,8 +99,11 @@ class Appearance:
         if self.noise_sigma <= 0.0:
             return colour
         rng = np.random.default_rng(np.random.SeedSequence([self.seed, APPEARANCE_STREAM, int(view_index)]))
-        noise = rng.normal(0.0, self.noise_sigma, size=colour.shape).astype(np.float32)
-        return np.clip(colour.astype(np.float32) + noise + 0.5, 0, 255).astype(np.uint8)
+        noisy = rng.standard_normal(colour.shape, dtype=np.float32)
+        noisy *= self.noise_sigma
+        noisy += colour
+        noisy += 0.5  # round to nearest on the cast below
+        return np.clip(noisy, 0, 255).astype(np.uint8)
 
 
 def resolve_appearance(value: str | None) -> str:
