@@ -192,7 +192,6 @@ def draw_scene(request: SceneRequest, model, grid, root: Path, on_view: Callable
     fruit_uuids = {f.id: f.uuids for f in model.fruits}
     # Organ class by id-buffer value (UUID + 1; 0 is the sky): the class image is one look-up.
     class_of_id = np.concatenate([[SKY], model.organ_of_uuid()]).astype(np.uint8) if request.classes else None
-    appearance = draw_appearance(request.appearance, request.seed)
     camera = request.camera
     scene_dir = root / request.folder
     writer = SceneWriter(scene_dir, resume_key(request, viewpoints))
@@ -208,7 +207,6 @@ def draw_scene(request: SceneRequest, model, grid, root: Path, on_view: Callable
                         on_view(done, len(viewpoints))
                     continue
                 colour, primitive_ids, depth = renderer.render(view, depth=request.depth)
-                colour = appearance.add_noise(colour, view.index)
                 classes = class_of_id[primitive_ids] if class_of_id is not None else None
                 labels = label_view(primitive_ids, lookup, request.min_fruit_pixels)
                 draw_silhouette = getattr(renderer, "silhouette_pixels", None)

@@ -11,7 +11,8 @@ the plants, the grid and the paper's sun draws are the same as under ``paper``):
 - exposure (0.6-1.6 x, log-uniform) and white balance (red and blue gains 1 +- up to 0.12, as
   a colour temperature shift; green 1);
 - sensor noise: Gaussian, standard deviation 0.5-4 grey levels of 255, drawn anew for every
-  view from the scene seed and the view's number, so a resumed scene writes the same pixels.
+  view from the scene seed and the view's number (so a resumed scene writes the same pixels) by
+  the renderer's shaders, at no measurable cost (:mod:`davis_ag.render.opengl`).
 
 Labels do not change: ids, masks, classes and depth come from the geometry, which appearance
 leaves alone. ``paper`` changes nothing: its scenes are the ones drawn before this option.
@@ -57,7 +58,7 @@ class Appearance:
         exposure: Factor on the radiance before the tone curve.
         white_balance: Gains on linear red, green and blue.
         noise_sigma: Sensor noise, standard deviation in grey levels (0-255); 0 for none.
-        seed: The scene seed (for the per-view noise).
+        seed: The scene seed (the sensor noise's, with each view's number).
     """
 
     mode: str
@@ -79,31 +80,16 @@ class Appearance:
             return base
         return replace(base, sun_elevation=self.sun_elevation, sun_azimuth=self.sun_azimuth,
                        sky_texture=helios_texture(self.sky) if self.sky else None,
-                       sun_strength=self.sun_strength, exposure=self.exposure, white_balance=self.white_balance)
+                       sun_strength=self.sun_strength, exposure=self.exposure, white_balance=self.white_balance,
+                       noise_sigma=self.noise_sigma, noise_seed=self.seed)
 
     def summary(self) -> dict:
         """JSON-ready record for scene.json."""
         record = asdict(self)
         record.pop("seed")
         record["white_balance"] = list(self.white_balance)
-        record["noise"] = "gaussian, per view, seeded by (scene seed, view number)" if self.noise_sigma else None
+        record["noise"] = "gaussian per pixel, per view, seeded by (scene seed, view number)" if self.noise_sigma else None
         return record
-
-    def add_noise(self, colour: np.ndarray, view_index: int) -> np.ndarray:
-        """The colour image with this scene's sensor noise for one view (unchanged without noise).
-
-        Args:
-            colour: (height, width, 3) uint8.
-            view_index: The view's number, which seeds its noise with the scene seed.
-        """
-        if self.noise_sigma <= 0.0:
-            return colour
-        rng = np.random.default_rng(np.random.SeedSequence([self.seed, APPEARANCE_STREAM, int(view_index)]))
-        noisy = rng.standard_normal(colour.shape, dtype=np.float32)
-        noisy *= self.noise_sigma
-        noisy += colour
-        noisy += 0.5  # round to nearest on the cast below
-        return np.clip(noisy, 0, 255).astype(np.uint8)
 
 
 def resolve_appearance(value: str | None) -> str:

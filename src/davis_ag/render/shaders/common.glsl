@@ -28,6 +28,34 @@ vec3 encode_srgb(vec3 c) {
     return mix(1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, c * 12.92, vec3(lessThanEqual(c, vec3(0.0031308))));
 }
 
+#ifdef SENSOR_NOISE
+// Sensor noise (randomised appearance), compiled in only where asked for: Gaussian, in grey levels
+// of the 8-bit output, drawn per pixel from an integer hash (PCG) of the pixel and the view's seed,
+// so it costs a few operations per fragment and no pass or read-back of its own.
+uniform float noise_sigma;      // standard deviation, grey levels of 255
+uniform uint noise_seed;        // one per view
+
+uint pcg_hash(uint v) {
+    uint state = v * 747796405u + 2891336453u;
+    uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+float unit_float(uint h) {
+    return (float(h >> 8u) + 0.5) / 16777216.0;  // (0, 1), never 0
+}
+
+vec3 sensor_noise() {
+    uvec2 p = uvec2(gl_FragCoord.xy);
+    uint h = pcg_hash(p.x ^ pcg_hash(p.y ^ pcg_hash(noise_seed)));
+    uint h2 = pcg_hash(h), h3 = pcg_hash(h2), h4 = pcg_hash(h3);
+    // Box-Muller: two pairs of uniforms, three of the four normals used.
+    float r1 = sqrt(-2.0 * log(unit_float(h))), r2 = sqrt(-2.0 * log(unit_float(h3)));
+    float a1 = 6.28318530718 * unit_float(h2), a2 = 6.28318530718 * unit_float(h4);
+    return vec3(r1 * cos(a1), r1 * sin(a1), r2 * cos(a2)) * (noise_sigma / 255.0);
+}
+#endif
+
 // Narkowicz's fit of the ACES curve, on radiance scaled by 0.6 as his note advises for the
 // unmodified ACES response.
 vec3 tone_curve(vec3 x) {

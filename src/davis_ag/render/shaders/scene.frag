@@ -96,6 +96,10 @@ void main() {
         direct += vec3(material.z * pow(max(dot(normal, normalize(sun + to_eye)), 0.0), material.w));
     }
     vec3 radiance = vec3(1.0, 0.9, 0.8) * (ambient + sunlit(normal) * sun_strength * direct);
-    out_colour = vec4(encode_srgb(tone_curve(radiance * white_balance * exposure)), 1.0);
+    vec3 encoded = encode_srgb(tone_curve(radiance * white_balance * exposure));
+#ifdef SENSOR_NOISE
+    encoded += sensor_noise();  // the 8-bit attachment clamps to [0, 1] and rounds
+#endif
+    out_colour = vec4(encoded, 1.0);
 #endif
 }
