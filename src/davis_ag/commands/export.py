@@ -31,6 +31,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         sub.add_argument("out", type=arguments.path, metavar="OUT", help="export folder (new, or a previous export)")
         sub.add_argument("--split", choices=("train", "test", "both"), default="both",
                          help="which split to write (default both)")
+        sub.add_argument("--organs", action="store_true",
+                         help="also the organ classes (soil, fruit, leaf, stem, trunk) as semantic masks, from "
+                              "the views' NNNN_class.png" + (" (with --task segment)" if name == "yolo" else
+                                                            " (RLE, category ids 101-105)"))
         if name == "yolo":
             sub.add_argument("--task", choices=("detect", "segment"), default="detect",
                              help="label lines: boxes (detect, default) or polygons (segment)")
@@ -85,12 +89,12 @@ def run(args: argparse.Namespace) -> int:
     if args.format == "coco":
         from davis_ag.detection.coco_export import export_coco
 
-        counts = export_coco(args.dir, args.out, splits)
+        counts = export_coco(args.dir, args.out, splits, organs=args.organs)
         unit = "annotations"
     else:
         from davis_ag.detection.yolo_export import export_yolo
 
-        counts = export_yolo(args.dir, args.out, args.task, splits)
+        counts = export_yolo(args.dir, args.out, args.task, splits, organs=args.organs)
         unit = "instances"
         if args.appearance_shift is not None:
             from davis_ag.detection.appearance_shift import shift_folder
