@@ -12,10 +12,10 @@ from PIL import Image
 
 from davis_ag.cli import main
 from davis_ag.data.reader import open_dataset
-from davis_ag.errors import UserError
 from davis_ag.detection.coco_export import export_coco
 from davis_ag.detection.instances import scenes_by_split
 from davis_ag.detection.yolo_export import export_yolo, flat_name
+from davis_ag.errors import UserError
 
 
 @pytest.fixture(scope="module")
