@@ -103,11 +103,9 @@ def bench_crop(crop: str, scratch: Path, repeats: int, documented: bool = True, 
     model, grid = grow_scene(request)
     grow_s = time.perf_counter() - started
     views = list(grid.viewpoints[: VIEWS[crop]])
-    fruit_id = 0
-    for plant in model.plants:  # the documented route labels fruit with object data
-        for object_id in plant.fruit_objects:
-            model.context.setObjectDataInt(object_id, "fruit_id", fruit_id)
-            fruit_id += 1
+    for fruit in model.fruits:  # the documented route labels fruit with object data (a cluster: its berries)
+        for object_id in {model.context.getPrimitiveParentObjectID(int(u)) for u in fruit.uuids}:
+            model.context.setObjectDataInt(object_id, "fruit_id", fruit.id)
     images = scratch / f"{crop}-documented"
     images.mkdir(parents=True)
     times: dict[str, list[float]] = {"ours": [], "documented": [], "floor": [], "no_classes": []}

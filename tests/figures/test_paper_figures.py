@@ -165,6 +165,27 @@ def test_stats_table3_and_fruit(real_root: Path, tmp_path: Path, capsys: pytest.
     per_view = [len(e["bounding_boxes"]) for e in raw.values()]
     assert fruit["boxes_per_view"]["mean"] == pytest.approx(np.mean(per_view))
     assert sum(fruit["oer"]["histogram"]["counts"]) == sum(per_view) == fruit["visible_fraction"]["n"]
+    # Refused moves, recomputed from annotations.json's pointers and boxes: from every box (this
+    # tiny scene has few starts below OER 0.4), then as stats counts them, from the starts only.
+    from davis_ag.benchmark.cache import load_scene_cache
+    from davis_ag.benchmark.moves import refused_moves
+    from davis_ag.scene.specs import SP_ACTIONS
+
+    cache = load_scene_cache(open_dataset(real_root).scene("Single-Strawberry/000"), real_root)
+    for max_oer in (1.01, 0.4):
+        starts = [(cache.view_names[cache.box_view[r]], int(cache.fruit_ids[cache.box_fruit[r]]))
+                  for r in range(len(cache.box_oer))
+                  if cache.box_oer[r] < max_oer and cache.box_pixels[r] >= meta["min_fruit_pixels"]]
+        no_view = sum(raw[view][move] == "" for view, _ in starts for move in SP_ACTIONS)
+        lost = sum(raw[view][move] != "" and fruit_id not in {b[4] for b in raw[raw[view][move]]["bounding_boxes"]}
+                   for view, fruit_id in starts for move in SP_ACTIONS)
+        counts = refused_moves(cache, SP_ACTIONS, meta["min_fruit_pixels"], max_oer)
+        assert (counts.starts, counts.moves, counts.no_view, counts.target_lost) == \
+            (len(starts), 6 * len(starts), no_view, lost)
+        assert max_oer < 1 or (len(starts) > 20 and no_view > 0 and lost > 0)
+    refused = stats["refused_moves"]["Single-Strawberry"]
+    assert (refused["starts"], refused["no_view"], refused["target_lost"]) == (len(starts), no_view, lost)
+    assert "moves refused from starts" in printed
 
 
 @pytest.mark.parametrize("args, words", [

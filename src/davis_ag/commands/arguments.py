@@ -154,6 +154,7 @@ def antialiasing_mode(text: str) -> str:
 def add_renderer_flags(parser: argparse.ArgumentParser) -> None:
     """``--renderer`` and ``--look``, shared by generate and preview."""
     from davis_ag.render.backends import LOOKS, RENDERERS
+    from davis_ag.scene.specs import PLANT_GENERATORS
 
     parser.add_argument("--renderer", choices=RENDERERS,
                         help="opengl: ours (default); helios: pyhelios's Visualizer, the slower reference")
@@ -163,3 +164,6 @@ def add_renderer_flags(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--antialiasing", type=antialiasing_mode, metavar="{fxaa,msaa,none}",
                         help="our renderer's: fxaa along silhouettes (default), msaa (4x samples: closest to "
                              "Helios's frames, several times slower without a GPU) or none; ids exact in every mode")
+    parser.add_argument("--plants", choices=PLANT_GENERATORS,
+                        help="canopy: Helios's Canopy Generator plants, as the paper's (default); architecture: "
+                             "pyhelios3d's PlantArchitecture plants bent towards them (our generator before 2026-11-24)")

@@ -17,6 +17,7 @@ from davis_ag.generate.run_progress import DEFAULT_MAX_RETRIES, RunOptions, defa
 from davis_ag.generate.runner import run_dataset
 from davis_ag.render.backends import DEFAULT_ANTIALIASING, DEFAULT_RENDERER, resolve_look
 from davis_ag.scene.camera import Camera
+from davis_ag.scene.specs import DEFAULT_PLANTS
 
 #: Flags that describe the one group of a config-less run.
 GROUP_FLAGS = ("crop", "scenario", "scenes", "first")
@@ -75,6 +76,8 @@ def run(args: argparse.Namespace) -> int:
             config = dataclasses.replace(config, antialiasing=args.antialiasing)
         if args.appearance is not None:
             config = dataclasses.replace(config, appearance=args.appearance)
+        if args.plants is not None:
+            config = dataclasses.replace(config, plants=args.plants)
         if args.renderer is not None or args.look is not None or args.no_depth:
             renderer = args.renderer or config.renderer
             look = args.look if args.look is not None else (config.look if args.renderer is None else None)
@@ -86,7 +89,7 @@ def run(args: argparse.Namespace) -> int:
                                      0 if args.first is None else args.first, args.seed or 0,
                                      args.size or (1280, 720), args.renderer or DEFAULT_RENDERER, args.look,
                                      not args.no_depth, args.antialiasing or DEFAULT_ANTIALIASING,
-                                     args.appearance or "paper")
+                                     args.plants or DEFAULT_PLANTS, args.appearance or "paper")
     if args.strawberry_altitudes:
         config = use_strawberry_altitudes(config, args.strawberry_altitudes)
     if args.executor != "ray" and args.address:

@@ -20,7 +20,7 @@ from davis_ag.labels.fruit_labels import fruit_lookup, label_view, visible_fract
 from davis_ag.render.backends import DEFAULT_RENDERER, open_renderer, resolve_look
 from davis_ag.scene.build import build_scene
 from davis_ag.scene.camera import Camera
-from davis_ag.scene.specs import crop_spec, plant_centres, scenario_spec
+from davis_ag.scene.specs import DEFAULT_PLANTS, crop_spec, plant_centres, scenario_spec
 from davis_ag.scene.view_grid import build_view_grid
 
 
@@ -49,9 +49,10 @@ def run(args: argparse.Namespace) -> int:
     # nominal grid, which slip does not change.
     _check_views(numbers, count_views(scenario, crop))
     arguments.prove_writable_folder(args.out)
-    request = SceneRequest(scenario, crop, args.index, args.seed, Camera(*args.size), renderer_name, look)
+    request = SceneRequest(scenario, crop, args.index, args.seed, Camera(*args.size), renderer_name, look,
+                           plants=args.plants or DEFAULT_PLANTS)
     rng = np.random.default_rng(request.seed)
-    model = build_scene(scenario, crop, rng)
+    model = build_scene(scenario, crop, rng, request.plants)
     grid = build_view_grid(scenario, crop, plant_centres(scenario, crop), model.aim_height, rng)
     _check_views(numbers, len(grid.viewpoints))
     lookup = fruit_lookup({f.id: f.uuids for f in model.fruits}, model.uuid_count)

@@ -7,13 +7,14 @@ scene has one; boxes per view from the annotations; the OER of every box from th
 
 from __future__ import annotations
 
+from dataclasses import asdict
 from typing import Any
 
 import numpy as np
 
 from davis_ag.data.reader import Dataset
 from davis_ag.figures.scene_numbers import box_oers, visible_fractions
-from davis_ag.scene.specs import CROPS, SCENARIOS
+from davis_ag.scene.specs import CROPS, SCENARIOS, parse_group_name
 
 #: Table 3 of the paper: (scenario, crop) -> (scenes, images).
 PAPER_TABLE3: dict[tuple[str, str], tuple[int, int]] = {
@@ -105,18 +106,44 @@ def fruit_statistics(dataset: Dataset, with_oer: bool = True) -> dict[str, Any]:
     return out
 
 
+def refused_move_statistics(dataset: Dataset) -> dict[str, Any]:
+    """Per group, the share of moves TVM-v0 refuses from its episode starts (:mod:`davis_ag.benchmark.moves`).
+
+    Reads (and if needed builds) the benchmark's observation caches. A group without an
+    eligible start has ``starts`` 0 and ``share`` None.
+    """
+    from davis_ag.benchmark.cache import load_scene_cache
+    from davis_ag.benchmark.moves import refused_moves_of_scenes
+
+    by_group: dict[str, list[Any]] = {}
+    for scene in dataset.scenes:
+        by_group.setdefault(scene.group, []).append(scene)
+    out: dict[str, Any] = {}
+    for group, scenes in by_group.items():
+        parsed = parse_group_name(group)
+        if parsed is None:
+            continue
+        caches = [load_scene_cache(s, dataset.root) for s in scenes]
+        counts = refused_moves_of_scenes(scenes, caches, parsed[0].name)
+        out[group] = {**asdict(counts), "share": None if not counts.moves else counts.share}
+    return out
+
+
 def dataset_statistics(dataset: Dataset, with_oer: bool = True) -> dict[str, Any]:
     """Everything ``davis-ag stats`` reports, JSON-ready.
 
     Args:
         dataset: The dataset.
-        with_oer: Include the OER distribution (reads every mask).
+        with_oer: Include the OER distribution (reads every mask) and the refused-move share
+            (reads the benchmark's caches).
 
     Returns:
-        ``{"dataset": root, "table3": ..., "fruit": ...}``.
+        ``{"dataset": root, "table3": ..., "fruit": ..., "refused_moves": ...}``.
     """
-    return {"dataset": str(dataset.root), "table3": table3(dataset),
-            "fruit": fruit_statistics(dataset, with_oer)}
+    stats = {"dataset": str(dataset.root), "table3": table3(dataset), "fruit": fruit_statistics(dataset, with_oer)}
+    if with_oer:
+        stats["refused_moves"] = refused_move_statistics(dataset)
+    return stats
 
 
 def _grid(rows: list[list[str]]) -> list[str]:
@@ -167,6 +194,11 @@ def format_statistics(stats: dict[str, Any]) -> str:
         rows.append(["boxes with OER < 0.4", *[f"{fruit[g]['oer']['below_0.4']:.1%}"
                                                 if fruit[g].get("oer") else "-" for g in names]])
     rows.append(["visible fraction", *[_stat(fruit[g]["visible_fraction"], "{:.2f}") for g in names]])
+    refused = stats.get("refused_moves", {})
+    if refused:
+        rows.append(["moves refused from starts", *[
+            f"{refused[g]['share']:.1%} of {refused[g]['moves']:,}" if refused.get(g, {}).get("share") is not None
+            else "-" for g in names]])
     lines += [""] + _grid(rows)
     missing = sum(fruit[g].get("masks_missing", 0) for g in names)
     if missing:

@@ -40,17 +40,18 @@ def dataset_settings(requests: Sequence[SceneRequest]) -> dict[str, Any]:
     first = requests[0]
     for request in requests:
         if request.dataset_seed != first.dataset_seed or request.camera != first.camera \
-                or (request.renderer, request.look, request.appearance) != (first.renderer, first.look,
-                                                                             first.appearance):
+                or (request.renderer, request.look, request.plants, request.appearance) != (
+                    first.renderer, first.look, first.plants, first.appearance):
             raise UserError("the scenes of one run must share the dataset seed, the image size, the renderer, "
-                            "the look and the appearance")
+                            "the look, the plant generator and the appearance")
     groups: dict[str, Any] = {}
     for request in requests:
         groups[request.folder.split("/")[0]] = {"grid": grid_settings(request.scenario, request.crop)}
     return {"format": DATASET_FORMAT, "seed": first.dataset_seed,
             "image_size": [first.camera.width, first.camera.height], "vfov_deg": first.camera.vfov,
             "renderer": first.renderer, "look": resolve_look(first.renderer, first.look),
-            "appearance": first.appearance, "classes": organ_table() if first.classes else None, "groups": groups}
+            "plants": first.plants, "appearance": first.appearance,
+            "classes": organ_table() if first.classes else None, "groups": groups}
 
 
 def complete_scenes(root: Path) -> list[str]:
@@ -88,10 +89,12 @@ def reconcile_settings(root: Path, wanted: dict[str, Any]) -> dict[str, Any]:
     if not present:  # nothing was finished with the old settings: they may change freely
         return wanted
     # Datasets from before the choice of renderer were drawn by Helios.
-    # ... and before randomised appearance, in the paper's.
-    old = {"renderer": "helios", "look": "helios", "appearance": "paper", **old}
+    # Datasets from before the choice of plants grew PlantArchitecture plants, and before
+    # randomised appearance had the paper's.
+    old = {"renderer": "helios", "look": "helios", "plants": "architecture", "appearance": "paper", **old}
     for key, flag in (("seed", "--seed"), ("image_size", "--size"), ("vfov_deg", "the field of view"),
-                      ("renderer", "--renderer"), ("look", "--look"), ("appearance", "--appearance")):
+                      ("renderer", "--renderer"), ("look", "--look"), ("plants", "--plants"),
+                      ("appearance", "--appearance")):
         if old.get(key) != wanted[key]:
             shown = [_shown(old.get(key)), _shown(wanted[key])]
             raise UserError(f"{root} holds scenes made with {key} {shown[0]}, not {shown[1]}: "

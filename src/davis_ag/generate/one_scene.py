@@ -26,7 +26,15 @@ from davis_ag.scene.appearance import draw_appearance, resolve_appearance
 from davis_ag.scene.build import build_scene
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.organs import ORGAN_NAMES, SKY
-from davis_ag.scene.specs import CROPS, SCENARIOS, CropSpec, ScenarioSpec, group_name, plant_centres
+from davis_ag.scene.specs import (
+    CROPS,
+    DEFAULT_PLANTS,
+    SCENARIOS,
+    CropSpec,
+    ScenarioSpec,
+    group_name,
+    plant_centres,
+)
 from davis_ag.scene.view_grid import build_view_grid
 
 SCENE_FORMAT = "davis-ag-scene/1"
@@ -69,6 +77,7 @@ class SceneRequest:
             renderer's own (``default`` for ours, ``helios`` for Helios).
         depth: Write ``images/NNNN_depth.png`` for every view.
         antialiasing: Our renderer's antialiasing: ``fxaa``, ``msaa`` or ``none``.
+        plants: The plant generator: ``canopy`` (default) or ``architecture``.
         appearance: ``paper`` or ``random`` (:mod:`davis_ag.scene.appearance`).
         classes: Write ``images/NNNN_class.png`` (organ classes) for every view.
     """
@@ -82,6 +91,7 @@ class SceneRequest:
     look: str | None = None
     depth: bool = True
     antialiasing: str = "fxaa"
+    plants: str = DEFAULT_PLANTS
     appearance: str = "paper"
     classes: bool = True
 
@@ -162,7 +172,7 @@ def grow_scene(request: SceneRequest):
     """
     rng = np.random.default_rng(request.seed)
     appearance = draw_appearance(request.appearance, request.seed)
-    model = build_scene(request.scenario, request.crop, rng, soil_texture=appearance.soil)
+    model = build_scene(request.scenario, request.crop, rng, request.plants, soil_texture=appearance.soil)
     model.lighting = appearance.lighting(model.lighting)
     grid = build_view_grid(request.scenario, request.crop, plant_centres(request.scenario, request.crop),
                            model.aim_height, rng)
@@ -261,6 +271,7 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict) -> dict:
         "scenario": request.scenario.name,
         "crop": request.crop.name,
         "scene": request.folder,
+        "plant_generator": model.plant_generator,
         "conventions": CONVENTIONS,
         "camera": request.camera.intrinsics(),
         "renderer": {"name": request.renderer, "look": resolve_look(request.renderer, request.look),

@@ -27,7 +27,7 @@ from davis_ag.atomic_files import atomic_output
 from davis_ag.errors import UserError
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.lighting import Lighting
-from davis_ag.scene.specs import CropSpec, ScenarioSpec, crop_spec, scenario_spec
+from davis_ag.scene.specs import DEFAULT_PLANTS, CropSpec, ScenarioSpec, check_plants, crop_spec, scenario_spec
 from davis_ag.scene.view_grid import Viewpoint
 
 CACHE_FILE = "live_geometry.npz"
@@ -47,6 +47,7 @@ class SceneSettings:
         index, seed, dataset_seed: Which scene.
         camera: The camera its views were drawn with.
         renderer, look, antialiasing: How its views were drawn.
+        plants: The plant generator (scenes from before the choice grew ``architecture`` plants).
     """
 
     folder: Path
@@ -60,6 +61,7 @@ class SceneSettings:
     renderer: str
     look: str
     antialiasing: str
+    plants: str = DEFAULT_PLANTS
 
     @property
     def cache_key(self) -> str:
@@ -67,7 +69,7 @@ class SceneSettings:
         meta = self.metadata
         keyed = {"version": CACHE_VERSION, "seed": self.seed, "dataset_seed": self.dataset_seed,
                  "scenario": meta["scenario"], "crop": meta["crop"], "scene": meta["scene"],
-                 "grid": meta["grid"], "generator": meta["generator"]}
+                 "grid": meta["grid"], "generator": meta["generator"], "plants": self.plants}
         return hashlib.sha256(json.dumps(keyed, sort_keys=True).encode()).hexdigest()[:20]
 
 
@@ -118,8 +120,8 @@ def read_settings(scene_dir: str | Path) -> SceneSettings:
         settings = SceneSettings(folder, metadata, scenario, crop, int(metadata["scene"].rsplit("/", 1)[1]),
                                  int(metadata["seed"]), int(metadata["dataset_seed"]), camera,
                                  str(renderer["name"]), str(renderer["look"]),
-                                 antialiasing)
-    except (KeyError, ValueError, TypeError, IndexError, AttributeError) as error:
+                                 antialiasing, check_plants(str(metadata.get("plant_generator", "architecture"))))
+    except (KeyError, ValueError, TypeError, IndexError, AttributeError, UserError) as error:
         raise UserError(f"{path}: lacks or mangles a setting needed to regrow the scene ({error!r}); "
                         "generate the scene again") from None
     return settings
@@ -176,7 +178,7 @@ def regrow(settings: SceneSettings) -> SceneAssets:
     from davis_ag.generate.one_scene import SceneRequest, grow_scene
 
     request = SceneRequest(settings.scenario, settings.crop, settings.index, settings.dataset_seed,
-                           settings.camera, renderer=settings.renderer, look=settings.look)
+                           settings.camera, renderer=settings.renderer, look=settings.look, plants=settings.plants)
     if request.seed != settings.seed:
         raise UserError(f"{settings.folder}/scene.json: seed {settings.seed} does not follow from dataset seed "
                         f"{settings.dataset_seed} and scene {settings.metadata['scene']}; the file was edited")
@@ -184,12 +186,18 @@ def regrow(settings: SceneSettings) -> SceneAssets:
     stored = settings.metadata
     version = f"pyhelios3d {stored['generator'].get('pyhelios3d')}, davis-ag {stored['generator'].get('version')}"
     regrown_fruit = json.loads(json.dumps([f.summary() for f in model.fruits]))
-    regrown_plants = json.loads(json.dumps([p.summary() for p in model.plants]))
-    if regrown_fruit != stored.get("fruits") or regrown_plants != stored.get("plants"):
+    regrown_plants = json.loads(json.dumps([_without_timing(p.summary()) for p in model.plants]))
+    stored_plants = [_without_timing(p) for p in stored.get("plants", [])]
+    if regrown_fruit != stored.get("fruits") or regrown_plants != stored_plants:
         raise UserError(f"{settings.folder}: regrowing from the seed gave other plants than scene.json records "
                         f"(made with {version}); reopen it with those versions")
     check_grid(settings, list(grid.viewpoints))
     return assets_from_model(model, grid)
+
+
+def _without_timing(plant: dict) -> dict:
+    """A plant's scene.json entry without what varies from run to run (its build time)."""
+    return {key: value for key, value in plant.items() if key != "build_s"} if isinstance(plant, dict) else plant
 
 
 def assets_from_model(model, grid) -> SceneAssets:

@@ -24,7 +24,14 @@ from davis_ag.scene.plants import (
     require_native_helios,
     sample_phenotype,
 )
-from davis_ag.scene.specs import MAX_FRUIT, CropSpec, ScenarioSpec, plant_positions
+from davis_ag.scene.specs import (
+    DEFAULT_PLANTS,
+    MAX_FRUIT,
+    CropSpec,
+    ScenarioSpec,
+    check_plants,
+    plant_positions,
+)
 
 #: Side of the square soil tile under every scene, m: wide enough to reach the horizon's haze.
 GROUND_SIZE = 60.0
@@ -70,6 +77,7 @@ class SceneModel:
         fruits: Every fruit, by id.
         lighting: Sun and sky.
         aim_height: Height single-plant cameras aim at, m.
+        plant_generator: Which generator grew the plants (``canopy`` or ``architecture``).
     """
 
     context: object
@@ -77,6 +85,7 @@ class SceneModel:
     fruits: list[Fruit]
     lighting: Lighting
     aim_height: float
+    plant_generator: str = DEFAULT_PLANTS
 
     @property
     def uuid_count(self) -> int:
@@ -144,8 +153,8 @@ def add_ground(context, soil_texture: str = "dirt.jpg") -> None:
     label_soil(context, tiles)
 
 
-def _fruit(context, fruit_id: int, plant: int, object_id: int) -> Fruit:
-    uuids = np.asarray(fruit_body_uuids(context, object_id), dtype=np.int64)
+def _fruit(context, fruit_id: int, plant: int, body: list[int]) -> Fruit:
+    uuids = np.asarray(body, dtype=np.int64)
     parts = primitive_vertices(context, list(uuids))
     by_count: dict[int, list[np.ndarray]] = {}
     for part in parts:
@@ -157,29 +166,16 @@ def _fruit(context, fruit_id: int, plant: int, object_id: int) -> Fruit:
                  tuple(float(v) for v in (lo + hi) / 2), tuple(float(v) for v in hi - lo))
 
 
-def build_scene(scenario: ScenarioSpec, crop: CropSpec, rng: np.random.Generator,
-                soil_texture: str = "dirt.jpg") -> SceneModel:
-    """Grow a scene's plants on soil, choose the sun and number the fruit.
+def _grow_architecture_plants(context, scenario: ScenarioSpec, crop: CropSpec,
+                              rng: np.random.Generator) -> list[GrownPlant]:
+    """PlantArchitecture plants grown towards their phenotypes (``--plants architecture``)."""
+    from pyhelios import PlantArchitecture
 
-    Args:
-        scenario: Single or multi plant.
-        crop: The crop.
-        rng: The scene's only source of randomness.
-        soil_texture: The soil's image (:func:`add_ground`).
-
-    Returns:
-        The :class:`SceneModel`.
-    """
-    require_native_helios()
-    from pyhelios import Context, PlantArchitecture
-
-    context = Context()
     plant_architecture = PlantArchitecture(context)
     plant_architecture.disableMessages()
-    plants: list[GrownPlant] = []
     with quiet_stdout():
         if crop.name == "vine":
-            from davis_ag.scene.goblet_vine import grow_goblet_vine, load_vine_model
+            from davis_ag.scene.goblet_vine import load_vine_model
 
             shoot_defaults = load_vine_model(plant_architecture)
         else:
@@ -188,18 +184,59 @@ def build_scene(scenario: ScenarioSpec, crop: CropSpec, rng: np.random.Generator
                 label: plant_architecture.getCurrentShootParameters(label)
                 for label in plant_architecture.listShootTypeLabels()
             }
+    plants = []
     for index, position in enumerate(plant_positions(scenario, crop)):
         target = sample_phenotype(crop, rng)
         seed = helios_seed(rng)
-        grow = grow_goblet_vine if crop.name == "vine" else grow_library_plant
+        if crop.name == "vine":
+            from davis_ag.scene.goblet_vine import grow_goblet_vine as grow
+        else:
+            grow = grow_library_plant
         plants.append(grow(context, plant_architecture, shoot_defaults, crop, index, position, target, seed))
+    for plant in plants:
+        plant.fruit_bodies = [fruit_body_uuids(context, object_id) for object_id in plant.fruit_objects]
+    return plants
+
+
+def _grow_canopy_plants(context, scenario: ScenarioSpec, crop: CropSpec, rng: np.random.Generator) -> list[GrownPlant]:
+    """Canopy Generator plants with the phenotypes drawn for them (``--plants canopy``)."""
+    from davis_ag.scene.canopy_plants import grow_canopy_plant
+
+    plants = []
+    for index, position in enumerate(plant_positions(scenario, crop)):
+        target = sample_phenotype(crop, rng)
+        seed = int(rng.integers(0, 2**31 - 1))
+        plants.append(grow_canopy_plant(context, crop, index, position, target, seed))
+    return plants
+
+
+def build_scene(scenario: ScenarioSpec, crop: CropSpec, rng: np.random.Generator,
+                plants: str = DEFAULT_PLANTS, soil_texture: str = "dirt.jpg") -> SceneModel:
+    """Grow a scene's plants on soil, choose the sun and number the fruit.
+
+    Args:
+        scenario: Single or multi plant.
+        crop: The crop.
+        rng: The scene's only source of randomness.
+        plants: The plant generator (:data:`~davis_ag.scene.specs.PLANT_GENERATORS`).
+        soil_texture: The soil's image (:func:`add_ground`).
+
+    Returns:
+        The :class:`SceneModel`.
+    """
+    require_native_helios()
+    from pyhelios import Context
+
+    context = Context()
+    grow = _grow_canopy_plants if check_plants(plants) == "canopy" else _grow_architecture_plants
+    grown = grow(context, scenario, crop, rng)
     add_ground(context, soil_texture)
 
     fruits: list[Fruit] = []
-    for plant in plants:
-        for object_id in plant.fruit_objects:
+    for plant in grown:
+        for body in plant.fruit_bodies:
             if len(fruits) >= MAX_FRUIT:
                 raise UserError(f"a {crop.name} scene grew more than {MAX_FRUIT} fruit, the most uint8 ids can label")
-            fruits.append(_fruit(context, len(fruits), plant.index, object_id))
+            fruits.append(_fruit(context, len(fruits), plant.index, body))
     lighting = Lighting(sun_elevation=float(rng.uniform(35.0, 75.0)), sun_azimuth=float(rng.uniform(0.0, 360.0)))
-    return SceneModel(context, plants, fruits, lighting, aim_height=crop.centre_height)
+    return SceneModel(context, grown, fruits, lighting, aim_height=crop.centre_height, plant_generator=plants)

@@ -26,6 +26,7 @@ import contextlib
 import math
 import os
 import sys
+import time
 from dataclasses import asdict, dataclass, field
 from typing import Callable
 
@@ -75,6 +76,9 @@ class GrownPlant:
         fruit_objects: Helios object ids of its fruit (a grape cluster is one object).
         uuids: Every primitive of the plant.
         builds: Builds it took, regrowths for too few fruit included.
+        fruit_bodies: Per fruit, the primitives of its body, when the builder knows them (the
+            Canopy Generator plants); otherwise read from ``fruit_objects``.
+        build_s: Seconds it took to build and measure.
     """
 
     index: int
@@ -85,6 +89,13 @@ class GrownPlant:
     fruit_objects: list[int]
     uuids: list[int] = field(repr=False)
     builds: int
+    fruit_bodies: list[list[int]] | None = field(default=None, repr=False)
+    build_s: float | None = None
+
+    @property
+    def fruit_count(self) -> int:
+        """How many fruit it bears (a grape cluster counts once)."""
+        return len(self.fruit_bodies) if self.fruit_bodies is not None else len(self.fruit_objects)
 
     def summary(self) -> dict:
         """JSON-ready description for scene.json."""
@@ -94,8 +105,9 @@ class GrownPlant:
             "position": list(self.position),
             "phenotype_target": asdict(self.target),
             "phenotype_measured": asdict(self.measured),
-            "fruit_count": len(self.fruit_objects),
+            "fruit_count": self.fruit_count,
             "builds": self.builds,
+            "build_s": None if self.build_s is None else round(self.build_s, 3),
         }
 
 
@@ -322,6 +334,7 @@ def grow_to_target(
         The grown plant, left in the context, every primitive labelled with its organ class.
     """
     builds = 0
+    started = time.perf_counter()
     while True:
         knobs = dict(first_knobs)
         history: list[tuple[float, float]] = []
@@ -339,7 +352,8 @@ def grow_to_target(
             if on_target or (attempt == MAX_BUILDS - 1 and in_range):
                 label_architecture_plant(context, plant_architecture, plant_id, woody_shoots)
                 return GrownPlant(index, seed, position, target, measured, list(fruit),
-                                  list(plant_architecture.getAllPlantUUIDs(plant_id)), builds)
+                                  list(plant_architecture.getAllPlantUUIDs(plant_id)), builds,
+                                  build_s=time.perf_counter() - started)
             history.append((knobs["plant_height"], measured.plant_height))
             knobs["plant_height"] = _next_height_knob(history, target.plant_height)
             # Fruit and leaf size are proportional to their prototype scales.

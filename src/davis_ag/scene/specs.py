@@ -145,6 +145,24 @@ def with_strawberry_altitudes(crop: CropSpec, choice: str) -> CropSpec:
     return replace(crop, altitudes=STRAWBERRY_ALTITUDES[choice]) if crop.name == "strawberry" else crop
 
 
+#: Plant generators: ``canopy`` (the default) rebuilds Helios's Canopy Generator, which grew the
+#: paper's plants (section III-A); ``architecture`` grows pyhelios3d's PlantArchitecture models,
+#: bent towards the paper by recipes (the generator before 2026-11-24).
+PLANT_GENERATORS: tuple[str, ...] = ("canopy", "architecture")
+DEFAULT_PLANTS = "canopy"
+
+
+def check_plants(name: str) -> str:
+    """The plant generator's name, checked.
+
+    Raises:
+        UserError: for an unknown generator.
+    """
+    if name not in PLANT_GENERATORS:
+        raise UserError(f"unknown plant generator {name!r}: choose {' or '.join(PLANT_GENERATORS)}")
+    return name
+
+
 #: Relative spread of the phenotype around Table 1, uniform (section III-A).
 PHENOTYPE_SPREAD: dict[str, float] = {"plant_height": 0.15, "fruit_radius": 0.20, "leaf_length": 0.20}
 
