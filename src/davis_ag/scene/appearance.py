@@ -12,7 +12,7 @@ the plants, the grid and the paper's sun draws are the same as under ``paper``):
   a colour temperature shift; green 1);
 - sensor noise: Gaussian, standard deviation 0.5-4 grey levels of 255, drawn anew for every
   view from the scene seed and the view's number (so a resumed scene writes the same pixels) by
-  the renderer's shaders, at no measurable cost (:mod:`davis_ag.render.opengl`).
+  the renderer's fragment shaders, in the same pass (:mod:`davis_ag.render.opengl`).
 
 Labels do not change: ids, masks, classes and depth come from the geometry, which appearance
 leaves alone. ``paper`` changes nothing: its scenes are the ones drawn before this option.
