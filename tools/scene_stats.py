@@ -73,7 +73,8 @@ def measure_plants(count: int, crops: list[str]) -> dict:
             seed = SceneRequest(scenario, crop, index, 0).seed
             model = build_scene(scenario, crop, np.random.default_rng(seed))
             plant = model.plants[0]
-            plants.append({**plant.summary(), "scene_seed": seed, "grow_s": round(time.perf_counter() - started, 1)})
+            plants.append({**plant.summary(), "build_s": None if plant.build_s is None else round(plant.build_s, 3),
+                           "scene_seed": seed, "grow_s": round(time.perf_counter() - started, 1)})
             print(f"{crop.name} {index}: {plant.fruit_count} fruit", file=sys.stderr, flush=True)
             del model
         out["crops"][crop.name] = plants

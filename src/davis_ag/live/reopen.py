@@ -186,18 +186,12 @@ def regrow(settings: SceneSettings) -> SceneAssets:
     stored = settings.metadata
     version = f"pyhelios3d {stored['generator'].get('pyhelios3d')}, davis-ag {stored['generator'].get('version')}"
     regrown_fruit = json.loads(json.dumps([f.summary() for f in model.fruits]))
-    regrown_plants = json.loads(json.dumps([_without_timing(p.summary()) for p in model.plants]))
-    stored_plants = [_without_timing(p) for p in stored.get("plants", [])]
-    if regrown_fruit != stored.get("fruits") or regrown_plants != stored_plants:
+    regrown_plants = json.loads(json.dumps([p.summary() for p in model.plants]))
+    if regrown_fruit != stored.get("fruits") or regrown_plants != stored.get("plants"):
         raise UserError(f"{settings.folder}: regrowing from the seed gave other plants than scene.json records "
                         f"(made with {version}); reopen it with those versions")
     check_grid(settings, list(grid.viewpoints))
     return assets_from_model(model, grid)
-
-
-def _without_timing(plant: dict) -> dict:
-    """A plant's scene.json entry without what varies from run to run (its build time)."""
-    return {key: value for key, value in plant.items() if key != "build_s"} if isinstance(plant, dict) else plant
 
 
 def assets_from_model(model, grid) -> SceneAssets:

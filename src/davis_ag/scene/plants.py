@@ -78,7 +78,8 @@ class GrownPlant:
         builds: Builds it took, regrowths for too few fruit included.
         fruit_bodies: Per fruit, the primitives of its body, when the builder knows them (the
             Canopy Generator plants); otherwise read from ``fruit_objects``.
-        build_s: Seconds it took to build and measure.
+        build_s: Seconds it took to build and measure (not in :meth:`summary`: scene.json is the
+            same, byte for byte, whenever the scene is made again).
     """
 
     index: int
@@ -107,7 +108,6 @@ class GrownPlant:
             "phenotype_measured": asdict(self.measured),
             "fruit_count": self.fruit_count,
             "builds": self.builds,
-            "build_s": None if self.build_s is None else round(self.build_s, 3),
         }
 
 
