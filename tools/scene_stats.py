@@ -12,7 +12,10 @@ when another is refreshed; docs/scenes.md is rewritten from whichever exist:
   view sees every fruit, how often changing altitude at a fixed position loses or gains fruit
   (Fig. 3), and the share of the published boxes (the crop's 210 pixels) with OER below 0.4.
 
-Run: ``python tools/scene_stats.py views``, ``... plants 10 [tomato,vine]``,
+- ``refused N WxH``: N single-plant scenes per crop with each plant generator, and the share of
+  moves TVM-v0 refuses from its episode starts (:mod:`davis_ag.benchmark.moves`).
+
+Run: ``python tools/scene_stats.py views``, ``... plants 10 [tomato,vine]``, ``... refused 2 640x360``,
 ``... findings 10 1280x720 [0.5]`` (the last argument: the grid step, default the paper's 0.25 m;
 one file per image size, docs/scenes-findings-WxH.json, since the OER share depends on it).
 With no argument it only rewrites docs/scenes.md, e.g. after ``tools/strawberry_recipes.py``.
@@ -70,7 +73,8 @@ def measure_plants(count: int, crops: list[str]) -> dict:
             seed = SceneRequest(scenario, crop, index, 0).seed
             model = build_scene(scenario, crop, np.random.default_rng(seed))
             plant = model.plants[0]
-            plants.append({**plant.summary(), "scene_seed": seed, "grow_s": round(time.perf_counter() - started, 1)})
+            plants.append({**plant.summary(), "build_s": None if plant.build_s is None else round(plant.build_s, 3),
+                           "scene_seed": seed, "grow_s": round(time.perf_counter() - started, 1)})
             print(f"{crop.name} {index}: {plant.fruit_count} fruit", file=sys.stderr, flush=True)
             del model
         out["crops"][crop.name] = plants
@@ -106,6 +110,56 @@ def measure_findings(count: int, size: tuple[int, int], step: float) -> dict:
                            "seconds": round(stats["total_s"], 1)})
             print(f"scene {index}: {scenes[-1]['fruit']} fruit", file=sys.stderr, flush=True)
     return {"size": list(size), "step": step, "scenes": scenes}
+
+
+def measure_refused(count: int, size: tuple[int, int], generators: list[str]) -> dict:
+    """Generate ``count`` SP scenes per crop with each plant generator; TVM-v0's refused moves.
+
+    Returns:
+        Per generator and crop: the counts of :func:`davis_ag.benchmark.moves.refused_moves`
+        summed over the scenes, and the seconds the scenes took.
+    """
+    from davis_ag.data.reader import open_dataset
+    from davis_ag.figures.dataset_stats import refused_move_statistics
+    from davis_ag.generate.one_scene import SceneRequest, generate_scene
+    from davis_ag.scene.camera import Camera
+
+    out: dict = {"size": list(size), "scenes_per_crop": count, "generators": {}}
+    for generator in generators:
+        with tempfile.TemporaryDirectory() as folder:
+            root = Path(folder)
+            seconds = {}
+            for crop in CROPS.values():
+                started = time.perf_counter()
+                for index in range(count):
+                    generate_scene(SceneRequest(scenario_spec("sp", crop), crop, index, 0, Camera(*size),
+                                                plants=generator), root)
+                seconds[crop.name] = round(time.perf_counter() - started, 1)
+                print(f"{generator} {crop.name}: {count} scenes", file=sys.stderr, flush=True)
+            groups = refused_move_statistics(open_dataset(root))
+            out["generators"][generator] = {name.split("-")[1].lower(): {**counts, "seconds": seconds[
+                name.split("-")[1].lower()]} for name, counts in groups.items()}
+    return out
+
+
+def refused_table() -> list[str]:
+    """Markdown: the share of moves TVM-v0 refuses from its episode starts, per crop and generator."""
+    path = DOCS / "scenes-refused.json"
+    if not path.exists():
+        return []
+    data = json.loads(path.read_text())
+    lines = [f"{data['scenes_per_crop']} single-plant scenes per crop (dataset seed 0) at "
+             f"{data['size'][0]}x{data['size'][1]}, every eligible start (a view and a target with OER "
+             f"below 0.4 and the crop's visible pixels) and every move of TVM-v0 (`davis-ag stats`); "
+             f"{data['machine']}.", "",
+             "| crop | plants | starts | moves refused | no view there | target not boxed there |",
+             "|---|---|---|---|---|---|"]
+    for generator, crops in data["generators"].items():
+        for crop, c in crops.items():
+            share = f"{(c['no_view'] + c['target_lost']) / c['moves']:.1%}" if c["moves"] else "-"
+            lines.append(f"| {crop} | {generator} | {c['starts']:,} | {share} | {c['no_view']:,} | "
+                         f"{c['target_lost']:,} |")
+    return lines
 
 
 def seeable(crop):
@@ -177,32 +231,44 @@ def views_table() -> list[str]:
     return lines
 
 
+#: Plant measurements per generator: the default's, kept fresh by ``plants N``, and the
+#: PlantArchitecture plants' as last measured (2026-11-22, before the Canopy Generator plants).
+PLANT_FILES = {"canopy": "scenes-plants.json", "architecture": "scenes-plants-architecture.json"}
+
+
 def plants_table() -> list[str]:
-    """Markdown: fruit per plant and measured phenotypes per crop."""
-    plants_file = DOCS / "scenes-plants.json"
-    if not plants_file.exists():
-        return []
-    data = json.loads(plants_file.read_text())
-    lines = [f"{data['plants_per_crop']} single plants per crop, grown as `davis-ag generate` grows them "
-             f"(scene seeds of dataset seed 0, scenes 0-{data['plants_per_crop'] - 1}); {data['machine']}.", "",
-             "| crop | fruit per plant: min / median / max | plant (vine: trunk) height, m | "
-             "fruit (vine: berry) radius, mm | leaf length, m | all in Table 1 +- spread | "
-             "grow s (median, shared machine) |",
-             "|---|---|---|---|---|---|---|"]
-    for name, plants in data["crops"].items():
-        crop = CROPS[name]
-        fruit = [p["fruit_count"] for p in plants]
-        measured = {k: [p["phenotype_measured"][k] for p in plants]
-                    for k in ("plant_height", "fruit_radius", "leaf_length")}
-        inside = all(abs(p["phenotype_measured"][k] / getattr(crop, k) - 1) <= PHENOTYPE_SPREAD[k] + 1e-9
-                     for p in plants for k in measured)
-        span = {k: f"{min(v) * (1000 if k == 'fruit_radius' else 1):.{1 if k == 'fruit_radius' else 2}f}-"
-                   f"{max(v) * (1000 if k == 'fruit_radius' else 1):.{1 if k == 'fruit_radius' else 2}f}"
-                for k, v in measured.items()}
-        lines.append(f"| {name} | {min(fruit)} / {np.median(fruit):g} / {max(fruit)} | {span['plant_height']} | "
-                     f"{span['fruit_radius']} | {span['leaf_length']} | {'yes' if inside else 'no'} | "
-                     f"{np.median([p['grow_s'] for p in plants]):.0f} |")
-    return lines
+    """Markdown: fruit per plant, measured phenotypes and growing time, per crop and generator."""
+    intro: list[str] = []
+    lines: list[str] = []
+    for generator, name in PLANT_FILES.items():
+        plants_file = DOCS / name
+        if not plants_file.exists():
+            continue
+        data = json.loads(plants_file.read_text())
+        if not lines:
+            lines = ["| crop | plants | fruit per plant: min / median / max | plant (vine: trunk) height, m | "
+                     "fruit (vine: berry) radius, mm | leaf length, m | all in Table 1 +- spread | "
+                     "seconds per plant, median (shared machine) |",
+                     "|---|---|---|---|---|---|---|---|"]
+        for crop_name, plants in data["crops"].items():
+            crop = CROPS[crop_name]
+            fruit = [p["fruit_count"] for p in plants]
+            measured = {k: [p["phenotype_measured"][k] for p in plants]
+                        for k in ("plant_height", "fruit_radius", "leaf_length")}
+            # 0.1 % of slack: a canopy plant is built at its drawn phenotype, which may lie on the edge.
+            inside = all(abs(p["phenotype_measured"][k] / getattr(crop, k) - 1) <= PHENOTYPE_SPREAD[k] + 1e-3
+                         for p in plants for k in measured)
+            span = {k: f"{min(v) * (1000 if k == 'fruit_radius' else 1):.{1 if k == 'fruit_radius' else 2}f}-"
+                       f"{max(v) * (1000 if k == 'fruit_radius' else 1):.{1 if k == 'fruit_radius' else 2}f}"
+                    for k, v in measured.items()}
+            seconds = [p["build_s"] if p.get("build_s") is not None else p["grow_s"] for p in plants]
+            lines.append(f"| {crop_name} | {generator} | {min(fruit)} / {np.median(fruit):g} / {max(fruit)} | "
+                         f"{span['plant_height']} | {span['fruit_radius']} | {span['leaf_length']} | "
+                         f"{'yes' if inside else 'no'} | {np.median(seconds):.1f} |")
+        intro.append(f"- `{generator}`: {data['plants_per_crop']} single plants per crop, grown as `davis-ag "
+                     f"generate --plants {generator}` grows them (scene seeds of dataset seed 0, scenes "
+                     f"0-{data['plants_per_crop'] - 1}); {data['machine']}.")
+    return [*intro, "", *lines] if lines else []
 
 
 def findings_file(size: tuple[int, int]) -> Path:
@@ -293,6 +359,8 @@ def render_markdown() -> str:
         lines += ["## Images per scene (Table 3)", "", *views, ""]
     if plants := plants_table():
         lines += ["## Fruit per plant", "", *plants, ""]
+    if refused := refused_table():
+        lines += ["## Moves the benchmark refuses from its episode starts", "", *refused, ""]
     if findings := findings_table():
         lines += ["## The paper's findings on single-plant strawberry scenes", "", *findings]
     if recipes := recipes_table():
@@ -315,6 +383,11 @@ def main(argv: list[str]) -> None:
         merged = {**saved, **fresh, "crops": {**saved["crops"], **fresh["crops"]}, "machine": machine}
         merged["crops"] = {name: merged["crops"][name] for name in CROPS if name in merged["crops"]}
         write_json_atomic(path, merged, indent=1)
+    elif argv and argv[0] == "refused":
+        size = tuple(int(v) for v in argv[2].split("x"))
+        generators = argv[3].split(",") if len(argv) > 3 else ["canopy", "architecture"]
+        write_json_atomic(DOCS / "scenes-refused.json",
+                          {**measure_refused(int(argv[1]), size, generators), "machine": machine}, indent=1)
     elif argv and argv[0] == "findings":
         size = tuple(int(v) for v in argv[2].split("x"))
         step = float(argv[3]) if len(argv) > 3 else 0.25

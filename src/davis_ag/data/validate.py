@@ -21,6 +21,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from davis_ag.data.class_checks import class_problems
 from davis_ag.data.reader import (
     ANNOTATIONS,
     NO_FRUIT,
@@ -188,10 +189,14 @@ def validate_scene(scene: Scene, quick: bool = False, box_tolerance: int | None 
             if depth.is_file():
                 for problem in depth_problems(record, depth, mask if has_mask else None, metadata):
                     flag(depth, problem)
+            classes = images / f"{record.name.removesuffix('.jpeg')}_class.png"
+            if classes.is_file() and not _outside(classes, scene.root):
+                for problem in class_problems(classes, mask if has_mask else None):
+                    flag(classes, problem)
 
     if images.is_dir():
         for path in sorted(images.iterdir()):
-            stem = next((path.name.removesuffix(end) for end in ("_seg.png", "_depth.png") if path.name.endswith(end)),
+            stem = next((path.name.removesuffix(end) for end in ("_seg.png", "_depth.png", "_class.png") if path.name.endswith(end)),
                         path.stem)
             if path.suffix.lower() in (".jpeg", ".jpg", ".png") and f"{stem}.jpeg" not in names:
                 flag(path, "has no entry in annotations.json")
@@ -446,3 +451,4 @@ def validate_dataset(path: str | Path, quick: bool = False, box_tolerance: int |
     for problem in _check_counts(dataset, counts):
         emit(problem)
     return report
+

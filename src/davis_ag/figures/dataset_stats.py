@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from davis_ag.data.reader import Dataset
+from davis_ag.errors import UserError
 from davis_ag.figures.scene_numbers import box_oers, visible_fractions
 from davis_ag.scene.specs import CROPS, SCENARIOS, parse_group_name
 
@@ -110,7 +111,8 @@ def refused_move_statistics(dataset: Dataset) -> dict[str, Any]:
     """Per group, the share of moves TVM-v0 refuses from its episode starts (:mod:`davis_ag.benchmark.moves`).
 
     Reads (and if needed builds) the benchmark's observation caches. A group without an
-    eligible start has ``starts`` 0 and ``share`` None.
+    eligible start has ``starts`` 0 and ``share`` None; one whose benchmark cache cannot be built
+    (a download without masks) has ``share`` None and ``skipped``, the reason.
     """
     from davis_ag.benchmark.cache import load_scene_cache
     from davis_ag.benchmark.moves import refused_moves_of_scenes
@@ -123,7 +125,11 @@ def refused_move_statistics(dataset: Dataset) -> dict[str, Any]:
         parsed = parse_group_name(group)
         if parsed is None:
             continue
-        caches = [load_scene_cache(s, dataset.root) for s in scenes]
+        try:
+            caches = [load_scene_cache(s, dataset.root) for s in scenes]
+        except UserError as error:  # no masks, no OER: nothing to start from
+            out[group] = {"share": None, "skipped": str(error)}
+            continue
         counts = refused_moves_of_scenes(scenes, caches, parsed[0].name)
         out[group] = {**asdict(counts), "share": None if not counts.moves else counts.share}
     return out

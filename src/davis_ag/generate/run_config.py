@@ -10,6 +10,7 @@ Format (every key but ``groups`` is optional)::
     depth: true                  # write images/NNNN_depth.png (uint16 mm) for every view
     antialiasing: fxaa           # our renderer's: fxaa (default), msaa (4x samples, slower) or none
     plants: canopy               # canopy (Helios's Canopy Generator, default) or architecture
+    appearance: paper            # paper (default) or random: sun, sky, soil, exposure, noise per scene
     strawberry_altitudes: table1 # table1 (25/40/55 cm, default) or readme (0.50/0.75/1.00 m)
     grid:                        # overrides the scenario's Table 2 grid for every group
       extent: [3.0, 3.0]         #   grid size along x and y, m
@@ -44,6 +45,7 @@ from typing import Any
 from davis_ag.errors import UserError
 from davis_ag.generate.one_scene import SceneRequest
 from davis_ag.render.backends import DEFAULT_RENDERER, resolve_antialiasing, resolve_look
+from davis_ag.scene.appearance import resolve_appearance
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import (
     DEFAULT_PLANTS,
@@ -61,7 +63,8 @@ from davis_ag.scene.specs import (
 MIN_IMAGE_SIDE = 16
 #: Scene folders are numbered NNN.
 MAX_SCENES = 1000
-TOP_KEYS = ("name", "seed", "image_size", "renderer", "look", "depth", "antialiasing", "plants", "strawberry_altitudes",
+TOP_KEYS = ("name", "seed", "image_size", "renderer", "look", "depth", "antialiasing", "plants", "appearance",
+            "strawberry_altitudes",
             "grid", "groups")
 GROUP_KEYS = ("scenario", "crop", "scenes", "first", "grid")
 GRID_KEYS = ("extent", "step", "altitude_levels", "headings")
@@ -109,6 +112,7 @@ class DatasetConfig:
         depth: Whether every view gets a depth image.
         antialiasing: Our renderer's antialiasing: ``fxaa``, ``msaa`` or ``none``.
         plants: The plant generator: ``canopy`` (default) or ``architecture``.
+        appearance: ``paper`` or ``random`` (:mod:`davis_ag.scene.appearance`).
     """
 
     name: str
@@ -121,6 +125,7 @@ class DatasetConfig:
     depth: bool = True
     antialiasing: str = "fxaa"
     plants: str = DEFAULT_PLANTS
+    appearance: str = "paper"
 
     def requests(self, only: list[str] | None = None) -> list[SceneRequest]:
         """Every scene to make, in group order, optionally narrowed to some groups or scenes.
@@ -137,7 +142,7 @@ class DatasetConfig:
         """
         look = resolve_look(self.renderer, self.look)
         everything = [SceneRequest(g.scenario, g.crop, i, self.seed, self.camera, self.renderer, look, self.depth,
-                                   self.antialiasing, self.plants)
+                                   self.antialiasing, self.plants, self.appearance)
                       for g in self.groups for i in g.indices]
         if not only:
             return everything
@@ -163,7 +168,8 @@ def _normalise_scene_id(text: str) -> str:
 
 def single_group_config(scenario: str, crop: str, scenes: int, first: int, seed: int,
                         size: tuple[int, int], renderer: str = DEFAULT_RENDERER, look: str | None = None,
-                        depth: bool = True, antialiasing: str = "fxaa", plants: str = DEFAULT_PLANTS) -> DatasetConfig:
+                        depth: bool = True, antialiasing: str = "fxaa", plants: str = DEFAULT_PLANTS,
+                        appearance: str = "paper") -> DatasetConfig:
     """The dataset the classic flags (--scenario --crop --scenes --first) describe.
 
     Returns:
@@ -180,7 +186,7 @@ def single_group_config(scenario: str, crop: str, scenes: int, first: int, seed:
         raise UserError(f"--seed {seed} is negative: use a whole number from 0")
     resolve_look(renderer, look)
     return DatasetConfig("command line", seed, Camera(*size), (group,), "the command line", renderer, look, depth,
-                         antialiasing, check_plants(plants))
+                         antialiasing, check_plants(plants), resolve_appearance(appearance))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -271,6 +277,10 @@ def parse_dataset_config(text: str, source: str, default_name: str = "dataset") 
     plants = data.get("plants", DEFAULT_PLANTS)
     if plants not in PLANT_GENERATORS:
         check.fail("plants", f"must be {' or '.join(PLANT_GENERATORS)}, not {plants!r}")
+    try:
+        appearance = resolve_appearance(data.get("appearance"))
+    except UserError as error:
+        check.fail("appearance", str(error))
     top_grid = check.grid_mapping(data.get("grid", {}), "grid")
     groups_data = data.get("groups")
     if not isinstance(groups_data, list) or not groups_data:
@@ -290,7 +300,7 @@ def parse_dataset_config(text: str, source: str, default_name: str = "dataset") 
     except UserError as error:
         check.fail("strawberry_altitudes", str(error))
     return DatasetConfig(name.strip(), seed, camera, tuple(groups), source, renderer, look, depth, antialiasing,
-                         plants)
+                         plants, appearance)
 
 
 def use_strawberry_altitudes(config: DatasetConfig, choice: str) -> DatasetConfig:

@@ -85,8 +85,9 @@ class SceneWriter:
         self._pending: list[tuple[str, list[Future], dict[str, Any]]] = []
 
     def add_view(self, name: str, colour: np.ndarray, segmentation: np.ndarray, entry: dict,
-                 depth: np.ndarray | None = None, extras: dict[str, Any] | None = None) -> None:
-        """Queue one view's image, segmentation, depth and annotations entry.
+                 depth: np.ndarray | None = None, extras: dict[str, Any] | None = None,
+                 classes: np.ndarray | None = None) -> None:
+        """Queue one view's image, segmentation, depth, organ classes and annotations entry.
 
         Args:
             name: Image name, ``NNNN.jpeg``.
@@ -97,6 +98,7 @@ class SceneWriter:
                 as ``NNNN_depth.png`` (uint16 millimetres) unless None.
             extras: JSON-ready data of the view the caller wants back when the scene is resumed
                 (``done[name]["extras"]``).
+            classes: (height, width) uint8 organ classes, written as ``NNNN_class.png`` unless None.
         """
         stem = name.rsplit(".", 1)[0]
         images = self.tmp_dir / "images"
@@ -106,9 +108,13 @@ class SceneWriter:
         if depth is not None:
             files.append(self._pool.submit(
                 lambda: Image.fromarray(depth_png(depth)).save(images / f"{stem}_depth.png", compress_level=1)))
+        if classes is not None:
+            files.append(self._pool.submit(
+                lambda: Image.fromarray(classes, mode="L").save(images / f"{stem}_class.png", compress_level=1)))
         self._pending.append((name, files, {"name": name, "entry": entry, "extras": extras or {},
                                             "files": [name, f"{stem}_seg.png"]
-                                            + ([f"{stem}_depth.png"] if depth is not None else [])}))
+                                            + ([f"{stem}_depth.png"] if depth is not None else [])
+                                            + ([f"{stem}_class.png"] if classes is not None else [])}))
         self.annotations[name] = entry
         if len(self._pending) > 8:
             self._drain(keep=4)

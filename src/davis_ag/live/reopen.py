@@ -27,7 +27,7 @@ from davis_ag.atomic_files import atomic_output
 from davis_ag.errors import UserError
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.lighting import Lighting
-from davis_ag.scene.specs import CropSpec, ScenarioSpec, crop_spec, scenario_spec
+from davis_ag.scene.specs import DEFAULT_PLANTS, CropSpec, ScenarioSpec, check_plants, crop_spec, scenario_spec
 from davis_ag.scene.view_grid import Viewpoint
 
 CACHE_FILE = "live_geometry.npz"
@@ -47,6 +47,7 @@ class SceneSettings:
         index, seed, dataset_seed: Which scene.
         camera: The camera its views were drawn with.
         renderer, look, antialiasing: How its views were drawn.
+        plants: The plant generator (scenes from before the choice grew ``architecture`` plants).
     """
 
     folder: Path
@@ -60,6 +61,7 @@ class SceneSettings:
     renderer: str
     look: str
     antialiasing: str
+    plants: str = DEFAULT_PLANTS
 
     @property
     def cache_key(self) -> str:
@@ -67,7 +69,7 @@ class SceneSettings:
         meta = self.metadata
         keyed = {"version": CACHE_VERSION, "seed": self.seed, "dataset_seed": self.dataset_seed,
                  "scenario": meta["scenario"], "crop": meta["crop"], "scene": meta["scene"],
-                 "grid": meta["grid"], "generator": meta["generator"]}
+                 "grid": meta["grid"], "generator": meta["generator"], "plants": self.plants}
         return hashlib.sha256(json.dumps(keyed, sort_keys=True).encode()).hexdigest()[:20]
 
 
@@ -118,8 +120,8 @@ def read_settings(scene_dir: str | Path) -> SceneSettings:
         settings = SceneSettings(folder, metadata, scenario, crop, int(metadata["scene"].rsplit("/", 1)[1]),
                                  int(metadata["seed"]), int(metadata["dataset_seed"]), camera,
                                  str(renderer["name"]), str(renderer["look"]),
-                                 antialiasing)
-    except (KeyError, ValueError, TypeError, IndexError, AttributeError) as error:
+                                 antialiasing, check_plants(str(metadata.get("plant_generator", "architecture"))))
+    except (KeyError, ValueError, TypeError, IndexError, AttributeError, UserError) as error:
         raise UserError(f"{path}: lacks or mangles a setting needed to regrow the scene ({error!r}); "
                         "generate the scene again") from None
     return settings
@@ -176,7 +178,7 @@ def regrow(settings: SceneSettings) -> SceneAssets:
     from davis_ag.generate.one_scene import SceneRequest, grow_scene
 
     request = SceneRequest(settings.scenario, settings.crop, settings.index, settings.dataset_seed,
-                           settings.camera, renderer=settings.renderer, look=settings.look)
+                           settings.camera, renderer=settings.renderer, look=settings.look, plants=settings.plants)
     if request.seed != settings.seed:
         raise UserError(f"{settings.folder}/scene.json: seed {settings.seed} does not follow from dataset seed "
                         f"{settings.dataset_seed} and scene {settings.metadata['scene']}; the file was edited")
