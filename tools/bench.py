@@ -12,7 +12,9 @@ For each crop (a single-plant strawberry and a single goblet vine, dataset seed 
 - documented: pyhelios as its documentation shows, on a stock Visualizer (the one
   :class:`davis_ag.render.helios.HeliosRenderer` sets up): ``printWindow`` to a JPEG, then
   ``writeImageBoundingBoxes`` and ``writeImageSegmentationMasks``, fruit labelled with object data;
-- floor: our renderer's draw and read-back alone (colour, ids, depth), nothing else.
+- floor: our renderer's draw and read-back alone (colour, ids, depth), nothing else;
+- no classes: ours without the organ class images (``NNNN_class.png``), to price that label:
+  it is a look-up on the id image the same pass drew, not a second render.
 
 Per path the median over repetitions of the mean seconds per view is reported. With strawberry,
 also the grid environment's steps/s and TVMContinuous-v0's at 224x224 (``--only continuous``
@@ -106,7 +108,7 @@ def bench_crop(crop: str, scratch: Path, repeats: int, documented: bool = True, 
             model.context.setObjectDataInt(object_id, "fruit_id", fruit.id)
     images = scratch / f"{crop}-documented"
     images.mkdir(parents=True)
-    times: dict[str, list[float]] = {"ours": [], "documented": [], "floor": []}
+    times: dict[str, list[float]] = {"ours": [], "documented": [], "floor": [], "no_classes": []}
     setup: list[float] = []
     helios = HeliosRenderer(model.context, request.camera, model.lighting) if documented else None
     ours_renderer = OpenGLRenderer(model.context, request.camera, model.lighting, antialiasing=antialiasing)
@@ -128,6 +130,8 @@ def bench_crop(crop: str, scratch: Path, repeats: int, documented: bool = True, 
             if helios is not None:
                 times["documented"].append(time_loop(views, documented_view))
             times["floor"].append(time_loop(views, lambda v: ours_renderer.render(v)))
+            no_classes = dataclasses.replace(request, classes=False)
+            times["no_classes"].append(time_ours(no_classes, model, grid, views, scratch / f"{crop}-plain-{repeat}")[0])
     finally:
         ours_renderer.close()
         if helios is not None:
@@ -136,6 +140,7 @@ def bench_crop(crop: str, scratch: Path, repeats: int, documented: bool = True, 
     result = {"views_timed": len(views) - 1, "repeats": repeats, "primitives": len(model.context.getAllUUIDs()),
               "grow_s": round(grow_s, 2), "setup_and_first_view_s": round(statistics.median(setup), 2),
               "seconds_per_view": median, "all_repeats": times}
+    result["classes_cost"] = median["ours"] / median["no_classes"]
     if "documented" in median:
         result["documented_over_ours"] = median["documented"] / median["ours"]
         result["ours_over_floor"] = median["ours"] / median["floor"]
@@ -386,6 +391,10 @@ def table(report: dict) -> str:
         lines.append(f"\nGrowing the plants and our draw and read-back alone (the floor column, no labels, no "
                      f"files) would take **{p['hours_one_machine_grow_and_draw_only']} h** on one such machine: "
                      "the least any work around the draw could reach with these plants and this antialiasing.")
+    lines.append("\nOrgan class images (`NNNN_class.png`, from the id image of the same pass), ours s/view with "
+                 "and without: " + ", ".join(
+                     f"{crop} {r['seconds_per_view']['ours']:.3f} / {r['seconds_per_view']['no_classes']:.3f} "
+                     f"(**{r['classes_cost']:.3f}x**)" for crop, r in report["crops"].items()) + ".")
     env = report.get("env_steps_per_second", {})
     if "steps_per_second" in env:
         lines.append(f"\nTVM environment on the strawberry scene: {env['steps_per_second']} steps/s.")

@@ -109,7 +109,15 @@ def test_commands(sp_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture[s
     assert args.func(args) == 0
     printed = capsys.readouterr().out
     assert "A2C" in printed and "Oracle" in printed and "OER_tau" in printed
-    assert set(json.loads(out.read_text())["policies"]) == {"LRD", "UDD", "Rand", "Oracle", "A2C"}
+    saved = json.loads(out.read_text())
+    assert set(saved["policies"]) == {"LRD", "UDD", "Rand", "Oracle", "A2C", "Best fixed action"}
+    assert saved["policies"]["A2C"]["play"] == "sampled"  # as reproduce plays it; --deterministic otherwise
+    assert "Best fixed action: always" in printed and "OER_tau exact" in printed
+    args = _parser().parse_args(
+        ["evaluate", "--dataset", str(sp_root), "--scenario", "sp", "--model", str(model), "--deterministic",
+         "--policies", "LRD", "--episodes", "3", "--sessions", "1", "--out", str(out)])
+    assert args.func(args) == 0
+    assert json.loads(out.read_text())["policies"]["A2C"]["play"] == "deterministic"
     assert out.with_suffix(".png").is_file()
 
 

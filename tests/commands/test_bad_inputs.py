@@ -187,3 +187,17 @@ def test_evaluate_keeps_its_results_when_the_final_write_fails(capsys: pytest.Ca
     kept = Path(line.split("it was kept in ")[1].split(":")[0])
     assert json.loads(kept.read_text())["protocol"]["episodes"] == 3
     assert not out.exists()
+
+
+def test_point_clouds_of_a_dataset_without_depth_or_camera(capsys: pytest.CaptureFixture[str], sp_root: Path,
+                                                           tmp_path: Path) -> None:
+    out = tmp_path / "clouds"
+    line = refused(capsys, "export", "pointcloud", str(sp_root), str(out))
+    assert "scene.json" in line or "depth" in line
+    refused(capsys, "export", "pointcloud", str(sp_root), str(out), "--voxel", "-1")
+    refused(capsys, "export", "pointcloud", str(sp_root), str(out), "--max-depth", "0")
+    refused(capsys, "export", "pointcloud", str(tmp_path / "missing"), str(out))
+    a_file = tmp_path / "file.txt"
+    a_file.write_text("x")
+    refused(capsys, "export", "pointcloud", str(sp_root), str(a_file))
+    assert a_file.read_text() == "x"

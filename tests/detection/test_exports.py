@@ -15,6 +15,7 @@ from davis_ag.data.reader import open_dataset
 from davis_ag.detection.coco_export import export_coco
 from davis_ag.detection.instances import scenes_by_split
 from davis_ag.detection.yolo_export import export_yolo, flat_name
+from davis_ag.errors import UserError
 
 
 @pytest.fixture(scope="module")
@@ -161,3 +162,67 @@ def test_appearance_shift_changes_the_export_not_the_dataset(dataset: Path, tmp_
     a = np.asarray(Image.open(shifted)).astype(float)
     b = np.asarray(Image.open(dataset / "Single-Strawberry" / "001" / "images" / "0001.jpeg")).astype(float)
     assert a.shape == b.shape and np.abs(a - b).mean() > 10
+
+
+def _with_classes(dataset: Path, folder: Path) -> tuple[Path, dict[str, np.ndarray]]:
+    """A copy of the tiny dataset with organ class images beside the views of one scene: sky on
+    top, soil below, leaf and stem blocks, and fruit exactly where the instance mask has fruit."""
+    import shutil
+
+    copy = folder / "with-classes"
+    shutil.copytree(dataset, copy)
+    written = {}
+    for view in open_dataset(copy).scene("Single-Strawberry/000"):
+        mask = view.mask()
+        classes = np.zeros(mask.shape, np.uint8)
+        classes[mask.shape[0] // 3:] = 1
+        classes[2:6, 2:10] = 3
+        classes[6:8, 2:10] = 4
+        classes[mask != 255] = 2
+        Image.fromarray(classes, mode="L").save(view.class_path)
+        written[view.name] = classes
+    return copy, written
+
+
+def test_coco_organs_are_semantic_rle_masks(dataset: Path, tmp_path: Path) -> None:
+    from pycocotools import mask as mask_utils
+    from pycocotools.coco import COCO
+
+    copy, written = _with_classes(dataset, tmp_path)
+    export_coco(copy, tmp_path / "out", progress=False, organs=True)
+    coco = COCO(str(tmp_path / "out" / "annotations" / "instances_train.json"))
+    names = {c["id"]: c["name"] for c in coco.loadCats(coco.getCatIds())}
+    assert {k: v for k, v in names.items() if k > 100} == {101: "soil", 102: "fruit", 103: "leaf", 104: "stem",
+                                                           105: "trunk"}
+    checked = 0
+    for image in coco.loadImgs(coco.getImgIds()):
+        organs = [a for a in coco.loadAnns(coco.getAnnIds(imgIds=image["id"])) if a["category_id"] > 100]
+        classes = written.get(image["view"]) if image["scene"] == "Single-Strawberry/000" else None
+        if classes is None:
+            assert organs == []  # views without a class image keep their fruit labels only
+            continue
+        assert sorted(a["category_id"] - 100 for a in organs) == sorted(set(np.unique(classes).tolist()) - {0})
+        for annotation in organs:
+            mask = mask_utils.decode(annotation["segmentation"]).astype(bool)
+            assert np.array_equal(mask, classes == annotation["category_id"] - 100)
+            assert annotation["area"] == mask.sum() and annotation["attributes"]["semantic"]
+            checked += 1
+    assert checked > 0
+    assert len({a["id"] for a in coco.loadAnns(coco.getAnnIds())}) == len(coco.getAnnIds())  # ids unique
+
+
+def test_yolo_organs_are_polygons_after_the_crops(dataset: Path, tmp_path: Path) -> None:
+    import yaml
+
+    copy, written = _with_classes(dataset, tmp_path)
+    with pytest.raises(UserError, match="--task segment"):
+        export_yolo(copy, tmp_path / "boxes", "detect", progress=False, organs=True)
+    export_yolo(copy, tmp_path / "out", "segment", progress=False, organs=True)
+    names = yaml.safe_load((tmp_path / "out" / "data.yaml").read_text())["names"]
+    assert names == {0: "strawberry", 1: "tomato", 2: "vine", 3: "organ_soil", 4: "organ_fruit", 5: "organ_leaf",
+                     6: "organ_stem", 7: "organ_trunk"}
+    for name, classes in written.items():
+        label = tmp_path / "out" / "labels" / "train" / f"{flat_name('Single-Strawberry/000/' + name)}.txt"
+        organ_classes = sorted(int(line.split()[0]) for line in label.read_text().splitlines()
+                               if int(line.split()[0]) >= 3)
+        assert organ_classes == sorted(2 + v for v in set(np.unique(classes).tolist()) - {0})

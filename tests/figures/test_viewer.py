@@ -69,6 +69,34 @@ def test_serves_the_page_the_scene_and_its_files(served: tuple[Path, int]) -> No
     assert status == 200 and overlay[:4] == b"\x89PNG"
 
 
+def test_organ_classes_are_a_layer_where_the_scene_has_them(served: tuple[Path, int]) -> None:
+    root, port = served
+    scene = json.loads(_get(port, "/api/scene?id=Single-Strawberry/000")[1])
+    assert scene["views"]["0001.jpeg"]["classes"] is False
+    assert _get(port, "/overlay/classes/Single-Strawberry/000/0001.jpeg")[0] == 404
+    images = root / "Single-Strawberry/000/images"
+    width, height = Image.open(images / "0001.jpeg").size
+    classes = np.zeros((height, width), np.uint8)
+    classes[height // 2:] = 1  # soil below the horizon, a fruit in the middle
+    classes[height // 2 - 2: height // 2 + 2, width // 2 - 2: width // 2 + 2] = 2
+    Image.fromarray(classes, mode="L").save(images / "0001_class.png")
+    server = _serve(root)  # a new server: scene payloads are built once
+    try:
+        port = server.server_address[1]
+        assert json.loads(_get(port, "/api/scene?id=Single-Strawberry/000")[1])["views"]["0001.jpeg"]["classes"]
+        status, body = _get(port, "/overlay/classes/Single-Strawberry/000/0001.jpeg")
+        assert status == 200 and body[:4] == b"\x89PNG"
+        import io
+
+        overlay = np.asarray(Image.open(io.BytesIO(body)))
+        assert overlay.shape == (height, width, 4)
+        assert (overlay[0, 0, 3] == 0) and overlay[-1, 0, 3] > 0  # sky transparent, soil drawn
+        assert tuple(overlay[height // 2, width // 2, :3]) == (220, 30, 40)  # fruit red
+    finally:
+        server.shutdown()
+        server.server_close()
+
+
 def test_no_path_reaches_outside_the_dataset(served: tuple[Path, int], tmp_path: Path) -> None:
     root, port = served
     images = root / "Single-Strawberry/000/images"

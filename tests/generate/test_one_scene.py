@@ -49,7 +49,7 @@ def test_generated_scene_is_a_sound_dataset(generated: tuple[Path, Path, dict]) 
     assert sorted(p.name for p in scene_dir.iterdir()) == ["annotations.json", "images", "scene.json"]
     names = [f"{i:04d}.jpeg" for i in range(1, VIEWS + 1)]
     assert sorted(p.name for p in (scene_dir / "images").iterdir()) == sorted(
-        names + [n.replace(".jpeg", suffix) for n in names for suffix in ("_seg.png", "_depth.png")])
+        names + [n.replace(".jpeg", suffix) for n in names for suffix in ("_seg.png", "_depth.png", "_class.png")])
 
     report = validate_dataset(root)
     assert report.ok, [str(p) for p in report.problems]
@@ -351,3 +351,82 @@ def test_depth_and_renderer_settings_flow_from_flags_and_configs() -> None:
         parse_dataset_config("look: blocky\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "test")
     with pytest.raises(UserError, match="helios look"):
         single_group_config("sp", "strawberry", 1, 0, 0, (96, 54), "helios", "default")
+
+
+def test_organ_classes_come_from_the_same_pass_as_the_masks(generated: tuple[Path, Path, dict],
+                                                            tmp_path: Path) -> None:
+    from davis_ag.scene.organs import FRUIT, LEAF, ORGAN_NAMES, SKY, SOIL, STEM
+
+    root, scene_dir, _ = generated
+    from davis_ag.generate.dataset_files import dataset_settings
+
+    assert [c["name"] for c in dataset_settings([REQUEST])["classes"]] == list(ORGAN_NAMES)
+    assert json.loads((scene_dir / "scene.json").read_text())["classes"]["table"] == list(ORGAN_NAMES)
+    (scene,) = open_dataset(root).scenes
+    seen: set[int] = set()
+    for view in scene:
+        classes, mask, depth = view.classes, view.mask(), view.depth
+        assert classes.dtype == np.uint8 and classes.shape == (CAMERA.height, CAMERA.width)
+        assert (classes[mask != 255] == FRUIT).all()  # every fruit pixel of the instance mask
+        assert ((classes == SKY) == (depth == 0)).all()  # nothing hit: sky, in both images
+        seen |= set(np.unique(classes).tolist())
+    assert {SKY, SOIL, FRUIT, LEAF, STEM} <= seen
+
+    # A scene without class images (the original layout, older datasets) still reads and validates;
+    # a class image that calls fruit pixels leaves is reported.
+    copy = tmp_path / "copy"
+    shutil.copytree(root, copy)
+    images = copy / scene_dir.relative_to(root) / "images"
+    boxed = next(v for v in scene if v.boxes)
+    for path in images.glob("*_class.png"):
+        if path.name != boxed.class_path.name:
+            path.unlink()
+    assert all(v.classes is None for v in open_dataset(copy).scenes[0] if v.name != boxed.name)
+    assert validate_dataset(copy).ok
+    wrong = np.where(boxed.mask() != 255, LEAF, boxed.classes).astype(np.uint8)
+    Image.fromarray(wrong, mode="L").save(images / boxed.class_path.name)
+    problems = [str(p) for p in validate_dataset(copy).problems]
+    assert len(problems) == 1 and boxed.class_path.name in problems[0] and "not class 2 (fruit)" in problems[0]
+
+
+def test_each_fruits_points_lie_around_its_centre(generated: tuple[Path, Path, dict], tmp_path: Path) -> None:
+    from davis_ag.data.point_cloud import export_point_clouds, read_ply
+
+    root, scene_dir, _ = generated
+    meta = json.loads((scene_dir / "scene.json").read_text())
+    out = tmp_path / "clouds"
+    assert export_point_clouds(root, out, fuse=True)["files"] == 1
+    points = read_ply(out / "Single-Strawberry" / "000.ply")
+    xyz = np.stack([points["x"], points["y"], points["z"]], axis=1).astype(np.float64)
+    checked = 0
+    for fruit in meta["fruits"]:
+        mine = points["fruit_id"] == fruit["id"]
+        if not mine.any():
+            continue
+        # Within the fruit's bounding sphere, give or take the depth image's millimetre steps.
+        reach = np.linalg.norm(fruit["size"]) / 2 + 0.003
+        assert np.linalg.norm(xyz[mine] - fruit["center"], axis=1).max() < reach, fruit["id"]
+        assert (points["organ"][mine] == 2).all()
+        checked += 1
+    assert checked >= 1 and (points["organ"] == 1).any()
+    assert export_point_clouds(root, out, max_depth=5.0)["files"] == VIEWS  # per view, beside the fused cloud
+    assert len(list((out / "Single-Strawberry" / "000").glob("*.ply"))) == VIEWS
+
+
+def test_random_appearance_changes_the_pictures_not_the_labels(generated: tuple[Path, Path, dict],
+                                                              tmp_path: Path) -> None:
+    _, paper_dir, _ = generated
+    random_dir, _ = generate_scene(replace(REQUEST, appearance="random"), tmp_path)
+    meta = json.loads((random_dir / "scene.json").read_text())
+    assert meta["appearance"]["mode"] == "random" and meta["lighting"]["sky_texture"] == meta["appearance"]["sky"]
+    assert (json.loads((random_dir / "annotations.json").read_text())
+            == json.loads((paper_dir / "annotations.json").read_text()))
+    differ = 0
+    for path in sorted((paper_dir / "images").iterdir()):
+        ours = np.asarray(Image.open(random_dir / "images" / path.name)).astype(int)
+        paper = np.asarray(Image.open(path)).astype(int)
+        if path.suffix == ".png":
+            assert np.array_equal(ours, paper), path.name  # masks, classes, depth
+        else:
+            differ += np.abs(ours - paper).mean() > 2
+    assert differ == VIEWS

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from davis_ag.workflows.reproduce import CONFIGS
@@ -118,3 +119,45 @@ def test_a_broken_ordering_names_the_steps_that_break() -> None:
         "Rand ~ LRD fails: .388 and .358 are .030 apart, more than their stds added (.005)",
         "LRD > UDD fails: .358 is not above .360"]
     assert ordering_failures(PAPER_ORDERINGS["mp"], stats) == []  # A2C > Rand > LRD ~ UDD
+
+
+def test_the_page_shows_what_each_policy_does(tmp_path: Path, sp_root: Path, one_thread: None) -> None:
+    # A real (tiny) run's records: a model, its training record, an evaluation with every row.
+    from davis_ag.benchmark.training import A2C_SETTINGS, train_a2c
+    from davis_ag.workflows.demo import run_baselines
+    from davis_ag.workflows.reproduce import _summary
+
+    (tmp_path / "docs").mkdir()
+    model = train_a2c(sp_root, "sp", total_timesteps=60, seed=0, out_path=tmp_path / "models" / "a2c_sp-strawberry",
+                      n_envs=2, arch="pooled", device="cpu", checkpoint_every=0)
+    results = run_baselines(sp_root, "sp", "strawberry", "test", 20, 3, model=model)
+    (tmp_path / "results").mkdir()
+    (tmp_path / "results" / "sp-strawberry.json").write_text(json.dumps(results))
+    state = {"results": {"sp": _summary(results)}}
+    page = tmp_path / "docs" / "results.md"
+    text = write_results_md(page, CONFIGS["medium"], state, tmp_path).read_text()
+    policies = results["policies"]
+    best = policies["Best fixed action"]
+    assert best["action"] in results["protocol"]["actions"] and policies["A2C"]["play"] == "sampled"
+    assert "| Best fixed action |" in text and f"(always `{best['action']}`)" in text
+    assert "A2C **beats** it" in text or "A2C **does not beat** it" in text
+    assert ", ".join(f"{k}={v}" for k, v in A2C_SETTINGS.items()) in text
+    assert "plays actions sampled from the policy" in text
+    assert "uniform over every eligible (view, target) pair" in text
+    # Exact beside sampled, and each policy's action shares.
+    lrd = policies["LRD"]
+    assert (f"| LRD | {_c(lrd['oer_tau']['mean'])} ± {_c(lrd['oer_tau']['sem'])} | {_c(lrd['exact']['oer_tau'])} |"
+            in text)
+    assert "| Policy | forward | backward | left | right | up | down | done |" in text
+    # Played as the benchmark plays it (sampled), the trained A2C is not one move repeated.
+    shares = np.array(list(policies["A2C"]["action_counts"].values())) / sum(policies["A2C"]["action_counts"].values())
+    assert (shares >= 0.05).sum() >= 2, policies["A2C"]["action_counts"]
+    counts = best["action_counts"]
+    assert f"| Best fixed action | " + " | ".join("100" if a == best["action"] else "0" for a in counts) + " |" in text
+    for picture in ("results-sp-strawberry-actions.png", "results-learning-curve.png"):
+        assert f"(images/{picture})" in text and (tmp_path / "docs" / "images" / picture).is_file()
+
+
+def _c(value: float) -> str:
+    text = f"{value:.3f}"
+    return text[1:] if text.startswith("0.") else text

@@ -19,6 +19,7 @@ import numpy as np
 import torch
 
 from davis_ag.benchmark import TVMEnv
+from davis_ag.benchmark.exact import action_probabilities
 from davis_ag.errors import UserError
 
 #: Section IV-B action sets by agent name. Rand uses every action of the environment, which in
@@ -85,6 +86,41 @@ class HeuristicAgent:
                                 f"lacks ({', '.join(names)})")
             indices = self._indices[names] = np.array([names.index(a) for a in wanted])
         return int(indices[self._rng.integers(len(indices))])
+
+    def action_probabilities(self, env: gym.Env) -> np.ndarray:
+        """Probability of each action index of ``env`` at every step (uniform over the set)."""
+        return action_probabilities(tvm(env).action_names, self.actions)
+
+
+class FixedActionAgent:
+    """Always plays the same action (by name): the trivial policies a learner must beat."""
+
+    def __init__(self, action: str, name: str | None = None) -> None:
+        """Args:
+            action: The action's name (``down``, ``done``, ...).
+            name: Label in results tables (default ``always <action>``).
+        """
+        self.action = action
+        self.name = name or f"always {action}"
+
+    def reset(self, seed: int | None = None) -> None:
+        """Nothing to reset: the policy has no randomness."""
+
+    def act(self, obs: np.ndarray, env: gym.Env) -> int:
+        """The action's index in ``env``.
+
+        Raises:
+            UserError: when the environment has no such action.
+        """
+        names = tvm(env).action_names
+        if self.action not in names:
+            raise UserError(f"{self.name}: this environment has no action {self.action!r} "
+                            f"({', '.join(names)})")
+        return names.index(self.action)
+
+    def action_probabilities(self, env: gym.Env) -> np.ndarray:
+        """Probability 1 on the action, 0 elsewhere."""
+        return action_probabilities(tvm(env).action_names, (self.action,))
 
 
 def heuristic(name: str, seed: int | None = None) -> HeuristicAgent:
@@ -156,6 +192,18 @@ class OracleAgent:
             self._plan = oracle_plan(next_view, oer, inner.current_view, inner.tau)
         t = inner.steps_taken
         return self._plan[t] if t < len(self._plan) else inner.done_action
+
+
+#: How the benchmark's A2C plays (``davis-ag reproduce``): False samples each action from the
+#: policy. Played deterministically, a policy repeats a refused move for the rest of the episode
+#: (the observation after a refused move is the same image), and a policy whose most likely
+#: action is the same at every start is exactly a fixed action: on the train split
+#: (tools/a2c_trials.py) a short-trained policy played deterministically was "always forward"
+#: while sampling it scored higher; trained longer, deterministic play scored about one standard
+#: deviation higher than sampling. Sampling is kept as the safe default on unseen scenes, where
+#: the policy is least sure; the benchmark also reports the deterministic play as the row
+#: ``A2C (deterministic)``.
+A2C_DETERMINISTIC = False
 
 
 class A2CAgent:

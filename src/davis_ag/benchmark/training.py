@@ -28,6 +28,27 @@ from davis_ag.provenance import code_version
 
 #: Steps between checkpoints by default: about a minute of training on a 2-core CPU.
 CHECKPOINT_EVERY = 10_000
+#: Environment steps per point of the learning curve kept in the training record (Fig. 4a).
+CURVE_EVERY = 1_000
+
+#: The A2C settings we train with, on top of Stable-Baselines3's defaults (the paper gives none).
+#: ``normalize_advantage`` scales each update's advantages to unit variance, so the size of the
+#: reward (``max(OER_tau - OER_0, 0)**2``, about .02 on average) stops setting the step size;
+#: ``ent_coef=0.01`` is then the usual entropy bonus, which keeps the policy from turning into a
+#: point mass on one move over a long run. Measured on the train split only
+#: (tools/a2c_trials.py): after enough steps A2C learns policies whose most likely move differs
+#: from start to start with these settings, with SB3's defaults and with the bonus alone (which
+#: left the flattest policy and the lowest sampled score); these learnt a little faster early on.
+#: What made the evaluated A2C a fixed action was chiefly too little training played
+#: deterministically (see ``A2C_DETERMINISTIC`` in agents.py).
+A2C_SETTINGS: dict[str, Any] = {"ent_coef": 0.01, "normalize_advantage": True}
+#: Stable-Baselines3's own A2C defaults for the settings above (what ``--a2c-settings sb3`` trains).
+SB3_DEFAULT_SETTINGS: dict[str, Any] = {"ent_coef": 0.0, "normalize_advantage": False}
+#: Named setting sets of :func:`train_a2c`.
+SETTINGS_PRESETS: dict[str, dict[str, Any]] = {"ours": A2C_SETTINGS, "sb3": SB3_DEFAULT_SETTINGS}
+#: SB3 A2C keyword arguments a setting set may change.
+TUNABLE = ("ent_coef", "normalize_advantage", "learning_rate", "n_steps", "gamma", "vf_coef",
+           "max_grad_norm", "gae_lambda")
 
 
 def make_vec_tvm(dataset: Any, scenario: str, n_envs: int, seed: int, split: str = "train",
@@ -97,14 +118,53 @@ class _Sittings:
         return [*self.earlier, now]
 
 
+class LearningCurve(BaseCallback):
+    """Episode rewards while training, averaged over bins of ``every`` environment steps (Fig. 4a).
+
+    Reads the ``episode`` entry SB3's ``Monitor`` puts in an ending step's info. Each point is
+    ``{"step", "episodes", "reward", "length"}``: the bin's last step, the episodes that ended in
+    it and their mean reward and length. Points before a resumed run's checkpoint are passed in.
+    """
+
+    def __init__(self, every: int = CURVE_EVERY, points: list[dict[str, Any]] | None = None) -> None:
+        super().__init__()
+        self.every = every
+        self.points: list[dict[str, Any]] = list(points or [])
+        self._rewards: list[float] = []
+        self._lengths: list[int] = []
+        self._edge = 0
+
+    def _on_training_start(self) -> None:
+        self._edge = (self.model.num_timesteps // self.every + 1) * self.every
+
+    def _on_step(self) -> bool:
+        for info in self.locals.get("infos", []):
+            episode = info.get("episode")
+            if episode:
+                self._rewards.append(float(episode["r"]))
+                self._lengths.append(int(episode["l"]))
+        if self.model.num_timesteps >= self._edge:
+            self.flush(self._edge)
+            self._edge += self.every
+        return True
+
+    def flush(self, step: int) -> None:
+        """Close the current bin at ``step`` (a bin without episodes adds no point)."""
+        if self._rewards:
+            self.points.append({"step": int(step), "episodes": len(self._rewards),
+                                "reward": round(float(sum(self._rewards) / len(self._rewards)), 6),
+                                "length": round(sum(self._lengths) / len(self._lengths), 4)})
+        self._rewards, self._lengths = [], []
+
+
 class _Checkpoint(BaseCallback):
     """Saves the model, the run's settings and its sittings every ``every`` environment steps."""
 
     def __init__(self, every: int, model_file: Path, settings_file: Path, settings: dict[str, Any],
-                 sittings: _Sittings) -> None:
+                 sittings: _Sittings, curve: LearningCurve) -> None:
         super().__init__()
         self.every, self.model_file, self.settings_file, self.settings = every, model_file, settings_file, settings
-        self.sittings = sittings
+        self.sittings, self.curve = sittings, curve
         self._last = 0
 
     def _on_training_start(self) -> None:
@@ -115,12 +175,15 @@ class _Checkpoint(BaseCallback):
             self._last = self.model.num_timesteps
             save_model(self.model, self.model_file)
             write_json_atomic(self.settings_file, {**self.settings, "timesteps_done": self._last,
-                                                   "sittings": self.sittings.upto(self._last)})
+                                                   "sittings": self.sittings.upto(self._last),
+                                                   "curve": self.curve.points})
         return True
 
 
-def _resumable(settings_file: Path, model_file: Path, settings: dict[str, Any]) -> tuple[int, list] | None:
-    """Steps done and sittings so far of a checkpoint of a run with the same settings, else None."""
+def _resumable(settings_file: Path, model_file: Path,
+               settings: dict[str, Any]) -> tuple[int, list, list] | None:
+    """Steps done, sittings and learning curve so far of a checkpoint of a run with the same
+    settings, else None."""
     try:
         saved = json.loads(settings_file.read_text())
     except (OSError, ValueError):
@@ -129,27 +192,35 @@ def _resumable(settings_file: Path, model_file: Path, settings: dict[str, Any]) 
         return None
     done = saved.pop("timesteps_done", None)
     sittings = saved.pop("sittings", [])
+    curve = saved.pop("curve", [])
+    # Checkpoints from before settings were recorded trained with SB3's defaults.
+    saved.setdefault("a2c_settings", SB3_DEFAULT_SETTINGS)
+    saved.setdefault("start_rule", "scene")  # and drew starts scene first
     if saved.get("dataset") == "/":
         # Checkpoints before this version recorded Path.root ("/") for any dataset given as a
         # path; they are taken as they were then, for whatever dataset the run names.
         saved["dataset"] = settings["dataset"]
     if saved != settings or not isinstance(done, int) or not isinstance(sittings, list):
         return None
-    return done, sittings
+    return done, sittings, curve if isinstance(curve, list) else []
 
 
 def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed: int = 0,
               out_path: str | os.PathLike[str] = "a2c.zip", n_envs: int = 8,
               crop: str | None = None, cache_dir: str | os.PathLike[str] | None = None,
               arch: str = "paper", device: str = "auto", verbose: int = 0,
-              callback: Any = None, checkpoint_every: int = CHECKPOINT_EVERY) -> Path:
+              callback: Any = None, checkpoint_every: int = CHECKPOINT_EVERY,
+              settings: str | dict[str, Any] = "ours") -> Path:
     """Train the paper's A2C agent on the train split and save it; resume a killed run.
 
-    Hyperparameters are Stable-Baselines3's A2C defaults (the paper gives none): learning rate
+    Hyperparameters (the paper gives none) are Stable-Baselines3's A2C defaults, learning rate
     7e-4, ``n_steps=5`` per environment and update, ``gamma=0.99``, ``gae_lambda=1``,
-    ``ent_coef=0``, ``vf_coef=0.5``, ``max_grad_norm=0.5``, RMSprop (alpha 0.99, eps 1e-5);
-    CnnPolicy scales the uint8 observation by 1/255. ``n_envs`` (8) is ours; the paper's
-    300K timesteps count environment steps over all environments.
+    ``vf_coef=0.5``, ``max_grad_norm=0.5``, RMSprop (alpha 0.99, eps 1e-5), changed by
+    ``settings``: by default :data:`A2C_SETTINGS` (``ent_coef=0.01``, normalised advantages);
+    ``"sb3"`` keeps SB3's ``ent_coef=0`` and raw advantages. CnnPolicy scales the uint8
+    observation by 1/255. ``n_envs`` (8) is ours; the paper's 300K timesteps count
+    environment steps over all environments. The training record (:func:`training_record_path`)
+    keeps the settings and the learning curve (:class:`LearningCurve`).
 
     Args:
         dataset: Dataset root or opened dataset.
@@ -168,6 +239,8 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
         checkpoint_every: Environment steps between checkpoints (0: none). A checkpoint of a run
             with the same settings beside ``out_path`` is resumed; it is removed once the final
             model is saved.
+        settings: A name of :data:`SETTINGS_PRESETS` (``ours``, ``sb3``) or a dict of SB3 A2C
+            arguments among :data:`TUNABLE`, applied over SB3's defaults.
 
     Returns:
         The saved model's path.
@@ -183,40 +256,61 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
         raise UserError("--timesteps and --n-envs must be positive, --checkpoint-every from 0")
     check_seed(seed, "--seed")
     check_device(device)
+    a2c_settings = resolve_settings(settings)
     final = model_path(Path(out_path).expanduser().absolute())
     prove_writable_file(final)  # before hours of training, not after
     model_file, settings_file = checkpoint_paths(final)
     # A path names the dataset itself (a Path's own .root would be "/"); a reader's dataset, its root.
     root = dataset if isinstance(dataset, (str, os.PathLike)) else getattr(dataset, "root", dataset)
     settings = {"dataset": str(Path(root).expanduser().absolute()), "scenario": scenario, "crop": crop,
-                "seed": seed, "n_envs": n_envs, "arch": arch, "algorithm": "A2C"}
+                "seed": seed, "n_envs": n_envs, "arch": arch, "algorithm": "A2C",
+                "a2c_settings": a2c_settings, "start_rule": "pairs"}
     env = make_vec_tvm(dataset, scenario, n_envs, seed, "train", crop, cache_dir)
     resumed = _resumable(settings_file, model_file, settings)
     if resumed is not None:
-        done, earlier = resumed
+        done, earlier, points = resumed
         model = A2C.load(model_file, env=env, device=device)
         print(f"resuming {final.name} from its checkpoint at {done} of {total_timesteps} steps", flush=True)
     else:
         model = A2C("CnnPolicy", env, seed=seed, device=device, verbose=verbose,
-                    policy_kwargs=dict(ARCHITECTURES[arch]))
-        done, earlier = 0, []
+                    policy_kwargs=dict(ARCHITECTURES[arch]), **a2c_settings)
+        done, earlier, points = 0, [], []
     sittings = _Sittings(earlier, done)
-    callbacks = [c for c in (callback,) if c is not None]
+    curve = LearningCurve(CURVE_EVERY, points)
+    callbacks = [c for c in (callback, curve) if c is not None]
     if checkpoint_every:
-        callbacks.append(_Checkpoint(checkpoint_every, model_file, settings_file, settings, sittings))
+        callbacks.append(_Checkpoint(checkpoint_every, model_file, settings_file, settings, sittings, curve))
     if total_timesteps > done:
         model.learn(total_timesteps=total_timesteps - done, callback=callbacks or None,
                     reset_num_timesteps=done == 0)
     env.close()
+    curve.flush(int(model.num_timesteps))
     saved = write_or_rescue(final, lambda path: save_model(model, path), "the trained model")
     record = sittings.upto(int(model.num_timesteps))
     seconds = sum(s["seconds"] for s in record)
     write_json_atomic(training_record_path(final), {
         **settings, "timesteps": int(model.num_timesteps), "sittings": record, "seconds": round(seconds, 1),
-        "steps_per_second": round((int(model.num_timesteps) - record[0]["from_step"]) / max(seconds, 1e-9), 1)})
+        "steps_per_second": round((int(model.num_timesteps) - record[0]["from_step"]) / max(seconds, 1e-9), 1),
+        "curve": curve.points})
     model_file.unlink(missing_ok=True)
     settings_file.unlink(missing_ok=True)
     return saved
+
+
+def resolve_settings(settings: str | dict[str, Any]) -> dict[str, Any]:
+    """The SB3 A2C arguments a setting set names (see :data:`SETTINGS_PRESETS`).
+
+    Raises:
+        UserError: for an unknown preset or an argument outside :data:`TUNABLE`.
+    """
+    if isinstance(settings, str):
+        if settings not in SETTINGS_PRESETS:
+            raise UserError(f"unknown A2C settings {settings!r}: choose one of {', '.join(SETTINGS_PRESETS)}")
+        return dict(SETTINGS_PRESETS[settings])
+    wrong = [k for k in settings if k not in TUNABLE]
+    if wrong:
+        raise UserError(f"A2C setting {wrong[0]!r} cannot be changed here: use {', '.join(TUNABLE)}")
+    return {**SB3_DEFAULT_SETTINGS, **settings}
 
 
 def check_device(device: str) -> None:

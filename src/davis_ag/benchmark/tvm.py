@@ -2,11 +2,15 @@
 
 An episode (section V-C):
 
-- ``reset`` draws, from ``self.np_random`` only, a scene of the split, then a view of it, then a
-  target fruit boxed in that view with OER < 0.4 and at least ``min_fruit_pixels`` visible
-  pixels (section III-C): scene.json's value where the scene has one (what its boxes were made
-  with), else the crop's, scaled by image area relative to 1280x720. Each level is uniform, so
-  every scene is equally likely. The (scene, view, fruit) start list is built once.
+- ``reset`` draws, from ``self.np_random`` only, a start: a (scene, view, target) of the split
+  whose target fruit is boxed in that view with OER < 0.4 and has at least ``min_fruit_pixels``
+  visible pixels (section III-C): scene.json's value where the scene has one (what its boxes
+  were made with), else the crop's, scaled by image area relative to 1280x720. By default
+  (``start_rule="pairs"``) every such start is equally likely, section V-C's "a random
+  viewpoint showing a target fruit with an OER < .400"; ``start_rule="scene"`` (the rule
+  before) draws a scene, then a view of it, then a target, each uniformly, so a scene with two
+  eligible starts gets as many episodes as one with two hundred. The start list is built once;
+  :meth:`TVMEnv.start_probabilities` gives each start's probability under the rule.
 - The observation is the view resized to 224x224 plus a fourth channel that is 255 inside the
   target's box and 0 elsewhere (section IV-C uses 1; 255 keeps one uint8 image space, which
   Stable-Baselines3 scales by 1/255 anyway).
@@ -59,6 +63,9 @@ def episode_reward(oer_0: float, oer_end: float) -> float:
     return float(max(oer_end - oer_0, 0.0) ** 2)
 #: Image area that the crops' ``min_fruit_pixels`` (section III-C) refer to.
 REFERENCE_PIXELS = 1280 * 720
+#: How ``reset`` draws a start: ``pairs`` uniform over every eligible (scene, view, target),
+#: ``scene`` uniform over scenes, then views, then targets (see the module docstring).
+START_RULES = ("pairs", "scene")
 
 
 @dataclass
@@ -87,7 +94,7 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
     def __init__(self, dataset: Any, scenario: str = "sp", split: str = "train",
                  crop: str | None = None, cache_dir: str | os.PathLike[str] | None = None,
                  max_start_oer: float = MAX_START_OER, tau: int | None = None,
-                 render_mode: str | None = None) -> None:
+                 render_mode: str | None = None, start_rule: str = "pairs") -> None:
         """Open the scenes of one scenario and split, building their caches if needed.
 
         Args:
@@ -100,6 +107,8 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
             max_start_oer: A target must start with an OER below this (0.4 in the paper).
             tau: Steps per episode; default the scenario's (3 SP, 5 MP).
             render_mode: ``None`` or ``"rgb_array"``.
+            start_rule: ``pairs`` (default: every eligible start equally likely) or ``scene``
+                (scene, then view, then target; see :data:`START_RULES`).
 
         Raises:
             UserError: when the path is not a dataset, the split has no scene, or no scene has
@@ -108,6 +117,9 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
         spec = scenario_spec(scenario)
         if render_mode not in (None, "rgb_array"):
             raise UserError(f"unknown render_mode {render_mode!r}: use None or 'rgb_array'")
+        if start_rule not in START_RULES:
+            raise UserError(f"unknown start_rule {start_rule!r}: use one of {', '.join(START_RULES)}")
+        self.start_rule = start_rule
         self.render_mode = render_mode
         self.dataset = as_dataset(dataset)
         self.scenario = spec.name
@@ -136,6 +148,10 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
                 f"no eligible start in the {split} split of {self.dataset.root} "
                 f"({len(self.scenes)} {spec.name} scenes): no boxed fruit has OER < "
                 f"{max_start_oer} and enough visible pixels; use another split or dataset")
+        # Every eligible start as (scene index, box row), in scene, view, annotation order.
+        self.starts: np.ndarray = np.array(
+            [(scene, int(box)) for scene, starts in self._starts for box in starts.boxes],
+            dtype=np.int64).reshape(-1, 2)
         self._scene = self._view = self._box = self._fruit = self._t = -1
         self._oer_0 = 0.0
         self._path: list[str] = []
@@ -183,6 +199,9 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
         super().reset(seed=seed)
         if options and "start" in options:
             self._force_start(*options["start"])
+        elif self.start_rule == "pairs":
+            scene, box = self.starts[int(self.np_random.integers(len(self.starts)))]
+            self._scene, self._box = int(scene), int(box)
         else:
             rng = self.np_random
             scene, starts = self._starts[int(rng.integers(len(self._starts)))]
@@ -198,6 +217,16 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
         self._path = [cache.view_names[self._view]]
         self._over = False
         return self._observation(), self._info()
+
+    def start_probabilities(self) -> np.ndarray:
+        """The probability that ``reset`` starts from each row of :attr:`starts` under the rule."""
+        if self.start_rule == "pairs":
+            return np.full(len(self.starts), 1.0 / len(self.starts))
+        weights = []
+        for _, starts in self._starts:
+            per_view = np.diff(starts.offsets)
+            weights.append(np.repeat(1.0 / (len(self._starts) * len(per_view) * per_view), per_view))
+        return np.concatenate(weights)
 
     def _force_start(self, scene_id: str, view_name: str, fruit_id: int) -> None:
         """Point the episode at a given scene, view and fruit (``options["start"]``)."""
@@ -291,15 +320,27 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
         """The current target's dynamics, for exact planners such as the Oracle agent.
 
         Returns:
+            What :meth:`target_move_table` returns for the current episode's scene and target.
+        """
+        return self.target_move_table(self._scene, self._fruit)
+
+    def target_move_table(self, scene: int, fruit: int) -> tuple[np.ndarray, np.ndarray]:
+        """One target's dynamics, read from the scene's tables (not the image).
+
+        Args:
+            scene: Index into :attr:`scenes`.
+            fruit: Column of the scene cache's ``fruit_ids`` (``box_fruit`` of a box row).
+
+        Returns:
             ``next_view``: ``(n_views, n_moves)`` int32, the view each move (actions
             ``0..done_action-1``) leads to from each view, with refused moves staying put;
             and ``oer``: ``(n_views,)`` float32, the target's OER per view, NaN where it has
             no box (such views are never entered).
         """
-        cache = self.caches[self._scene]
+        cache = self.caches[scene]
         nxt = cache.pointers[:, self._columns]
         here = np.arange(cache.n_views, dtype=np.int32)[:, None]
-        boxes = cache.box_index[:, self._fruit]
+        boxes = cache.box_index[:, fruit]
         valid = (nxt >= 0) & (boxes[np.maximum(nxt, 0)] >= 0)
         oer = np.where(boxes >= 0, cache.box_oer[np.maximum(boxes, 0)], np.nan)
         return np.where(valid, nxt, here).astype(np.int32), oer.astype(np.float32)

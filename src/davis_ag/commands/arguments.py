@@ -47,6 +47,30 @@ def whole(text: str) -> int:
     return value
 
 
+def _finite(text: str) -> float | None:
+    try:
+        value = float(text.strip())
+    except ValueError:
+        return None
+    return value if value == value and abs(value) != float("inf") else None
+
+
+def positive_float(text: str) -> float:
+    """Parse a finite number above 0 (a length in metres)."""
+    value = _finite(text)
+    if value is None or value <= 0:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number above 0")
+    return value
+
+
+def non_negative_float(text: str) -> float:
+    """Parse a finite number from 0 (a length in metres)."""
+    value = _finite(text)
+    if value is None or value < 0:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number from 0")
+    return value
+
+
 def bounded(low: int, high: int) -> Callable[[str], int]:
     """A parser of whole numbers from ``low`` to ``high`` (a sanity bound that keeps a typo such as
     an extra zero from starting days of work or exhausting memory)."""

@@ -22,7 +22,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="benchmark LRD, UDD, Rand, Oracle (and a trained A2C) as in Table 4",
         description="Run every policy on the same episodes of the test split (sessions x "
                     "episodes, fixed seeds), print a Table 4 style summary, write it as JSON and "
-                    "a PNG bar chart.",
+                    "a PNG bar chart. On the grid the row 'Best fixed action' (the best policy that "
+                    "always plays one action) is added, and the image-blind policies get their "
+                    "exact expectations beside the sampled means.",
     )
     parser.add_argument("--dataset", type=arguments.path, required=True, metavar="DIR", help="dataset root")
     parser.add_argument("--scenario", required=True, choices=["sp", "mp"],
@@ -39,7 +41,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         default=None, help="comma-separated baselines (grid default: LRD,UDD,Rand,Oracle; "
                                            "continuous: LR,UD,Rand,Greedy)")
     parser.add_argument("--stochastic", action="store_true",
-                        help="let A2C (or the continuous Model) sample its actions instead of taking the most likely one")
+                        help="let A2C (or the continuous Model) sample its actions instead of taking the most likely one "
+                             "(grid A2C samples by default, as davis-ag reproduce plays it)")
+    parser.add_argument("--deterministic", action="store_true",
+                        help="grid A2C takes its most likely action instead of sampling")
     parser.add_argument("--episodes", type=arguments.bounded(1, 10**6), default=200,
                         help="episodes per session (200)")
     parser.add_argument("--sessions", type=arguments.bounded(1, 1000), default=3, help="sessions (3)")
@@ -86,14 +91,17 @@ def run(args: argparse.Namespace) -> int:
             env.close()
     else:
         from davis_ag.benchmark import TVMEnv
-        from davis_ag.benchmark.agents import build_agents
+        from davis_ag.benchmark.agents import A2C_DETERMINISTIC, build_agents
         from davis_ag.benchmark.evaluation import evaluate_agents
 
-        agents = build_agents(names, model=args.model, deterministic=not args.stochastic)
+        if args.stochastic and args.deterministic:
+            raise UserError("--stochastic and --deterministic contradict each other: give one")
+        deterministic = args.deterministic or (A2C_DETERMINISTIC and not args.stochastic)
+        agents = build_agents(names, model=args.model, deterministic=deterministic)
         env = TVMEnv(args.dataset, scenario=args.scenario, split=args.split, crop=args.crop,
                      cache_dir=args.cache_dir)
         results = evaluate_agents(env, agents, episodes=args.episodes, sessions=args.sessions,
-                                  seed=args.seed, keep_episodes=True)
+                                  seed=args.seed, keep_episodes=True, best_fixed_action=True)
     print(format_table(results))
     # The JSON is the result: keep it somewhere even when --out fails at the end.
     write_or_rescue(out, lambda path: write_json(results, path), "the results")

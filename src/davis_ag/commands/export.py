@@ -1,4 +1,5 @@
-"""``davis-ag export coco|yolo DIR OUT``: a DAVIS-Ag dataset in a detection format, by split."""
+"""``davis-ag export coco|yolo|pointcloud DIR OUT``: a DAVIS-Ag dataset in a detection format, by split,
+or as point clouds (PLY) from its depth images."""
 
 from __future__ import annotations
 
@@ -9,18 +10,19 @@ from davis_ag.commands import arguments
 from davis_ag.errors import UserError
 
 #: What an export folder may already hold (a previous export, which is refreshed in place).
-_OURS = {"coco": {"annotations"}, "yolo": {"images", "labels", "data.yaml"}}
+_OURS = {"coco": {"annotations"}, "yolo": {"images", "labels", "data.yaml"}, "pointcloud": set()}
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``export`` sub-command with its ``coco`` and ``yolo`` formats."""
     parser = subparsers.add_parser(
-        "export", help="write a dataset as COCO (RLE masks) or YOLO (ultralytics) detection data",
+        "export", help="write a dataset as COCO (RLE masks) or YOLO (ultralytics) detection data, or point clouds",
         description="Export a DAVIS-Ag dataset for detectors, one set per split (splits.json, else the "
                     "benchmark's seeded 70/30 split by scene). coco: OUT/annotations/instances_<split>.json "
                     "with RLE masks, boxes, fruit ids and visible fractions, images referenced in place. "
-                    "yolo: the ultralytics layout (images/, labels/, data.yaml).")
-    formats = parser.add_subparsers(dest="format", required=True, metavar="{coco,yolo}")
+                    "yolo: the ultralytics layout (images/, labels/, data.yaml). pointcloud: PLY point "
+                    "clouds in the world frame from the depth images, with colour, organ class and fruit id.")
+    formats = parser.add_subparsers(dest="format", required=True, metavar="{coco,yolo,pointcloud}")
     for name, help_text in (("coco", "COCO instances JSON, masks as pycocotools RLE"),
                             ("yolo", "ultralytics layout: images/, labels/, data.yaml")):
         sub = formats.add_parser(name, help=help_text, description=help_text)
@@ -29,6 +31,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         sub.add_argument("out", type=arguments.path, metavar="OUT", help="export folder (new, or a previous export)")
         sub.add_argument("--split", choices=("train", "test", "both"), default="both",
                          help="which split to write (default both)")
+        sub.add_argument("--organs", action="store_true",
+                         help="also the organ classes (soil, fruit, leaf, stem, trunk) as semantic masks, from "
+                              "the views' NNNN_class.png" + (" (with --task segment)" if name == "yolo" else
+                                                            " (RLE, category ids 101-105)"))
         if name == "yolo":
             sub.add_argument("--task", choices=("detect", "segment"), default="detect",
                              help="label lines: boxes (detect, default) or polygons (segment)")
@@ -37,6 +43,20 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                                   "exported image (copies; the dataset is untouched): a stand-in for real "
                                   "photographs when none are at hand")
         sub.set_defaults(func=run)
+    cloud = formats.add_parser(
+        "pointcloud", help="PLY point clouds from the depth images (world frame, colour, organ, fruit id)",
+        description="One PLY per view (OUT/<group>/<scene>/NNNN.ply), or per scene with --fuse "
+                    "(OUT/<group>/<scene>.ply): points in the world frame from each depth image, the "
+                    "recorded intrinsics and the pose, with colour, organ class and fruit id.")
+    cloud.add_argument("dir", type=arguments.path, metavar="DIR", help="dataset root, group folder or scene folder")
+    cloud.add_argument("out", type=arguments.path, metavar="OUT", help="export folder (new, or a previous export)")
+    cloud.add_argument("--fuse", action="store_true", help="one cloud per scene, all its views joined")
+    cloud.add_argument("--max-depth", type=arguments.positive_float, default=5.0, metavar="M",
+                       help="drop points farther than this from the camera, m (default 5; the far soil "
+                            "reaches 30 m)")
+    cloud.add_argument("--voxel", type=arguments.non_negative_float, default=None, metavar="M",
+                       help="keep one point per cube of this side, m (default 0.005 with --fuse, else 0: all)")
+    cloud.set_defaults(func=run)
 
 
 def check_out(out: Path, fmt: str) -> None:
@@ -44,7 +64,10 @@ def check_out(out: Path, fmt: str) -> None:
     if out.exists() and not out.is_dir():
         raise UserError(f"{out}: is a file; give a folder for the export")
     if out.is_dir():
-        foreign = sorted(p.name for p in out.iterdir() if p.name not in _OURS[fmt])
+        from davis_ag.scene.specs import parse_group_name
+
+        foreign = sorted(p.name for p in out.iterdir() if p.name not in _OURS[fmt]
+                         and not (fmt == "pointcloud" and p.is_dir() and parse_group_name(p.name)))
         if foreign:
             raise UserError(f"{out}: holds {', '.join(foreign[:3])}{' ...' if len(foreign) > 3 else ''}, "
                             f"which is not a {fmt} export; give a new or empty folder")
@@ -54,8 +77,10 @@ def run(args: argparse.Namespace) -> int:
     """Export ``args.dir`` to ``args.out``; prints the counts per split."""
     from davis_ag.data.reader import open_dataset
 
-    splits = ("train", "test") if args.split == "both" else (args.split,)
     open_dataset(args.dir)  # a bad DIR is reported before anything is created
+    if args.format == "pointcloud":
+        return run_point_clouds(args)
+    splits = ("train", "test") if args.split == "both" else (args.split,)
     check_out(args.out, args.format)
     try:
         args.out.mkdir(parents=True, exist_ok=True)
@@ -64,12 +89,12 @@ def run(args: argparse.Namespace) -> int:
     if args.format == "coco":
         from davis_ag.detection.coco_export import export_coco
 
-        counts = export_coco(args.dir, args.out, splits)
+        counts = export_coco(args.dir, args.out, splits, organs=args.organs)
         unit = "annotations"
     else:
         from davis_ag.detection.yolo_export import export_yolo
 
-        counts = export_yolo(args.dir, args.out, args.task, splits)
+        counts = export_yolo(args.dir, args.out, args.task, splits, organs=args.organs)
         unit = "instances"
         if args.appearance_shift is not None:
             from davis_ag.detection.appearance_shift import shift_folder
@@ -79,4 +104,15 @@ def run(args: argparse.Namespace) -> int:
         print(f"{split}: {c['images']} images, {c[unit]} {unit}")
     where = args.out / "annotations" if args.format == "coco" else args.out / "data.yaml"
     print(f"wrote {where}")
+    return 0
+
+
+def run_point_clouds(args: argparse.Namespace) -> int:
+    """Write the PLY point clouds of ``args.dir`` under ``args.out``; prints the counts."""
+    from davis_ag.data.point_cloud import export_point_clouds
+
+    check_out(args.out, "pointcloud")
+    voxel = args.voxel if args.voxel is not None else (0.005 if args.fuse else 0.0)
+    counts = export_point_clouds(args.dir, args.out, args.fuse, args.max_depth, voxel)
+    print(f"{counts['scenes']} scenes: {counts['files']} PLY files, {counts['points']:,} points; wrote {args.out}")
     return 0

@@ -37,6 +37,9 @@ def register(subparsers) -> None:
     arguments.add_renderer_flags(parser)
     parser.add_argument("--no-depth", action="store_true",
                         help="do not write images/NNNN_depth.png (uint16 millimetres along the optical axis)")
+    parser.add_argument("--appearance", choices=("paper", "random"),
+                        help="paper: the paper's sky, soil and exposure (default); random: per scene, from its "
+                             "seed, the sun, sky, soil, exposure, white balance and sensor noise (labels unchanged)")
     parser.add_argument("--out", type=arguments.path, required=True, help="dataset folder")
     parser.add_argument("--strawberry-altitudes", choices=("table1", "readme"),
                         help="strawberry camera altitudes: table1 = Table 1's 25/40/55 cm (default), "
@@ -71,6 +74,8 @@ def run(args: argparse.Namespace) -> int:
                              camera=config.camera if args.size is None else Camera(*args.size))
         if args.antialiasing is not None:
             config = dataclasses.replace(config, antialiasing=args.antialiasing)
+        if args.appearance is not None:
+            config = dataclasses.replace(config, appearance=args.appearance)
         if args.plants is not None:
             config = dataclasses.replace(config, plants=args.plants)
         if args.renderer is not None or args.look is not None or args.no_depth:
@@ -84,7 +89,7 @@ def run(args: argparse.Namespace) -> int:
                                      0 if args.first is None else args.first, args.seed or 0,
                                      args.size or (1280, 720), args.renderer or DEFAULT_RENDERER, args.look,
                                      not args.no_depth, args.antialiasing or DEFAULT_ANTIALIASING,
-                                     args.plants or DEFAULT_PLANTS)
+                                     args.plants or DEFAULT_PLANTS, args.appearance or "paper")
     if args.strawberry_altitudes:
         config = use_strawberry_altitudes(config, args.strawberry_altitudes)
     if args.executor != "ray" and args.address:

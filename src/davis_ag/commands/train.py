@@ -12,8 +12,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "train",
         help="train an A2C agent for target visibility maximisation",
-        description="Train Stable-Baselines3 A2C (CnnPolicy with the paper's network, SB3 default "
-                    "hyperparameters) on the train split of the TVM environment and save a .zip.",
+        description="Train Stable-Baselines3 A2C (CnnPolicy with the paper's network; SB3's default "
+                    "hyperparameters with an entropy bonus and normalised advantages) on the train split "
+                    "of the TVM environment and save a .zip, with a training record (settings, sittings, "
+                    "learning curve) beside it.",
     )
     parser.add_argument("--dataset", type=arguments.path, required=True, metavar="DIR", help="dataset root")
     parser.add_argument("--scenario", required=True, choices=["sp", "mp"],
@@ -27,6 +29,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--arch", choices=["paper", "nature", "pooled"], default="paper",
                         help="network: paper (section V-B, default), nature (SB3's NatureCNN) or pooled "
                              "(fast smoke tests)")
+    parser.add_argument("--a2c-settings", choices=["ours", "sb3"], default="ours",
+                        help="ours (default): SB3's A2C defaults with ent_coef=0.01 and normalised advantages, "
+                             "which keep the policy from collapsing to one move; sb3: SB3's defaults alone")
     parser.add_argument("--device", default="auto", help="torch device (default: auto)")
     parser.add_argument("--cache-dir", type=arguments.path, default=None, metavar="DIR",
                         help="observation cache folder (default: DIR/.davis_ag_cache)")
@@ -49,6 +54,7 @@ def run(args: argparse.Namespace) -> int:
     path = train_a2c(args.dataset, args.scenario, total_timesteps=args.timesteps, seed=args.seed,
                      out_path=args.out, n_envs=args.n_envs, crop=args.crop,
                      cache_dir=args.cache_dir, arch=args.arch, device=args.device,
-                     verbose=args.verbose, checkpoint_every=args.checkpoint_every)
+                     verbose=args.verbose, checkpoint_every=args.checkpoint_every,
+                     settings=args.a2c_settings)
     print(f"saved {path}")
     return 0

@@ -105,6 +105,28 @@ class View:
             return None
         return read_depth(check_inside(self.depth_path, self.scene.root))
 
+    @property
+    def class_path(self) -> Path:
+        """Where the organ class image is (``images/0001_class.png``), whether or not it exists."""
+        return view_file(self.scene.path, self.name, "classes")
+
+    @property
+    def classes(self) -> np.ndarray | None:
+        """The organ class image: ``H x W`` uint8, one value per class of
+        :data:`davis_ag.scene.organs.ORGAN_NAMES` (0 sky, 1 soil, 2 fruit, 3 leaf, 4 stem, 5 trunk);
+        ``None`` where the dataset has none (the original download, datasets made before it).
+
+        Raises:
+            UserError: when the file exists but cannot be read or is not 8-bit single-channel.
+        """
+        if not self.class_path.is_file():
+            return None
+        classes = load_pixels(check_inside(self.class_path, self.scene.root), None)
+        if classes.dtype != np.uint8 or classes.ndim != 2:
+            raise UserError(f"{self.class_path}: a class image must be an 8-bit single-channel PNG; "
+                            "regenerate the scene")
+        return classes
+
     def next(self, action: str) -> View | None:
         """The view an action leads to.
 

@@ -24,6 +24,7 @@ from typing import Any
 
 from pydantic import BaseModel, ValidationError
 
+from davis_ag.data.class_checks import class_problems
 from davis_ag.data.reader import (
     ANNOTATIONS,
     NO_FRUIT,
@@ -201,6 +202,10 @@ def validate_scene(scene: Scene, quick: bool = False, box_tolerance: int | None 
             if depth.is_file():
                 for problem in depth_problems(record, depth, mask if has_mask else None, metadata):
                     flag(depth, problem)
+            classes = view_file(scene.path, record.name, "classes")
+            if classes.is_file() and not _outside(classes, scene.root):
+                for problem in class_problems(classes, mask if has_mask else None):
+                    flag(classes, problem)
 
     if images.is_dir():
         for path in sorted(images.iterdir()):
@@ -464,3 +469,4 @@ def validate_dataset(path: str | Path, quick: bool = False, box_tolerance: int |
     for problem in _check_counts(dataset, counts):
         emit(problem)
     return report
+

@@ -12,7 +12,8 @@ annotation: ``bbox`` is the published box (``[xmin, ymin, width, height]``, incl
 extent, which is COCO's convention for pixel masks), ``segmentation`` the RLE of the fruit's
 pixels (views without ``_seg.png`` get boxes only, no ``segmentation`` key), ``area`` its pixel
 count, and ``attributes`` the stable ``fruit_id`` and the ``visible_fraction``. One category per
-crop, fixed ids: strawberry 1, tomato 2, vine 3.
+crop, fixed ids: strawberry 1, tomato 2, vine 3. With ``organs``, the organ classes as semantic
+masks too (:mod:`davis_ag.detection.organ_export`).
 
 The JSON is streamed: images and annotations go to two temporary files as views are read, then
 are joined into the final file, which appears atomically.
@@ -37,6 +38,7 @@ from davis_ag.detection.instances import (
     iter_split_views,
     scenes_by_split,
 )
+from davis_ag.detection.organ_export import ORGAN_CATEGORY_BASE, coco_organ_categories, organ_masks
 
 
 def rle_of(mask: np.ndarray) -> dict[str, Any]:
@@ -74,6 +76,23 @@ def _annotation_entries(item: LabelledView, image_id: int, first_id: int) -> lis
     return entries
 
 
+def organ_annotations(item: LabelledView, image_id: int, first_id: int) -> list[dict[str, Any]]:
+    """One semantic annotation per organ class present in the view (see
+    :mod:`davis_ag.detection.organ_export`); none without a class image."""
+    from davis_ag.scene.organs import ORGAN_NAMES
+
+    entries = []
+    for value, mask in organ_masks(item.view):
+        rows, cols = np.nonzero(mask)
+        x0, y0 = int(cols.min()), int(rows.min())
+        entries.append({"id": first_id + len(entries), "image_id": image_id,
+                        "category_id": ORGAN_CATEGORY_BASE + value,
+                        "bbox": [x0, y0, int(cols.max()) - x0 + 1, int(rows.max()) - y0 + 1], "iscrowd": 0,
+                        "area": int(mask.sum()), "segmentation": rle_of(mask),
+                        "attributes": {"organ": ORGAN_NAMES[value], "semantic": True}})
+    return entries
+
+
 def _write_array_items(handle: IO[str], items: list[dict[str, Any]], first: bool) -> bool:
     for item in items:
         handle.write(("" if first else ",\n") + json.dumps(item, separators=(",", ":")))
@@ -82,7 +101,7 @@ def _write_array_items(handle: IO[str], items: list[dict[str, Any]], first: bool
 
 
 def write_coco_split(scenes: list[Scene], root: Path, target: Path, split: str,
-                     progress: bool = True) -> dict[str, int]:
+                     progress: bool = True, organs: bool = False) -> dict[str, int]:
     """Write one split's COCO instances file.
 
     Args:
@@ -91,18 +110,21 @@ def write_coco_split(scenes: list[Scene], root: Path, target: Path, split: str,
         target: The JSON file to write (atomically).
         split: Its name, recorded in ``info``.
         progress: Show a tqdm bar on stderr.
+        organs: Add the organ classes' semantic masks.
 
     Returns:
         ``{"images": n, "annotations": m}``.
     """
     from tqdm import tqdm
 
+
     counts = {"images": 0, "annotations": 0}
     header = {"info": {"description": f"DAVIS-Ag {split} split, exported by davis-ag",
                        "image_root": str(root), "split": split, "scenes": [s.id for s in scenes]},
               "licenses": [],
               "categories": [{"id": i + 1, "name": name, "supercategory": "fruit"}
-                             for i, name in enumerate(CATEGORIES)]}
+                             for i, name in enumerate(CATEGORIES)]
+              + (coco_organ_categories() if organs else [])}
     with tempfile.TemporaryDirectory(dir=target.parent, prefix=".coco-") as tmp:
         images_path, annotations_path = Path(tmp) / "images", Path(tmp) / "annotations"
         with open(images_path, "w") as images, open(annotations_path, "w") as annotations:
@@ -112,6 +134,8 @@ def write_coco_split(scenes: list[Scene], root: Path, target: Path, split: str,
                 image_id = counts["images"] + 1
                 first_image = _write_array_items(images, [_image_entry(item, image_id, root)], first_image)
                 entries = _annotation_entries(item, image_id, counts["annotations"] + 1)
+                if organs:
+                    entries += organ_annotations(item, image_id, counts["annotations"] + 1 + len(entries))
                 first_annotation = _write_array_items(annotations, entries, first_annotation)
                 counts["images"] += 1
                 counts["annotations"] += len(entries)
@@ -130,7 +154,7 @@ def write_coco_split(scenes: list[Scene], root: Path, target: Path, split: str,
 
 
 def export_coco(dataset_dir: Path, out_dir: Path, splits: tuple[str, ...] = ("train", "test"),
-                progress: bool = True) -> dict[str, dict[str, int]]:
+                progress: bool = True, organs: bool = False) -> dict[str, dict[str, int]]:
     """Export a DAVIS-Ag dataset to COCO instances files, one per split.
 
     Args:
@@ -138,6 +162,7 @@ def export_coco(dataset_dir: Path, out_dir: Path, splits: tuple[str, ...] = ("tr
         out_dir: Folder that receives ``annotations/instances_<split>.json``.
         splits: Which splits to write.
         progress: Show progress bars.
+        organs: Add the organ classes' semantic masks (views with class images).
 
     Returns:
         Per split, the image and annotation counts.
@@ -146,5 +171,5 @@ def export_coco(dataset_dir: Path, out_dir: Path, splits: tuple[str, ...] = ("tr
     by_split = scenes_by_split(dataset)
     (out_dir / "annotations").mkdir(parents=True, exist_ok=True)
     return {split: write_coco_split(by_split[split], dataset.root, out_dir / "annotations" /
-                                    f"instances_{split}.json", split, progress)
+                                    f"instances_{split}.json", split, progress, organs)
             for split in splits}

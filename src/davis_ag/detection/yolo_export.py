@@ -26,6 +26,7 @@ import numpy as np
 from davis_ag.atomic_files import write_text_atomic
 from davis_ag.data.reader import Scene, open_dataset
 from davis_ag.detection.instances import CATEGORIES, LabelledView, count_views, iter_split_views, scenes_by_split
+from davis_ag.detection.organ_export import organ_masks, yolo_organ_class, yolo_organ_names
 from davis_ag.errors import UserError
 
 TASKS = ("detect", "segment")
@@ -76,6 +77,15 @@ def label_lines(item: LabelledView, task: str) -> list[str]:
     return lines
 
 
+def organ_lines(item: LabelledView) -> list[str]:
+    """One segment line per organ class present in the view (see
+    :mod:`davis_ag.detection.organ_export`); none without a class image."""
+    w, h = float(item.width), float(item.height)
+    return [f"{yolo_organ_class(value)} " + " ".join(f"{(x + 0.5) / w:.6f} {(y + 0.5) / h:.6f}"
+                                                     for x, y in mask_polygon(mask))
+            for value, mask in organ_masks(item.view)]
+
+
 def place_image(source: Path, target: Path) -> None:
     """Hard-link ``source`` to ``target`` (a copy where links are impossible); replaces ``target``."""
     target.unlink(missing_ok=True)
@@ -86,7 +96,7 @@ def place_image(source: Path, target: Path) -> None:
 
 
 def write_yolo_split(scenes: list[Scene], out_dir: Path, split: str, task: str = "detect",
-                     progress: bool = True) -> dict[str, int]:
+                     progress: bool = True, organs: bool = False) -> dict[str, int]:
     """Write one split's images and labels.
 
     Returns:
@@ -102,6 +112,8 @@ def write_yolo_split(scenes: list[Scene], out_dir: Path, split: str, task: str =
     for item in iter_split_views(scenes, with_masks=task == "segment"):
         name = flat_name(f"{item.view.scene.id}/{item.view.name}")
         lines = label_lines(item, task)
+        if organs:
+            lines += organ_lines(item)
         write_text_atomic(labels / f"{name}.txt", "".join(f"{line}\n" for line in lines))
         place_image(item.view.image_path, images / f"{name}.jpeg")
         counts["images"] += 1
@@ -122,7 +134,8 @@ def data_yaml(out_dir: Path, names: dict[int, str] | None = None) -> Path:
 
 
 def export_yolo(dataset_dir: Path, out_dir: Path, task: str = "detect",
-                splits: tuple[str, ...] = ("train", "test"), progress: bool = True) -> dict[str, dict[str, int]]:
+                splits: tuple[str, ...] = ("train", "test"), progress: bool = True,
+                organs: bool = False) -> dict[str, dict[str, int]]:
     """Export a DAVIS-Ag dataset to the ultralytics layout.
 
     Args:
@@ -131,19 +144,26 @@ def export_yolo(dataset_dir: Path, out_dir: Path, task: str = "detect",
         task: ``detect`` (boxes) or ``segment`` (polygons).
         splits: Which splits to write.
         progress: Show progress bars.
+        organs: Add one polygon per organ class present (``segment`` only; see
+            :mod:`davis_ag.detection.organ_export`).
 
     Returns:
         Per split, the image and instance counts.
 
     Raises:
-        UserError: for an unknown task.
+        UserError: for an unknown task, or organs with boxes.
     """
     if task not in TASKS:
         raise UserError(f"unknown task {task!r}: choose one of {', '.join(TASKS)}")
+    if organs and task != "segment":
+        raise UserError("--organs exports semantic masks as polygons: add --task segment")
     dataset = open_dataset(dataset_dir)
     by_split = scenes_by_split(dataset)
-    counts = {split: write_yolo_split(by_split[split], out_dir, split, task, progress) for split in splits}
+    counts = {split: write_yolo_split(by_split[split], out_dir, split, task, progress, organs) for split in splits}
     for split in ("train", "test"):  # ultralytics wants every folder the YAML names
         (out_dir / "images" / split).mkdir(parents=True, exist_ok=True)
-    data_yaml(out_dir)
+    names = dict(enumerate(CATEGORIES))
+    if organs:
+        names.update(yolo_organ_names())
+    data_yaml(out_dir, names)
     return counts

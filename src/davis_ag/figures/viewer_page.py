@@ -2,8 +2,8 @@
 
 Keys follow the paper's actions: arrows or W/S/A/D move forward/backward/left/right, R and F
 (or Page Up/Down) go up and down, Q and E rotate counter-clockwise and clockwise (MP scenes);
-B, M and Z toggle the boxes, the instance masks and the depth image (Z only where the scene
-has depth images). A click on the map jumps to that position at the current altitude,
+B, M, Z and O toggle the boxes, the instance masks, the depth image and the organ classes (Z
+and O only where the scene has depth or class images). A click on the map jumps to that position at the current altitude,
 keeping the heading nearest the current one. The address keeps ``#scene=...&view=...``, so a
 view can be bookmarked. ``window.viewer`` exposes the state for tests.
 """
@@ -33,6 +33,7 @@ table{border-collapse:collapse;font-size:13px}td{padding:1px 6px}
   <button id="boxes-toggle" class="on" title="B">boxes</button>
   <button id="mask-toggle" title="M">masks</button>
   <button id="depth-toggle" class="hidden" title="Z">depth</button>
+  <button id="classes-toggle" class="hidden" title="O">organs</button>
   <span id="message"></span>
 </header>
 <main>
@@ -40,6 +41,7 @@ table{border-collapse:collapse;font-size:13px}td{padding:1px 6px}
     <div id="stage">
       <img id="photo" alt="view">
       <img id="depth" class="layer hidden" alt="depth">
+      <img id="classes" class="layer hidden" alt="organ classes">
       <img id="mask" class="layer hidden" alt="instance mask">
       <canvas id="boxes" class="layer"></canvas>
     </div>
@@ -54,7 +56,7 @@ table{border-collapse:collapse;font-size:13px}td{padding:1px 6px}
       <kbd>&larr;</kbd>/<kbd>A</kbd> left, <kbd>&rarr;</kbd>/<kbd>D</kbd> right,
       <kbd>R</kbd>/<kbd>PgUp</kbd> up, <kbd>F</kbd>/<kbd>PgDn</kbd> down,
       <kbd>Q</kbd> rotate ccw, <kbd>E</kbd> rotate cw;
-      <kbd>B</kbd> boxes, <kbd>M</kbd> masks, <kbd>Z</kbd> depth; click the map to jump.</p>
+      <kbd>B</kbd> boxes, <kbd>M</kbd> masks, <kbd>Z</kbd> depth, <kbd>O</kbd> organs; click the map to jump.</p>
   </div>
 </main>
 <script>
@@ -63,7 +65,7 @@ const KEYS = {ArrowUp:"forward", w:"forward", ArrowDown:"backward", s:"backward"
   ArrowLeft:"left", a:"left", ArrowRight:"right", d:"right", r:"up", PageUp:"up",
   f:"down", PageDown:"down", q:"rotate_ccw", e:"rotate_cw"};
 const viewer = window.viewer = {scene: null, view: null, data: null, path: [],
-  layers: {boxes: true, mask: false, depth: false}, moves: 0};
+  layers: {boxes: true, mask: false, depth: false, classes: false}, moves: 0};
 const $ = (id) => document.getElementById(id);
 const enc = (id) => id.split("/").map(encodeURIComponent).join("/");
 const esc = (text) => String(text).replace(/[&<>'"]/g, c => "&#" + c.charCodeAt(0) + ";");
@@ -93,6 +95,9 @@ async function loadScene(id, viewName) {
   const hasDepth = Object.values(viewer.data.views).some(v => v.depth);
   $("depth-toggle").classList.toggle("hidden", !hasDepth);
   if (!hasDepth) viewer.layers.depth = false;
+  const hasClasses = Object.values(viewer.data.views).some(v => v.classes);
+  $("classes-toggle").classList.toggle("hidden", !hasClasses);
+  if (!hasClasses) viewer.layers.classes = false;
   show(viewer.data.views[viewName] ? viewName : viewer.data.order[0]);
 }
 
@@ -106,6 +111,7 @@ function show(name) {
   $("photo").src = "/image/" + base + "/" + encodeURIComponent(name);
   $("mask").src = v.mask ? "/overlay/mask/" + base + "/" + encodeURIComponent(name) : "";
   $("depth").src = v.depth ? "/overlay/depth/" + base + "/" + encodeURIComponent(name) : "";
+  $("classes").src = v.classes ? "/overlay/classes/" + base + "/" + encodeURIComponent(name) : "";
   $("view-name").textContent = viewer.scene + " " + name;
   $("pose").textContent = v.pose ? "pose x=" + v.pose[0].toFixed(3) + " y=" + v.pose[1].toFixed(3)
     + " z=" + v.pose[2].toFixed(2) + " yaw=" + v.pose[3].toFixed(0) + " pitch=" + v.pose[4].toFixed(1) : "no pose";
@@ -122,7 +128,8 @@ function drawLayers() {
   const v = viewer.data.views[viewer.view];
   $("mask").classList.toggle("hidden", !(viewer.layers.mask && v.mask));
   $("depth").classList.toggle("hidden", !(viewer.layers.depth && v.depth));
-  for (const k of ["boxes", "mask", "depth"]) $(k + "-toggle").classList.toggle("on", viewer.layers[k]);
+  $("classes").classList.toggle("hidden", !(viewer.layers.classes && v.classes));
+  for (const k of ["boxes", "mask", "depth", "classes"]) $(k + "-toggle").classList.toggle("on", viewer.layers[k]);
   const photo = $("photo"), canvas = $("boxes");
   // The canvas has the displayed size, not the image's: boxes and labels stay crisp and
   // readable on small images scaled up.
@@ -219,6 +226,7 @@ function jump(name) {
 
 function toggle(layer) {
   if (layer === "depth" && $("depth-toggle").classList.contains("hidden")) { say("no depth images in this scene"); return; }
+  if (layer === "classes" && $("classes-toggle").classList.contains("hidden")) { say("no organ class images in this scene"); return; }
   viewer.layers[layer] = !viewer.layers[layer];
   drawLayers();
 }
@@ -230,12 +238,13 @@ document.addEventListener("keydown", (event) => {
   else if (key === "b") toggle("boxes");
   else if (key === "m") toggle("mask");
   else if (key === "z") toggle("depth");
+  else if (key === "o") toggle("classes");
 });
 $("map").addEventListener("click", (event) => {
   const name = event.target.getAttribute && event.target.getAttribute("data-view");
   if (name) jump(name);
 });
-for (const k of ["boxes", "mask", "depth"]) $(k + "-toggle").addEventListener("click", () => toggle(k));
+for (const k of ["boxes", "mask", "depth", "classes"]) $(k + "-toggle").addEventListener("click", () => toggle(k));
 $("scene-select").addEventListener("change", (event) => loadScene(event.target.value));
 window.addEventListener("resize", () => viewer.repaint && viewer.repaint());
 

@@ -52,7 +52,7 @@ def scene_payload(scene: Scene) -> dict[str, Any]:
 
     Returns:
         ``{"id", "actions", "altitudes", "plants", "size", "views": {name: {"pose", "boxes",
-        "pointers", "mask", "depth"}}, "order": [names]}``.
+        "pointers", "mask", "depth", "classes"}}, "order": [names]}``.
     """
     views = {}
     for name, view in scene.views.items():
@@ -62,6 +62,7 @@ def scene_payload(scene: Scene) -> dict[str, Any]:
             "pointers": dict(view.pointers),
             "mask": view.mask_path.is_file(),
             "depth": view.depth_path.is_file(),
+            "classes": view.class_path.is_file(),
         }
     camera = (scene.metadata or {}).get("camera") or {}
     size = [camera.get("width"), camera.get("height")] if camera.get("width") else None
@@ -96,6 +97,20 @@ def depth_picture(depth: np.ndarray) -> bytes:
         picture[valid] = (colormaps["viridis_r"](scaled[valid])[:, :3] * 255).astype(np.uint8)
     buffer = io.BytesIO()
     Image.fromarray(picture, "RGB").save(buffer, format="PNG")
+    return buffer.getvalue()
+
+
+def classes_overlay(classes: np.ndarray) -> bytes:
+    """An RGBA PNG of an organ class image in the class colours of docs/labels.md, sky transparent."""
+    from PIL import Image
+
+    from davis_ag.figures.label_pictures import ORGAN_COLOURS
+
+    table = np.zeros((256, 4), dtype=np.uint8)
+    table[: len(ORGAN_COLOURS), :3] = ORGAN_COLOURS
+    table[1: len(ORGAN_COLOURS), 3] = 200
+    buffer = io.BytesIO()
+    Image.fromarray(table[classes], "RGBA").save(buffer, format="PNG")
     return buffer.getvalue()
 
 
@@ -202,7 +217,7 @@ def make_handler(viewer: Viewer, page: bytes) -> type[BaseHTTPRequestHandler]:
                 if path is None:
                     return self._missing()
                 self._send(HTTPStatus.OK, path.read_bytes(), _TYPES[path.suffix], cache=True)
-            elif head == "overlay" and rest and rest[0] in ("mask", "depth") and (found := _split_scene(rest[1:])):
+            elif head == "overlay" and rest and rest[0] in ("mask", "depth", "classes") and (found := _split_scene(rest[1:])):
                 self._overlay(rest[0], *found)
             else:
                 self._missing()
@@ -217,6 +232,10 @@ def make_handler(viewer: Viewer, page: bytes) -> type[BaseHTTPRequestHandler]:
                 if mask is None:
                     return self._missing("no mask")
                 return self._send(HTTPStatus.OK, mask_overlay(mask), "image/png", cache=True)
+            if layer == "classes":
+                if viewer.file(scene, view.class_path.name) is None:
+                    return self._missing("no organ classes")
+                return self._send(HTTPStatus.OK, classes_overlay(view.classes), "image/png", cache=True)
             path = viewer.file(scene, view.depth_path.name)
             if path is None:
                 return self._missing("no depth")

@@ -8,6 +8,7 @@ use, so a name or an encoding changes in one place::
     <root>/<Group>/<NNN>/images/NNNN.jpeg          colour, JPEG quality 95
     <root>/<Group>/<NNN>/images/NNNN_seg.png       uint8 fruit id per pixel, 255 = no fruit
     <root>/<Group>/<NNN>/images/NNNN_depth.png     uint16 mm along the optical axis, 0 = nothing hit
+    <root>/<Group>/<NNN>/images/NNNN_class.png     uint8 organ class per pixel
 
 A new per-view image is one more entry in :data:`VIEW_FILES` (its suffix and what it holds);
 :func:`view_file`, :func:`view_of_file` and the validator's stray-file check then know it.
@@ -37,6 +38,7 @@ VIEW_FILES: dict[str, tuple[str, str]] = {
     "image": (IMAGE_SUFFIX, "RGB, JPEG"),
     "mask": ("_seg.png", "uint8 fruit id per pixel, 255 = no fruit"),
     "depth": ("_depth.png", "uint16 millimetres along the optical axis, 0 = nothing hit"),
+    "classes": ("_class.png", "uint8 organ class per pixel (davis_ag.scene.organs)"),
 }
 
 
@@ -89,7 +91,8 @@ def decode_depth(millimetres: np.ndarray) -> np.ndarray:
 
 
 def write_view_files(images_dir: Path, name: str, colour: np.ndarray | None = None,
-                     segmentation: np.ndarray | None = None, depth: np.ndarray | None = None) -> list[str]:
+                     segmentation: np.ndarray | None = None, depth: np.ndarray | None = None,
+                     classes: np.ndarray | None = None) -> list[str]:
     """Encode and write a view's files (those given) into ``images/``; not atomic by itself.
 
     Args:
@@ -98,6 +101,7 @@ def write_view_files(images_dir: Path, name: str, colour: np.ndarray | None = No
         colour: ``H x W x 3`` uint8.
         segmentation: ``H x W`` uint8 fruit ids, 255 elsewhere.
         depth: ``H x W`` metres along the optical axis, 0 where nothing is hit.
+        classes: ``H x W`` uint8 organ classes.
 
     Returns:
         The names of the files written.
@@ -114,6 +118,9 @@ def write_view_files(images_dir: Path, name: str, colour: np.ndarray | None = No
     if depth is not None:
         Image.fromarray(encode_depth(depth)).save(images_dir / view_file_name(name, "depth"), compress_level=1)
         written.append(view_file_name(name, "depth"))
+    if classes is not None:
+        Image.fromarray(classes, mode="L").save(images_dir / view_file_name(name, "classes"), compress_level=1)
+        written.append(view_file_name(name, "classes"))
     return written
 
 

@@ -34,6 +34,7 @@ from pydantic import (
 )
 
 from davis_ag.errors import UserError
+from davis_ag.scene.appearance import APPEARANCES, DEFAULT_APPEARANCE
 from davis_ag.scene.specs import ALL_ACTIONS, DEFAULT_PLANTS, PLANT_GENERATORS, crop_spec, group_name, scenario_spec
 
 #: Largest seed: NumPy's legacy seeding, Gymnasium and Stable-Baselines3 take 32-bit seeds.
@@ -229,6 +230,7 @@ class DatasetConfigFile(_Model):
     depth: StrictBool = True
     antialiasing: Annotated[Literal["fxaa", "msaa", "none"], BeforeValidator(_antialiasing)] = "fxaa"
     plants: Literal[PLANT_GENERATORS] = DEFAULT_PLANTS  # type: ignore[valid-type]
+    appearance: Literal[APPEARANCES] = DEFAULT_APPEARANCE  # type: ignore[valid-type]
     strawberry_altitudes: Literal["table1", "readme"] = "table1"
     grid: GridOverride | None = None
     groups: list[GroupEntry]
@@ -277,6 +279,14 @@ class DatasetGroup(_Model):
     grid: GridSettings
 
 
+class OrganClass(_Model):
+    """One row of dataset.json's organ class table: a value of NNNN_class.png and what it covers."""
+
+    value: whole(0, 255)
+    name: str
+    covers: str
+
+
 class DatasetFile(_Model):
     """``dataset.json``: the settings every scene of one folder shares; a later run with other
     settings is refused before anything is written. Keys of later versions are kept."""
@@ -291,6 +301,10 @@ class DatasetFile(_Model):
     look: Literal["default", "helios"] = "helios"
     # Datasets from before the choice of plants grew PlantArchitecture plants.
     plants: Literal[PLANT_GENERATORS] = "architecture"  # type: ignore[valid-type]
+    # ... and before randomised appearance, the paper's.
+    appearance: Literal[APPEARANCES] = "paper"  # type: ignore[valid-type]
+    #: The organ class table of NNNN_class.png, where the scenes have them.
+    classes: list[OrganClass] | None = None
     groups: dict[str, DatasetGroup]
 
 

@@ -15,17 +15,18 @@ import json
 from pathlib import Path
 from typing import Any, Sequence
 
-from davis_ag.atomic_files import write_json_atomic
-from davis_ag.errors import UserError
-from davis_ag.generate.one_scene import SceneRequest
-from davis_ag.generate.run_config import grid_settings
-from davis_ag.render.backends import resolve_look
-from davis_ag.scene.specs import parse_group_name
 from pydantic import ValidationError
 
+from davis_ag.atomic_files import write_json_atomic
+from davis_ag.errors import UserError
 from davis_ag.formats.layout import ANNOTATIONS, DATASET_FILE, SPLITS_FILE
 from davis_ag.formats.models import DatasetFile, SplitsFile, one_line
 from davis_ag.formats.splits import recorded_seed, split_scenes
+from davis_ag.generate.one_scene import SceneRequest
+from davis_ag.generate.run_config import grid_settings
+from davis_ag.render.backends import resolve_look
+from davis_ag.scene.organs import organ_table
+from davis_ag.scene.specs import parse_group_name
 
 DATASET_FORMAT = "davis-ag-dataset/1"
 
@@ -39,16 +40,18 @@ def dataset_settings(requests: Sequence[SceneRequest]) -> dict[str, Any]:
     first = requests[0]
     for request in requests:
         if request.dataset_seed != first.dataset_seed or request.camera != first.camera \
-                or (request.renderer, request.look, request.plants) != (first.renderer, first.look, first.plants):
+                or (request.renderer, request.look, request.plants, request.appearance) != (
+                    first.renderer, first.look, first.plants, first.appearance):
             raise UserError("the scenes of one run must share the dataset seed, the image size, the renderer, "
-                            "the look and the plant generator")
+                            "the look, the plant generator and the appearance")
     groups: dict[str, Any] = {}
     for request in requests:
         groups[request.folder.split("/")[0]] = {"grid": grid_settings(request.scenario, request.crop)}
     return DatasetFile(format=DATASET_FORMAT, seed=first.dataset_seed,
                        image_size=(first.camera.width, first.camera.height), vfov_deg=first.camera.vfov,
                        renderer=first.renderer, look=resolve_look(first.renderer, first.look),
-                       plants=first.plants, groups=groups).to_json()
+                       plants=first.plants, appearance=first.appearance,
+                       classes=organ_table() if first.classes else None, groups=groups).to_json()
 
 
 def complete_scenes(root: Path) -> list[str]:
@@ -88,7 +91,8 @@ def reconcile_settings(root: Path, wanted: dict[str, Any]) -> dict[str, Any]:
     if not present:  # nothing was finished with the old settings: they may change freely
         return wanted
     for key, flag in (("seed", "--seed"), ("image_size", "--size"), ("vfov_deg", "the field of view"),
-                      ("renderer", "--renderer"), ("look", "--look"), ("plants", "--plants")):
+                      ("renderer", "--renderer"), ("look", "--look"), ("plants", "--plants"),
+                      ("appearance", "--appearance")):
         if old.get(key) != wanted[key]:
             shown = [_shown(old.get(key)), _shown(wanted[key])]
             raise UserError(f"{root} holds scenes made with {key} {shown[0]}, not {shown[1]}: "

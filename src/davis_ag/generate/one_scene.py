@@ -24,8 +24,10 @@ from davis_ag.errors import UserError
 from davis_ag.generate.scene_writer import SceneWriter
 from davis_ag.labels.fruit_labels import fruit_lookup, label_view, visible_fractions
 from davis_ag.render.backends import ANTIALIASING_DESCRIPTIONS, DEFAULT_RENDERER, open_renderer, resolve_look
+from davis_ag.scene.appearance import draw_appearance, resolve_appearance
 from davis_ag.scene.build import build_scene
 from davis_ag.scene.camera import Camera
+from davis_ag.scene.organs import ORGAN_NAMES, SKY
 from davis_ag.scene.specs import (
     CROPS,
     DEFAULT_PLANTS,
@@ -58,6 +60,8 @@ CONVENTIONS = {
     "visible_fraction": "visible pixels of a fruit over the pixels it would cover with nothing in front",
     "depth": "images/NNNN_depth.png: uint16 millimetres from the camera plane along the optical axis "
              "(camera-space z), 0 where nothing is hit, 65535 for 65.535 m or more; row 0 at the top",
+    "classes": "images/NNNN_class.png: uint8 organ class per pixel (" + ", ".join(
+        f"{value} {name}" for value, name in enumerate(ORGAN_NAMES)) + "), from the same pass as the ids",
 }
 
 
@@ -76,6 +80,8 @@ class SceneRequest:
         depth: Write ``images/NNNN_depth.png`` for every view.
         antialiasing: Our renderer's antialiasing: ``fxaa``, ``msaa`` or ``none``.
         plants: The plant generator: ``canopy`` (default) or ``architecture``.
+        appearance: ``paper`` or ``random`` (:mod:`davis_ag.scene.appearance`).
+        classes: Write ``images/NNNN_class.png`` (organ classes) for every view.
     """
 
     scenario: ScenarioSpec
@@ -88,6 +94,14 @@ class SceneRequest:
     depth: bool = True
     antialiasing: str = "fxaa"
     plants: str = DEFAULT_PLANTS
+    appearance: str = "paper"
+    classes: bool = True
+
+    def __post_init__(self) -> None:
+        resolve_appearance(self.appearance)
+        if self.appearance != "paper" and self.renderer != "opengl":
+            raise UserError(f"appearance {self.appearance} needs our renderer: drop --renderer {self.renderer} "
+                            "or use --appearance paper")
 
     @property
     def seed(self) -> int:
@@ -159,7 +173,9 @@ def grow_scene(request: SceneRequest):
         The :class:`~davis_ag.scene.build.SceneModel` and its view grid.
     """
     rng = np.random.default_rng(request.seed)
-    model = build_scene(request.scenario, request.crop, rng, request.plants)
+    appearance = draw_appearance(request.appearance, request.seed)
+    model = build_scene(request.scenario, request.crop, rng, request.plants, soil_texture=appearance.soil)
+    model.lighting = appearance.lighting(model.lighting)
     grid = build_view_grid(request.scenario, request.crop, plant_centres(request.scenario, request.crop),
                            model.aim_height, rng)
     return model, grid
@@ -186,6 +202,8 @@ def draw_scene(request: SceneRequest, model, grid, root: Path, on_view: Callable
     lookup = fruit_lookup({f.id: f.uuids for f in model.fruits}, model.uuid_count)
     polygons = {f.id: f.polygons for f in model.fruits}
     fruit_uuids = {f.id: f.uuids for f in model.fruits}
+    # Organ class by id-buffer value (UUID + 1; 0 is the sky): the class image is one look-up.
+    class_of_id = np.concatenate([[SKY], model.organ_of_uuid()]).astype(np.uint8) if request.classes else None
     camera = request.camera
     scene_dir = root / request.folder
     writer = SceneWriter(scene_dir, resume_key(request, viewpoints))
@@ -201,6 +219,7 @@ def draw_scene(request: SceneRequest, model, grid, root: Path, on_view: Callable
                         on_view(done, len(viewpoints))
                     continue
                 colour, primitive_ids, depth = renderer.render(view, depth=request.depth)
+                classes = class_of_id[primitive_ids] if class_of_id is not None else None
                 labels = label_view(primitive_ids, lookup, request.min_fruit_pixels)
                 draw_silhouette = getattr(renderer, "silhouette_pixels", None)
                 silhouette = (lambda fruit_id, view=view: draw_silhouette(view, fruit_id, fruit_uuids[fruit_id])) \
@@ -210,7 +229,8 @@ def draw_scene(request: SceneRequest, model, grid, root: Path, on_view: Callable
                                         **grid.pointers(view.index)).to_json()
                 visible[view.image_name] = {str(k): v for k, v in fractions.items()}
                 writer.add_view(view.image_name, colour, labels.segmentation, entry,
-                                depth if request.depth else None, {"visible": visible[view.image_name]})
+                                depth if request.depth else None, {"visible": visible[view.image_name]},
+                                classes=classes)
                 if on_view:
                     on_view(done, len(viewpoints))
             writer.wait()  # every image written before the Visualizer's teardown moves the cwd
@@ -261,8 +281,14 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict) -> dict:
                      if request.renderer == "opengl" else "Helios Visualizer, 4x multisampled colour"},
         "depth": {"file": "images/NNNN_depth.png", "dtype": "uint16", "unit": "mm",
                   "axis": "optical (camera-space z)", "no_hit": 0} if request.depth else None,
+        "classes": {"file": "images/NNNN_class.png", "dtype": "uint8", "table": list(ORGAN_NAMES)}
+        if request.classes else None,
+        "appearance": draw_appearance(request.appearance, request.seed).summary(),
         "lighting": {"model": "phong_shadowed", "sun_elevation_deg": model.lighting.sun_elevation,
-                     "sun_azimuth_deg": model.lighting.sun_azimuth, "sun_direction": model.lighting.direction},
+                     "sun_azimuth_deg": model.lighting.sun_azimuth, "sun_direction": model.lighting.direction,
+                     "sun_strength": model.lighting.sun_strength, "exposure": model.lighting.exposure,
+                     "white_balance": list(model.lighting.white_balance),
+                     "sky_texture": Path(model.lighting.sky_texture).name if model.lighting.sky_texture else None},
         "grid": {"extent_m": list(request.scenario.extent), "step_m": request.scenario.step,
                  "altitudes_m": [request.crop.altitudes[i] for i in request.scenario.altitude_levels],
                  "headings": request.scenario.headings, "exclusion_radius_m": request.crop.exclusion_radius,

@@ -10,6 +10,7 @@ Format (every key but ``groups`` is optional)::
     depth: true                  # write images/NNNN_depth.png (uint16 mm) for every view
     antialiasing: fxaa           # our renderer's: fxaa (default), msaa (4x samples, slower) or none
     plants: canopy               # canopy (Helios's Canopy Generator, default) or architecture
+    appearance: paper            # paper (default) or random: sun, sky, soil, exposure, noise per scene
     strawberry_altitudes: table1 # table1 (25/40/55 cm, default) or readme (0.50/0.75/1.00 m)
     grid:                        # overrides the scenario's Table 2 grid for every group
       extent: [3.0, 3.0]         #   grid size along x and y, m
@@ -45,6 +46,7 @@ from davis_ag.errors import UserError
 from davis_ag.formats.models import MAX_SCENES, DatasetConfigFile, check_image_size, check_seed, one_line
 from davis_ag.generate.one_scene import SceneRequest
 from davis_ag.render.backends import DEFAULT_RENDERER, resolve_look
+from davis_ag.scene.appearance import resolve_appearance
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import (
     DEFAULT_PLANTS,
@@ -101,6 +103,7 @@ class DatasetConfig:
         depth: Whether every view gets a depth image.
         antialiasing: Our renderer's antialiasing: ``fxaa``, ``msaa`` or ``none``.
         plants: The plant generator: ``canopy`` (default) or ``architecture``.
+        appearance: ``paper`` or ``random`` (:mod:`davis_ag.scene.appearance`).
     """
 
     name: str
@@ -113,6 +116,7 @@ class DatasetConfig:
     depth: bool = True
     antialiasing: str = "fxaa"
     plants: str = DEFAULT_PLANTS
+    appearance: str = "paper"
 
     def requests(self, only: list[str] | None = None) -> list[SceneRequest]:
         """Every scene to make, in group order, optionally narrowed to some groups or scenes.
@@ -129,7 +133,7 @@ class DatasetConfig:
         """
         look = resolve_look(self.renderer, self.look)
         everything = [SceneRequest(g.scenario, g.crop, i, self.seed, self.camera, self.renderer, look, self.depth,
-                                   self.antialiasing, self.plants)
+                                   self.antialiasing, self.plants, self.appearance)
                       for g in self.groups for i in g.indices]
         if not only:
             return everything
@@ -155,7 +159,8 @@ def _normalise_scene_id(text: str) -> str:
 
 def single_group_config(scenario: str, crop: str, scenes: int, first: int, seed: int,
                         size: tuple[int, int], renderer: str = DEFAULT_RENDERER, look: str | None = None,
-                        depth: bool = True, antialiasing: str = "fxaa", plants: str = DEFAULT_PLANTS) -> DatasetConfig:
+                        depth: bool = True, antialiasing: str = "fxaa", plants: str = DEFAULT_PLANTS,
+                        appearance: str = "paper") -> DatasetConfig:
     """The dataset the classic flags (--scenario --crop --scenes --first) describe.
 
     Returns:
@@ -172,7 +177,7 @@ def single_group_config(scenario: str, crop: str, scenes: int, first: int, seed:
     size = check_image_size(size, "--size")
     resolve_look(renderer, look)
     return DatasetConfig("command line", seed, Camera(*size), (group,), "the command line", renderer, look, depth,
-                         antialiasing, check_plants(plants))
+                         antialiasing, check_plants(plants), resolve_appearance(appearance))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -255,7 +260,7 @@ def parse_dataset_config(text: str, source: str, default_name: str = "dataset") 
         groups.append(GroupConfig(apply_grid(scenario, changes, where), crop, entry.scenes, entry.first))
     return DatasetConfig((model.name or default_name).strip(), model.seed, Camera(*model.image_size), tuple(groups),
                          source, model.renderer, model.look, model.depth, model.antialiasing,
-                         model.plants)
+                         model.plants, model.appearance)
 
 
 def use_strawberry_altitudes(config: DatasetConfig, choice: str) -> DatasetConfig:

@@ -75,8 +75,9 @@ class SceneWriter:
         self._pending: list[tuple[str, list[Future], dict[str, Any]]] = []
 
     def add_view(self, name: str, colour: np.ndarray, segmentation: np.ndarray, entry: dict,
-                 depth: np.ndarray | None = None, extras: dict[str, Any] | None = None) -> None:
-        """Queue one view's image, segmentation, depth and annotations entry.
+                 depth: np.ndarray | None = None, extras: dict[str, Any] | None = None,
+                 classes: np.ndarray | None = None) -> None:
+        """Queue one view's image, segmentation, depth, organ classes and annotations entry.
 
         Args:
             name: Image name, ``NNNN.jpeg``.
@@ -87,15 +88,19 @@ class SceneWriter:
                 as ``NNNN_depth.png`` (uint16 millimetres) unless None.
             extras: JSON-ready data of the view the caller wants back when the scene is resumed
                 (``done[name]["extras"]``).
+            classes: (height, width) uint8 organ classes, written as ``NNNN_class.png`` unless None.
         """
         images = self.tmp_dir / IMAGES
         files = [self._pool.submit(write_view_files, images, name, colour=colour),
                  self._pool.submit(write_view_files, images, name, segmentation=segmentation)]
         if depth is not None:
             files.append(self._pool.submit(write_view_files, images, name, depth=depth))
+        if classes is not None:
+            files.append(self._pool.submit(write_view_files, images, name, classes=classes))
         self._pending.append((name, files, {"name": name, "entry": entry, "extras": extras or {},
                                             "files": [name, view_file_name(name, "mask")]
-                                            + ([view_file_name(name, "depth")] if depth is not None else [])}))
+                                            + ([view_file_name(name, "depth")] if depth is not None else [])
+                                            + ([view_file_name(name, "classes")] if classes is not None else [])}))
         self.annotations[name] = entry
         if len(self._pending) > 8:
             self._drain(keep=4)

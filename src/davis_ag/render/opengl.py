@@ -117,18 +117,20 @@ class OpenGLRenderer:
         ctx = self.ctx
         helios = self.look == "helios"
         look = ("HELIOS_LOOK",) if helios else ()
+        # Sensor noise is compiled in only where drawn: llvmpipe would pay for a branch on a uniform.
+        noisy = (*look, "SENSOR_NOISE") if self.lighting.noise_sigma > 0 else look
         self._programs = {
-            "scene": ctx.program(vertex_shader=_shader("scene.vert"), fragment_shader=_fragment("scene.frag", look)),
+            "scene": ctx.program(vertex_shader=_shader("scene.vert"), fragment_shader=_fragment("scene.frag", noisy)),
             "ids": ctx.program(vertex_shader=_shader("scene.vert"),
                                fragment_shader=_fragment("scene.frag", ("IDS_ONLY", *look))),
             "shadow": ctx.program(vertex_shader=_shader("shadow.vert"), fragment_shader=_fragment("shadow.frag", look)),
-            "sky": ctx.program(vertex_shader=_shader("sky.vert"), fragment_shader=_fragment("sky.frag", look)),
+            "sky": ctx.program(vertex_shader=_shader("sky.vert"), fragment_shader=_fragment("sky.frag", noisy)),
         }
         if self.antialiasing == "fxaa":
             self._programs["fxaa"] = ctx.program(vertex_shader=_shader("sky.vert"), fragment_shader=_shader("fxaa.frag"))
         if self.antialiasing == "none":  # colour and ids without the depth output, for render(depth=False)
             self._programs["no_depth"] = ctx.program(vertex_shader=_shader("scene.vert"),
-                                                     fragment_shader=_fragment("scene.frag", ("NO_DEPTH", *look)))
+                                                     fragment_shader=_fragment("scene.frag", ("NO_DEPTH", *noisy)))
         # The programs that shade the scene: the same uniforms for each.
         self._shading = [self._programs[k] for k in ("scene", "no_depth") if k in self._programs]
         # Samplers first: the shadow pass below samples leaf textures already.
@@ -224,8 +226,15 @@ class OpenGLRenderer:
         # Uniforms that hold for every view.
         for program in (*self._shading, self._programs["ids"]):
             self._set(program, "light_projection", gl_matrix(self._light))
-        self._set(self._programs["sky"], "exposure", EXPOSURE)
-        for name, value in (("sun", self.lighting.direction), ("exposure", EXPOSURE),
+        exposure = EXPOSURE * self.lighting.exposure
+        white_balance = tuple(float(v) for v in self.lighting.white_balance)
+        self._set(self._programs["sky"], "exposure", exposure)
+        self._set(self._programs["sky"], "white_balance", white_balance)
+        for program in (*self._shading, self._programs["sky"]):
+            self._set(program, "noise_sigma", float(self.lighting.noise_sigma))
+        for name, value in (("sun", self.lighting.direction), ("exposure", exposure),
+                            ("sun_strength", float(self.lighting.sun_strength)),
+                            ("white_balance", white_balance),
                             ("sky_ambient", SKY_AMBIENT),
                             ("ground_ambient", GROUND_AMBIENT), ("material", MATERIAL),
                             ("shadow_bias", SHADOW_BIAS),
@@ -291,6 +300,10 @@ class OpenGLRenderer:
             box = helios_shadow_box(self.camera, eye, target, self.lighting.direction)
             for program in self._shading:
                 self._set(program, "shadow_box", gl_matrix(box))
+        if self.lighting.noise_sigma > 0:  # a new noise pattern for every view, fixed by the scene's seed
+            seed = int(np.random.SeedSequence([self.lighting.noise_seed, view.index]).generate_state(1)[0])
+            for program in (*self._shading, self._programs["sky"]):
+                self._set(program, "noise_seed", seed)
         self._set(self._programs["sky"], "inverse_rotation_projection",
                   gl_matrix(np.linalg.inv(projection.astype(np.float64) @ rotation)))
 

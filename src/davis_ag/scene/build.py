@@ -121,8 +121,11 @@ def helios_texture(name: str) -> str:
     return str(path)
 
 
-def add_ground(context) -> None:
+def add_ground(context, soil_texture: str = "dirt.jpg") -> None:
     """Textured soil at z = 0: fine patches under the grid, a coarse ring out to the horizon.
+
+    Every soil primitive is labelled with the organ class ``soil``. ``soil_texture`` is an image
+    shipped with Helios (:func:`helios_texture`); randomised appearance picks others.
 
     Helios keeps textures at a low resolution, so a texture stretched over metres turns into a
     checkerboard of blocks; one texture per ``NEAR_PATCH`` patch keeps the soil's grain. The far
@@ -131,10 +134,12 @@ def add_ground(context) -> None:
     """
     from pyhelios.types import int2, vec2, vec3
 
-    texture = helios_texture("dirt.jpg")
+    from davis_ag.scene.organ_labels import label_soil
+
+    texture = helios_texture(soil_texture)
     patches = int(round(NEAR_SIZE / NEAR_PATCH))
-    context.addTileObject(center=vec3(0.0, 0.0, 0.0), size=vec2(NEAR_SIZE, NEAR_SIZE),
-                          subdiv=int2(patches, patches), texturefile=texture)
+    tiles = [context.addTileObject(center=vec3(0.0, 0.0, 0.0), size=vec2(NEAR_SIZE, NEAR_SIZE),
+                                   subdiv=int2(patches, patches), texturefile=texture)]
     band = (GROUND_SIZE - NEAR_SIZE) / 2
     offset = (NEAR_SIZE + band) / 2
     strips = [  # (centre x, centre y, size x, size y): north, south, east, west
@@ -143,8 +148,9 @@ def add_ground(context) -> None:
     ]
     for x, y, width, depth in strips:
         repeats = int2(max(1, round(width / FAR_REPEAT)), max(1, round(depth / FAR_REPEAT)))
-        context.addTileObject(center=vec3(x, y, 0.0), size=vec2(width, depth), subdiv=int2(1, 1),
-                              texturefile=texture, texture_repeat=repeats)
+        tiles.append(context.addTileObject(center=vec3(x, y, 0.0), size=vec2(width, depth), subdiv=int2(1, 1),
+                                           texturefile=texture, texture_repeat=repeats))
+    label_soil(context, tiles)
 
 
 def _fruit(context, fruit_id: int, plant: int, body: list[int]) -> Fruit:
@@ -205,7 +211,7 @@ def _grow_canopy_plants(context, scenario: ScenarioSpec, crop: CropSpec, rng: np
 
 
 def build_scene(scenario: ScenarioSpec, crop: CropSpec, rng: np.random.Generator,
-                plants: str = DEFAULT_PLANTS) -> SceneModel:
+                plants: str = DEFAULT_PLANTS, soil_texture: str = "dirt.jpg") -> SceneModel:
     """Grow a scene's plants on soil, choose the sun and number the fruit.
 
     Args:
@@ -213,6 +219,7 @@ def build_scene(scenario: ScenarioSpec, crop: CropSpec, rng: np.random.Generator
         crop: The crop.
         rng: The scene's only source of randomness.
         plants: The plant generator (:data:`~davis_ag.scene.specs.PLANT_GENERATORS`).
+        soil_texture: The soil's image (:func:`add_ground`).
 
     Returns:
         The :class:`SceneModel`.
@@ -223,7 +230,7 @@ def build_scene(scenario: ScenarioSpec, crop: CropSpec, rng: np.random.Generator
     context = Context()
     grow = _grow_canopy_plants if check_plants(plants) == "canopy" else _grow_architecture_plants
     grown = grow(context, scenario, crop, rng)
-    add_ground(context)
+    add_ground(context, soil_texture)
 
     fruits: list[Fruit] = []
     for plant in grown:

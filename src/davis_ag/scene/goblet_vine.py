@@ -36,6 +36,8 @@ ARM_COUNT = (4, 6)
 BERRY_COLOUR = (0.26, 0.12, 0.30)
 #: Berry radius and leaf length of the library's grapevine shoots as built, for the first guess.
 DEFAULT_SIZES = (0.0085, 0.16)
+#: The vine's woody shoot types, labelled ``trunk`` (the cane wood the arms are made of included).
+WOODY_SHOOTS = ("grapevine_trunk", "goblet_arm")
 
 
 def load_vine_model(plant_architecture) -> dict[str, dict]:
@@ -109,7 +111,7 @@ def grow_goblet_vine(
         "leaf_length": target.leaf_length / DEFAULT_SIZES[1],
     }
     vine = grow_to_target(context, plant_architecture, crop, index, position, target, seed, build,
-                          first_knobs, blades_per_leaf(shoot_defaults))
+                          first_knobs, blades_per_leaf(shoot_defaults), woody_shoots=WOODY_SHOOTS)
     # The library's berries are near black (0.05, 0.08, 0.1) and render as silhouettes.
     from pyhelios.types import RGBcolor
 

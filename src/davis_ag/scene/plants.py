@@ -33,6 +33,7 @@ from typing import Callable
 import numpy as np
 
 from davis_ag.errors import UserError
+from davis_ag.scene.organ_labels import label_architecture_plant
 from davis_ag.scene.plant_geometry import (  # noqa: F401 - re-exported for the plant builders
     berry_radii,
     fruit_body_uuids,
@@ -310,6 +311,7 @@ def grow_to_target(
     build: BuildPlant,
     first_knobs: dict[str, float],
     blades_per_leaf: int,
+    woody_shoots: tuple[str, ...] = (),
 ) -> GrownPlant:
     """Build, measure, correct and rebuild a plant until it matches its target phenotype.
 
@@ -326,9 +328,10 @@ def grow_to_target(
             parameters) and a seed.
         first_knobs: The knobs of the first build.
         blades_per_leaf: Leaf blades on one petiole, to measure whole leaves.
+        woody_shoots: Shoot types labelled ``trunk`` (see :mod:`davis_ag.scene.organ_labels`).
 
     Returns:
-        The grown plant, left in the context.
+        The grown plant, left in the context, every primitive labelled with its organ class.
     """
     builds = 0
     started = time.perf_counter()
@@ -347,6 +350,7 @@ def grow_to_target(
             in_range = in_table_range(measured, crop)
             on_target = max(relative_error(measured, target).values()) <= TOLERANCE and in_range
             if on_target or (attempt == MAX_BUILDS - 1 and in_range):
+                label_architecture_plant(context, plant_architecture, plant_id, woody_shoots)
                 return GrownPlant(index, seed, position, target, measured, list(fruit),
                                   list(plant_architecture.getAllPlantUUIDs(plant_id)), builds,
                                   build_s=time.perf_counter() - started)

@@ -85,7 +85,11 @@ def evaluation_split(root: Path, scenario: str, crop: str) -> str:
 
 def run_baselines(root: Path, scenario: str, crop: str, split: str, episodes: int, sessions: int,
                   seed: int = 0, model: Path | None = None) -> dict[str, Any]:
-    """Evaluate LRD, UDD, Rand, Oracle (and A2C when ``model`` is given) as in Table 4.
+    """Evaluate LRD, UDD, Rand, Oracle, the Best fixed action (and A2C when ``model`` is given)
+    as in Table 4.
+
+    A2C plays as :data:`davis_ag.benchmark.agents.A2C_DETERMINISTIC` says (sampled); the same model taking
+    its most likely action is the extra row ``A2C (deterministic)``.
 
     Args:
         root: The dataset root.
@@ -101,14 +105,18 @@ def run_baselines(root: Path, scenario: str, crop: str, split: str, episodes: in
         What :func:`davis_ag.benchmark.evaluation.evaluate_agents` returns.
     """
     from davis_ag.benchmark import TVMEnv
-    from davis_ag.benchmark.agents import build_agents
+    from davis_ag.benchmark.agents import A2C_DETERMINISTIC, A2CAgent, build_agents
     from davis_ag.benchmark.evaluation import evaluate_agents
 
-    names = list(BASELINES) + (["A2C"] if model else [])
-    agents = build_agents(names, model=model)
+    agents = build_agents(list(BASELINES))
+    if model:
+        agents = build_agents(["A2C"], model=model, deterministic=A2C_DETERMINISTIC) + agents
+        deterministic = A2CAgent(agents[0].model, deterministic=True)
+        deterministic.name = "A2C (deterministic)"
+        agents.insert(1, deterministic)
     env = TVMEnv(root, scenario=scenario, split=split, crop=crop)
     results = evaluate_agents(env, agents, episodes=episodes, sessions=sessions, seed=seed,
-                              keep_episodes=True)
+                              keep_episodes=True, best_fixed_action=True)
     results["protocol"]["crop"] = crop
     env.close()
     return results

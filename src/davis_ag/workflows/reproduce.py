@@ -87,8 +87,8 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
     """
     from davis_ag.atomic_files import prove_writable_file, prove_writable_folder, write_or_rescue
     from davis_ag.benchmark.evaluation import format_table, write_json
+    from davis_ag.benchmark.training import A2C_SETTINGS, train_a2c
     from davis_ag.figures.result_charts import plot_results
-    from davis_ag.benchmark.training import train_a2c
     from davis_ag.data.validate import validate_dataset
     from davis_ag.generate.one_scene import SceneRequest
     from davis_ag.scene.camera import Camera
@@ -152,14 +152,16 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
         model = out / "models" / f"a2c_{key}.zip"
         timesteps = config.sp_timesteps if scenario_name == "sp" else config.mp_timesteps
         stamp = out / "models" / f"a2c_{key}.json"
-        if not model.is_file() or load_state(stamp).get("timesteps") != timesteps:
+        # A model made with other A2C settings (or before they were recorded) is trained anew.
+        made = load_state(stamp)
+        if not model.is_file() or made.get("timesteps") != timesteps or made.get("a2c_settings") != A2C_SETTINGS:
             print(f"training A2C (the paper's network) on {key} train split for {timesteps} steps", flush=True)
             start = time.perf_counter()
             train_a2c(root, scenario_name, total_timesteps=timesteps, seed=config.seed,
                       out_path=model, n_envs=config.n_envs, crop=crop_name, device="cpu",
                       callback=_progress_callback(timesteps, key))
             seconds = time.perf_counter() - start
-            write_json_atomic(stamp, {"timesteps": timesteps, "seconds": seconds})
+            write_json_atomic(stamp, {"timesteps": timesteps, "seconds": seconds, "a2c_settings": A2C_SETTINGS})
             record(f"{key}: train A2C", seconds,
                    f"{timesteps} steps, {timesteps / seconds:.1f} steps/s (incl. cache build)")
         print(f"benchmark on split {split!r}: {config.sessions} x {config.episodes} episodes", flush=True)
@@ -193,15 +195,24 @@ def _reusable_results(path: Path, model: Path, split: str, config: ReproduceConf
         return None
     same = (protocol.get("split") == split and protocol.get("episodes") == config.episodes
             and protocol.get("sessions") == config.sessions and protocol.get("seed") == config.seed)
-    return results if fresh and same and "A2C" in results.get("policies", {}) else None
+    # Evaluations from before the Best fixed action row and the uniform start rule are run anew.
+    current = protocol.get("start_rule") == "pairs" and "Best fixed action" in results.get("policies", {})
+    return results if fresh and same and current and "A2C" in results.get("policies", {}) else None
 
 
 def _summary(results: dict[str, Any]) -> dict[str, Any]:
-    """The part of the evaluation results that results.md needs."""
-    return {"protocol": results["protocol"],
-            "policies": {name: {k: {"mean": v["mean"], "std": v["std"]} for k, v in stats.items()
-                                if isinstance(v, dict) and "mean" in v}
-                         for name, stats in results["policies"].items()}}
+    """The part of the evaluation results that results.md needs: per policy the metrics' mean, std
+    and standard error, the exact expectations, action counts, how A2C played, the fixed action;
+    and the exact values of every fixed action."""
+    kept = ("exact", "action_counts", "play", "action")
+    summary = {"protocol": results["protocol"],
+               "policies": {name: {**{k: {s: v[s] for s in ("mean", "std", "sem") if s in v}
+                                      for k, v in stats.items() if isinstance(v, dict) and "mean" in v},
+                                   **{k: stats[k] for k in kept if k in stats}}
+                            for name, stats in results["policies"].items()}}
+    if "fixed_actions" in results:
+        summary["fixed_actions"] = results["fixed_actions"]
+    return summary
 
 
 def _progress_callback(total: int, label: str) -> Any:

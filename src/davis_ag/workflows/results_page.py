@@ -16,7 +16,9 @@ from collections import Counter
 from pathlib import Path
 from typing import Any
 
+from davis_ag.benchmark.exact import BEST_FIXED
 from davis_ag.formats.layout import SCENE_METADATA
+from davis_ag.workflows.results_policies import learning_curve_section, ordered, policy_sections
 
 #: Table 4 of the paper: scenario -> metric -> policy -> value.
 PAPER_TABLE4: dict[str, dict[str, dict[str, float]]] = {
@@ -110,6 +112,13 @@ def _cell(value: float | None) -> str:
     return text[1:] if text.startswith("0.") else text
 
 
+def _a2c_play(state: dict[str, Any]) -> str:
+    """How the run's A2C played: ``sampled``, ``deterministic`` (the default before it was recorded)."""
+    plays = {r["policies"]["A2C"].get("play", "deterministic")
+             for r in state.get("results", {}).values() if "A2C" in r.get("policies", {})}
+    return "sampled" if plays == {"sampled"} else "deterministic" if plays <= {"deterministic"} else "sampled and deterministic"
+
+
 def _load(path: Path) -> dict[str, Any]:
     try:
         data = json.loads(path.read_text())
@@ -185,8 +194,16 @@ def _notes(config: Any, state: dict[str, Any], out: Path | None) -> list[str]:
                  "work may share the machine, so rates (e.g. A2C steps/s) can vary between stages.")
     notes.append("Oracle is not in the paper: it plays the best reachable final OER within tau "
                  "steps from the environment's tables, an upper bound for any policy.")
-    notes.append("Episode starts follow section V-C: a boxed target with OER < 0.4 and at least the "
-                 "crop's pixel threshold; reward max(OER_end - OER_0, 0)^2 at the end.")
+    for scenario, result in state.get("results", {}).items():
+        protocol = result["protocol"]
+        rule = protocol.get("start_rule", "scene")
+        how = ("uniform over every eligible (view, target) pair of the split's scenes" if rule == "pairs" else
+               "a scene first, then a view of it, then a target, each uniformly (the rule before; a scene "
+               "with few eligible starts gets as many episodes as one with many)")
+        count = f" ({protocol['starts']} eligible starts)" if "starts" in protocol else ""
+        notes.append(f"{scenario.upper()} episode starts{count}: {how}. Eligible (section V-C): a boxed target "
+                     "with OER < 0.4 and at least the crop's pixel threshold; reward max(OER_end - OER_0, 0)^2 "
+                     "at the end.")
     return notes
 
 
@@ -278,7 +295,8 @@ def readme_block(config: Any, state: dict[str, Any]) -> str:
             f"MP vine scenes at {config.size[0]}x{config.size[1]}, A2C {config.sp_timesteps:,} (SP) and "
             f"{config.mp_timesteps:,} (MP) steps; OER_tau, mean ± std over {config.sessions} sessions of "
             f"{config.episodes} episodes on the split each row names. Table 4's rows are the paper's.")
-    lines = [head, "", "| | A2C | LRD | UDD | Rand | Oracle (ours only) |", "|---|---|---|---|---|---|"]
+    lines = [head, "", "| | A2C | LRD | UDD | Rand | Oracle (ours only) | Best fixed action (ours only) |",
+             "|---|---|---|---|---|---|---|"]
     verdicts = []
     for scenario in ("sp", "mp"):
         result = results.get(scenario)
@@ -286,7 +304,7 @@ def readme_block(config: Any, state: dict[str, Any]) -> str:
             policies = result["policies"]
             scenes, split = len(result["protocol"].get("scenes", [])), result["protocol"]["split"]
             cells = [f"{_cell(policies[n]['oer_tau']['mean'])} ± {_cell(policies[n]['oer_tau']['std'])}"
-                     if n in policies else "–" for n in ("A2C", "LRD", "UDD", "Rand", "Oracle")]
+                     if n in policies else "–" for n in ("A2C", "LRD", "UDD", "Rand", "Oracle", BEST_FIXED)]
             lines.append(f"| {TITLES[scenario]}, ours ({scenes} {split} scene{'s' if scenes != 1 else ''}) | "
                          + " | ".join(cells) + " |")
             failures = ordering_failures(PAPER_ORDERINGS[scenario], policies)
@@ -294,11 +312,11 @@ def readme_block(config: Any, state: dict[str, Any]) -> str:
                        else "**does not hold** (" + "; ".join(failures) + ")")
             verdicts.append(f"{TITLES[scenario]}: {' '.join(PAPER_ORDERINGS[scenario])} {verdict}.")
         else:
-            lines.append(f"| {TITLES[scenario]}, ours | not run | | | | |")
+            lines.append(f"| {TITLES[scenario]}, ours | not run | | | | | |")
         paper = PAPER_TABLE4[scenario]["oer_tau"]
         lines.append(f"| {TITLES[scenario]}, paper (Table 4) | "
                      + " | ".join(f"{_cell(paper[n])} ± {_cell(PAPER_TABLE4_STD[scenario]['oer_tau'][n])}"
-                                  for n in ("A2C", "LRD", "UDD", "Rand")) + " | - |")
+                                  for n in ("A2C", "LRD", "UDD", "Rand")) + " | - | - |")
     if verdicts:
         lines += ["", "The paper's orderings in this run (`~`: means within their two standard deviations "
                   "added): " + " ".join(verdicts)]
@@ -340,7 +358,7 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
         f"{config.seed}; box thresholds scaled by image area; A2C (SB3 defaults, the paper's "
         f"network of section V-B, {config.n_envs} environments) for {config.sp_timesteps:,} (SP) and "
         f"{config.mp_timesteps:,} (MP) environment steps; evaluation {config.sessions} sessions x "
-        f"{config.episodes} episodes, seed {config.seed}, A2C deterministic.",
+        f"{config.episodes} episodes, seed {config.seed}, A2C {_a2c_play(state)}.",
         "- **Paper**: 86 SP strawberry and 44 MP vine scenes at 1280x720 (Table 3), A2C for 300K "
         "steps, 3 sessions x 200 episodes on the test split.",
         f"- **Machine**: {machine_description()}.",
@@ -358,9 +376,7 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
                   f"sessions of {protocol['episodes']} episodes.", "",
                   "| Policy | OER_tau ours | OER_tau paper | Cum. reward ours | Cum. reward paper "
                   "| Ep. length ours | Ep. length paper |", "|---|---|---|---|---|---|---|"]
-        for name in ("A2C", "LRD", "UDD", "Rand", "Oracle"):
-            if name not in policies:
-                continue
+        for name in ordered(policies):
             cells = [name]
             for metric in ("oer_tau", "reward", "length"):
                 stat = policies[name][metric]
@@ -373,6 +389,8 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
         if "oer_0" in policies.get("LRD", {}):
             lines += ["", f"Mean start OER (OER_0) of these episodes: {_cell(policies['LRD']['oer_0']['mean'])}."]
         lines.append("")
+        lines += policy_sections(scenario, result, out, Path(path))
+    lines += learning_curve_section(out, Path(path))
     lines += ["## Notes", ""] + [f"- {note}" for note in _notes(config, state, out)] + [""]
     lines += _how_made(state, out)
     lines += ["## Wall time per stage", "", "| Stage | Seconds | Code | Note |", "|---|---|---|---|"]

@@ -28,6 +28,35 @@ vec3 encode_srgb(vec3 c) {
     return mix(1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, c * 12.92, vec3(lessThanEqual(c, vec3(0.0031308))));
 }
 
+#ifdef SENSOR_NOISE
+// Sensor noise (randomised appearance), compiled in only where asked for: Gaussian, in grey levels
+// of the 8-bit output, per pixel and channel from an integer hash (PCG) of the pixel and the
+// view's seed. Each channel sums the four bytes of one hash (Irwin-Hall: near Gaussian, within
+// +-3.5 sigma): three hashes and some adds per fragment, cheaper on a software rasteriser than
+// Box-Muller's logarithms and cosines, and no pass or read-back of its own.
+uniform float noise_sigma;      // standard deviation, grey levels of 255
+uniform uint noise_seed;        // one per view
+
+uint pcg_hash(uint v) {
+    uint state = v * 747796405u + 2891336453u;
+    uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+float byte_sum(uint h) {
+    return float((h & 255u) + ((h >> 8u) & 255u) + ((h >> 16u) & 255u) + (h >> 24u));
+}
+
+vec3 sensor_noise() {
+    uvec2 p = uvec2(gl_FragCoord.xy);
+    uint h = pcg_hash(p.x ^ pcg_hash(p.y ^ noise_seed));
+    uint h2 = pcg_hash(h), h3 = pcg_hash(h2);
+    // Four bytes: mean 510, standard deviation 2 * 73.9 = 147.8 grey levels.
+    vec3 sums = vec3(byte_sum(h), byte_sum(h2), byte_sum(h3));
+    return (sums - 510.0) * (noise_sigma / (147.8 * 255.0));
+}
+#endif
+
 // Narkowicz's fit of the ACES curve, on radiance scaled by 0.6 as his note advises for the
 // unmodified ACES response.
 vec3 tone_curve(vec3 x) {

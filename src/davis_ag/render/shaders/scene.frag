@@ -6,6 +6,8 @@ uniform sampler2D shadow_map;
 uniform vec3 sun;               // unit vector towards the sun
 uniform vec3 eye;               // camera position
 uniform float exposure;
+uniform float sun_strength;     // factor on the direct light (randomised appearance; 1 otherwise)
+uniform vec3 white_balance;     // gains on linear red, green and blue (1, 1, 1 otherwise)
 uniform vec3 sky_ambient;
 uniform vec3 ground_ambient;
 uniform vec4 material;          // ambient, diffuse, specular weights and shininess
@@ -93,7 +95,11 @@ void main() {
     if (lambert > 0.0) {
         direct += vec3(material.z * pow(max(dot(normal, normalize(sun + to_eye)), 0.0), material.w));
     }
-    vec3 radiance = vec3(1.0, 0.9, 0.8) * (ambient + sunlit(normal) * direct);
-    out_colour = vec4(encode_srgb(tone_curve(radiance * exposure)), 1.0);
+    vec3 radiance = vec3(1.0, 0.9, 0.8) * (ambient + sunlit(normal) * sun_strength * direct);
+    vec3 encoded = encode_srgb(tone_curve(radiance * white_balance * exposure));
+#ifdef SENSOR_NOISE
+    encoded += sensor_noise();  // the 8-bit attachment clamps to [0, 1] and rounds
+#endif
+    out_colour = vec4(encoded, 1.0);
 #endif
 }

@@ -4,6 +4,7 @@ uniform sampler2D sky;
 uniform vec2 sky_scale;
 uniform mat4 inverse_rotation_projection;  // clip space -> world direction (camera rotation only)
 uniform float exposure;
+uniform vec3 white_balance;
 
 in vec2 ndc;
 
@@ -23,7 +24,11 @@ void main() {
 #else
     vec3 c = textureLod(sky, vec2(fract(coordinate.x), coordinate.y), 0.0).rgb;
 #endif
-    out_colour = vec4(encode_srgb(tone_curve(decode_srgb(c) * exposure)), 1.0);
+    vec3 encoded = encode_srgb(tone_curve(decode_srgb(c) * white_balance * exposure));
+#ifdef SENSOR_NOISE
+    encoded += sensor_noise();
+#endif
+    out_colour = vec4(encoded, 1.0);
     out_id = 0u;
     out_depth = 0.0;
 }

@@ -1,0 +1,51 @@
+"""Checks of an organ class image (``images/NNNN_class.png``) against its view's instance mask."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from davis_ag.data.annotation_schema import NO_FRUIT
+from davis_ag.scene.organs import FRUIT, ORGAN_NAMES
+
+
+def class_problems(class_path: Path, mask_path: Path | None) -> list[str]:
+    """Check a class image: 8-bit, one channel, known class values, the mask's size, and every
+    fruit pixel of the instance mask labelled ``fruit`` (both come from the same id pass).
+
+    Args:
+        class_path: ``images/NNNN_class.png``.
+        mask_path: The view's ``_seg.png``, when present.
+
+    Returns:
+        One reason per problem.
+    """
+    from PIL import Image
+
+    try:
+        with Image.open(class_path) as im:
+            mode, classes = im.mode, np.asarray(im)
+    except Exception as error:  # Pillow raises many types for a damaged file
+        return [f"cannot decode ({error})"]
+    if mode not in ("L", "P") or classes.dtype != np.uint8 or classes.ndim != 2:
+        return [f"must be a uint8 single-channel PNG, got mode {mode}"]
+    problems = []
+    unknown = np.unique(classes[classes >= len(ORGAN_NAMES)])
+    if unknown.size:
+        problems.append(f"holds class values {unknown.tolist()[:5]}, not in the table 0..{len(ORGAN_NAMES) - 1} "
+                        f"({', '.join(ORGAN_NAMES)})")
+    if mask_path is None:
+        return problems
+    try:
+        with Image.open(mask_path) as im:
+            mask = np.asarray(im)
+    except Exception:  # the mask's own check reports it
+        return problems
+    if mask.shape != classes.shape:
+        return problems + [f"is {classes.shape[1]}x{classes.shape[0]} but its mask is {mask.shape[1]}x{mask.shape[0]}"]
+    fruit = mask != NO_FRUIT
+    wrong = int(np.count_nonzero(fruit & (classes != FRUIT)))
+    if wrong:
+        problems.append(f"{wrong} of {int(fruit.sum())} fruit pixels of the mask are not class {FRUIT} (fruit)")
+    return problems

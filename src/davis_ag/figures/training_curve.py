@@ -1,0 +1,65 @@
+"""Fig. 4a: episodic reward while A2C trains, from the learning curve in a model's training record
+(``NAME.training.json``, written by :func:`davis_ag.benchmark.training.train_a2c`)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from davis_ag.errors import UserError
+from davis_ag.figures.canvas import FORMATS, Plotted, new_figure, save_formats
+
+#: Points (of 1K steps each) in the rolling average drawn over the raw curve, as the paper's
+#: "some level of rolling average applied for clarity".
+ROLLING_POINTS = 10
+
+
+def rolling_mean(values: np.ndarray, weights: np.ndarray, window: int) -> np.ndarray:
+    """Episode-weighted mean over the last ``window`` points (fewer at the start)."""
+    kernel = np.ones(window)
+    sums = np.convolve(values * weights, kernel)[: len(values)]
+    counts = np.convolve(weights, kernel)[: len(values)]
+    return sums / np.maximum(counts, 1e-12)
+
+
+def plot_learning_curve(records: dict[str, dict[str, Any]], out: str | Path,
+                        formats: tuple[str, ...] = FORMATS, window: int = ROLLING_POINTS) -> Plotted:
+    """Fig. 4a: mean episodic reward per 1K training steps, with a rolling average, per model.
+
+    Args:
+        records: Label (e.g. ``sp-strawberry``) to a training record with a ``curve``.
+        out: Output path without suffix.
+        formats: File formats to write.
+        window: Points in the rolling average.
+
+    Returns:
+        The paths and ``{label: {"steps": [...], "reward": [...], "smoothed": [...]}}``.
+
+    Raises:
+        UserError: when no record has a learning curve (models trained before curves were kept).
+    """
+    curves = {label: r["curve"] for label, r in records.items() if r.get("curve")}
+    if not curves:
+        raise UserError("no training record holds a learning curve: retrain with this version of "
+                        "`davis-ag train`, which keeps one in NAME.training.json")
+    figure = new_figure(6.0, 3.6)
+    axes = figure.add_subplot(1, 1, 1)
+    data = {}
+    for k, (label, curve) in enumerate(curves.items()):
+        steps = np.array([p["step"] for p in curve], dtype=float)
+        reward = np.array([p["reward"] for p in curve], dtype=float)
+        episodes = np.array([p["episodes"] for p in curve], dtype=float)
+        smoothed = rolling_mean(reward, episodes, window)
+        axes.plot(steps / 1000, reward, color=f"C{k}", alpha=0.25, linewidth=0.8)
+        axes.plot(steps / 1000, smoothed, color=f"C{k}", linewidth=1.8, label=label)
+        data[label] = {"steps": steps.astype(int).tolist(), "reward": reward.tolist(),
+                       "smoothed": smoothed.tolist()}
+    axes.set_xlabel("training steps (thousands)")
+    axes.set_ylabel("episodic reward")
+    axes.set_title(f"A2C learning curve: mean reward per 1K steps (faint), rolling mean of {window} (bold)",
+                   fontsize=8)
+    axes.legend(fontsize=8)
+    figure.tight_layout()
+    return Plotted(save_formats(figure, out, formats), data)

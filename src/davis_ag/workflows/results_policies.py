@@ -1,0 +1,179 @@
+"""The parts of ``docs/results.md`` that show what each policy does, from a run's own records.
+
+Per scenario: whether A2C beats the ``Best fixed action`` row, the exact expectations of the
+image-blind policies beside their sampled means, each policy's action histogram (a table and
+Fig. 4c as a picture), and how A2C was trained and played; then the learning curve (Fig. 4a)
+from the training records. Pictures go to ``images/`` beside the page.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from davis_ag.benchmark.exact import BEST_FIXED
+
+#: Row order of the policies on the page.
+POLICY_ORDER = ("A2C", "A2C (deterministic)", "LRD", "UDD", "Rand", BEST_FIXED, "Oracle")
+GROUPS = {"sp": "sp-strawberry", "mp": "mp-vine"}
+
+
+def cell(value: float | None) -> str:
+    """Table 4 style: three decimals, no leading zero below 1 (``.433``)."""
+    if value is None:
+        return "–"
+    text = f"{value:.3f}"
+    return text[1:] if text.startswith("0.") else text
+
+
+def _load(path: Path) -> dict[str, Any]:
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return {}
+    return data if isinstance(data, dict) else {}
+
+
+def ordered(policies: dict[str, Any]) -> list[str]:
+    """The run's policy names in page order (unknown names last, as they came)."""
+    return [n for n in POLICY_ORDER if n in policies] + [n for n in policies if n not in POLICY_ORDER]
+
+
+def versus_best_fixed(policies: dict[str, Any]) -> str | None:
+    """Whether A2C's OER_tau beats the Best fixed action's by more than their stds added."""
+    if "A2C" not in policies or BEST_FIXED not in policies:
+        return None
+    a, b = policies["A2C"]["oer_tau"], policies[BEST_FIXED]["oer_tau"]
+    gap, spread = a["mean"] - b["mean"], a["std"] + b["std"]
+    action = policies[BEST_FIXED].get("action", "?")
+    verdict = ("**beats** it" if gap > spread else
+               "**does not beat** it by more than their standard deviations added")
+    return (f"A2C against `{BEST_FIXED}` (always `{action}`): OER_tau {cell(a['mean'])} ± {cell(a['std'])} "
+            f"against {cell(b['mean'])} ± {cell(b['std'])}, {cell(gap) if gap >= 0 else '-' + cell(-gap)} "
+            f"apart, stds added {cell(spread)}: A2C {verdict}.")
+
+
+def exact_table(policies: dict[str, Any], fixed: dict[str, dict[str, float]] | None) -> list[str]:
+    """Sampled mean ± standard error beside the exact expectation, per image-blind policy."""
+    names = [n for n in ordered(policies) if "exact" in policies[n]]
+    if not names:
+        return []
+    lines = ["Exact expectations (dynamic programming over the environment's move tables, every start "
+             "of the split weighted as episodes draw it) beside the sampled means (± standard error of "
+             "the mean over all episodes):", "",
+             "| Policy | OER_tau sampled | OER_tau exact | Reward sampled | Reward exact "
+             "| Length sampled | Length exact |", "|---|---|---|---|---|---|---|"]
+    for name in names:
+        row = [name]
+        for key in ("oer_tau", "reward", "length"):
+            stat = policies[name][key]
+            row += [f"{cell(stat['mean'])} ± {cell(stat.get('sem'))}", cell(policies[name]["exact"][key])]
+        lines.append("| " + " | ".join(row) + " |")
+    if fixed:
+        lines += ["", "Exact OER_tau of every fixed action on this split: "
+                  + ", ".join(f"{action} {cell(v['oer_tau'])}" for action, v in fixed.items()) + "."]
+    return lines + [""]
+
+
+def action_table(policies: dict[str, Any], actions: list[str]) -> list[str]:
+    """Share of each action per policy over every episode played (Fig. 4c as a table)."""
+    names = [n for n in ordered(policies) if "action_counts" in policies[n]]
+    if not names or not actions:
+        return []
+    lines = ["Share of each action over every step played (%):", "",
+             "| Policy | " + " | ".join(actions) + " |", "|---" * (len(actions) + 1) + "|"]
+    for name in names:
+        counts = policies[name]["action_counts"]
+        total = max(sum(counts.values()), 1)
+        lines.append(f"| {name} | " + " | ".join(f"{100 * counts.get(a, 0) / total:.0f}" for a in actions) + " |")
+    return lines + [""]
+
+
+def a2c_line(scenario: str, policies: dict[str, Any], out: Path | None) -> str | None:
+    """How A2C was trained (its settings, from the training record) and how it played."""
+    from davis_ag.benchmark.training import SB3_DEFAULT_SETTINGS, training_record_path
+
+    if "A2C" not in policies:
+        return None
+    record = _load(training_record_path(out / "models" / f"a2c_{GROUPS[scenario]}.zip")) if out else {}
+    settings = record.get("a2c_settings", SB3_DEFAULT_SETTINGS if record else None)
+    trained = ("settings not recorded" if settings is None else
+               ", ".join(f"{k}={v}" for k, v in settings.items()) + " over Stable-Baselines3's A2C defaults"
+               " (learning rate 7e-4, n_steps 5, gamma .99, vf_coef .5, max_grad_norm .5, RMSprop)")
+    play = policies["A2C"].get("play", "deterministic")
+    how = ("actions sampled from the policy" if play == "sampled"
+           else "the most likely action at every step (deterministic)")
+    text = (f"A2C: trained with {trained}, on starts drawn by the `{record.get('start_rule', 'scene')}` rule; "
+            f"plays {how}.")
+    if "A2C (deterministic)" in policies:
+        text += " `A2C (deterministic)` is the same model taking its most likely action."
+    text += " The settings and the play were chosen on training scenes only (tools/a2c_trials.py)."
+    return text
+
+
+def action_figure(scenario: str, out: Path | None, page: Path) -> str | None:
+    """Draw Fig. 4c/5 of the run's results into ``images/`` beside the page; its Markdown link."""
+    from davis_ag.errors import UserError
+    from davis_ag.figures.benchmark_plots import plot_actions
+
+    results = _load(out / "results" / f"{GROUPS[scenario]}.json") if out else {}
+    if not results.get("policies"):
+        return None
+    target = page.parent / "images" / f"results-{GROUPS[scenario]}-actions"
+    try:
+        plot_actions(results, target, formats=("png",), source=f"{GROUPS[scenario]}.json")
+    except (UserError, KeyError, TypeError):
+        return None  # results from before per-episode records: the table above still shows the shares
+    return f"![actions per policy and A2C's choices, {GROUPS[scenario]}](images/{target.name}.png)"
+
+
+def learning_curve_section(out: Path | None, page: Path) -> list[str]:
+    """Fig. 4a from the run's training records, drawn into ``images/`` beside the page."""
+    from davis_ag.benchmark.training import training_record_path
+    from davis_ag.errors import UserError
+    from davis_ag.figures.training_curve import plot_learning_curve
+
+    if out is None:
+        return []
+    records = {key: _load(training_record_path(out / "models" / f"a2c_{key}.zip")) for key in GROUPS.values()}
+    records = {key: r for key, r in records.items() if r}
+    if not records:
+        return []
+    target = page.parent / "images" / "results-learning-curve"
+    try:
+        plotted = plot_learning_curve(records, target, formats=("png",))
+    except UserError:
+        return ["## A2C learning curve", "", "The training records hold no learning curve (models trained "
+                "before curves were kept).", ""]
+    lines = ["## A2C learning curve", "",
+             "Mean episodic reward per 1,000 training steps on the train split (Fig. 4a), read from "
+             "each model's training record:", "", f"![A2C learning curve](images/{target.name}.png)", ""]
+    for key, data in plotted.data.items():
+        smoothed = data["smoothed"]
+        if smoothed:
+            lines.append(f"- {key}: rolling mean {cell(smoothed[0])} at {data['steps'][0]:,} steps, "
+                         f"{cell(smoothed[-1])} at {data['steps'][-1]:,} steps.")
+    return lines + [""]
+
+
+def policy_sections(scenario: str, result: dict[str, Any], out: Path | None, page: Path) -> list[str]:
+    """Everything the page shows per scenario about what the policies do."""
+    policies = result["policies"]
+    lines: list[str] = []
+    verdict = versus_best_fixed(policies)
+    if verdict:
+        lines += [verdict, ""]
+    if BEST_FIXED in policies:
+        lines += [f"`{BEST_FIXED}` is the best of the policies that always play the same action, chosen "
+                  "by exact OER_tau on this split and played on the same episodes: a learner that "
+                  "collapsed to one move scores no better than it.", ""]
+    line = a2c_line(scenario, policies, out)
+    if line:
+        lines += [line, ""]
+    lines += exact_table(policies, result.get("fixed_actions"))
+    lines += action_table(policies, list(result["protocol"].get("actions", [])))
+    figure = action_figure(scenario, out, page)
+    if figure:
+        lines += [figure, ""]
+    return lines

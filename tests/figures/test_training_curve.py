@@ -1,0 +1,29 @@
+"""Fig. 4a from a training record's learning curve."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from davis_ag.errors import UserError
+from davis_ag.figures.training_curve import plot_learning_curve, rolling_mean
+
+
+def test_rolling_mean_weights_points_by_their_episodes() -> None:
+    values, weights = np.array([1.0, 0.0, 0.0, 4.0]), np.array([1.0, 3.0, 1.0, 1.0])
+    # Window 2: (1*1)/1, (1*1+0*3)/4, (0*3+0*1)/4, (0*1+4*1)/2.
+    assert rolling_mean(values, weights, 2) == pytest.approx([1.0, 0.25, 0.0, 2.0])
+
+
+def test_learning_curve_png_and_numbers(tmp_path: Path) -> None:
+    curve = [{"step": 1000 * (k + 1), "episodes": 300, "reward": 0.01 + 0.001 * k, "length": 2.9} for k in range(30)]
+    plotted = plot_learning_curve({"sp-strawberry": {"curve": curve}, "mp-vine": {}}, tmp_path / "curve",
+                                  formats=("png",), window=5)
+    assert plotted.paths == [tmp_path / "curve.png"] and plotted.paths[0].read_bytes()[:4] == b"\x89PNG"
+    data = plotted.data["sp-strawberry"]
+    assert data["steps"][-1] == 30_000 and data["smoothed"][-1] == pytest.approx(np.mean([0.01 + 0.001 * k for k in range(25, 30)]))
+    assert "mp-vine" not in plotted.data  # a record without a curve draws nothing
+    with pytest.raises(UserError, match="no training record holds a learning curve"):
+        plot_learning_curve({"sp-strawberry": {}}, tmp_path / "none", formats=("png",))
