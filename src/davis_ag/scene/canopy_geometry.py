@@ -120,8 +120,13 @@ class LeafMesh:
 
     def diameter(self) -> float:
         """Largest distance between two of its vertices (m): its size, whatever its orientation."""
-        points = np.unique(self.triangles.reshape(-1, 3), axis=0)
-        return float(np.sqrt(((points[:, None, :] - points[None, :, :]) ** 2).sum(-1)).max())
+        return diameter(self.triangles.reshape(-1, 3))
+
+
+def diameter(points: np.ndarray) -> float:
+    """Largest distance between two of the points (m)."""
+    points = np.unique(np.round(points, 7), axis=0)
+    return float(np.sqrt(((points[:, None, :] - points[None, :, :]) ** 2).sum(-1)).max())
 
 
 def cupped_leaflet(columns: int = 4, rows: int = 4, rise: float = 0.6, knee: float = 0.4) -> LeafMesh:

@@ -22,7 +22,7 @@ import numpy as np
 
 from davis_ag.errors import UserError
 from davis_ag.scene.canopy import PART_BUILDERS, UNIT_LEAVES
-from davis_ag.scene.canopy_geometry import PlantParts, Sphere, Tube
+from davis_ag.scene.canopy_geometry import PlantParts, Sphere, Tube, diameter
 from davis_ag.scene.organs import FRUIT, LEAF, ORGAN_DATA
 from davis_ag.scene.plant_geometry import fruit_radius, primitive_vertices
 from davis_ag.scene.plants import GrownPlant, Phenotype
@@ -107,11 +107,6 @@ def _sphere_radius(points: np.ndarray) -> float:
     return float(np.linalg.norm(points - points.mean(axis=0), axis=1).mean())
 
 
-def _diameter(points: np.ndarray) -> float:
-    points = np.unique(np.round(points, 7), axis=0)
-    return float(np.sqrt(((points[:, None, :] - points[None, :, :]) ** 2).sum(-1)).max())
-
-
 def measure_placed(context, placed: PlacedPlant, crop: CropSpec) -> Phenotype:
     """Measure height, fruit radius and leaf length of a placed plant (see the module docstring)."""
     frame = placed.stems if crop.name == "strawberry" else placed.stems[:1]  # tomato: main stem; vine: trunk
@@ -122,8 +117,8 @@ def measure_placed(context, placed: PlacedPlant, crop: CropSpec) -> Phenotype:
     radii = [_sphere_radius(p) if crop.name != "strawberry" else fruit_radius(p) for p in pieces]
     radius = float(np.median(radii)) / crop.fruit_size_per_radius if radii else float("nan")
     unit = UNIT_LEAVES[crop.name]()
-    unit_size = _diameter(unit.triangles.reshape(-1, 3))
-    sizes = [_diameter(np.concatenate(primitive_vertices(context, leaf))) for leaf in placed.leaves]
+    unit_size = unit.diameter()
+    sizes = [diameter(np.concatenate(primitive_vertices(context, leaf))) for leaf in placed.leaves]
     return Phenotype(plant_height=height, fruit_radius=radius, leaf_length=max(sizes) / unit_size if sizes else float("nan"))
 
 

@@ -9,7 +9,6 @@ across code changes says so itself.
 
 from __future__ import annotations
 
-import json
 import os
 import platform
 from collections import Counter
@@ -18,7 +17,7 @@ from typing import Any
 
 from davis_ag.benchmark.exact import BEST_FIXED
 from davis_ag.formats.layout import SCENE_METADATA
-from davis_ag.workflows.results_policies import learning_curve_section, ordered, policy_sections
+from davis_ag.workflows.results_policies import learning_curve_section, load_json_object, ordered, policy_sections
 
 #: Table 4 of the paper: scenario -> metric -> policy -> value.
 PAPER_TABLE4: dict[str, dict[str, dict[str, float]]] = {
@@ -119,14 +118,6 @@ def _a2c_play(state: dict[str, Any]) -> str:
     return "sampled" if plays == {"sampled"} else "deterministic" if plays <= {"deterministic"} else "sampled and deterministic"
 
 
-def _load(path: Path) -> dict[str, Any]:
-    try:
-        data = json.loads(path.read_text())
-    except (OSError, ValueError):
-        return {}
-    return data if isinstance(data, dict) else {}
-
-
 def _counted(counter: Counter) -> str:
     return "; ".join(f"{value} ({n} scene{'s' if n > 1 else ''})" for value, n in counter.most_common())
 
@@ -135,7 +126,7 @@ def scene_provenance(dataset: Path, scenes: list[str]) -> list[str]:
     """One line per fact about how a group's scenes were made, from their scene.json files."""
     versions, renderers, sizes = Counter(), Counter(), Counter()
     for scene in scenes:
-        meta = _load(dataset / scene / SCENE_METADATA)
+        meta = load_json_object(dataset / scene / SCENE_METADATA)
         versions[meta.get("generator", {}).get("version", "unrecorded")] += 1
         renderer = meta.get("renderer", {})
         renderers[f"{renderer.get('name', '?')} renderer, {renderer.get('look', '?')} look, antialiasing: "
@@ -167,7 +158,7 @@ def _notes(config: Any, state: dict[str, Any], out: Path | None) -> list[str]:
 
     notes = []
     for scenario, key in GROUPS.items():
-        record = _load(training_record_path(out / "models" / f"a2c_{key}.zip")) if out else {}
+        record = load_json_object(training_record_path(out / "models" / f"a2c_{key}.zip")) if out else {}
         steps, rate = record.get("timesteps"), record.get("steps_per_second")
         if steps and rate and steps < PAPER_TIMESTEPS:
             notes.append(f"A2C on {key} trained for {steps:,} environment steps, {steps / PAPER_TIMESTEPS:.1%} of "
@@ -220,7 +211,7 @@ def _how_made(state: dict[str, Any], out: Path | None) -> list[str]:
             continue
         lines.append(f"- **{key}**, {len(scenes)} scene(s):")
         lines += [f"  - {line}" for line in scene_provenance(out / "dataset", scenes)]
-        record = _load(training_record_path(out / "models" / f"a2c_{key}.zip"))
+        record = load_json_object(training_record_path(out / "models" / f"a2c_{key}.zip"))
         if record:
             lines.append(f"  - A2C: {training_provenance(record)}")
     return lines + [""]
@@ -244,11 +235,11 @@ def stage_rows(state: dict[str, Any], out: Path | None) -> list[tuple[str, float
         key, _, step = stage.partition(": ")
         seconds, code, note = entry["seconds"], entry.get("code", "unrecorded"), entry["note"]
         if out is not None and step == "generate" and state.get("scene_folders", {}).get(key):
-            code = _counted(Counter(_load(out / "dataset" / scene / SCENE_METADATA).get("generator", {})
+            code = _counted(Counter(load_json_object(out / "dataset" / scene / SCENE_METADATA).get("generator", {})
                                     .get("version", "unrecorded") for scene in state["scene_folders"][key]))
         record: dict[str, Any] = {}
         if step == "train A2C" and out is not None:  # only a training stage has a record
-            record = _load(training_record_path(out / "models" / f"a2c_{key}.zip"))
+            record = load_json_object(training_record_path(out / "models" / f"a2c_{key}.zip"))
         if record.get("sittings"):
             sittings = record["sittings"]
             seconds = record.get("seconds", seconds)

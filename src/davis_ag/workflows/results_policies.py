@@ -27,7 +27,8 @@ def cell(value: float | None) -> str:
     return text[1:] if text.startswith("0.") else text
 
 
-def _load(path: Path) -> dict[str, Any]:
+def load_json_object(path: Path) -> dict[str, Any]:
+    """A JSON file's object, or {} when it is missing, unreadable or not an object."""
     try:
         data = json.loads(path.read_text())
     except (OSError, ValueError):
@@ -96,7 +97,7 @@ def a2c_line(scenario: str, policies: dict[str, Any], out: Path | None) -> str |
 
     if "A2C" not in policies:
         return None
-    record = _load(training_record_path(out / "models" / f"a2c_{GROUPS[scenario]}.zip")) if out else {}
+    record = load_json_object(training_record_path(out / "models" / f"a2c_{GROUPS[scenario]}.zip")) if out else {}
     settings = record.get("a2c_settings", SB3_DEFAULT_SETTINGS if record else None)
     trained = ("settings not recorded" if settings is None else
                ", ".join(f"{k}={v}" for k, v in settings.items()) + " over Stable-Baselines3's A2C defaults"
@@ -117,7 +118,7 @@ def action_figure(scenario: str, out: Path | None, page: Path) -> str | None:
     from davis_ag.errors import UserError
     from davis_ag.figures.benchmark_plots import plot_actions
 
-    results = _load(out / "results" / f"{GROUPS[scenario]}.json") if out else {}
+    results = load_json_object(out / "results" / f"{GROUPS[scenario]}.json") if out else {}
     if not results.get("policies"):
         return None
     target = page.parent / "images" / f"results-{GROUPS[scenario]}-actions"
@@ -136,7 +137,7 @@ def learning_curve_section(out: Path | None, page: Path) -> list[str]:
 
     if out is None:
         return []
-    records = {key: _load(training_record_path(out / "models" / f"a2c_{key}.zip")) for key in GROUPS.values()}
+    records = {key: load_json_object(training_record_path(out / "models" / f"a2c_{key}.zip")) for key in GROUPS.values()}
     records = {key: r for key, r in records.items() if r}
     if not records:
         return []
