@@ -39,6 +39,7 @@ from davis_ag.scene.specs import (
     CROPS,
     PHENOTYPE_SPREAD,
     SEEABLE_FRUIT_PIXELS,
+    group_name,
     scenario_spec,
 )
 from davis_ag.scene.view_grid import views_per_scene
@@ -137,17 +138,22 @@ def measure_refused(count: int, size: tuple[int, int], generators: list[str]) ->
                 seconds[crop.name] = round(time.perf_counter() - started, 1)
                 print(f"{generator} {crop.name}: {count} scenes", file=sys.stderr, flush=True)
             groups = refused_move_statistics(open_dataset(root))
-            out["generators"][generator] = {name.split("-")[1].lower(): {**counts, "seconds": seconds[
-                name.split("-")[1].lower()]} for name, counts in groups.items()}
+            out["generators"][generator] = {crop.name: {**groups[group_name(scenario_spec("sp"), crop)],
+                                                        "seconds": seconds[crop.name]} for crop in CROPS.values()}
     return out
+
+
+def saved(name: str) -> dict | None:
+    """A measurement saved under docs/, or None before it was made."""
+    path = DOCS / name
+    return json.loads(path.read_text()) if path.exists() else None
 
 
 def refused_table() -> list[str]:
     """Markdown: the share of moves TVM-v0 refuses from its episode starts, per crop and generator."""
-    path = DOCS / "scenes-refused.json"
-    if not path.exists():
+    data = saved("scenes-refused.json")
+    if data is None:
         return []
-    data = json.loads(path.read_text())
     lines = [f"{data['scenes_per_crop']} single-plant scenes per crop (dataset seed 0) at "
              f"{data['size'][0]}x{data['size'][1]}, every eligible start (a view and a target with OER "
              f"below 0.4 and the crop's visible pixels) and every move of TVM-v0 (`davis-ag stats`); "
@@ -319,10 +325,9 @@ def findings_lines(data: dict) -> list[str]:
 
 def recipes_table() -> list[str]:
     """Markdown: the strawberry recipes tried for Fig. 2 and the OER share (tools/strawberry_recipes.py)."""
-    path = DOCS / "scenes-strawberry-recipes.json"
-    if not path.exists():
+    data = saved("scenes-strawberry-recipes.json")
+    if data is None:
         return []
-    data = json.loads(path.read_text())
     lines = [f"Scenes {', '.join(str(i) for i in data['scenes'])} of dataset seed 0, grown under each recipe and "
              f"drawn at {data['size'][0]}x{data['size'][1]} on the grid every {data['step']:g} m, at both "
              f"strawberry altitude sets (`tools/strawberry_recipes.py`; {data['machine']}). \"hidden by fruit\": "
