@@ -113,19 +113,6 @@ def test_bad_values_of_evaluate(extra: list[str], message: str, capsys: pytest.C
     assert not list(tmp_path.iterdir())
 
 
-def test_a_config_the_renderer_cannot_draw_is_refused_before_any_plant_grows(
-        capsys: pytest.CaptureFixture[str], tmp_path: Path, never_grow: None) -> None:
-    config = tmp_path / "huge.yaml"
-    config.write_text("image_size: 99999x99999\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n")
-    line = refused(capsys, "generate", "--config", str(config), "--out", str(tmp_path / "out"))
-    assert line.endswith(f"{config}: image_size: 99999x99999: each side must be from 16 to 8192 pixels "
-                         "(the renderer's limit)"), line
-    config.write_text("groups: [{scenario: sp, crop: banana, scenes: 1}]\n")
-    line = refused(capsys, "generate", "--config", str(config), "--out", str(tmp_path / "out"))
-    assert line.endswith("groups.0.crop: unknown crop 'banana': choose one of strawberry, tomato, vine"), line
-    assert not (tmp_path / "out").exists()
-
-
 @pytest.mark.parametrize("extra, message", [
     (["--seed", "-1"], "--seed"), (["--timesteps", "0"], "--timesteps"), (["--n-envs", "0"], "--n-envs"),
     (["--device", "banana"], "--device"), (["--verbose", "7"], "--verbose"), (["--crop", "vine"], "no sp/vine"),
