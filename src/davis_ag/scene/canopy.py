@@ -240,7 +240,7 @@ def _goblet_leaves(cane: np.ndarray, origin: np.ndarray, width: float, rng: np.r
 def goblet_vine_parts(phenotype: Phenotype, origin: np.ndarray, rng: np.random.Generator) -> PlantParts:
     """A Canopy Generator goblet vine at ``origin`` (see the module docstring)."""
     trunk_height, berry, width = phenotype.plant_height, phenotype.fruit_radius, phenotype.leaf_length
-    parts = PlantParts(leaf_texture=texture_path("grape_leaf"), trunk_top=float(origin[2] + trunk_height))
+    parts = PlantParts(leaf_texture=texture_path("grape_leaf"))
     wood, wood_subdivisions = texture_path("wood"), GOBLET["wood_subdivisions"]
     trunk = origin + np.outer([0.0, 0.2, 0.22, 0.6, 0.96, 1.0], [0.0, 0.0, trunk_height])
     trunk_radii = GOBLET["trunk_radius"] * np.array([0.75, 0.8, 1.0, 0.7, 0.95, 0.1])

@@ -221,11 +221,9 @@ class PlantParts:
         leaves: One mesh per leaf (strawberry: per leaflet).
         leaf_texture: The leaves' texture file.
         fruits: One entry per labelled fruit: its tubes or spheres (a grape cluster: its berries).
-        trunk_top: Height of the vine's trunk, m (None for the other crops).
     """
 
     tubes: list[Tube] = field(default_factory=list)
     leaves: list[LeafMesh] = field(default_factory=list)
     leaf_texture: str = ""
     fruits: list[list[Tube | Sphere]] = field(default_factory=list)
-    trunk_top: float | None = None
