@@ -49,13 +49,14 @@ class ReproduceConfig:
 #: ``small``: 43 min of stages measured on a 2-core CPU machine without GPU (docs/results.md);
 #: a 3 x 2 m MP grid and 10 % / 5 % of the paper's A2C steps: not comparable with Table 4.
 #: ``medium``: the paper's grids (Table 2: 3 x 3 m SP, 7 x 3 m MP) and protocol (300K A2C steps,
-#: 3 sessions of 200 episodes) on 10 SP strawberry and 4 MP vine scenes at 640x360 (the policy
-#: sees 224x224 either way), a few hours on such a machine, resumable across sittings.
+#: 3 sessions of 200 episodes) on 10 SP strawberry and 10 MP vine scenes at 640x360 (the policy
+#: sees 224x224 either way; the 70/30 split leaves 3 test scenes of each), a few hours on such a
+#: machine, resumable across sittings.
 #: ``paper-scale``: Table 3's scene counts at 1280x720 and 300K A2C steps (days on such a machine).
 CONFIGS: dict[str, ReproduceConfig] = {
     "small": ReproduceConfig("small", (640, 360), sp_scenes=3, mp_scenes=2, mp_extent=(3.0, 2.0),
                              sp_timesteps=30_000, mp_timesteps=15_000),
-    "medium": ReproduceConfig("medium", (640, 360), sp_scenes=10, mp_scenes=4, mp_extent=None,
+    "medium": ReproduceConfig("medium", (640, 360), sp_scenes=10, mp_scenes=10, mp_extent=None,
                               sp_timesteps=300_000, mp_timesteps=300_000),
     "paper-scale": ReproduceConfig("paper-scale", (1280, 720), sp_scenes=86, mp_scenes=44,
                                    mp_extent=None, sp_timesteps=300_000, mp_timesteps=300_000),
