@@ -117,36 +117,17 @@ def test_native_helios_is_loaded() -> None:
     require_native_helios()  # pyhelios would otherwise silently run in mock mode
 
 
-def new_plant_architecture(crop: CropSpec):  # type: ignore[no-untyped-def]
-    """A Helios Context and PlantArchitecture with the crop's model loaded, and its shoot types."""
-    from pyhelios import Context, PlantArchitecture
-
-    context = Context()
-    plant_architecture = PlantArchitecture(context)
-    plant_architecture.disableMessages()
-    with quiet_stdout():
-        if crop.name == "vine":
-            from davis_ag.scene.goblet_vine import load_vine_model
-
-            shoot_defaults = load_vine_model(plant_architecture)
-        else:
-            plant_architecture.loadPlantModelFromLibrary(crop.helios_model)
-            shoot_defaults = {label: plant_architecture.getCurrentShootParameters(label)
-                              for label in plant_architecture.listShootTypeLabels()}
-    return context, plant_architecture, shoot_defaults
-
-
 def grow(crop: CropSpec, seed: int, position: tuple[float, float]) -> tuple[object, object, GrownPlant]:
     """Grow one plant the way build_scene does, from a generator seeded with ``seed``."""
-    from davis_ag.scene.goblet_vine import grow_goblet_vine
-    from davis_ag.scene.plants import grow_library_plant
+    from pyhelios import Context
 
-    context, plant_architecture, shoot_defaults = new_plant_architecture(crop)
+    from davis_ag.scene.architecture_plants import grow_architecture_plant, load_architecture_model
+
+    model = load_architecture_model(Context(), crop)
     rng = np.random.default_rng(seed)
     target = sample_phenotype(crop, rng)
-    grow_plant = grow_goblet_vine if crop.name == "vine" else grow_library_plant
-    plant = grow_plant(context, plant_architecture, shoot_defaults, crop, 0, position, target, helios_seed(rng))
-    return context, plant_architecture, plant
+    plant = grow_architecture_plant(model, 0, position, target, helios_seed(rng))
+    return model.context, model.plant_architecture, plant
 
 
 # One plant per crop (tomato and vine builds take seconds each); generator seeds picked among the
@@ -212,10 +193,14 @@ def test_grown_plant_matches_its_target_within_table_1(crop: str, seed: int) -> 
 
 
 def test_distinct_helios_seeds_give_distinct_plants() -> None:
+    from pyhelios import Context
     from pyhelios.types import vec3
 
+    from davis_ag.scene.architecture_plants import load_architecture_model
+
     crop = CROPS["strawberry"]
-    context, plant_architecture, _ = new_plant_architecture(crop)
+    model = load_architecture_model(Context(), crop)
+    context, plant_architecture = model.context, model.plant_architecture
 
     def build(seed: int) -> np.ndarray:
         context.seedRandomGenerator(seed)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import copy
 
-from davis_ag.scene.plants import LEAF_UNIT
+from davis_ag.scene.architecture_plants import LEAF_UNIT
 from davis_ag.scene.shoot_recipes import SHOOT_RECIPES, with_shoot_recipe
 from davis_ag.scene.specs import CROPS
 

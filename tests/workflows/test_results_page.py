@@ -42,11 +42,13 @@ def test_an_ordering_fails_where_a_step_is_reversed_or_apart() -> None:
     assert ordering_holds(PAPER_ORDERINGS["mp"], stats) is None
 
 
-def write_scene(root: Path, folder: str, version: str) -> None:
+def write_scene(root: Path, folder: str, version: str, plants: str | None = None) -> None:
     scene = root / "dataset" / folder
     scene.mkdir(parents=True)
     meta = {"generator": {"version": version}, "camera": {"width": 640, "height": 360},
             "renderer": {"name": "opengl", "look": "default", "antialiasing": "4x multisampled colour"}}
+    if plants is not None:
+        meta["plant_generator"] = plants
     (scene / "scene.json").write_text(json.dumps(meta))
 
 
@@ -83,6 +85,25 @@ def test_a_run_resumed_across_code_changes_says_so(tmp_path: Path) -> None:
     assert ("| sp-strawberry: train A2C | 7200 | 0.1.0+aaaa, 0.1.0+bbbb | 300,000 steps in 2 sitting(s), "
             "41.7 steps/s over the sittings' wall time |") in text
     assert "71.4" not in text and "| total | 7212 | | |" in text
+
+
+def test_how_the_run_was_made_names_the_plants_and_the_a2c_settings(tmp_path: Path) -> None:
+    # Issue 22: the page says which plant generator made the scenes and how A2C was set up.
+    folders = ["Single-Strawberry/000", "Single-Strawberry/001", "Single-Strawberry/002"]
+    write_scene(tmp_path, folders[0], "0.1.0+aaaa", plants="canopy")
+    write_scene(tmp_path, folders[1], "0.1.0+aaaa", plants="canopy")
+    write_scene(tmp_path, folders[2], "0.1.0+aaaa")  # from before scene.json recorded its plants
+    (tmp_path / "models").mkdir()
+    record = {"timesteps": 300_000, "seconds": 6000.0, "steps_per_second": 50.0, "arch": "paper", "n_envs": 8,
+              "a2c_settings": {"ent_coef": 0.01, "normalize_advantage": True},
+              "sittings": [{"code": "0.1.0+aaaa", "from_step": 0, "to_step": 300_000, "seconds": 6000.0}]}
+    (tmp_path / "models" / "a2c_sp-strawberry.training.json").write_text(json.dumps(record))
+    state = {"scene_folders": {"sp-strawberry": folders}, "results": {}, "stages": {}}
+    text = write_results_md(tmp_path / "results.md", CONFIGS["medium"], state, tmp_path).read_text()
+    how = text.split("## How this run was made", 1)[1]
+    assert "plants grown by `--plants canopy` (2 scenes); `--plants architecture` (1 scene)" in how
+    assert "settings ent_coef=0.01, normalize_advantage=True over SB3's A2C defaults" in how
+    assert "SB3 defaults" not in text.split("## How this run was made", 1)[0]
 
 
 def test_the_readme_block_beside_docs_is_rewritten_from_the_run(tmp_path: Path) -> None:
@@ -153,7 +174,7 @@ def test_the_page_shows_what_each_policy_does(tmp_path: Path, sp_root: Path, one
     shares = np.array(list(policies["A2C"]["action_counts"].values())) / sum(policies["A2C"]["action_counts"].values())
     assert (shares >= 0.05).sum() >= 2, policies["A2C"]["action_counts"]
     counts = best["action_counts"]
-    assert f"| Best fixed action | " + " | ".join("100" if a == best["action"] else "0" for a in counts) + " |" in text
+    assert "| Best fixed action | " + " | ".join("100" if a == best["action"] else "0" for a in counts) + " |" in text
     for picture in ("results-sp-strawberry-actions.png", "results-learning-curve.png"):
         assert f"(images/{picture})" in text and (tmp_path / "docs" / "images" / picture).is_file()
 

@@ -17,10 +17,8 @@ from davis_ag.scene.organs import ORGAN_DATA
 from davis_ag.scene.plants import (
     GrownPlant,
     fruit_body_uuids,
-    grow_library_plant,
     helios_seed,
     primitive_vertices,
-    quiet_stdout,
     require_native_helios,
     sample_phenotype,
 )
@@ -169,30 +167,13 @@ def _fruit(context, fruit_id: int, plant: int, body: list[int]) -> Fruit:
 def _grow_architecture_plants(context, scenario: ScenarioSpec, crop: CropSpec,
                               rng: np.random.Generator) -> list[GrownPlant]:
     """PlantArchitecture plants grown towards their phenotypes (``--plants architecture``)."""
-    from pyhelios import PlantArchitecture
+    from davis_ag.scene.architecture_plants import grow_architecture_plant, load_architecture_model
 
-    plant_architecture = PlantArchitecture(context)
-    plant_architecture.disableMessages()
-    with quiet_stdout():
-        if crop.name == "vine":
-            from davis_ag.scene.goblet_vine import load_vine_model
-
-            shoot_defaults = load_vine_model(plant_architecture)
-        else:
-            plant_architecture.loadPlantModelFromLibrary(crop.helios_model)
-            shoot_defaults = {
-                label: plant_architecture.getCurrentShootParameters(label)
-                for label in plant_architecture.listShootTypeLabels()
-            }
+    model = load_architecture_model(context, crop)
     plants = []
     for index, position in enumerate(plant_positions(scenario, crop)):
         target = sample_phenotype(crop, rng)
-        seed = helios_seed(rng)
-        if crop.name == "vine":
-            from davis_ag.scene.goblet_vine import grow_goblet_vine as grow
-        else:
-            grow = grow_library_plant
-        plants.append(grow(context, plant_architecture, shoot_defaults, crop, index, position, target, seed))
+        plants.append(grow_architecture_plant(model, index, position, target, helios_seed(rng)))
     for plant in plants:
         plant.fruit_bodies = [fruit_body_uuids(context, object_id) for object_id in plant.fruit_objects]
     return plants

@@ -19,6 +19,7 @@ import math
 import numpy as np
 
 from davis_ag.scene.plants import (
+    ArchitectureModel,
     GrownPlant,
     Phenotype,
     blades_per_leaf,
@@ -27,7 +28,6 @@ from davis_ag.scene.plants import (
     prepare_build,
     quiet_stdout,
 )
-from davis_ag.scene.specs import CropSpec
 
 TRUNK_NODES = 7
 ARM_NODES = 3
@@ -55,28 +55,17 @@ def load_vine_model(plant_architecture) -> dict[str, dict]:
             for label in plant_architecture.listShootTypeLabels()}
 
 
-def grow_goblet_vine(
-    context,
-    plant_architecture,
-    shoot_defaults: dict[str, dict],
-    crop: CropSpec,
-    index: int,
-    position: tuple[float, float],
-    target: Phenotype,
-    seed: int,
-) -> GrownPlant:
+def grow_goblet_vine(model: ArchitectureModel, index: int, position: tuple[float, float],
+                     target: Phenotype, seed: int) -> GrownPlant:
     """Grow one goblet vine to a target trunk height, berry radius and leaf length.
 
-    Args:
-        context: The scene's Helios Context.
-        plant_architecture: Its PlantArchitecture, prepared by :func:`load_vine_model`.
-        shoot_defaults: What :func:`load_vine_model` returned.
-        crop, index, position, target, seed: As for :func:`davis_ag.scene.plants.grow_to_target`.
-
-    Returns:
-        The grown vine, left in the context.
+    ``model`` holds the shoot types :func:`load_vine_model` loaded; the other arguments are as for
+    :func:`davis_ag.scene.plants.grow_to_target`. Returns the grown vine, left in the context.
     """
     from pyhelios.types import AxisRotation, vec3
+
+    context, plant_architecture, crop = model.context, model.plant_architecture, model.crop
+    shoot_defaults = model.shoot_defaults
 
     def build(knobs: dict, seed: int) -> tuple[int, float]:
         prepare_build(context, plant_architecture, shoot_defaults, crop, knobs, seed)

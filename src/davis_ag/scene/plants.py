@@ -247,7 +247,7 @@ def scaled_shoot_parameters(defaults: dict, crop: CropSpec, knobs: dict[str, flo
 # Growing
 
 
-def _lift_to_ground(context, plant_architecture, plant_id: int) -> None:
+def lift_to_ground(context, plant_architecture, plant_id: int) -> None:
     """Raise a plant whose drooping fruit would hang below the soil, as if on a small mound."""
     from pyhelios.types import vec3
 
@@ -264,17 +264,6 @@ def _lift_to_ground(context, plant_architecture, plant_id: int) -> None:
         context.translateObject(objects, shift)
     if loose:
         context.translatePrimitive(loose, shift)
-
-
-#: Measured height ~ a + b * knob for our plants (fitted on a few seeds), used only for
-#: the first build's guess; later builds correct it by the secant through the last two builds.
-HEIGHT_MODEL = {"strawberry": (-0.07, 0.43), "tomato": (0.505, 0.68)}
-#: Fruit size (half the mean principal extent) and leaf length of the library models as built,
-#: for the first build's guess.
-DEFAULT_SIZES = {"strawberry": (0.037, 0.139), "tomato": (0.016, 0.205)}
-#: Blades measured as one leaf where not all of a petiole's: Table 1's strawberry leaf length is
-#: a leaflet's, as ``leaf_length`` is in the Canopy Generator that made the original's plants.
-LEAF_UNIT = {"strawberry": 1}
 
 
 def _next_height_knob(history: list[tuple[float, float]], target: float) -> float:
@@ -294,6 +283,23 @@ def in_table_range(measured: Phenotype, crop: CropSpec, slack: float = 0.0) -> b
         abs(getattr(measured, name) / value - 1.0) <= PHENOTYPE_SPREAD[name] + slack
         for name, value in nominal.items()
     )
+
+
+@dataclass
+class ArchitectureModel:
+    """One crop's PlantArchitecture model in a scene's Context, ready to grow plants.
+
+    Attributes:
+        context: The scene's Helios Context.
+        plant_architecture: Its PlantArchitecture, with the crop's shoot types loaded.
+        crop: The crop.
+        shoot_defaults: The parameters of every shoot type as loaded, read before any change.
+    """
+
+    context: object
+    plant_architecture: object
+    crop: CropSpec
+    shoot_defaults: dict[str, dict]
 
 
 #: Builds a plant from knobs and a seed; returns its id and, for the vine, its trunk's top.
@@ -380,45 +386,3 @@ def prepare_build(context, plant_architecture, shoot_defaults: dict[str, dict], 
         if internode is not None:
             plant_architecture.setPhytomerCreationFunction(label, fixed_internode(plant_architecture, internode))
     context.seedRandomGenerator(seed)
-
-
-def grow_library_plant(
-    context,
-    plant_architecture,
-    shoot_defaults: dict[str, dict],
-    crop: CropSpec,
-    index: int,
-    position: tuple[float, float],
-    target: Phenotype,
-    seed: int,
-) -> GrownPlant:
-    """Grow a strawberry or tomato from the PlantArchitecture library to a target phenotype.
-
-    Args:
-        context: The scene's Helios Context.
-        plant_architecture: Its PlantArchitecture, with ``crop.helios_model`` loaded.
-        shoot_defaults: The library's parameters of every shoot type, read before any change.
-        crop, index, position, target, seed: As for :func:`grow_to_target`.
-
-    Returns:
-        The grown plant, left in the context.
-    """
-    from pyhelios.types import vec3
-
-    def build(knobs: dict, seed: int) -> tuple[int, None]:
-        prepare_build(context, plant_architecture, shoot_defaults, crop, knobs, seed)
-        with quiet_stdout():
-            plant_id = plant_architecture.buildPlantInstanceFromLibrary(
-                vec3(position[0], position[1], 0.0), crop.age_days)
-        _lift_to_ground(context, plant_architecture, plant_id)
-        return plant_id, None
-
-    intercept, slope = HEIGHT_MODEL[crop.name]
-    first_knobs = {
-        "plant_height": max(0.2, (target.plant_height - intercept) / slope),
-        "fruit_radius": target.fruit_radius * crop.fruit_size_per_radius / DEFAULT_SIZES[crop.name][0],
-        "leaf_length": target.leaf_length / DEFAULT_SIZES[crop.name][1],
-    }
-    blades = LEAF_UNIT.get(crop.name, blades_per_leaf(shoot_defaults))
-    return grow_to_target(context, plant_architecture, crop, index, position, target, seed, build,
-                          first_knobs, blades)

@@ -11,7 +11,7 @@ Strawberry: 50 nodes, as the original's 50 stems. Growth is determinate and stop
 flower, so the nodes must come faster (``phyllochron_min`` 0.5 instead of 2 days); one floral
 bud per node and a fruit set of 0.5 (library: 0.3) give about 25 fruit (measured by
 tools/scene_stats.py: docs/scenes.md). The leaf length is measured per leaflet, as the Canopy
-Generator's ``leaf_length`` is (``plants.LEAF_UNIT``), which doubles the leaflets.
+Generator's ``leaf_length`` is (``architecture_plants.LEAF_UNIT``), which doubles the leaflets.
 Where the fruit hang decides how many a camera sees (Fig. 2). The library builder makes every
 internode 4 mm whatever ``internode_length_max`` says, so 50 nodes stacked into a 20 cm column
 with fruit hanging all the way up it, outside a narrow tuft of leaves: no view of ours saw fewer

@@ -124,10 +124,12 @@ def _counted(counter: Counter) -> str:
 
 def scene_provenance(dataset: Path, scenes: list[str]) -> list[str]:
     """One line per fact about how a group's scenes were made, from their scene.json files."""
-    versions, renderers, sizes = Counter(), Counter(), Counter()
+    versions, plants, renderers, sizes = Counter(), Counter(), Counter(), Counter()
     for scene in scenes:
         meta = load_json_object(dataset / scene / SCENE_METADATA)
         versions[meta.get("generator", {}).get("version", "unrecorded")] += 1
+        # Scenes from before the Canopy Generator plants record no generator: PlantArchitecture's.
+        plants[f"`--plants {meta.get('plant_generator', 'architecture')}`"] += 1
         renderer = meta.get("renderer", {})
         renderers[f"{renderer.get('name', '?')} renderer, {renderer.get('look', '?')} look, antialiasing: "
                   f"{renderer.get('antialiasing', '?')}"] += 1
@@ -135,6 +137,7 @@ def scene_provenance(dataset: Path, scenes: list[str]) -> list[str]:
         sizes[f"{camera.get('width', '?')}x{camera.get('height', '?')}"] += 1
     lines = [f"code: {_counted(versions)}"
              + (" — made by more than one version of the code" if len(versions) > 1 else ""),
+             f"plants grown by {_counted(plants)}",
              f"drawn with the {_counted(renderers)}", f"image size {_counted(sizes)}"]
     return lines
 
@@ -145,7 +148,10 @@ def training_provenance(record: dict[str, Any]) -> str:
     codes = Counter(s.get("code", "unrecorded") for s in sittings)
     text = (f"{record.get('timesteps', 0):,} steps in {len(sittings)} sitting(s), "
             f"{record.get('seconds', 0) / 3600:.2f} h, {record.get('steps_per_second', 0):.1f} steps/s; "
-            f"network `{record.get('arch', '?')}`, {record.get('n_envs', '?')} environments, code "
+            f"network `{record.get('arch', '?')}`, {record.get('n_envs', '?')} environments, settings "
+            + (", ".join(f"{k}={v}" for k, v in record["a2c_settings"].items()) if "a2c_settings" in record
+               else "not recorded (SB3's defaults)")
+            + " over SB3's A2C defaults, code "
             + ", ".join(codes))
     if len(codes) > 1:
         text += " — the code changed between sittings"
@@ -346,8 +352,8 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
         f"- **Configuration** `{config.name}`: {config.sp_scenes} SP strawberry scene(s) (Table 2's "
         f"grid, {sp_views} views each) and {config.mp_scenes} MP vine scene(s) (grid {mp_grid}, 0.5 m "
         f"step, 12 headings, 2 altitudes) at {config.size[0]}x{config.size[1]}, dataset seed "
-        f"{config.seed}; box thresholds scaled by image area; A2C (SB3 defaults, the paper's "
-        f"network of section V-B, {config.n_envs} environments) for {config.sp_timesteps:,} (SP) and "
+        f"{config.seed}; box thresholds scaled by image area; A2C (Stable-Baselines3, the paper's "
+        f"network of section V-B, {config.n_envs} environments; its settings under each scenario) for {config.sp_timesteps:,} (SP) and "
         f"{config.mp_timesteps:,} (MP) environment steps; evaluation {config.sessions} sessions x "
         f"{config.episodes} episodes, seed {config.seed}, A2C {_a2c_play(state)}.",
         "- **Paper**: 86 SP strawberry and 44 MP vine scenes at 1280x720 (Table 3), A2C for 300K "
