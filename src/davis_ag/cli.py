@@ -6,11 +6,12 @@ import argparse
 import importlib
 import sys
 
-from davis_ag.provenance import code_version
 from davis_ag.errors import UserError
+from davis_ag.provenance import code_version
 
-# Each name is a module of davis_ag.commands defining ``register(subparsers)``; the registered
-# parser's ``func`` default takes the parsed arguments and returns an exit code.
+# Each name is a module of davis_ag.commands defining HELP, DESCRIPTION, add_arguments(parser),
+# run(args) and maybe FORMATTER_CLASS (the package's docstring says what each is); add_command alone
+# makes the sub-parsers from them, so that every command's is made the same way.
 COMMANDS = ["generate", "validate", "train", "evaluate", "preview", "demo", "reproduce", "stats", "plot",
             "view", "export", "transfer"]
 
@@ -31,7 +32,25 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"davis-ag {code_version()}")
     subparsers = parser.add_subparsers(dest="command", required=True)
     for name in COMMANDS:
-        importlib.import_module(f"davis_ag.commands.{name}").register(subparsers)
+        add_command(subparsers, name)
+    return parser
+
+
+def add_command(subparsers: argparse._SubParsersAction, name: str) -> argparse.ArgumentParser:
+    """Add the sub-command ``name``, its parser made from its module in :mod:`davis_ag.commands`.
+
+    Args:
+        subparsers: what the parser's ``add_subparsers()`` returned.
+        name: the command, the name of its module (one of :data:`COMMANDS`).
+
+    Returns:
+        The sub-command's parser, its ``func`` default the module's ``run``.
+    """
+    module = importlib.import_module(f"davis_ag.commands.{name}")
+    parser = subparsers.add_parser(name, help=module.HELP, description=module.DESCRIPTION,
+                                   formatter_class=getattr(module, "FORMATTER_CLASS", argparse.HelpFormatter))
+    module.add_arguments(parser)
+    parser.set_defaults(func=module.run)
     return parser
 
 

@@ -18,8 +18,7 @@ from davis_ag.benchmark.evaluation import (
     run_episode,
     write_json,
 )
-from davis_ag.commands import evaluate as evaluate_command
-from davis_ag.commands import train as train_command
+from davis_ag.cli import add_command
 from davis_ag.errors import UserError
 from davis_ag.figures.result_charts import plot_results
 
@@ -28,8 +27,8 @@ def _parser() -> argparse.ArgumentParser:
     # Only our commands: the CLI's other sub-commands are not needed (nor maybe present) here.
     parser = argparse.ArgumentParser(prog="davis-ag")
     sub = parser.add_subparsers(dest="command", required=True)
-    train_command.register(sub)
-    evaluate_command.register(sub)
+    add_command(sub, "train")
+    add_command(sub, "evaluate")
     return parser
 
 

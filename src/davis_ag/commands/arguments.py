@@ -165,3 +165,16 @@ def add_renderer_flags(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--plants", choices=PLANT_GENERATORS,
                         help="canopy: Helios's Canopy Generator plants, as the paper's (default); architecture: "
                              "pyhelios3d's PlantArchitecture plants bent towards them (our generator before 2026-11-24)")
+
+
+def add_dataset_flags(parser: argparse.ArgumentParser, verb: str) -> None:
+    """Add ``--dataset``, ``--scenario`` and ``--crop``, shared by train and evaluate.
+
+    Args:
+        parser: the sub-command's parser.
+        verb: what the command does, as ``--crop``'s help says it: "train" gives "train on one crop only".
+    """
+    parser.add_argument("--dataset", type=path, required=True, metavar="DIR", help="dataset root")
+    parser.add_argument("--scenario", required=True, choices=["sp", "mp"],
+                        help="single plant (tau=3) or multi plant (tau=5)")
+    parser.add_argument("--crop", default=None, help=f"{verb} on one crop only (default: all)")

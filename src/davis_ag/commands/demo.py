@@ -11,12 +11,13 @@ import argparse
 
 from davis_ag.commands import arguments
 
+HELP = "generate a small dataset, validate it, run the baselines, write a report"
+DESCRIPTION = __doc__
+FORMATTER_CLASS = argparse.RawDescriptionHelpFormatter
 
-def register(subparsers: argparse._SubParsersAction) -> None:
-    """Add the ``demo`` sub-command."""
-    parser = subparsers.add_parser(
-        "demo", help="generate a small dataset, validate it, run the baselines, write a report",
-        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add ``demo``'s arguments to its ``parser`` (see :mod:`davis_ag.commands`)."""
     parser.add_argument("--out", type=arguments.path, required=True, metavar="DIR",
                         help="output folder (DIR/dataset, DIR/report/index.html)")
     parser.add_argument("--scenes", type=arguments.bounded(1, 1000), default=2,
@@ -28,7 +29,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help="episodes per session (default 200)")
     parser.add_argument("--sessions", type=arguments.bounded(1, 1000), default=3,
                         help="evaluation sessions (default 3)")
-    parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:

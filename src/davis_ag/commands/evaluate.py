@@ -9,27 +9,21 @@ from davis_ag.atomic_files import write_or_rescue
 from davis_ag.commands import arguments
 from davis_ag.errors import UserError
 
+HELP = "benchmark LRD, UDD, Rand, Oracle (and a trained A2C) as in Table 4"
+DESCRIPTION = ("Run every policy on the same episodes of the test split (sessions x episodes, fixed seeds), "
+               "print a Table 4 style summary, write it as JSON and a PNG bar chart. On the grid the row "
+               "'Best fixed action' (the best policy that always plays one action) is added, and the "
+               "image-blind policies get their exact expectations beside the sampled means.")
+
 #: What --policies accepts on the grid (A2C needs --model too).
 POLICIES = ("LRD", "UDD", "Rand", "Oracle", "A2C")
 #: What --policies accepts with --env continuous (Model needs --model: a PPO or SAC .zip).
 CONTINUOUS_POLICIES = ("LR", "UD", "Rand", "Greedy", "Model")
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
-    """Add the ``evaluate`` sub-command."""
-    parser = subparsers.add_parser(
-        "evaluate",
-        help="benchmark LRD, UDD, Rand, Oracle (and a trained A2C) as in Table 4",
-        description="Run every policy on the same episodes of the test split (sessions x "
-                    "episodes, fixed seeds), print a Table 4 style summary, write it as JSON and "
-                    "a PNG bar chart. On the grid the row 'Best fixed action' (the best policy that "
-                    "always plays one action) is added, and the image-blind policies get their "
-                    "exact expectations beside the sampled means.",
-    )
-    parser.add_argument("--dataset", type=arguments.path, required=True, metavar="DIR", help="dataset root")
-    parser.add_argument("--scenario", required=True, choices=["sp", "mp"],
-                        help="single plant (tau=3) or multi plant (tau=5)")
-    parser.add_argument("--crop", default=None, help="evaluate on one crop only (default: all)")
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add ``evaluate``'s arguments to its ``parser`` (see :mod:`davis_ag.commands`)."""
+    arguments.add_dataset_flags(parser, "evaluate")
     parser.add_argument("--split", default="test", choices=["train", "test", "all"],
                         help="scenes to evaluate on (default: test)")
     parser.add_argument("--model", type=arguments.path, default=None, metavar="MODEL.zip",
@@ -54,7 +48,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--out", type=arguments.path, required=True, metavar="RESULTS.json", help="results file")
     parser.add_argument("--plot", type=arguments.path, default=None, metavar="PNG",
                         help="bar chart (default: the --out path with .png)")
-    parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:

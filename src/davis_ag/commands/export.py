@@ -9,19 +9,19 @@ from pathlib import Path
 from davis_ag.commands import arguments
 from davis_ag.errors import UserError
 
+HELP = "write a dataset as COCO (RLE masks) or YOLO (ultralytics) detection data, or point clouds"
+DESCRIPTION = ("Export a DAVIS-Ag dataset for detectors, one set per split (splits.json, else the benchmark's "
+               "seeded 70/30 split by scene). coco: OUT/annotations/instances_<split>.json with RLE masks, "
+               "boxes, fruit ids and visible fractions, images referenced in place. yolo: the ultralytics "
+               "layout (images/, labels/, data.yaml). pointcloud: PLY point clouds in the world frame from "
+               "the depth images, with colour, organ class and fruit id.")
+
 #: What an export folder may already hold (a previous export, which is refreshed in place).
 _OURS = {"coco": {"annotations"}, "yolo": {"images", "labels", "data.yaml"}, "pointcloud": set()}
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
-    """Add the ``export`` sub-command with its ``coco`` and ``yolo`` formats."""
-    parser = subparsers.add_parser(
-        "export", help="write a dataset as COCO (RLE masks) or YOLO (ultralytics) detection data, or point clouds",
-        description="Export a DAVIS-Ag dataset for detectors, one set per split (splits.json, else the "
-                    "benchmark's seeded 70/30 split by scene). coco: OUT/annotations/instances_<split>.json "
-                    "with RLE masks, boxes, fruit ids and visible fractions, images referenced in place. "
-                    "yolo: the ultralytics layout (images/, labels/, data.yaml). pointcloud: PLY point "
-                    "clouds in the world frame from the depth images, with colour, organ class and fruit id.")
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add ``export``'s formats, each a sub-parser with its own arguments (see :mod:`davis_ag.commands`)."""
     formats = parser.add_subparsers(dest="format", required=True, metavar="{coco,yolo,pointcloud}")
     for name, help_text in (("coco", "COCO instances JSON, masks as pycocotools RLE"),
                             ("yolo", "ultralytics layout: images/, labels/, data.yaml")):
@@ -42,7 +42,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                              help="re-colour, light from one side, blur, add noise and re-compress every "
                                   "exported image (copies; the dataset is untouched): a stand-in for real "
                                   "photographs when none are at hand")
-        sub.set_defaults(func=run)
     cloud = formats.add_parser(
         "pointcloud", help="PLY point clouds from the depth images (world frame, colour, organ, fruit id)",
         description="One PLY per view (OUT/<group>/<scene>/NNNN.ply), or per scene with --fuse "
@@ -56,7 +55,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                             "reaches 30 m)")
     cloud.add_argument("--voxel", type=arguments.non_negative_float, default=None, metavar="M",
                        help="keep one point per cube of this side, m (default 0.005 with --fuse, else 0: all)")
-    cloud.set_defaults(func=run)
 
 
 def check_out(out: Path, fmt: str) -> None:

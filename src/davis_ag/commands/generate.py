@@ -19,14 +19,16 @@ from davis_ag.render.backends import DEFAULT_ANTIALIASING, DEFAULT_RENDERER, res
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import DEFAULT_PLANTS
 
+HELP = "render DAVIS-Ag scenes (Helios plants, our OpenGL renderer)"
+DESCRIPTION = __doc__
+FORMATTER_CLASS = argparse.RawDescriptionHelpFormatter
+
 #: Flags that describe the one group of a config-less run.
 GROUP_FLAGS = ("crop", "scenario", "scenes", "first")
 
 
-
-def register(subparsers) -> None:
-    parser = subparsers.add_parser("generate", help="render DAVIS-Ag scenes (Helios plants, our OpenGL renderer)",
-                                   description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add ``generate``'s arguments to its ``parser`` (see :mod:`davis_ag.commands`)."""
     parser.add_argument("--config", help="dataset config: a preset (paper, mini) or a YAML file")
     parser.add_argument("--crop", help="strawberry, tomato or vine (default strawberry; not with --config)")
     parser.add_argument("--scenario", help="sp (single plant) or mp (multi plant) (default sp)")
@@ -59,7 +61,6 @@ def register(subparsers) -> None:
     parser.add_argument("--max-retries", type=arguments.bounded(0, 100), default=DEFAULT_MAX_RETRIES,
                         help=f"tries again for a scene whose worker died (default {DEFAULT_MAX_RETRIES})")
     parser.add_argument("--quiet", action="store_true", help="no progress bars")
-    parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:

@@ -8,16 +8,15 @@ from __future__ import annotations
 import argparse
 
 from davis_ag.commands import arguments
+from davis_ag.figures.plots import KINDS, PlotRequest, make_plot
+
+HELP = "draw one of the paper's figures (PNG, SVG and the numbers as JSON)"
+DESCRIPTION = __doc__ + "\nkinds:\n" + "\n".join(f"  {k:<11} {v}" for k, v in KINDS.items())
+FORMATTER_CLASS = argparse.RawDescriptionHelpFormatter
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
-    """Add the ``plot`` sub-command."""
-    from davis_ag.figures.plots import KINDS
-
-    kinds = "\n".join(f"  {k:<11} {v}" for k, v in KINDS.items())
-    parser = subparsers.add_parser(
-        "plot", help="draw one of the paper's figures (PNG, SVG and the numbers as JSON)",
-        description=f"{__doc__}\nkinds:\n{kinds}", formatter_class=argparse.RawDescriptionHelpFormatter)
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add ``plot``'s arguments to its ``parser`` (see :mod:`davis_ag.commands`)."""
     parser.add_argument("kind", choices=list(KINDS), help="which figure")
     parser.add_argument("dataset", type=arguments.path, nargs="?", default=None, metavar="DIR",
                         help="dataset root, group or scene folder (all kinds but actions)")
@@ -37,13 +36,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--out", type=arguments.path, required=True, metavar="PATH",
                         help="output path without suffix: PATH.png, PATH.svg, PATH.json")
     parser.add_argument("--formats", default="png,svg", help="figure formats (default png,svg)")
-    parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     """Draw the figure and print where it went."""
     from davis_ag.errors import UserError
-    from davis_ag.figures.plots import PlotRequest, make_plot
 
     formats = tuple(f.strip().lower() for f in args.formats.split(",") if f.strip())
     bad = [f for f in formats if f not in ("png", "svg", "pdf")]

@@ -23,10 +23,12 @@ from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import DEFAULT_PLANTS, crop_spec, plant_centres, scenario_spec
 from davis_ag.scene.view_grid import build_view_grid
 
+HELP = "render a few views of one scene with boxes drawn"
+DESCRIPTION = __doc__
 
-def register(subparsers) -> None:
-    parser = subparsers.add_parser("preview", help="render a few views of one scene with boxes drawn",
-                                   description=__doc__)
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add ``preview``'s arguments to its ``parser`` (see :mod:`davis_ag.commands`)."""
     parser.add_argument("--crop", default="strawberry", help="strawberry, tomato or vine")
     parser.add_argument("--scenario", default="sp", help="sp or mp")
     parser.add_argument("--seed", type=arguments.seed, default=0, help="dataset seed (default 0)")
@@ -36,7 +38,6 @@ def register(subparsers) -> None:
     parser.add_argument("--size", type=arguments.image_size, default=(1280, 720), help="image size (default 1280x720)")
     arguments.add_renderer_flags(parser)
     parser.add_argument("--out", type=arguments.path, required=True, help="folder for the pictures")
-    parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:

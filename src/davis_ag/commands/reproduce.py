@@ -22,12 +22,13 @@ from davis_ag.workflows.reproduce import (
 )
 from davis_ag.workflows.results_page import write_results_md
 
+HELP = "reproduce Table 4: generate, train A2C, benchmark, write results.md"
+DESCRIPTION = __doc__
+FORMATTER_CLASS = argparse.RawDescriptionHelpFormatter
 
-def register(subparsers: argparse._SubParsersAction) -> None:
-    """Add the ``reproduce`` sub-command."""
-    parser = subparsers.add_parser(
-        "reproduce", help="reproduce Table 4: generate, train A2C, benchmark, write results.md",
-        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add ``reproduce``'s arguments to its ``parser`` (see :mod:`davis_ag.commands`)."""
     parser.add_argument("--out", type=arguments.path, required=True, metavar="DIR", help="work folder")
     parser.add_argument("--results", type=arguments.path, default="docs/results.md", metavar="MD",
                         help="Markdown results file (default: docs/results.md)")
@@ -45,7 +46,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--only", choices=["sp", "mp"], default=None, help="run one scenario only")
     parser.add_argument("--rewrite-results", action="store_true",
                         help="only rewrite --results from DIR/state.json; run nothing")
-    parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:

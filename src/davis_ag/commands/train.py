@@ -6,21 +6,15 @@ import argparse
 
 from davis_ag.commands import arguments
 
+HELP = "train an A2C agent for target visibility maximisation"
+DESCRIPTION = ("Train Stable-Baselines3 A2C (CnnPolicy with the paper's network; SB3's default hyperparameters "
+               "with an entropy bonus and normalised advantages) on the train split of the TVM environment and "
+               "save a .zip, with a training record (settings, sittings, learning curve) beside it.")
 
-def register(subparsers: argparse._SubParsersAction) -> None:
-    """Add the ``train`` sub-command."""
-    parser = subparsers.add_parser(
-        "train",
-        help="train an A2C agent for target visibility maximisation",
-        description="Train Stable-Baselines3 A2C (CnnPolicy with the paper's network; SB3's default "
-                    "hyperparameters with an entropy bonus and normalised advantages) on the train split "
-                    "of the TVM environment and save a .zip, with a training record (settings, sittings, "
-                    "learning curve) beside it.",
-    )
-    parser.add_argument("--dataset", type=arguments.path, required=True, metavar="DIR", help="dataset root")
-    parser.add_argument("--scenario", required=True, choices=["sp", "mp"],
-                        help="single plant (tau=3) or multi plant (tau=5)")
-    parser.add_argument("--crop", default=None, help="train on one crop only (default: all)")
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add ``train``'s arguments to its ``parser`` (see :mod:`davis_ag.commands`)."""
+    arguments.add_dataset_flags(parser, "train")
     parser.add_argument("--timesteps", type=arguments.bounded(1, 10**9), default=300_000, metavar="N",
                         help="environment steps (default: 300000, as in the paper)")
     parser.add_argument("--seed", type=arguments.seed, default=0, help="seed of SB3 and the environments")
@@ -40,7 +34,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help="save a checkpoint beside --out every N steps (0: never); running the same "
                              "command again resumes from it (default: 10000)")
     parser.add_argument("--verbose", type=int, choices=(0, 1, 2), default=1, help="SB3 verbosity (default: 1)")
-    parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:

@@ -7,16 +7,15 @@ import argparse
 from davis_ag.commands import arguments
 from davis_ag.errors import UserError
 
+HELP = "Table 5: YOLOv5n real-only vs pre-trained on DAVIS-Ag, over random splits"
+DESCRIPTION = ("Pre-train YOLOv5n (ultralytics, built from its YAML, nothing downloaded) on a DAVIS-Ag dataset, "
+               "then, on N random train/test splits of a real set, train it from scratch (Real-Only) and from "
+               "the pre-trained weights (DAVIS-Ag -> Real) with the same budget, and report mAP@50 and "
+               "mAP@50:95 per split like Table 5. Needs pip install 'davis-ag[detect]'.")
 
-def register(subparsers: argparse._SubParsersAction) -> None:
-    """Add the ``transfer`` sub-command."""
-    parser = subparsers.add_parser(
-        "transfer", help="Table 5: YOLOv5n real-only vs pre-trained on DAVIS-Ag, over random splits",
-        description="Pre-train YOLOv5n (ultralytics, built from its YAML, nothing downloaded) on a DAVIS-Ag "
-                    "dataset, then, on N random train/test splits of a real set, train it from scratch "
-                    "(Real-Only) and from the pre-trained weights (DAVIS-Ag -> Real) with the same budget, "
-                    "and report mAP@50 and mAP@50:95 per split like Table 5. Needs "
-                    "pip install 'davis-ag[detect]'.")
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add ``transfer``'s arguments to its ``parser`` (see :mod:`davis_ag.commands`)."""
     parser.add_argument("--pretrain", type=arguments.path, required=True, metavar="DIR",
                         help="DAVIS-Ag dataset to pre-train on (e.g. Single-Strawberry scenes)")
     parser.add_argument("--real", type=arguments.path, required=True, metavar="PATH",
@@ -38,7 +37,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--workers", type=arguments.whole, default=0, help="data-loading processes (0)")
     parser.add_argument("--results", type=arguments.path, default=None, metavar="MD",
                         help="also write a Markdown report (e.g. docs/transfer/results.md)")
-    parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:

@@ -7,16 +7,14 @@ import sys
 
 from davis_ag.commands import arguments
 
+HELP = "check a dataset: schema, files, pointers, boxes against masks"
+DESCRIPTION = ("Check a DAVIS-Ag dataset (ours or the original download): every annotations.json entry, image "
+               "and mask, every pointer and every box against its mask. Prints one 'path: reason' line per "
+               "problem and a summary; exits 0 when sound, 1 otherwise.")
 
-def register(subparsers: argparse._SubParsersAction) -> None:
-    """Add the ``validate`` sub-command."""
-    parser = subparsers.add_parser(
-        "validate",
-        help="check a dataset: schema, files, pointers, boxes against masks",
-        description="Check a DAVIS-Ag dataset (ours or the original download): every annotations.json "
-                    "entry, image and mask, every pointer and every box against its mask. Prints one "
-                    "'path: reason' line per problem and a summary; exits 0 when sound, 1 otherwise.",
-    )
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add ``validate``'s arguments to its ``parser`` (see :mod:`davis_ag.commands`)."""
     parser.add_argument("dir", type=arguments.path, metavar="DIR", help="dataset root, group folder (e.g. Single-Strawberry) "
                                                    "or scene folder")
     parser.add_argument("--quick", action="store_true",
@@ -24,7 +22,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--box-tolerance", type=arguments.whole, default=None, metavar="PX",
                         help="pixels a box edge may differ from its mask's extent (default: 0 for scenes "
                              "with scene.json, 1 for the original download)")
-    parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
