@@ -24,3 +24,17 @@ def test_progress_of_a_resumed_run_starts_at_its_checkpoint(tmp_path: Path, one_
     # 80 steps came from the checkpoint and 80 from this sitting: the count ends at the total,
     # where it used to end at 80 ("80 of 160 steps" for a finished run).
     assert resumed.steps == 160
+
+
+def test_the_configurations_table_in_the_docs_is_the_codes() -> None:
+    # docs/benchmark.md's table of `reproduce --config` sizes follows CONFIGS, never a hand copy.
+    from davis_ag.workflows.reproduce import CONFIGS, CONFIGS_MARKER, configurations_table
+
+    page = (Path(__file__).resolve().parents[2] / "docs" / "benchmark.md").read_text()
+    section = page.split(f"<!-- {CONFIGS_MARKER}:start -->\n", 1)[1].split(f"\n<!-- {CONFIGS_MARKER}:end -->", 1)[0]
+    assert section == configurations_table(), (
+        "docs/benchmark.md is behind CONFIGS; rewrite it: python -c \"from davis_ag.atomic_files import "
+        "write_marked_section as w; from davis_ag.workflows import reproduce as r; "
+        "w('docs/benchmark.md', r.CONFIGS_MARKER, r.configurations_table())\"")
+    # Issue 22: medium's MP split keeps at least 3 test scenes (70/30 of 10 or more).
+    assert CONFIGS["medium"].mp_scenes >= 10 and "| `medium` | 10 scenes | 10 scenes," in section
