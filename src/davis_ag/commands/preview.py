@@ -50,8 +50,8 @@ def run(args: argparse.Namespace) -> int:
     # nominal grid, which slip does not change.
     _check_views(numbers, count_views(scenario, crop))
     arguments.prove_writable_folder(args.out)
-    request = SceneRequest(scenario, crop, args.index, args.seed, Camera(*args.size), renderer_name, look,
-                           plants=args.plants or DEFAULT_PLANTS)
+    request = SceneRequest(scenario, crop, args.index, args.seed, Camera(*args.size), renderer=renderer_name,
+                           look=look, plants=args.plants or DEFAULT_PLANTS)
     rng = np.random.default_rng(request.seed)
     model = build_scene(scenario, crop, rng, request.plants)
     grid = build_view_grid(scenario, crop, plant_centres(scenario, crop), model.aim_height, rng)

@@ -10,9 +10,9 @@ from __future__ import annotations
 import json
 import platform
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 
@@ -65,15 +65,13 @@ CONVENTIONS = {
 }
 
 
-@dataclass(frozen=True)
-class SceneRequest:
-    """Which scene to make.
+@dataclass(frozen=True, kw_only=True)
+class SceneSettings:
+    """How a dataset's scenes are made, whichever scene: shared by :class:`SceneRequest` and the
+    dataset config (:class:`davis_ag.generate.run_config.DatasetConfig`), keyword-only so each
+    keeps its own positional fields first.
 
     Attributes:
-        scenario, crop: What kind of scene.
-        index: Scene number within its group (folder ``NNN``).
-        dataset_seed: The dataset's seed.
-        camera: Image size and field of view.
         renderer: ``opengl`` (ours) or ``helios`` (pyhelios's Visualizer, the reference).
         look: ``default`` or ``helios`` (see :mod:`davis_ag.render.backends`); None: the
             renderer's own (``default`` for ours, ``helios`` for Helios).
@@ -81,6 +79,29 @@ class SceneRequest:
         antialiasing: Our renderer's antialiasing: ``fxaa``, ``msaa`` or ``none``.
         plants: The plant generator: ``canopy`` (default) or ``architecture``.
         appearance: ``paper`` or ``random`` (:mod:`davis_ag.scene.appearance`).
+    """
+
+    renderer: str = DEFAULT_RENDERER
+    look: str | None = None
+    depth: bool = True
+    antialiasing: str = "fxaa"
+    plants: str = DEFAULT_PLANTS
+    appearance: str = "paper"
+
+    def scene_settings(self) -> dict[str, Any]:
+        """These settings alone, as keyword arguments of :class:`SceneRequest`."""
+        return {f.name: getattr(self, f.name) for f in fields(SceneSettings)}
+
+
+@dataclass(frozen=True)
+class SceneRequest(SceneSettings):
+    """Which scene to make, and how (the :class:`SceneSettings`, by keyword).
+
+    Attributes:
+        scenario, crop: What kind of scene.
+        index: Scene number within its group (folder ``NNN``).
+        dataset_seed: The dataset's seed.
+        camera: Image size and field of view.
         classes: Write ``images/NNNN_class.png`` (organ classes) for every view.
     """
 
@@ -89,13 +110,7 @@ class SceneRequest:
     index: int
     dataset_seed: int
     camera: Camera = Camera()
-    renderer: str = DEFAULT_RENDERER
-    look: str | None = None
-    depth: bool = True
-    antialiasing: str = "fxaa"
-    plants: str = DEFAULT_PLANTS
-    appearance: str = "paper"
-    classes: bool = True
+    classes: bool = field(default=True, kw_only=True)
 
     def __post_init__(self) -> None:
         resolve_appearance(self.appearance)

@@ -44,7 +44,7 @@ from pydantic import ValidationError
 
 from davis_ag.errors import UserError
 from davis_ag.formats.models import MAX_SCENES, DatasetConfigFile, check_image_size, check_seed, one_line
-from davis_ag.generate.one_scene import SceneRequest
+from davis_ag.generate.one_scene import SceneRequest, SceneSettings
 from davis_ag.render.backends import DEFAULT_RENDERER, resolve_look
 from davis_ag.scene.appearance import resolve_appearance
 from davis_ag.scene.camera import Camera
@@ -89,8 +89,9 @@ class GroupConfig:
 
 
 @dataclass(frozen=True)
-class DatasetConfig:
-    """A whole dataset.
+class DatasetConfig(SceneSettings):
+    """A whole dataset: its groups, and how every scene is made (the :class:`SceneSettings`, by
+    keyword).
 
     Attributes:
         name: A label (the preset or file name by default).
@@ -98,12 +99,6 @@ class DatasetConfig:
         camera: Image size and field of view.
         groups: The groups, in file order.
         source: Where it was read from (for messages).
-        renderer: ``opengl`` or ``helios``.
-        look: ``default`` or ``helios``; None for the renderer's own.
-        depth: Whether every view gets a depth image.
-        antialiasing: Our renderer's antialiasing: ``fxaa``, ``msaa`` or ``none``.
-        plants: The plant generator: ``canopy`` (default) or ``architecture``.
-        appearance: ``paper`` or ``random`` (:mod:`davis_ag.scene.appearance`).
     """
 
     name: str
@@ -111,12 +106,6 @@ class DatasetConfig:
     camera: Camera
     groups: tuple[GroupConfig, ...]
     source: str = "<config>"
-    renderer: str = DEFAULT_RENDERER
-    look: str | None = None
-    depth: bool = True
-    antialiasing: str = "fxaa"
-    plants: str = DEFAULT_PLANTS
-    appearance: str = "paper"
 
     def requests(self, only: list[str] | None = None) -> list[SceneRequest]:
         """Every scene to make, in group order, optionally narrowed to some groups or scenes.
@@ -131,9 +120,8 @@ class DatasetConfig:
         Raises:
             UserError: when an ``only`` entry names nothing of this dataset.
         """
-        look = resolve_look(self.renderer, self.look)
-        everything = [SceneRequest(g.scenario, g.crop, i, self.seed, self.camera, self.renderer, look, self.depth,
-                                   self.antialiasing, self.plants, self.appearance)
+        settings = {**self.scene_settings(), "look": resolve_look(self.renderer, self.look)}
+        everything = [SceneRequest(g.scenario, g.crop, i, self.seed, self.camera, **settings)
                       for g in self.groups for i in g.indices]
         if not only:
             return everything
@@ -176,8 +164,9 @@ def single_group_config(scenario: str, crop: str, scenes: int, first: int, seed:
     check_seed(seed, "--seed")
     size = check_image_size(size, "--size")
     resolve_look(renderer, look)
-    return DatasetConfig("command line", seed, Camera(*size), (group,), "the command line", renderer, look, depth,
-                         antialiasing, check_plants(plants), resolve_appearance(appearance))
+    return DatasetConfig("command line", seed, Camera(*size), (group,), "the command line", renderer=renderer,
+                         look=look, depth=depth, antialiasing=antialiasing, plants=check_plants(plants),
+                         appearance=resolve_appearance(appearance))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -259,8 +248,8 @@ def parse_dataset_config(text: str, source: str, default_name: str = "dataset") 
         changes = {**(model.grid.changes() if model.grid else {}), **(entry.grid.changes() if entry.grid else {})}
         groups.append(GroupConfig(apply_grid(scenario, changes, where), crop, entry.scenes, entry.first))
     return DatasetConfig((model.name or default_name).strip(), model.seed, Camera(*model.image_size), tuple(groups),
-                         source, model.renderer, model.look, model.depth, model.antialiasing,
-                         model.plants, model.appearance)
+                         source, renderer=model.renderer, look=model.look, depth=model.depth,
+                         antialiasing=model.antialiasing, plants=model.plants, appearance=model.appearance)
 
 
 def use_strawberry_altitudes(config: DatasetConfig, choice: str) -> DatasetConfig:
