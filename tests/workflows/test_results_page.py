@@ -103,7 +103,8 @@ def test_how_the_run_was_made_names_the_plants_and_the_a2c_settings(tmp_path: Pa
     how = text.split("## How this run was made", 1)[1]
     assert "plants grown by `--plants canopy` (2 scenes); `--plants architecture` (1 scene)" in how
     assert "settings ent_coef=0.01, normalize_advantage=True over SB3's A2C defaults" in how
-    assert "SB3 defaults" not in text.split("## How this run was made", 1)[0]
+    head = text.split("## How this run was made", 1)[0]
+    assert "SB3 defaults" not in head and "A2C not evaluated yet" in head  # no play before an evaluation
 
 
 def test_the_readme_block_beside_docs_is_rewritten_from_the_run(tmp_path: Path) -> None:

@@ -115,6 +115,8 @@ def _a2c_play(state: dict[str, Any]) -> str:
     """How the run's A2C played: ``sampled``, ``deterministic`` (the default before it was recorded)."""
     plays = {r["policies"]["A2C"].get("play", "deterministic")
              for r in state.get("results", {}).values() if "A2C" in r.get("policies", {})}
+    if not plays:
+        return "not evaluated yet"
     return "sampled" if plays == {"sampled"} else "deterministic" if plays <= {"deterministic"} else "sampled and deterministic"
 
 
