@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import time
 from pathlib import Path
 from typing import Any
@@ -21,7 +22,9 @@ from stable_baselines3.common.callbacks import BaseCallback
 
 from davis_ag.atomic_files import atomic_output, prove_writable_file, write_json_atomic, write_or_rescue
 from davis_ag.benchmark import TVMEnv
+from davis_ag.benchmark.tvm import as_dataset
 from davis_ag.benchmark.networks import ARCHITECTURES
+from davis_ag.benchmark.selection import KeepBestOnTrain, check_keep, snapshot_path
 from davis_ag.errors import UserError
 from davis_ag.formats.models import check_seed
 from davis_ag.provenance import code_version
@@ -30,6 +33,9 @@ from davis_ag.provenance import code_version
 CHECKPOINT_EVERY = 10_000
 #: Environment steps per point of the learning curve kept in the training record (Fig. 4a).
 CURVE_EVERY = 1_000
+#: Steps between train-split scores of the policy when a run keeps its best snapshot
+#: (:mod:`davis_ag.benchmark.selection`): 30 scores over 300K steps, a few per cent of the time.
+SELECT_EVERY = 10_000
 
 #: The A2C settings we train with, on top of Stable-Baselines3's defaults (the paper gives none).
 #: ``normalize_advantage`` scales each update's advantages to unit variance, so the size of the
@@ -69,8 +75,6 @@ def make_vec_tvm(dataset: Any, scenario: str, n_envs: int, seed: int, split: str
         The vectorised environment.
     """
     from stable_baselines3.common.env_util import make_vec_env
-
-    from davis_ag.benchmark.tvm import as_dataset
 
     opened = as_dataset(dataset)
     kwargs = {"dataset": opened, "scenario": scenario, "split": split, "crop": crop,
@@ -161,10 +165,10 @@ class _Checkpoint(BaseCallback):
     """Saves the model, the run's settings and its sittings every ``every`` environment steps."""
 
     def __init__(self, every: int, model_file: Path, settings_file: Path, settings: dict[str, Any],
-                 sittings: _Sittings, curve: LearningCurve) -> None:
+                 sittings: _Sittings, curve: LearningCurve, selection: KeepBestOnTrain | None) -> None:
         super().__init__()
         self.every, self.model_file, self.settings_file, self.settings = every, model_file, settings_file, settings
-        self.sittings, self.curve = sittings, curve
+        self.sittings, self.curve, self.selection = sittings, curve, selection
         self._last = 0
 
     def _on_training_start(self) -> None:
@@ -174,16 +178,19 @@ class _Checkpoint(BaseCallback):
         if self.model.num_timesteps - self._last >= self.every:
             self._last = self.model.num_timesteps
             save_model(self.model, self.model_file)
+            scores = self.selection.scores if self.selection else []
             write_json_atomic(self.settings_file, {**self.settings, "timesteps_done": self._last,
                                                    "sittings": self.sittings.upto(self._last),
-                                                   "curve": self.curve.points})
+                                                   "curve": self.curve.points, "selection": scores})
+            if self.selection:  # the checkpoint now names the best snapshot: older ones can go
+                self.selection.prune()
         return True
 
 
 def _resumable(settings_file: Path, model_file: Path,
-               settings: dict[str, Any]) -> tuple[int, list, list] | None:
-    """Steps done, sittings and learning curve so far of a checkpoint of a run with the same
-    settings, else None."""
+               settings: dict[str, Any]) -> tuple[int, list, list, list] | None:
+    """Steps done, sittings, learning curve and snapshot scores so far of a checkpoint of a run
+    with the same settings, else None."""
     try:
         saved = json.loads(settings_file.read_text())
     except (OSError, ValueError):
@@ -193,16 +200,18 @@ def _resumable(settings_file: Path, model_file: Path,
     done = saved.pop("timesteps_done", None)
     sittings = saved.pop("sittings", [])
     curve = saved.pop("curve", [])
+    scores = saved.pop("selection", [])
     # Checkpoints from before settings were recorded trained with SB3's defaults.
     saved.setdefault("a2c_settings", SB3_DEFAULT_SETTINGS)
     saved.setdefault("start_rule", "scene")  # and drew starts scene first
+    saved.setdefault("keep", "last")  # and kept the last snapshot
     if saved.get("dataset") == "/":
         # Checkpoints before this version recorded Path.root ("/") for any dataset given as a
         # path; they are taken as they were then, for whatever dataset the run names.
         saved["dataset"] = settings["dataset"]
     if saved != settings or not isinstance(done, int) or not isinstance(sittings, list):
         return None
-    return done, sittings, curve if isinstance(curve, list) else []
+    return done, sittings, curve if isinstance(curve, list) else [], scores if isinstance(scores, list) else []
 
 
 def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed: int = 0,
@@ -210,7 +219,8 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
               crop: str | None = None, cache_dir: str | os.PathLike[str] | None = None,
               arch: str = "paper", device: str = "auto", verbose: int = 0,
               callback: Any = None, checkpoint_every: int = CHECKPOINT_EVERY,
-              settings: str | dict[str, Any] = "ours") -> Path:
+              settings: str | dict[str, Any] = "ours", keep: str = "best-train",
+              select_every: int = SELECT_EVERY) -> Path:
     """Train the paper's A2C agent on the train split and save it; resume a killed run.
 
     Hyperparameters (the paper gives none) are Stable-Baselines3's A2C defaults, learning rate
@@ -219,8 +229,10 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
     ``settings``: by default :data:`A2C_SETTINGS` (``ent_coef=0.01``, normalised advantages);
     ``"sb3"`` keeps SB3's ``ent_coef=0`` and raw advantages. CnnPolicy scales the uint8
     observation by 1/255. ``n_envs`` (8) is ours; the paper's 300K timesteps count
-    environment steps over all environments. The training record (:func:`training_record_path`)
-    keeps the settings and the learning curve (:class:`LearningCurve`).
+    environment steps over all environments. By default the saved model is the snapshot that
+    scored best on the train split (``keep``, :mod:`davis_ag.benchmark.selection`), not the
+    last. The training record (:func:`training_record_path`) keeps the settings, the learning
+    curve (:class:`LearningCurve`) and the snapshots' train-split scores.
 
     Args:
         dataset: Dataset root or opened dataset.
@@ -241,6 +253,9 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
             model is saved.
         settings: A name of :data:`SETTINGS_PRESETS` (``ours``, ``sb3``) or a dict of SB3 A2C
             arguments among :data:`TUNABLE`, applied over SB3's defaults.
+        keep: ``best-train`` (default): save the snapshot with the best train-split OER_tau,
+            scored every ``select_every`` steps and at the end; ``last``: the last one.
+        select_every: Environment steps between train-split scores (``best-train`` only).
 
     Returns:
         The saved model's path.
@@ -252,8 +267,9 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
 
     if arch not in ARCHITECTURES:
         raise UserError(f"unknown network {arch!r}: choose one of {', '.join(ARCHITECTURES)}")
-    if total_timesteps < 1 or n_envs < 1 or checkpoint_every < 0:
+    if total_timesteps < 1 or n_envs < 1 or checkpoint_every < 0 or select_every < 0:
         raise UserError("--timesteps and --n-envs must be positive, --checkpoint-every from 0")
+    check_keep(keep)
     check_seed(seed, "--seed")
     check_device(device)
     a2c_settings = resolve_settings(settings)
@@ -264,11 +280,13 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
     root = dataset if isinstance(dataset, (str, os.PathLike)) else getattr(dataset, "root", dataset)
     settings = {"dataset": str(Path(root).expanduser().absolute()), "scenario": scenario, "crop": crop,
                 "seed": seed, "n_envs": n_envs, "arch": arch, "algorithm": "A2C",
-                "a2c_settings": a2c_settings, "start_rule": "pairs"}
-    env = make_vec_tvm(dataset, scenario, n_envs, seed, "train", crop, cache_dir)
+                "a2c_settings": a2c_settings, "start_rule": "pairs", "keep": keep}
+    opened = as_dataset(dataset)
+    env = make_vec_tvm(opened, scenario, n_envs, seed, "train", crop, cache_dir)
     resumed = _resumable(settings_file, model_file, settings)
+    scores: list[dict[str, Any]] = []
     if resumed is not None:
-        done, earlier, points = resumed
+        done, earlier, points, scores = resumed
         model = A2C.load(model_file, env=env, device=device)
         print(f"resuming {final.name} from its checkpoint at {done} of {total_timesteps} steps", flush=True)
     else:
@@ -277,24 +295,47 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
         done, earlier, points = 0, [], []
     sittings = _Sittings(earlier, done)
     curve = LearningCurve(CURVE_EVERY, points)
-    callbacks = [c for c in (callback, curve) if c is not None]
+    selection = None
+    if keep == "best-train":
+        scoring_env = TVMEnv(opened, scenario, split="train", crop=crop, cache_dir=cache_dir)
+        selection = KeepBestOnTrain(scoring_env, final, select_every, save_model, scores,
+                                    prune_at_once=not checkpoint_every)
+    callbacks = [c for c in (callback, curve, selection) if c is not None]
     if checkpoint_every:
-        callbacks.append(_Checkpoint(checkpoint_every, model_file, settings_file, settings, sittings, curve))
+        callbacks.append(_Checkpoint(checkpoint_every, model_file, settings_file, settings, sittings, curve,
+                                     selection))
     if total_timesteps > done:
         model.learn(total_timesteps=total_timesteps - done, callback=callbacks or None,
                     reset_num_timesteps=done == 0)
     env.close()
     curve.flush(int(model.num_timesteps))
-    saved = write_or_rescue(final, lambda path: save_model(model, path), "the trained model")
+    extra: dict[str, Any] = {}
+    if selection is None:
+        saved = write_or_rescue(final, lambda path: save_model(model, path), "the trained model")
+    else:
+        selection.score_now()  # the last snapshot competes too
+        best = snapshot_path(final, selection.best["step"])
+        saved = write_or_rescue(final, lambda path: _copy_atomic(best, path), "the trained model")
+        extra["selection"] = selection.record()
+        print(f"kept the snapshot at {selection.best['step']} steps (train-split OER_tau "
+              f"{selection.best['oer_tau']:.3f}, the best of {len(selection.scores)})", flush=True)
     record = sittings.upto(int(model.num_timesteps))
     seconds = sum(s["seconds"] for s in record)
     write_json_atomic(training_record_path(final), {
         **settings, "timesteps": int(model.num_timesteps), "sittings": record, "seconds": round(seconds, 1),
         "steps_per_second": round((int(model.num_timesteps) - record[0]["from_step"]) / max(seconds, 1e-9), 1),
-        "curve": curve.points})
+        "curve": curve.points, **extra})
     model_file.unlink(missing_ok=True)
     settings_file.unlink(missing_ok=True)
+    if selection is not None:
+        selection.prune(keep_none=True)
     return saved
+
+
+def _copy_atomic(source: Path, path: Path) -> None:
+    """Copy ``source`` to ``path`` through a temporary sibling."""
+    with open(source, "rb") as src, atomic_output(path, "wb") as handle:
+        shutil.copyfileobj(src, handle)
 
 
 def resolve_settings(settings: str | dict[str, Any]) -> dict[str, Any]:

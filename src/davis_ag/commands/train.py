@@ -9,7 +9,7 @@ from davis_ag.commands import arguments
 HELP = "train an A2C agent for target visibility maximisation"
 DESCRIPTION = ("Train Stable-Baselines3 A2C (CnnPolicy with the paper's network; SB3's default hyperparameters "
                "with an entropy bonus and normalised advantages) on the train split of the TVM environment and "
-               "save a .zip, with a training record (settings, sittings, learning curve) beside it.")
+               "save a .zip (the snapshot that scored best on the train split), with a training record (settings, sittings, learning curve) beside it.")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -26,6 +26,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--a2c-settings", choices=["ours", "sb3"], default="ours",
                         help="ours (default): SB3's A2C defaults with ent_coef=0.01 and normalised advantages, "
                              "which keep the policy from collapsing to one move; sb3: SB3's defaults alone")
+    parser.add_argument("--keep", choices=["best-train", "last"], default="best-train",
+                        help="which snapshot to save: best-train (default) scores the policy on the train split "
+                             "every 10000 steps and at the end (200 sampled episodes) and keeps the best; "
+                             "last keeps the last")
     parser.add_argument("--device", default="auto", help="torch device (default: auto)")
     parser.add_argument("--cache-dir", type=arguments.path, default=None, metavar="DIR",
                         help="observation cache folder (default: DIR/.davis_ag_cache)")
@@ -48,6 +52,6 @@ def run(args: argparse.Namespace) -> int:
                      out_path=args.out, n_envs=args.n_envs, crop=args.crop,
                      cache_dir=args.cache_dir, arch=args.arch, device=args.device,
                      verbose=args.verbose, checkpoint_every=args.checkpoint_every,
-                     settings=args.a2c_settings)
+                     settings=args.a2c_settings, keep=args.keep)
     print(f"saved {path}")
     return 0

@@ -62,6 +62,9 @@ CONFIGS: dict[str, ReproduceConfig] = {
                                    mp_extent=None, sp_timesteps=300_000, mp_timesteps=300_000),
 }
 
+#: Which snapshot of each A2C run is evaluated: the best on the train split
+#: (:mod:`davis_ag.benchmark.selection`).
+KEEP = "best-train"
 #: Marker of docs/benchmark.md's table of the configurations (:func:`configurations_table`).
 CONFIGS_MARKER = "reproduce-configs"
 #: Scene counts of Table 3 (SP strawberry, MP vine), what a configuration is measured against.
@@ -184,16 +187,18 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
         model = out / "models" / f"a2c_{key}.zip"
         timesteps = config.sp_timesteps if scenario_name == "sp" else config.mp_timesteps
         stamp = out / "models" / f"a2c_{key}.json"
-        # A model made with other A2C settings (or before they were recorded) is trained anew.
+        # A model made with other A2C settings or keep rule (or before they were recorded:
+        # those kept the last snapshot) is trained anew.
         made = load_state(stamp)
-        if not model.is_file() or made.get("timesteps") != timesteps or made.get("a2c_settings") != A2C_SETTINGS:
+        wanted = {"timesteps": timesteps, "a2c_settings": A2C_SETTINGS, "keep": KEEP}
+        if not model.is_file() or any(made.get(k, "last" if k == "keep" else None) != v for k, v in wanted.items()):
             print(f"training A2C (the paper's network) on {key} train split for {timesteps} steps", flush=True)
             start = time.perf_counter()
             train_a2c(root, scenario_name, total_timesteps=timesteps, seed=config.seed,
                       out_path=model, n_envs=config.n_envs, crop=crop_name, device="cpu",
-                      callback=_progress_callback(timesteps, key))
+                      callback=_progress_callback(timesteps, key), keep=KEEP)
             seconds = time.perf_counter() - start
-            write_json_atomic(stamp, {"timesteps": timesteps, "seconds": seconds, "a2c_settings": A2C_SETTINGS})
+            write_json_atomic(stamp, {**wanted, "seconds": seconds})
             record(f"{key}: train A2C", seconds,
                    f"{timesteps} steps, {timesteps / seconds:.1f} steps/s (incl. cache build)")
         print(f"benchmark on split {split!r}: {config.sessions} x {config.episodes} episodes", flush=True)

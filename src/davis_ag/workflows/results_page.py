@@ -157,6 +157,17 @@ def training_provenance(record: dict[str, Any]) -> str:
             + ", ".join(codes))
     if len(codes) > 1:
         text += " — the code changed between sittings"
+    selection = record.get("selection")
+    if selection and selection.get("kept_step") is not None:
+        scores = selection["scores"]
+        kept = next(s for s in scores if s["step"] == selection["kept_step"])
+        last = max(scores, key=lambda s: s["step"])
+        text += (f"; kept the snapshot at {kept['step']:,} steps, the best of {len(scores)} scored on the "
+                 f"train split ({selection['episodes']} {selection['play']} episodes each, every "
+                 f"{selection['every']:,} steps): train OER_tau {kept['oer_tau']:.3f}, the last snapshot's "
+                 f"{last['oer_tau']:.3f}")
+    else:
+        text += "; kept the last snapshot"
     return text
 
 

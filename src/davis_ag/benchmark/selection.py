@@ -1,0 +1,142 @@
+"""Which A2C snapshot a training run keeps: the last one, or the best one on the train split.
+
+Why: A2C with SB3's learning rate (7e-4, RMSprop) on the paper's 72M-parameter network moves a
+long way in a few updates. On SP strawberry (2026-11-24 ``medium`` run) the 300K-step snapshot put
+probability .998 on "backward" at every train start, while the episodes of the last rollouts
+earned .05-.06 reward and, trained on from that snapshot, the policy was varied again within ten
+updates: the last snapshot is a draw from a policy that swings, not where training converged.
+So by default a run plays ``episodes`` episodes on the *train* split every ``every`` steps (sampled
+play as in evaluation, the same starts and seeds each time, so snapshots are compared on equal
+terms) and keeps the snapshot with the highest mean OER_tau. The test split is never touched.
+
+Snapshots are files named by their step (``NAME.best-0010000.zip``); a superseded one is removed
+only after a checkpoint that names the new best is written, so a killed run resumes with the
+best it had.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+from stable_baselines3.common.callbacks import BaseCallback
+
+from davis_ag.errors import UserError
+
+#: What a training run keeps: ``best-train`` (default) or ``last``.
+KEEP_RULES: tuple[str, ...] = ("best-train", "last")
+#: Train-split episodes per snapshot score: one of the paper's 200-episode sessions.
+SELECT_EPISODES = 200
+#: Base seed of the scoring episodes (fixed: every snapshot plays the same starts and draws).
+SELECT_SEED = 12345
+
+
+def check_keep(keep: str) -> str:
+    """Refuse a keep rule other than :data:`KEEP_RULES`.
+
+    Raises:
+        UserError: naming the rule and the choices.
+    """
+    if keep not in KEEP_RULES:
+        raise UserError(f"unknown --keep {keep!r}: choose one of {', '.join(KEEP_RULES)}")
+    return keep
+
+
+def snapshot_path(final: Path, step: int) -> Path:
+    """The file of the snapshot taken at ``step`` of a run saving to ``final`` (``NAME.zip``)."""
+    stem = final.with_suffix("")
+    return stem.with_name(f"{stem.name}.best-{step:07d}.zip")
+
+
+def train_split_score(model: Any, env: Any, episodes: int = SELECT_EPISODES,
+                      seed: int = SELECT_SEED) -> dict[str, float]:
+    """Mean OER_tau and reward of ``model`` over ``episodes`` episodes of ``env`` (the train split).
+
+    Play is sampled or deterministic as in the benchmark (``A2C_DETERMINISTIC``). Torch's random
+    state is restored afterwards, so scoring does not change the training run's own draws.
+
+    Returns:
+        ``{"oer_tau", "reward", "length"}``, means over the episodes.
+    """
+    from davis_ag.benchmark.agents import A2C_DETERMINISTIC, A2CAgent
+    from davis_ag.benchmark.evaluation import episode_seeds, run_episode
+
+    agent = A2CAgent(model, deterministic=A2C_DETERMINISTIC)
+    resets, draws = episode_seeds(seed, 0, episodes)
+    with torch.random.fork_rng(devices=[]):
+        records = [run_episode(env, agent, r, d) for r, d in zip(resets, draws)]
+    return {key: round(float(np.mean([r[key] for r in records])), 6)
+            for key in ("oer_tau", "reward", "length")}
+
+
+class KeepBestOnTrain(BaseCallback):
+    """Scores the policy on the train split every ``every`` steps and at the end; saves each new
+    best as a snapshot file (see the module docstring).
+
+    ``scores`` is a list of ``{"step", "oer_tau", "reward", "length"}``; ``best`` the entry of the
+    kept snapshot. Earlier scores of a resumed run are passed in.
+    """
+
+    def __init__(self, env: Any, final: Path, every: int, save: Any,
+                 scores: list[dict[str, Any]] | None = None, episodes: int = SELECT_EPISODES,
+                 prune_at_once: bool = False) -> None:
+        super().__init__()
+        self.env, self.final, self.every, self.save = env, final, every, save
+        self.episodes, self.prune_at_once = episodes, prune_at_once
+        self.scores: list[dict[str, Any]] = list(scores or [])
+        if self.best is not None and not snapshot_path(final, self.best["step"]).is_file():
+            print(f"note: the best snapshot so far ({self.best['step']} steps) is gone; "
+                  "earlier scores are dropped", flush=True)
+            self.scores = []
+        self._last = 0
+
+    @property
+    def best(self) -> dict[str, Any] | None:
+        """The highest-scoring entry (the earliest of ties), or ``None`` before any score."""
+        return max(self.scores, key=lambda s: (s["oer_tau"], -s["step"])) if self.scores else None
+
+    def _on_training_start(self) -> None:
+        self._last = self.model.num_timesteps
+
+    def _on_step(self) -> bool:
+        if self.every and self.model.num_timesteps - self._last >= self.every:
+            self._last = self.model.num_timesteps
+            self.score_now()
+        return True
+
+    def score_now(self) -> None:
+        """Score the current policy; save it when it is the best so far."""
+        step = int(self.model.num_timesteps)
+        if any(s["step"] == step for s in self.scores):
+            return
+        before = self.best
+        entry = {"step": step, **train_split_score(self.model, self.env, self.episodes)}
+        self.scores.append(entry)
+        if self.best is entry:
+            self.save(self.model, snapshot_path(self.final, step))
+        if self.prune_at_once:
+            self.prune()
+        print(f"train-split score at {step} steps: OER_tau {entry['oer_tau']:.3f}"
+              + (" (best so far)" if self.best is entry else f" (best {before['oer_tau']:.3f} at {before['step']})"),
+              flush=True)
+
+    def prune(self, keep_none: bool = False) -> None:
+        """Remove every snapshot file but the best's (all of them with ``keep_none``)."""
+        best = self.best
+        for path in self.final.parent.glob(f"{self.final.with_suffix('').name}.best-*.zip"):
+            if keep_none or best is None or path != snapshot_path(self.final, best["step"]):
+                path.unlink(missing_ok=True)
+
+    def record(self) -> dict[str, Any]:
+        """What the training record says of the choice."""
+        best = self.best
+        return {"rule": "best-train", "every": self.every, "episodes": self.episodes,
+                "play": _play(), "scores": self.scores, "kept_step": best["step"] if best else None}
+
+
+def _play() -> str:
+    from davis_ag.benchmark.agents import A2C_DETERMINISTIC
+
+    return "deterministic" if A2C_DETERMINISTIC else "sampled"
