@@ -27,3 +27,19 @@ def test_learning_curve_png_and_numbers(tmp_path: Path) -> None:
     assert "mp-vine" not in plotted.data  # a record without a curve draws nothing
     with pytest.raises(UserError, match="no training record holds a learning curve"):
         plot_learning_curve({"sp-strawberry": {}}, tmp_path / "none", formats=("png",))
+
+
+def test_a_record_that_kept_its_best_snapshot_draws_the_scores(tmp_path: Path) -> None:
+    curve = [{"step": 1000 * (k + 1), "episodes": 300, "reward": 0.02, "length": 3.0} for k in range(30)]
+    scores = [{"step": 10_000, "oer_tau": 0.50}, {"step": 20_000, "oer_tau": 0.58}, {"step": 30_000, "oer_tau": 0.44}]
+    selection = {"scores": scores, "kept_step": 20_000}
+    plotted = plot_learning_curve({"sp-strawberry": {"curve": curve, "selection": selection}},
+                                  tmp_path / "curve", formats=("png",))
+    data = plotted.data["sp-strawberry"]
+    assert data["scored_steps"] == [10_000, 20_000, 30_000] and data["scored_oer_tau"] == [0.50, 0.58, 0.44]
+    assert data["kept_step"] == 20_000
+    from PIL import Image
+
+    alone = plot_learning_curve({"sp-strawberry": {"curve": curve}}, tmp_path / "alone", formats=("png",))
+    with Image.open(plotted.paths[0]) as two, Image.open(alone.paths[0]) as one:
+        assert two.height > 1.4 * one.height  # a second panel under the curve

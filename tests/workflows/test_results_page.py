@@ -103,6 +103,14 @@ def test_how_the_run_was_made_names_the_plants_and_the_a2c_settings(tmp_path: Pa
     how = text.split("## How this run was made", 1)[1]
     assert "plants grown by `--plants canopy` (2 scenes); `--plants architecture` (1 scene)" in how
     assert "settings ent_coef=0.01, normalize_advantage=True over SB3's A2C defaults" in how
+    assert "kept the last snapshot" in how  # a record from before snapshots were scored
+    record["selection"] = {"rule": "best-train", "every": 10_000, "episodes": 200, "play": "sampled",
+                           "kept_step": 120_000, "scores": [{"step": 120_000, "oer_tau": 0.561},
+                                                            {"step": 300_000, "oer_tau": 0.437}]}
+    (tmp_path / "models" / "a2c_sp-strawberry.training.json").write_text(json.dumps(record))
+    how = write_results_md(tmp_path / "results.md", CONFIGS["medium"], state, tmp_path).read_text()
+    assert ("kept the snapshot at 120,000 steps, the best of 2 scored on the train split (200 sampled "
+            "episodes each, every 10,000 steps): train OER_tau 0.561, the last snapshot's 0.437") in how
     head = text.split("## How this run was made", 1)[0]
     assert "SB3 defaults" not in head and "A2C not evaluated yet" in head  # no play before an evaluation
 

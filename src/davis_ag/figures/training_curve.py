@@ -34,8 +34,12 @@ def plot_learning_curve(records: dict[str, dict[str, Any]], out: str | Path,
         formats: File formats to write.
         window: Points in the rolling average.
 
+    Records that kept their best train-split snapshot (``selection``) get a second panel: each
+    snapshot's train-split OER_tau against its step, the kept one ringed.
+
     Returns:
-        The paths and ``{label: {"steps": [...], "reward": [...], "smoothed": [...]}}``.
+        The paths and ``{label: {"steps": [...], "reward": [...], "smoothed": [...]}}`` (with
+        ``"scored_steps"``, ``"scored_oer_tau"`` and ``"kept_step"`` for a record with a selection).
 
     Raises:
         UserError: when no record has a learning curve (models trained before curves were kept).
@@ -44,9 +48,11 @@ def plot_learning_curve(records: dict[str, dict[str, Any]], out: str | Path,
     if not curves:
         raise UserError("no training record holds a learning curve: retrain with this version of "
                         "`davis-ag train`, which keeps one in NAME.training.json")
-    figure = new_figure(6.0, 3.6)
-    axes = figure.add_subplot(1, 1, 1)
-    data = {}
+    selections = {label: records[label]["selection"] for label in curves
+                  if (records[label].get("selection") or {}).get("scores")}
+    figure = new_figure(6.0, 5.6 if selections else 3.6)
+    axes = figure.add_subplot(2, 1, 1) if selections else figure.add_subplot(1, 1, 1)
+    data: dict[str, dict[str, Any]] = {}
     for k, (label, curve) in enumerate(curves.items()):
         steps = np.array([p["step"] for p in curve], dtype=float)
         reward = np.array([p["reward"] for p in curve], dtype=float)
@@ -61,5 +67,25 @@ def plot_learning_curve(records: dict[str, dict[str, Any]], out: str | Path,
     axes.set_title(f"A2C learning curve: mean reward per 1K steps (faint), rolling mean of {window} (bold)",
                    fontsize=8)
     axes.legend(fontsize=8)
+    if selections:
+        lower = figure.add_subplot(2, 1, 2, sharex=axes)
+        for k, label in enumerate(curves):
+            if label not in selections:
+                continue
+            scores = sorted(selections[label]["scores"], key=lambda e: e["step"])
+            steps = np.array([e["step"] for e in scores], dtype=float)
+            oer = np.array([e["oer_tau"] for e in scores], dtype=float)
+            kept = selections[label].get("kept_step")
+            lower.plot(steps / 1000, oer, color=f"C{k}", marker="o", markersize=3, linewidth=1, label=label)
+            if kept is not None and kept in steps:
+                lower.plot(kept / 1000, oer[list(steps).index(kept)], marker="o", markersize=11,
+                           markerfacecolor="none", markeredgecolor="black", linestyle="none")
+            data[label].update(scored_steps=steps.astype(int).tolist(), scored_oer_tau=oer.tolist(),
+                               kept_step=kept)
+        lower.set_xlabel("training steps (thousands)")
+        lower.set_ylabel("train-split OER_tau")
+        lower.set_title("each snapshot on the train split (200 sampled episodes); ringed: the one kept",
+                        fontsize=8)
+        lower.legend(fontsize=8)
     figure.tight_layout()
     return Plotted(save_formats(figure, out, formats), data)
