@@ -75,6 +75,9 @@ def main() -> int:
     parser.add_argument("--device", default="cpu")
     parser.add_argument("--cache-dir", type=Path, default=None)
     parser.add_argument("--baselines", action="store_true", help="also play the fixed actions and heuristics")
+    parser.add_argument("--keep", choices=["last", "best-train"], default="last",
+                        help="snapshot to play (default last: a trial scores its settings, and the best "
+                             "train-split snapshot would be scored on the split that chose it)")
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     env = TVMEnv(args.dataset, "sp", split="train", crop="strawberry", cache_dir=args.cache_dir)
@@ -84,7 +87,7 @@ def main() -> int:
         model = train_a2c(args.dataset, "sp", total_timesteps=args.timesteps, seed=args.seed,
                           out_path=args.out / f"{name}.zip", n_envs=args.n_envs, crop="strawberry",
                           arch=args.arch, device=args.device, checkpoint_every=0, settings=settings,
-                          cache_dir=args.cache_dir)
+                          cache_dir=args.cache_dir, keep=args.keep)
         seconds = time.perf_counter() - start
         deterministic = A2CAgent(model, deterministic=True, device=args.device)
         deterministic.name = "A2C deterministic"
