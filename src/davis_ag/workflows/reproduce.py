@@ -189,9 +189,9 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
         stamp = out / "models" / f"a2c_{key}.json"
         # A model made with other A2C settings or keep rule (or before they were recorded:
         # those kept the last snapshot) is trained anew.
-        made = load_state(stamp)
+        made = {"keep": "last", **load_state(stamp)}
         wanted = {"timesteps": timesteps, "a2c_settings": A2C_SETTINGS, "keep": KEEP}
-        if not model.is_file() or any(made.get(k, "last" if k == "keep" else None) != v for k, v in wanted.items()):
+        if not model.is_file() or any(made.get(k) != v for k, v in wanted.items()):
             print(f"training A2C (the paper's network) on {key} train split for {timesteps} steps", flush=True)
             start = time.perf_counter()
             train_a2c(root, scenario_name, total_timesteps=timesteps, seed=config.seed,
