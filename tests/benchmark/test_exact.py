@@ -15,6 +15,7 @@ from davis_ag.benchmark.exact import (
     action_probabilities,
     expected_metrics,
     fixed_action_expectations,
+    split_fixed_actions,
     start_expectations,
 )
 
@@ -132,3 +133,15 @@ def test_fixed_action_agent_matches_its_exact_value(sp_root: Path) -> None:
     assert agent.name == "always left"
     assert expected_metrics(env, agent.action_probabilities(env)) == pytest.approx(
         fixed_action_expectations(env)["left"])
+
+
+def test_the_train_split_yardstick_is_every_fixed_action_on_train(sp_root: Path) -> None:
+    # Where an A2C snapshot is chosen (train), the page sets it beside always playing one move there.
+    env = TVMEnv(sp_root, "sp", split="train", crop="strawberry")
+    train = split_fixed_actions(sp_root, "sp", "train", "strawberry")
+    assert train["split"] == "train" and train["starts"] == len(env.starts) > 0
+    assert list(train["fixed_actions"]) == list(env.action_names)
+    for action, values in fixed_action_expectations(env).items():
+        assert train["fixed_actions"][action] == pytest.approx(values)
+    test = split_fixed_actions(sp_root, "sp", "test", "strawberry")
+    assert test["starts"] != train["starts"] or test["fixed_actions"] != train["fixed_actions"]

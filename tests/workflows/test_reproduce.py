@@ -1,4 +1,5 @@
-"""``davis-ag reproduce``'s training progress counts a resumed run from its checkpoint."""
+"""``davis-ag reproduce``: a resumed run's progress starts at its checkpoint, the configurations
+table follows the code, an evaluation gets the train-split yardstick."""
 
 from __future__ import annotations
 
@@ -38,3 +39,15 @@ def test_the_configurations_table_in_the_docs_is_the_codes() -> None:
         "w('docs/benchmark.md', r.CONFIGS_MARKER, r.configurations_table())\"")
     # Issue 22: medium's MP split keeps at least 3 test scenes (70/30 of 10 or more).
     assert CONFIGS["medium"].mp_scenes >= 10 and "| `medium` | 10 scenes | 10 scenes," in section
+
+
+def test_an_evaluation_gets_the_train_split_yardstick_once(sp_root: Path) -> None:
+    # A reused evaluation from before the yardstick gets it; one that has it is not recomputed.
+    from davis_ag.benchmark.exact import split_fixed_actions
+    from davis_ag.workflows.reproduce import _summary, add_train_split
+
+    results = {"protocol": {"split": "test"}, "policies": {}}
+    assert add_train_split(results, sp_root, "sp", "strawberry")
+    assert results["train_split"] == split_fixed_actions(sp_root, "sp", "train", "strawberry")
+    assert not add_train_split(results, sp_root, "sp", "strawberry")
+    assert _summary(results)["train_split"] == results["train_split"]

@@ -115,6 +115,29 @@ def test_how_the_run_was_made_names_the_plants_and_the_a2c_settings(tmp_path: Pa
     assert "SB3 defaults" not in head and "A2C not evaluated yet" in head  # no play before an evaluation
 
 
+def test_the_kept_snapshot_is_set_beside_the_best_fixed_action_on_train(tmp_path: Path) -> None:
+    # Issue 22: a learner that beats one move on its own scenes but not on test is told apart from
+    # one that learned nothing; the numbers come from the training record and the evaluation's JSON.
+    from davis_ag.workflows.results_policies import train_split_line
+
+    (tmp_path / "models").mkdir()
+    record = {"selection": {"rule": "best-train", "every": 10_000, "episodes": 200, "play": "sampled",
+                            "kept_step": 240_000, "scores": [{"step": 240_000, "oer_tau": 0.565},
+                                                             {"step": 300_000, "oer_tau": 0.444}]}}
+    (tmp_path / "models" / "a2c_sp-strawberry.training.json").write_text(json.dumps(record))
+    fixed = {a: {"oer_tau": v, "reward": 0.0, "length": 3.0} for a, v in (("up", 0.41), ("backward", 0.434))}
+    result = {"train_split": {"split": "train", "starts": 176, "fixed_actions": fixed}}
+    assert train_split_line("sp", result, tmp_path).startswith(
+        "On the train split (176 eligible starts), where the snapshot was chosen: A2C's kept snapshot "
+        "(240,000 steps) scores OER_tau .565 (200 sampled episodes), the best fixed action there (always "
+        "`backward`) .434 exactly, .131 above it; the last snapshot (300,000 steps) .444.")
+    fixed["backward"]["oer_tau"] = 0.6
+    assert ".035 below it" in train_split_line("sp", result, tmp_path)
+    # Without the yardstick (an evaluation from before it) or a scored run, no line.
+    assert train_split_line("sp", {}, tmp_path) is None
+    assert train_split_line("mp", result, tmp_path) is None
+
+
 def test_the_readme_block_beside_docs_is_rewritten_from_the_run(tmp_path: Path) -> None:
     # A results page in a project's docs/ writes the README's block too: no number copied by hand.
     (tmp_path / "docs").mkdir()

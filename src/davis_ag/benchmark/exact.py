@@ -116,6 +116,28 @@ def fixed_action_expectations(env: TVMEnv) -> dict[str, dict[str, float]]:
             for a, name in enumerate(inner.action_names)}
 
 
+def split_fixed_actions(dataset: Any, scenario: str, split: str, crop: str | None) -> dict[str, Any]:
+    """Every fixed action's exact expectations on one split of a dataset, and its start count.
+
+    The yardstick on the split an A2C snapshot is chosen on (train): a snapshot that scores no
+    better than always playing one move there has not learned to use the image.
+
+    Args:
+        dataset: A dataset root or an opened dataset.
+        scenario: ``sp`` or ``mp``.
+        split: ``train``, ``test`` or ``all``.
+        crop: The crop (``None``: every crop of the scenario).
+
+    Returns:
+        ``{"split", "starts", "fixed_actions"}``; ``fixed_actions`` as :func:`fixed_action_expectations`.
+    """
+    env = TVMEnv(dataset, scenario=scenario, split=split, crop=crop)
+    try:
+        return {"split": split, "starts": len(env.starts), "fixed_actions": fixed_action_expectations(env)}
+    finally:
+        env.close()
+
+
 def best_fixed_action(expectations: dict[str, dict[str, float]]) -> str:
     """The action whose fixed policy has the highest expected OER_tau (ties: the first action)."""
     return max(expectations, key=lambda name: expectations[name]["oer_tau"])

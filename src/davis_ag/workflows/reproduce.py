@@ -12,6 +12,7 @@ import json
 import sys
 import time
 from dataclasses import asdict, dataclass, replace
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -208,11 +209,13 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
             start = time.perf_counter()
             results = run_baselines(root, scenario_name, crop_name, split, config.episodes,
                                     config.sessions, config.seed, model=model)
-            write_or_rescue(results_json, lambda path: write_json(results, path), "the results")
+            write_or_rescue(results_json, partial(write_json, results), "the results")
             plot_results(results, results_json.with_suffix(".png"))
             record(f"{key}: evaluate", time.perf_counter() - start, f"split {split}")
         else:
             print(f"reusing {results_json}", flush=True)
+        if add_train_split(results, root, scenario_name, crop_name):
+            write_or_rescue(results_json, partial(write_json, results), "the results")
         print(format_table(results), flush=True)
         state["results"][scenario_name] = _summary(results)
         record(f"{key}: evaluate", state["stages"][f"{key}: evaluate"]["seconds"],
@@ -237,18 +240,34 @@ def _reusable_results(path: Path, model: Path, split: str, config: ReproduceConf
     return results if fresh and same and current and "A2C" in results.get("policies", {}) else None
 
 
+def add_train_split(results: dict[str, Any], root: Path, scenario: str, crop: str) -> bool:
+    """Add the yardstick of the split A2C's snapshot was chosen on: every fixed action's exact
+    expectations on train (``results["train_split"]``); an evaluation that has it is left alone.
+
+    Returns:
+        Whether it was added (the results file needs writing).
+    """
+    from davis_ag.benchmark.exact import split_fixed_actions
+
+    if "train_split" in results:
+        return False
+    results["train_split"] = split_fixed_actions(root, scenario, "train", crop)
+    return True
+
+
 def _summary(results: dict[str, Any]) -> dict[str, Any]:
     """The part of the evaluation results that results.md needs: per policy the metrics' mean, std
     and standard error, the exact expectations, action counts, how A2C played, the fixed action;
-    and the exact values of every fixed action."""
+    and the exact values of every fixed action, on the evaluated split and on train."""
     kept = ("exact", "action_counts", "play", "action")
     summary = {"protocol": results["protocol"],
                "policies": {name: {**{k: {s: v[s] for s in ("mean", "std", "sem") if s in v}
                                       for k, v in stats.items() if isinstance(v, dict) and "mean" in v},
                                    **{k: stats[k] for k in kept if k in stats}}
                             for name, stats in results["policies"].items()}}
-    if "fixed_actions" in results:
-        summary["fixed_actions"] = results["fixed_actions"]
+    for key in ("fixed_actions", "train_split"):
+        if key in results:
+            summary[key] = results[key]
     return summary
 
 

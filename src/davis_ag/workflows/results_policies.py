@@ -1,9 +1,9 @@
 """The parts of ``docs/results.md`` that show what each policy does, from a run's own records.
 
-Per scenario: whether A2C beats the ``Best fixed action`` row, the exact expectations of the
-image-blind policies beside their sampled means, each policy's action histogram (a table and
-Fig. 4c as a picture), and how A2C was trained and played; then the learning curve (Fig. 4a)
-from the training records. Pictures go to ``images/`` beside the page.
+Per scenario: whether A2C beats the ``Best fixed action`` row (on test, and its kept snapshot
+on the train split it was chosen on), the exact expectations of the image-blind policies beside
+their sampled means, each policy's action histogram (a table and Fig. 4c as a picture), and how
+A2C was trained and played; then the learning curve (Fig. 4a) from the training records. Pictures go to ``images/`` beside the page.
 """
 
 from __future__ import annotations
@@ -113,6 +113,34 @@ def a2c_line(scenario: str, policies: dict[str, Any], out: Path | None) -> str |
     return text
 
 
+def train_split_line(scenario: str, result: dict[str, Any], out: Path | None) -> str | None:
+    """A2C's kept snapshot against the best fixed action on the train split, where it was chosen.
+
+    Beside the test verdict this separates a policy that did not learn (no better than one move
+    on the scenes it trained on) from one that does not carry over to unseen scenes.
+    """
+    from davis_ag.benchmark.training import training_record_path
+
+    train = result.get("train_split")
+    record = load_json_object(training_record_path(out / "models" / f"a2c_{GROUPS[scenario]}.zip")) if out else {}
+    selection = record.get("selection") or {}
+    scores = {s["step"]: s["oer_tau"] for s in selection.get("scores", [])}
+    if not train or not train.get("fixed_actions") or selection.get("kept_step") not in scores:
+        return None
+    fixed = train["fixed_actions"]
+    action = max(fixed, key=lambda name: fixed[name]["oer_tau"])
+    kept, best = scores[selection["kept_step"]], fixed[action]["oer_tau"]
+    last_step = max(scores)
+    gap = kept - best
+    return (f"On the train split ({train['starts']} eligible starts), where the snapshot was chosen: A2C's "
+            f"kept snapshot ({selection['kept_step']:,} steps) scores OER_tau {cell(kept)} "
+            f"({selection['episodes']} {selection['play']} episodes), the best fixed action there "
+            f"(always `{action}`) {cell(best)} exactly, {cell(abs(gap))} {'above' if gap >= 0 else 'below'} it; "
+            f"the last snapshot ({last_step:,} steps) {cell(scores[last_step])}. "
+            "Above it on train but not on test: a policy that does not carry over to unseen scenes; "
+            "not above it on train: a policy that did not learn.")
+
+
 def action_figure(scenario: str, out: Path | None, page: Path) -> str | None:
     """Draw Fig. 4c/5 of the run's results into ``images/`` beside the page; its Markdown link."""
     from davis_ag.errors import UserError
@@ -169,9 +197,9 @@ def policy_sections(scenario: str, result: dict[str, Any], out: Path | None, pag
         lines += [f"`{BEST_FIXED}` is the best of the policies that always play the same action, chosen "
                   "by exact OER_tau on this split and played on the same episodes: a learner that "
                   "collapsed to one move scores no better than it.", ""]
-    line = a2c_line(scenario, policies, out)
-    if line:
-        lines += [line, ""]
+    for line in (train_split_line(scenario, result, out), a2c_line(scenario, policies, out)):
+        if line:
+            lines += [line, ""]
     lines += exact_table(policies, result.get("fixed_actions"))
     lines += action_table(policies, list(result["protocol"].get("actions", [])))
     figure = action_figure(scenario, out, page)
