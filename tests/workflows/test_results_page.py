@@ -202,6 +202,9 @@ def test_the_page_shows_what_each_policy_does(tmp_path: Path, sp_root: Path, one
     assert (f"| LRD | {_c(lrd['oer_tau']['mean'])} ± {_c(lrd['oer_tau']['sem'])} | {_c(lrd['exact']['oer_tau'])} |"
             in text)
     assert "| Policy | forward | backward | left | right | up | down | done |" in text
+    # The episodes' drawn starts beside every start's mean OER_0 (always `done` ends where it starts).
+    assert (f"Mean start OER (OER_0) of these episodes: {_c(policies['LRD']['oer_0']['mean'])}, against "
+            f"{_c(results['fixed_actions']['done']['oer_tau'])} over every eligible start of the split (exact)") in text
     # Played as the benchmark plays it (sampled), the trained A2C is not one move repeated.
     shares = np.array(list(policies["A2C"]["action_counts"].values())) / sum(policies["A2C"]["action_counts"].values())
     assert (shares >= 0.05).sum() >= 2, policies["A2C"]["action_counts"]

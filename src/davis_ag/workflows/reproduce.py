@@ -145,8 +145,8 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
     state.setdefault("stages", {})
     state.setdefault("results", {})
 
-    def record(stage: str, seconds: float, note: str = "") -> None:
-        state["stages"][stage] = {"seconds": round(seconds, 1), "note": note, "code": code_version()}
+    def record(stage: str, seconds: float, note: str = "", code: str | None = None) -> None:
+        state["stages"][stage] = {"seconds": round(seconds, 1), "note": note, "code": code or code_version()}
         write_json_atomic(state_path, state, indent=2)
 
     camera = Camera(*config.size)
@@ -218,8 +218,9 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
             write_or_rescue(results_json, partial(write_json, results), "the results")
         print(format_table(results), flush=True)
         state["results"][scenario_name] = _summary(results)
-        record(f"{key}: evaluate", state["stages"][f"{key}: evaluate"]["seconds"],
-               state["stages"][f"{key}: evaluate"]["note"])
+        evaluated = state["stages"][f"{key}: evaluate"]
+        # A reused evaluation keeps the code that ran it.
+        record(f"{key}: evaluate", evaluated["seconds"], evaluated["note"], evaluated.get("code"))
         write_results_md(results_md, config, state, out)
         print(f"wrote {results_md}", flush=True)
     return 0

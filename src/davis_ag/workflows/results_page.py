@@ -397,7 +397,14 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
             lines.append("| " + " | ".join(cells) + " |")
         lines += ["", _comparison(scenario, policies)]
         if "oer_0" in policies.get("LRD", {}):
-            lines += ["", f"Mean start OER (OER_0) of these episodes: {_cell(policies['LRD']['oer_0']['mean'])}."]
+            text = f"Mean start OER (OER_0) of these episodes: {_cell(policies['LRD']['oer_0']['mean'])}"
+            done = result.get("fixed_actions", {}).get("done")
+            if done:
+                # Always `done` ends where it starts: its exact OER_tau is the mean OER_0 of all starts.
+                text += (f", against {_cell(done['oer_tau'])} over every eligible start of the split (exact). "
+                         "Every policy plays the same drawn starts, so the draw moves all their sampled "
+                         "means together; the exact values below do not depend on it")
+            lines += ["", text + "."]
         lines.append("")
         lines += policy_sections(scenario, result, out, Path(path))
     lines += learning_curve_section(out, Path(path))
