@@ -3,7 +3,8 @@
 Per scenario: whether A2C beats the ``Best fixed action`` row (on test, and its kept snapshot
 on the train split it was chosen on), the exact expectations of the image-blind policies beside
 their sampled means, each policy's action histogram (a table and Fig. 4c as a picture), and how
-A2C was trained and played; then the learning curve (Fig. 4a) from the training records. Pictures go to ``images/`` beside the page.
+A2C was trained and played; then the learning curve (Fig. 4a) from the training records.
+Pictures go to ``images/`` beside the page.
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from davis_ag.benchmark.exact import BEST_FIXED
+from davis_ag.benchmark.exact import BEST_FIXED, best_fixed_action
 
 #: Row order of the policies on the page.
 POLICY_ORDER = ("A2C", "A2C (deterministic)", "LRD", "UDD", "Rand", BEST_FIXED, "Oracle")
@@ -128,11 +129,11 @@ def train_split_line(scenario: str, result: dict[str, Any], out: Path | None) ->
     if not train or not train.get("fixed_actions") or selection.get("kept_step") not in scores:
         return None
     fixed = train["fixed_actions"]
-    action = max(fixed, key=lambda name: fixed[name]["oer_tau"])
+    action = best_fixed_action(fixed)
     kept, best = scores[selection["kept_step"]], fixed[action]["oer_tau"]
     last_step = max(scores)
     gap = kept - best
-    return (f"On the train split ({train['starts']} eligible starts), where the snapshot was chosen: A2C's "
+    return (f"On the train split ({train['starts']:,} eligible starts), where the snapshot was chosen: A2C's "
             f"kept snapshot ({selection['kept_step']:,} steps) scores OER_tau {cell(kept)} "
             f"({selection['episodes']} {selection['play']} episodes), the best fixed action there "
             f"(always `{action}`) {cell(best)} exactly, {cell(abs(gap))} {'above' if gap >= 0 else 'below'} it; "
