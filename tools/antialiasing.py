@@ -147,7 +147,7 @@ def measure(crop: str, camera: Camera) -> list[dict]:
                 if box[4] in boxes:
                     box_error = max(box_error, int(np.abs(np.subtract(box[:4], boxes[box[4]][:4])).max()))
         pixels = len(views) * camera.width * camera.height
-        rows.append({"crop": crop, "option": name, "wall_ms": 1000 * statistics.median(t[0] for t in timings[name]),
+        rows.append({"crop": crop, "plants": model.plant_generator, "option": name, "wall_ms": 1000 * statistics.median(t[0] for t in timings[name]),
                      "cpu_ms": 1000 * statistics.median(t[1] for t in timings[name]),
                      "ids_differ_percent": 100 * differ / pixels, "min_fruit_iou": min(ious, default=1.0),
                      "max_box_error_px": box_error, "mean_colour_difference": statistics.mean(colour)})
@@ -156,7 +156,9 @@ def measure(crop: str, camera: Camera) -> list[dict]:
 
 def table(rows: list[dict], camera: Camera) -> str:
     """The Markdown table, and which option is fastest among those meeting the criteria."""
-    lines = [f"{camera.width}x{camera.height}, {VIEWS} views per crop, median of {REPEATS} interleaved repetitions, "
+    plants = ", ".join(sorted({row["plants"] for row in rows}))
+    lines = [f"{camera.width}x{camera.height}, `--plants {plants}`, {VIEWS} views per crop, median of {REPEATS} "
+             "interleaved repetitions, "
              f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs at the end.", "",
              "| crop | option | wall ms/view | CPU ms/view | ids differ | min fruit IoU | max box error | "
              "mean colour difference | meets the criteria |", "|---|---|---|---|---|---|---|---|---|"]

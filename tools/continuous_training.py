@@ -14,6 +14,7 @@ training episode; with ``--doc`` the numbers are written between the file's
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import tempfile
 import time
@@ -43,6 +44,7 @@ def main() -> None:
     load = os.getloadavg()[0]
     with tempfile.TemporaryDirectory(prefix="davis-ag-ppo-") as scratch:
         scene_dir = continuous_scene(Path(scratch))
+        plants = json.loads((scene_dir / "scene.json").read_text())["plant_generator"]
         started = time.perf_counter()
         model, records = train_continuous(scene_dir, "sp", total_timesteps=args.timesteps, seed=0,
                                           out_path=Path(scratch) / "ppo.zip", arch=args.arch,
@@ -60,7 +62,8 @@ def main() -> None:
     print(table)
     gains = np.array([r["oer_tau"] - r["oer_0"] for r in records])
     quarter = max(1, len(gains) // 4)
-    text = (f"PPO (SB3 defaults, n_steps 128, batch 32, {args.arch} network), {args.timesteps:,} steps "
+    text = (f"PPO (SB3 defaults, n_steps 128, batch 32, {args.arch} network; `--plants {plants}`), "
+            f"{args.timesteps:,} steps "
             f"({len(records):,} episodes) in {train_s / 60:.1f} min, load average {load:.2f} at the start, "
             f"{os.getloadavg()[0]:.2f} at the end. Mean OER gain per training episode: "
             f"{gains[:quarter].mean():+.3f} in the first quarter, {gains[-quarter:].mean():+.3f} in the last. "

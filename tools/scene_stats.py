@@ -328,7 +328,11 @@ def recipes_table() -> list[str]:
     data = saved("scenes-strawberry-recipes.json")
     if data is None:
         return []
-    lines = [f"Scenes {', '.join(str(i) for i in data['scenes'])} of dataset seed 0, grown under each recipe and "
+    # Recipes are PlantArchitecture shoot parameters; a file from before the key existed measured those plants.
+    plants = data.get("plants", "architecture")
+    lines = [f"The shoot recipes of the `--plants {plants}` strawberry (`scene/shoot_recipes.py`; the default "
+             "Canopy Generator plants take Table 1's parameters instead). "
+             f"Scenes {', '.join(str(i) for i in data['scenes'])} of dataset seed 0, grown under each recipe and "
              f"drawn at {data['size'][0]}x{data['size'][1]} on the grid every {data['step']:g} m, at both "
              f"strawberry altitude sets (`tools/strawberry_recipes.py`; {data['machine']}). \"hidden by fruit\": "
              "of the box pixels that are not the target in boxes with OER < 0.4, the share covered by other fruit.",
@@ -369,7 +373,8 @@ def render_markdown() -> str:
     if findings := findings_table():
         lines += ["## The paper's findings on single-plant strawberry scenes", "", *findings]
     if recipes := recipes_table():
-        lines += ["## Strawberry recipes tried for Fig. 2 and the OER share together", "", *recipes]
+        lines += ["## PlantArchitecture strawberry recipes tried for Fig. 2 and the OER share together", "",
+                  *recipes]
     return "\n".join(lines)
 
 

@@ -1,10 +1,12 @@
-"""Which strawberry shoot recipes meet section IV's Fig. 2 and section V-C's OER share at once (a tool).
+"""Which PlantArchitecture strawberry recipes meet section IV's Fig. 2 and section V-C's OER share at once (a tool).
 
     .venv/bin/python tools/strawberry_recipes.py [--scenes 0,3] [--size 1280x720]
 
 Issue 10 asks for a single-strawberry scene where some views see fewer than 5 fruit and some 16
 or more (Fig. 2), and for about 4 % of boxes with OER < 0.4 (section V-C, 2-8 % accepted). This
-tool grows the same scenes under candidate recipes (the default's keys overridden), at both
+tool grows the same scenes with ``--plants architecture`` (the generator the recipes in
+``scene/shoot_recipes.py`` shape; the default Canopy Generator plants take Table 1's parameters)
+under candidate recipes (the default's keys overridden), at both
 strawberry altitude sets, on the grid every 0.5 m, and measures for each: the Fig. 2 counts
 (fruit the Synthetic Annotation plug-in would box, as ``tools/scene_stats.py`` counts them), the
 OER < 0.4 share of the published boxes (210 pixels), and why boxes fall below 0.4: how much of a
@@ -34,6 +36,8 @@ from davis_ag.atomic_files import write_json_atomic
 DOCS = Path(__file__).resolve().parent.parent / "docs"
 OUT = DOCS / "scenes-strawberry-recipes.json"
 P = "phytomer_parameters"
+#: The plant generator whose shoots the recipes shape.
+PLANTS = "architecture"
 #: Our recipe, as the package ships it; every candidate overrides some of its keys.
 DEFAULT_RECIPE = shoot_recipes.SHOOT_RECIPES["strawberry"]
 #: Candidate recipes: a name, what they try, and the keys they override (uniform ranges).
@@ -87,7 +91,7 @@ def measure_scene(index: int, size: tuple[int, int], altitudes: str) -> dict:
     grid = dataclasses.replace(scenario_spec("sp", crop), step=0.5)
     with tempfile.TemporaryDirectory() as folder:
         root = Path(folder)
-        request = SceneRequest(grid, seeable(crop), index, 0, Camera(*size))
+        request = SceneRequest(grid, seeable(crop), index, 0, Camera(*size), plants=PLANTS)
         threshold = published_pixels(request)
         scene_dir, _ = generate_scene(request, root)
         meta = json.loads((scene_dir / "scene.json").read_text())
@@ -133,7 +137,7 @@ def main() -> None:
     apply_recipe({})
     machine = (f"{platform.machine()} with {os.cpu_count()} cores, measured {time.strftime('%Y-%m-%d')}, "
                f"load average {os.getloadavg()[0]:.1f} at the end")
-    write_json_atomic(OUT, {"size": list(size), "step": 0.5, "scenes": scenes, "machine": machine,
+    write_json_atomic(OUT, {"plants": PLANTS, "size": list(size), "step": 0.5, "scenes": scenes, "machine": machine,
                             "recipes": rows}, indent=1)
     print(f"wrote {OUT}")
 
