@@ -259,7 +259,10 @@ def add_train_split(results: dict[str, Any], root: Path, scenario: str, crop: st
 def _summary(results: dict[str, Any]) -> dict[str, Any]:
     """The part of the evaluation results that results.md needs: per policy the metrics' mean, std
     and standard error, the exact expectations, action counts, how A2C played, the fixed action;
-    and the exact values of every fixed action, on the evaluated split and on train."""
+    the exact values of every fixed action, on the evaluated split and on train; and A2C against
+    the Best fixed action episode by episode."""
+    from davis_ag.benchmark.paired import PAIRED_KEY, a2c_against_best_fixed
+
     kept = ("exact", "action_counts", "play", "action")
     summary = {"protocol": results["protocol"],
                "policies": {name: {**{k: {s: v[s] for s in ("mean", "std", "sem") if s in v}
@@ -269,6 +272,8 @@ def _summary(results: dict[str, Any]) -> dict[str, Any]:
     for key in ("fixed_actions", "train_split"):
         if key in results:
             summary[key] = results[key]
+    if paired := a2c_against_best_fixed(results):  # needs the episodes, which the summary leaves out
+        summary[PAIRED_KEY] = paired
     return summary
 
 

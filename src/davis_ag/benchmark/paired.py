@@ -1,0 +1,114 @@
+"""How far apart two policies are on the same episodes, and how sure that gap is.
+
+Every policy of an evaluation plays the same episodes (:func:`davis_ag.benchmark.evaluation.episode_seeds`),
+so two policies can be compared episode by episode. Table 4's ± is the standard deviation of the
+three session means: it says how much another draw of sessions would move a mean, not whether
+a gap between two policies would survive other starts. Here the per-episode differences of
+OER_tau are resampled (a bootstrap over episodes, which are independent draws of a start and of
+the policies' own randomness) for an interval on the mean gap, and the gap is also given per
+test scene, since a split of a few scenes can owe its verdict to one of them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+from scipy import stats
+
+from davis_ag.benchmark.exact import BEST_FIXED
+
+#: Bootstrap resamples; the interval's last digit is stable at this count.
+RESAMPLES = 10_000
+#: Two-sided confidence of the interval.
+CONFIDENCE = 0.95
+#: Key of A2C against the Best fixed action (:func:`a2c_against_best_fixed`) in a results summary.
+PAIRED_KEY = "a2c_vs_best_fixed"
+
+
+@dataclass(frozen=True)
+class SceneGap:
+    """The mean gap on one test scene.
+
+    Attributes:
+        scene: The scene (``group/NNN``).
+        gap: Mean OER_tau of the first policy minus the second's over the scene's episodes.
+        episodes: Episodes played on the scene.
+        starts: Distinct (start view, target fruit) pairs among them.
+    """
+
+    scene: str
+    gap: float
+    episodes: int
+    starts: int
+
+
+@dataclass(frozen=True)
+class PairedGap:
+    """Mean OER_tau of one policy minus another's on the same episodes.
+
+    Attributes:
+        gap: The mean of the per-episode differences.
+        low, high: The :data:`CONFIDENCE` bootstrap interval (percentile) of that mean.
+        episodes: Episodes compared.
+        per_scene: The gap on each test scene, in scene order.
+    """
+
+    gap: float
+    low: float
+    high: float
+    episodes: int
+    per_scene: tuple[SceneGap, ...]
+
+
+def _start(episode: dict[str, Any]) -> tuple:
+    """What makes two episodes the same: session, scene, start view and target fruit."""
+    return episode["session"], episode["scene"], episode["path"][0], episode["target_fruit"]
+
+
+def paired_gap(first: list[dict[str, Any]], second: list[dict[str, Any]], seed: int = 0) -> PairedGap:
+    """Compare two policies' episode records (the ``episodes`` lists of an evaluation's JSON).
+
+    Args:
+        first, second: Each policy's episodes, in the order they were played.
+        seed: Seed of the bootstrap's resampling (the evaluation's, so a page is redrawn identically).
+
+    Returns:
+        The mean gap (first minus second), its bootstrap interval and the gap per scene.
+
+    Raises:
+        ValueError: The two lists are empty or are not the same episodes.
+    """
+    if not first or len(first) != len(second) or any(_start(a) != _start(b) for a, b in zip(first, second)):
+        raise ValueError("the two policies did not play the same episodes")
+    differences = np.array([a["oer_tau"] - b["oer_tau"] for a, b in zip(first, second)], dtype=float)
+    if np.ptp(differences) == 0:  # no spread to resample: the interval is the point
+        low = high = float(differences[0])
+    else:  # percentile, not BCa: BCa is undefined when most differences are equal (policies that agree)
+        interval = stats.bootstrap((differences,), np.mean, n_resamples=RESAMPLES, confidence_level=CONFIDENCE,
+                                   method="percentile", random_state=np.random.default_rng(seed)).confidence_interval
+        low, high = float(interval.low), float(interval.high)
+    scenes = [a["scene"] for a in first]
+    per_scene = []
+    for scene in sorted(set(scenes)):
+        mask = np.array([s == scene for s in scenes])
+        starts = {_start(a)[2:] for a, s in zip(first, scenes) if s == scene}
+        per_scene.append(SceneGap(scene, float(differences[mask].mean()), int(mask.sum()), len(starts)))
+    return PairedGap(float(differences.mean()), low, high, len(differences), tuple(per_scene))
+
+
+def a2c_against_best_fixed(results: dict[str, Any]) -> dict[str, Any] | None:
+    """:func:`paired_gap` of ``A2C`` and ``Best fixed action`` in an evaluation's results, as JSON.
+
+    Args:
+        results: An evaluation's results (``policies`` with their ``episodes``, ``protocol``).
+
+    Returns:
+        The gap as a dict, or None when either policy or its episode records are missing.
+    """
+    policies = results.get("policies", {})
+    records = [policies.get(name, {}).get("episodes") for name in ("A2C", BEST_FIXED)]
+    if not all(records):
+        return None
+    return asdict(paired_gap(*records, seed=int(results.get("protocol", {}).get("seed", 0))))
