@@ -148,14 +148,22 @@ def test_the_readme_block_beside_docs_is_rewritten_from_the_run(tmp_path: Path) 
                 for name, m in (("A2C", .6), ("Rand", .45), ("LRD", .44), ("UDD", .3))}
     state = {"results": {"sp": {"protocol": {"split": "test", "tau": 3, "sessions": 3, "episodes": 200,
                                              "scenes": ["Single-Strawberry/003", "Single-Strawberry/007"]},
-                                "policies": policies}}}
-    write_results_md(tmp_path / "docs" / "results.md", CONFIGS["medium"], state, tmp_path)
+                                "policies": policies,
+                                "a2c_vs_best_fixed": {"gap": 0.027, "low": 0.01, "high": 0.04, "episodes": 600,
+                                                      "per_scene": [{"scene": "Single-Strawberry/003", "gap": -0.2,
+                                                                     "episodes": 22, "starts": 1}]}}}}
+    page = write_results_md(tmp_path / "docs" / "results.md", CONFIGS["medium"], state, tmp_path).read_text()
+    assert ("A2C minus `Best fixed action`: +.027, 95% bootstrap interval over episodes +.010 to +.040 (10,000 "
+            "resamples), above zero. Per test scene: Single-Strawberry/003 -.200 (22 episodes, 1 start); A2C is "
+            "ahead on 0 of 1.") in page
     text = readme.read_text()
     assert "stale" not in text and text.startswith("# p\n\nbefore\n") and text.endswith("after\n")
     assert "| SP strawberry, ours (2 test scenes) | .600 ± .010 | .440 ± .010 | .300 ± .010 | .450 ± .010 | – |" in text
     assert "| SP strawberry, paper (Table 4) | .520 ± .004 | .433 ± .007 | .371 ± .008 | .438 ± .101 | - |" in text
     assert "| MP vine, ours | not run |" in text and "| MP vine, paper (Table 4) | .369 ± .009 |" in text
     assert "SP strawberry: A2C > Rand ~ LRD > UDD **holds**." in text
+    assert ("A2C minus `Best fixed action` on the same episodes (95% bootstrap interval over the test starts): "
+            "SP strawberry +.027 (+.010 to +.040).") in text
     # A page written elsewhere (a work folder beside the README) leaves the README alone.
     other = tmp_path / "work"
     other.mkdir()

@@ -16,8 +16,15 @@ from pathlib import Path
 from typing import Any
 
 from davis_ag.benchmark.exact import BEST_FIXED
+from davis_ag.benchmark.paired import CONFIDENCE, PAIRED_KEY
 from davis_ag.formats.layout import SCENE_METADATA
-from davis_ag.workflows.results_policies import learning_curve_section, load_json_object, ordered, policy_sections
+from davis_ag.workflows.results_policies import (
+    learning_curve_section,
+    load_json_object,
+    ordered,
+    policy_sections,
+    signed,
+)
 
 #: Table 4 of the paper: scenario -> metric -> policy -> value.
 PAPER_TABLE4: dict[str, dict[str, dict[str, float]]] = {
@@ -330,6 +337,11 @@ def readme_block(config: Any, state: dict[str, Any]) -> str:
     if verdicts:
         lines += ["", "The paper's orderings in this run (`~`: means within their two standard deviations "
                   "added): " + " ".join(verdicts)]
+    gaps = [f"{TITLES[s]} {signed(p['gap'])} ({signed(p['low'])} to {signed(p['high'])})"
+            for s in ("sp", "mp") if (p := results.get(s, {}).get(PAIRED_KEY))]
+    if gaps:
+        lines += ["", f"A2C minus `{BEST_FIXED}` on the same episodes ({CONFIDENCE:.0%} bootstrap interval over "
+                  "the test starts): " + ", ".join(gaps) + "."]
     return "\n".join(lines)
 
 
