@@ -88,6 +88,11 @@ def test_table_json_and_plot(sp_root: Path, tmp_path: Path) -> None:
     assert "LRD" in lines[0] and "Rand" in lines[0]
     assert [line.split()[0] for line in lines[2:5]] == ["OER_tau", "Cum.", "Ep."]
     assert "±" in lines[2]
+    # The footer explains the exact rows only where there are some.
+    assert ("OER_tau exact" in table) == ("exact: expectation" in table)
+    blind = {**results, "policies": {n: {k: v for k, v in p.items() if k != "exact"}
+                                     for n, p in results["policies"].items()}}
+    assert "exact" not in format_table(blind)
     out = write_json(results, tmp_path / "r" / "results.json")
     assert json.loads(out.read_text())["policies"].keys() == {"LRD", "Rand"}
     png = plot_results(results, tmp_path / "r" / "results.png")

@@ -195,7 +195,8 @@ def format_table(results: dict[str, Any]) -> str:
             stat = policies[name][key]
             row.append(f"{_number(stat['mean'])} ±{_number(stat['std'])}")
         cells.append(row)
-    if any("exact" in policies[name] for name in names):
+    exact = any("exact" in policies[name] for name in names)
+    if exact:
         for key, title in METRICS.items():
             cells.append(["", f"{title} exact", *(_number(policies[n]["exact"][key]) if "exact" in policies[n]
                                                   else "-" for n in names)])
@@ -203,7 +204,7 @@ def format_table(results: dict[str, Any]) -> str:
     lines = ["  ".join(c.ljust(w) for c, w in zip(row, widths)).rstrip() for row in cells]
     lines.insert(1, "-" * len(lines[0]))
     lines.append(f"mean ±std over {protocol['sessions']} sessions of {protocol['episodes']} "
-                 f"episodes, tau={protocol['tau']}; exact: expectation over the split's starts")
+                 f"episodes, tau={protocol['tau']}" + ("; exact: expectation over the split's starts" if exact else ""))
     if BEST_FIXED in policies:
         lines.append(f"{BEST_FIXED}: always {policies[BEST_FIXED]['action']}, the best single action "
                      "by exact OER_tau on this split")
