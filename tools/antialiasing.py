@@ -147,7 +147,8 @@ def measure(crop: str, camera: Camera) -> list[dict]:
                 if box[4] in boxes:
                     box_error = max(box_error, int(np.abs(np.subtract(box[:4], boxes[box[4]][:4])).max()))
         pixels = len(views) * camera.width * camera.height
-        rows.append({"crop": crop, "plants": model.plant_generator, "option": name, "wall_ms": 1000 * statistics.median(t[0] for t in timings[name]),
+        rows.append({"crop": crop, "plants": model.plant_generator, "option": name,
+                     "wall_ms": 1000 * statistics.median(t[0] for t in timings[name]),
                      "cpu_ms": 1000 * statistics.median(t[1] for t in timings[name]),
                      "ids_differ_percent": 100 * differ / pixels, "min_fruit_iou": min(ious, default=1.0),
                      "max_box_error_px": box_error, "mean_colour_difference": statistics.mean(colour)})

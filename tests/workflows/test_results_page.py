@@ -162,7 +162,7 @@ def test_the_readme_block_beside_docs_is_rewritten_from_the_run(tmp_path: Path) 
     assert "| SP strawberry, paper (Table 4) | .520 ± .004 | .433 ± .007 | .371 ± .008 | .438 ± .101 | - |" in text
     assert "| MP vine, ours | not run |" in text and "| MP vine, paper (Table 4) | .369 ± .009 |" in text
     assert "SP strawberry: A2C > Rand ~ LRD > UDD **holds**." in text
-    assert ("A2C minus `Best fixed action` on the same episodes (95% bootstrap interval over the test starts): "
+    assert ("A2C minus `Best fixed action` on the same episodes (95% bootstrap interval over the test episodes): "
             "SP strawberry +.027 (+.010 to +.040).") in text
     # A page written elsewhere (a work folder beside the README) leaves the README alone.
     other = tmp_path / "work"

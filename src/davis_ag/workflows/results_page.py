@@ -341,7 +341,7 @@ def readme_block(config: Any, state: dict[str, Any]) -> str:
             for s in ("sp", "mp") if (p := results.get(s, {}).get(PAIRED_KEY))]
     if gaps:
         lines += ["", f"A2C minus `{BEST_FIXED}` on the same episodes ({CONFIDENCE:.0%} bootstrap interval over "
-                  "the test starts): " + ", ".join(gaps) + "."]
+                  "the test episodes): " + ", ".join(gaps) + "."]
     return "\n".join(lines)
 
 
