@@ -132,6 +132,7 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
     from davis_ag.provenance import code_version
     from davis_ag.workflows.demo import evaluation_split, generate_scenes, run_baselines
     from davis_ag.workflows.results_page import write_results_md
+    from davis_ag.workflows.results_policies import model_path
 
     out = prove_writable_folder(out)  # absolute at once: Helios moves the working directory
     results_md = prove_writable_file(results_md, "--results")
@@ -185,9 +186,9 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
                 print(problem, flush=True)
             return 1
         split = evaluation_split(root, scenario_name, crop_name)
-        model = out / "models" / f"a2c_{key}.zip"
+        model = model_path(out, key)
         timesteps = config.sp_timesteps if scenario_name == "sp" else config.mp_timesteps
-        stamp = out / "models" / f"a2c_{key}.json"
+        stamp = model.with_suffix(".json")
         # A model made with other A2C settings or keep rule (or before they were recorded:
         # those kept the last snapshot) is trained anew.
         made = {"keep": "last", **load_state(stamp)}

@@ -19,11 +19,13 @@ from davis_ag.benchmark.exact import BEST_FIXED
 from davis_ag.benchmark.paired import CONFIDENCE, PAIRED_KEY
 from davis_ag.formats.layout import SCENE_METADATA
 from davis_ag.workflows.results_policies import (
+    cell,
     learning_curve_section,
     load_json_object,
     ordered,
     policy_sections,
     signed,
+    training_record,
 )
 
 #: Table 4 of the paper: scenario -> metric -> policy -> value.
@@ -92,11 +94,11 @@ def ordering_failures(order: tuple[str, ...], policies: dict[str, dict[str, Any]
     for left, relation, right in zip(order[0::2], order[1::2], order[2::2]):
         a, b = stats[left], stats[right]
         if relation == ">" and not a["mean"] > b["mean"]:
-            failures.append(f"{left} > {right} fails: {_cell(a['mean'])} is not above {_cell(b['mean'])}")
+            failures.append(f"{left} > {right} fails: {cell(a['mean'])} is not above {cell(b['mean'])}")
         gap, spread = abs(a["mean"] - b["mean"]), a["std"] + b["std"]
         if relation == "~" and gap > spread:
-            failures.append(f"{left} ~ {right} fails: {_cell(a['mean'])} and {_cell(b['mean'])} are "
-                            f"{_cell(gap)} apart, more than their stds added ({_cell(spread)})")
+            failures.append(f"{left} ~ {right} fails: {cell(a['mean'])} and {cell(b['mean'])} are "
+                            f"{cell(gap)} apart, more than their stds added ({cell(spread)})")
     return failures
 
 
@@ -109,13 +111,6 @@ def ordering_holds(order: tuple[str, ...], policies: dict[str, dict[str, Any]],
     """
     failures = ordering_failures(order, policies, metric)
     return None if failures is None else not failures
-
-
-def _cell(value: float | None) -> str:
-    if value is None:
-        return "–"
-    text = f"{value:.3f}"
-    return text[1:] if text.startswith("0.") else text
 
 
 def _a2c_play(state: dict[str, Any]) -> str:
@@ -180,11 +175,9 @@ def training_provenance(record: dict[str, Any]) -> str:
 
 def _notes(config: Any, state: dict[str, Any], out: Path | None) -> list[str]:
     """Plain statements of where this run differs from the paper's, from what it measured."""
-    from davis_ag.benchmark.training import training_record_path
-
     notes = []
     for scenario, key in GROUPS.items():
-        record = load_json_object(training_record_path(out / "models" / f"a2c_{key}.zip")) if out else {}
+        record = training_record(out, key)
         steps, rate = record.get("timesteps"), record.get("steps_per_second")
         if steps and rate and steps < PAPER_TIMESTEPS:
             notes.append(f"A2C on {key} trained for {steps:,} environment steps, {steps / PAPER_TIMESTEPS:.1%} of "
@@ -226,8 +219,6 @@ def _notes(config: Any, state: dict[str, Any], out: Path | None) -> list[str]:
 
 def _how_made(state: dict[str, Any], out: Path | None) -> list[str]:
     """The "How this run was made" section, from scene.json files, training records and stages."""
-    from davis_ag.benchmark.training import training_record_path
-
     lines = ["## How this run was made", ""]
     if out is None:
         return lines + ["No work folder was given, so the run's records were not read.", ""]
@@ -237,7 +228,7 @@ def _how_made(state: dict[str, Any], out: Path | None) -> list[str]:
             continue
         lines.append(f"- **{key}**, {len(scenes)} scene(s):")
         lines += [f"  - {line}" for line in scene_provenance(out / "dataset", scenes)]
-        record = load_json_object(training_record_path(out / "models" / f"a2c_{key}.zip"))
+        record = training_record(out, key)
         if record:
             lines.append(f"  - A2C: {training_provenance(record)}")
     return lines + [""]
@@ -254,8 +245,6 @@ def stage_rows(state: dict[str, Any], out: Path | None) -> list[tuple[str, float
     Returns:
         ``(stage, seconds, code, note)`` rows in the run's order.
     """
-    from davis_ag.benchmark.training import training_record_path
-
     rows = []
     for stage, entry in state.get("stages", {}).items():
         key, _, step = stage.partition(": ")
@@ -265,7 +254,7 @@ def stage_rows(state: dict[str, Any], out: Path | None) -> list[tuple[str, float
                                     .get("version", "unrecorded") for scene in state["scene_folders"][key]))
         record: dict[str, Any] = {}
         if step == "train A2C" and out is not None:  # only a training stage has a record
-            record = load_json_object(training_record_path(out / "models" / f"a2c_{key}.zip"))
+            record = training_record(out, key)
         if record.get("sittings"):
             sittings = record["sittings"]
             seconds = record.get("seconds", seconds)
@@ -284,7 +273,7 @@ def _comparison(scenario: str, policies: dict[str, dict[str, Any]]) -> str:
     text = " ".join(order)
     if failures is None:
         return f"The paper's ordering of OER_tau, {text}, cannot be checked: a policy was not run."
-    measured = ", ".join(f"{name} {_cell(policies[name]['oer_tau']['mean'])} ± {_cell(policies[name]['oer_tau']['std'])}"
+    measured = ", ".join(f"{name} {cell(policies[name]['oer_tau']['mean'])} ± {cell(policies[name]['oer_tau']['std'])}"
                          for name in order[::2])
     verdict = "holds" if not failures else "does not hold"
     paper_note = "" if ordering_holds(order, paper) else " (nor does it hold in Table 4's own numbers)"
@@ -320,7 +309,7 @@ def readme_block(config: Any, state: dict[str, Any]) -> str:
         if result:
             policies = result["policies"]
             scenes, split = len(result["protocol"].get("scenes", [])), result["protocol"]["split"]
-            cells = [f"{_cell(policies[n]['oer_tau']['mean'])} ± {_cell(policies[n]['oer_tau']['std'])}"
+            cells = [f"{cell(policies[n]['oer_tau']['mean'])} ± {cell(policies[n]['oer_tau']['std'])}"
                      if n in policies else "–" for n in ("A2C", "LRD", "UDD", "Rand", "Oracle", BEST_FIXED)]
             lines.append(f"| {TITLES[scenario]}, ours ({scenes} {split} scene{'s' if scenes != 1 else ''}) | "
                          + " | ".join(cells) + " |")
@@ -332,7 +321,7 @@ def readme_block(config: Any, state: dict[str, Any]) -> str:
             lines.append(f"| {TITLES[scenario]}, ours | not run | | | | | |")
         paper = PAPER_TABLE4[scenario]["oer_tau"]
         lines.append(f"| {TITLES[scenario]}, paper (Table 4) | "
-                     + " | ".join(f"{_cell(paper[n])} ± {_cell(PAPER_TABLE4_STD[scenario]['oer_tau'][n])}"
+                     + " | ".join(f"{cell(paper[n])} ± {cell(PAPER_TABLE4_STD[scenario]['oer_tau'][n])}"
                                   for n in ("A2C", "LRD", "UDD", "Rand")) + " | - | - |")
     if verdicts:
         lines += ["", "The paper's orderings in this run (`~`: means within their two standard deviations "
@@ -402,18 +391,18 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
             cells = [name]
             for metric in ("oer_tau", "reward", "length"):
                 stat = policies[name][metric]
-                cells.append(f"{_cell(stat['mean'])} ± {_cell(stat['std'])}")
+                cells.append(f"{cell(stat['mean'])} ± {cell(stat['std'])}")
                 paper_mean = PAPER_TABLE4[scenario][metric].get(name)
-                cells.append(_cell(paper_mean) if paper_mean is None
-                             else f"{_cell(paper_mean)} ± {_cell(PAPER_TABLE4_STD[scenario][metric][name])}")
+                cells.append(cell(paper_mean) if paper_mean is None
+                             else f"{cell(paper_mean)} ± {cell(PAPER_TABLE4_STD[scenario][metric][name])}")
             lines.append("| " + " | ".join(cells) + " |")
         lines += ["", _comparison(scenario, policies)]
         if "oer_0" in policies.get("LRD", {}):
-            text = f"Mean start OER (OER_0) of these episodes: {_cell(policies['LRD']['oer_0']['mean'])}"
+            text = f"Mean start OER (OER_0) of these episodes: {cell(policies['LRD']['oer_0']['mean'])}"
             done = result.get("fixed_actions", {}).get("done")
             if done:
                 # Always `done` ends where it starts: its exact OER_tau is the mean OER_0 of all starts.
-                text += (f", against {_cell(done['oer_tau'])} over every eligible start of the split (exact). "
+                text += (f", against {cell(done['oer_tau'])} over every eligible start of the split (exact). "
                          "Every policy plays the same drawn starts, so the draw moves all their sampled "
                          "means together; the exact values below do not depend on it")
             lines += ["", text + "."]

@@ -39,6 +39,18 @@ def load_json_object(path: Path) -> dict[str, Any]:
     return data if isinstance(data, dict) else {}
 
 
+def model_path(out: Path, group: str) -> Path:
+    """Where a run keeps a group's A2C model (``models/a2c_<group>.zip``)."""
+    return out / "models" / f"a2c_{group}.zip"
+
+
+def training_record(out: Path | None, group: str) -> dict[str, Any]:
+    """A run's A2C training record for a group; {} without a run folder or a record."""
+    from davis_ag.benchmark.training import training_record_path
+
+    return load_json_object(training_record_path(model_path(out, group))) if out else {}
+
+
 def ordered(policies: dict[str, Any]) -> list[str]:
     """The run's policy names in page order (unknown names last, as they came)."""
     return [n for n in POLICY_ORDER if n in policies] + [n for n in policies if n not in POLICY_ORDER]
@@ -119,11 +131,11 @@ def action_table(policies: dict[str, Any], actions: list[str]) -> list[str]:
 
 def a2c_line(scenario: str, policies: dict[str, Any], out: Path | None) -> str | None:
     """How A2C was trained (its settings, from the training record) and how it played."""
-    from davis_ag.benchmark.training import SB3_DEFAULT_SETTINGS, training_record_path
+    from davis_ag.benchmark.training import SB3_DEFAULT_SETTINGS
 
     if "A2C" not in policies:
         return None
-    record = load_json_object(training_record_path(out / "models" / f"a2c_{GROUPS[scenario]}.zip")) if out else {}
+    record = training_record(out, GROUPS[scenario])
     settings = record.get("a2c_settings", SB3_DEFAULT_SETTINGS if record else None)
     trained = ("settings not recorded" if settings is None else
                ", ".join(f"{k}={v}" for k, v in settings.items()) + " over Stable-Baselines3's A2C defaults"
@@ -145,10 +157,8 @@ def train_split_line(scenario: str, result: dict[str, Any], out: Path | None) ->
     Beside the test verdict this separates a policy that did not learn (no better than one move
     on the scenes it trained on) from one that does not carry over to unseen scenes.
     """
-    from davis_ag.benchmark.training import training_record_path
-
     train = result.get("train_split")
-    record = load_json_object(training_record_path(out / "models" / f"a2c_{GROUPS[scenario]}.zip")) if out else {}
+    record = training_record(out, GROUPS[scenario])
     selection = record.get("selection") or {}
     scores = {s["step"]: s["oer_tau"] for s in selection.get("scores", [])}
     if not train or not train.get("fixed_actions") or selection.get("kept_step") not in scores:
@@ -185,13 +195,12 @@ def action_figure(scenario: str, out: Path | None, page: Path) -> str | None:
 
 def learning_curve_section(out: Path | None, page: Path) -> list[str]:
     """Fig. 4a from the run's training records, drawn into ``images/`` beside the page."""
-    from davis_ag.benchmark.training import training_record_path
     from davis_ag.errors import UserError
     from davis_ag.figures.training_curve import plot_learning_curve
 
     if out is None:
         return []
-    records = {key: load_json_object(training_record_path(out / "models" / f"a2c_{key}.zip")) for key in GROUPS.values()}
+    records = {key: training_record(out, key) for key in GROUPS.values()}
     records = {key: r for key, r in records.items() if r}
     if not records:
         return []
