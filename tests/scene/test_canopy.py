@@ -10,10 +10,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from davis_ag.scene.canopy import strawberry_parts
+from davis_ag.scene.canopy import GRAPE_LEAF_STALK_UV, GRAPE_LEAF_TIP_UV, goblet_vine_parts, strawberry_parts
 from davis_ag.scene.canopy_geometry import (
     bent_shoot,
     cart2sphere,
+    flat_tile,
     interpolate_tube,
     rotate,
     rotation,
@@ -107,6 +108,41 @@ def test_same_seed_same_plant_other_seed_other_plant():
     c = strawberry_parts(Phenotype(0.4, 0.025, 0.1), np.zeros(3), np.random.default_rng(4))
     assert np.array_equal(a.leaves[10].triangles, b.leaves[10].triangles)
     assert not np.allclose(a.leaves[10].triangles, c.leaves[10].triangles)
+
+
+def _distance_to_polyline(point: np.ndarray, nodes: np.ndarray) -> float:
+    a, b = nodes[:-1], nodes[1:]
+    t = np.clip(((point - a) * (b - a)).sum(1) / np.maximum(((b - a) ** 2).sum(1), 1e-18), 0.0, 1.0)
+    return float(np.linalg.norm(a + t[:, None] * (b - a) - point, axis=1).min())
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_vine_leaves_hang_from_their_stalks_next_to_the_cane(seed):
+    """grapevine.cpp (2023): the leaf prototype is a tile turned half a turn (make_SphericalCoord(0,
+    M_PI)), tilted by -Rtheta about y, turned by Rphi about z with a rotate that turns by -Rphi, and
+    placed at pos_leaf - leaf_offset: every leaf hangs with its stalk end above its tip and nearer
+    the cane it grows on than its tip is."""
+    parts = goblet_vine_parts(Phenotype(0.7, 0.0075, 0.18), np.zeros(3), np.random.default_rng(seed))
+    canes = [tube.nodes for tube in parts.tubes[1:]]  # the trunk first, then one tube per cane
+    assert len(canes) == 20 and len(parts.leaves) > 100
+    stalk_up = nearer = 0
+    for leaf in parts.leaves:
+        stalk, tip = leaf.point_at(GRAPE_LEAF_STALK_UV), leaf.point_at(GRAPE_LEAF_TIP_UV)
+        stalk_up += stalk[2] > tip[2]
+        cane_distance = [(_distance_to_polyline(stalk, c), _distance_to_polyline(tip, c)) for c in canes]
+        nearest = min(cane_distance)  # the cane the stalk is closest to
+        nearer += nearest[0] < nearest[1]
+    # Rtheta is 0.4 pi +- 10 %: every leaf hangs stalk up, whatever its turn about z.
+    assert stalk_up == len(parts.leaves)
+    assert nearer >= 0.9 * len(parts.leaves)
+
+
+def test_leaf_points_follow_their_texture_coordinates():
+    tile = flat_tile(2.0, 1.0)  # x from -1 to 1, u from 0 to 1
+    assert np.allclose(tile.point_at((0.25, 0.5)), [-0.5, 0.0, 0.0])
+    assert np.allclose(flat_tile(2.0, 1.0, flip=True).point_at((0.25, 0.5)), [0.5, 0.0, 0.0])
+    with pytest.raises(ValueError):
+        tile.point_at((1.5, 0.5))
 
 
 # ---------------------------------------------------------------------------------------------

@@ -22,7 +22,8 @@ What each plant is (Table 1's parameters in capitals: H height, R fruit radius, 
   cluster of 1-3 fruit (spheres of radius R) hangs 4 R below the point 25 % along the shoot.
 - goblet vine: a trunk H tall (radius 5 cm) and two opposite fans of ten canes from its head,
   from horizontal to near vertical, each with a cluster of grape berries (radius R, about 100
-  per cluster) near its base and leaves up to L wide along it.
+  per cluster) near its base and leaves up to L wide along it, each hanging from its stalk
+  (stalk end above the tip and next to the cane).
 
 Textures come from pyhelios3d's assets (the plug-in's own are not shipped): see ``TEXTURES``.
 Every primitive carries its organ class (:mod:`davis_ag.scene.organs`).
@@ -64,6 +65,11 @@ TEXTURES = {
     "grape_leaf": "plantarchitecture/assets/textures/GrapeLeaf.png",  # GrapeLeaf.png
     "wood": "visualizer/textures/wood.jpg",  # wood.jpg
 }
+#: Where the grape leaf texture's stalk (the petiole's junction) and tip lie, in texture
+#: coordinates, read off ``GrapeLeaf.png`` (the same picture as the plug-in's): the stalk at
+#: 27 % of the width from the left, the main lobe's tip at the right edge, both on the midline.
+GRAPE_LEAF_STALK_UV = (0.27, 0.5)
+GRAPE_LEAF_TIP_UV = (0.98, 0.5)
 #: The plug-in's defaults that Table 1 does not list (``CanopyGenerator.cpp``'s constructors).
 STEM_COLOUR = (0.35, 0.45, 0.2)
 TOMATO_COLOUR = (0.7, 0.28, 0.2)
@@ -216,9 +222,17 @@ def grape_cluster(top: np.ndarray, berry: float, cluster: float, rng: np.random.
 
 
 def _goblet_leaves(cane: np.ndarray, origin: np.ndarray, width: float, rng: np.random.Generator) -> list[LeafMesh]:
-    """Leaves along a cane from its tip down, growing from 0.1 to nearly ``width`` wide."""
+    """Leaves along a cane from its tip down, growing from 0.1 to nearly ``width`` wide.
+
+    As the 2023 plug-in places them, with the 2023 core's conventions: the prototype tile is made
+    turned half a turn about z (``make_SphericalCoord(0, M_PI)``), so its stalk end (texture u
+    small, :data:`GRAPE_LEAF_STALK_UV`) starts on +x; the tilt about y then lifts the stalk end
+    above the tip; ``CompoundObject::rotate`` about z turns by ``-Rphi``, which points the stalk
+    end back at the cane; and the leaf sits at ``pos_leaf - leaf_offset``, on the side of the cane
+    opposite the offset.
+    """
     leaves = []
-    tile = flat_tile(1.0, 1.0)
+    tile = flat_tile(1.0, 1.0, flip=True)
     flip = 1 if rng.random() < 0.5 else 0
     fraction = 1.0
     while fraction > 0.5 * width:  # the plug-in compares the fraction with half the leaf width
@@ -229,9 +243,10 @@ def _goblet_leaves(cane: np.ndarray, origin: np.ndarray, width: float, rng: np.r
         offset = rotate_about_line(np.array([0.0, size * (0.3 + vary(rng, 0.25)), 0.0]), np.zeros(3), normal,
                                    flip * PI + rng.random() * 0.25 * PI)
         side = 1.0 if flip % 2 == 0 else -1.0
-        turn = -side * 0.5 * PI * (1.0 + vary(rng, 0.4))
-        tilt = 0.4 * PI * (1.0 + vary(rng, 0.1))
-        leaves.append(tile.transformed(np.array([size, size, 1.0]), [(-tilt, "y"), (turn, "z")], origin + at + offset))
+        r_phi = -side * 0.5 * PI * (1.0 + vary(rng, 0.4))
+        r_theta = 0.4 * PI * (1.0 + vary(rng, 0.1))
+        leaves.append(tile.transformed(np.array([size, size, 1.0]), [(-r_theta, "y"), (-r_phi, "z")],
+                                       origin + at - offset))
         fraction -= GOBLET["leaf_spacing_fraction"] * size * (1.0 + vary(rng, 0.25))
         flip += 1
     return leaves

@@ -122,6 +122,25 @@ class LeafMesh:
         """Largest distance between two of its vertices (m): its size, whatever its orientation."""
         return diameter(self.triangles.reshape(-1, 3))
 
+    def point_at(self, uv: tuple[float, float]) -> np.ndarray:
+        """Where a texture coordinate lies on the leaf: a texel (its stalk, its tip) in space.
+
+        Args:
+            uv: Texture coordinate inside the leaf's texture.
+
+        Returns:
+            (3,) position, interpolated inside the first triangle whose texture coordinates hold it.
+        """
+        target = np.asarray(uv, dtype=float)
+        for corners, uvs in zip(self.triangles, self.uvs):
+            edges = np.array([uvs[1] - uvs[0], uvs[2] - uvs[0]]).T
+            if abs(np.linalg.det(edges)) < 1e-12:
+                continue
+            b1, b2 = np.linalg.solve(edges, target - uvs[0])
+            if min(b1, b2, 1.0 - b1 - b2) >= -1e-9:
+                return corners[0] + b1 * (corners[1] - corners[0]) + b2 * (corners[2] - corners[0])
+        raise ValueError(f"texture coordinate {tuple(uv)} lies on none of the leaf's triangles")
+
 
 def diameter(points: np.ndarray) -> float:
     """Largest distance between two of the points (m)."""
