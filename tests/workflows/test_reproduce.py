@@ -51,3 +51,22 @@ def test_an_evaluation_gets_the_train_split_yardstick_once(sp_root: Path) -> Non
     assert results["train_split"] == split_fixed_actions(sp_root, "sp", "train", "strawberry")
     assert not add_train_split(results, sp_root, "sp", "strawberry")
     assert _summary(results)["train_split"] == results["train_split"]
+
+
+def test_a_run_the_disk_cannot_hold_is_refused_before_anything_is_written(tmp_path: Path) -> None:
+    # Issue 32: paper-scale writes about 48 GB of views and 21 GB of observation caches.
+    from dataclasses import replace
+
+    from davis_ag.errors import UserError
+    from davis_ag.workflows.reproduce import CONFIGS, disk_needed, reproduce
+
+    paper = CONFIGS["paper-scale"]
+    # Table 3's 86 SP strawberry and 44 MP vine scenes (285 and 1,800 views, Table 2) at 1280x720.
+    views = 86 * 285 + 44 * 1800
+    assert 0.4e6 * views < disk_needed(paper) < 0.5e6 * views + 224 * 224 * 4 * views
+    huge = replace(paper, name="huge", sp_scenes=10**7)
+    out = tmp_path / "out"
+    with pytest.raises(UserError, match=r"needs about .* GB more under .* GB free: free space, or pass --out"):
+        reproduce(huge, out, tmp_path / "results.md")
+    assert not out.exists() and not (tmp_path / "results.md").exists()
+

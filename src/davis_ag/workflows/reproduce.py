@@ -63,6 +63,15 @@ CONFIGS: dict[str, ReproduceConfig] = {
                                    mp_extent=None, sp_timesteps=300_000, mp_timesteps=300_000),
 }
 
+#: Bytes one 1280x720 view writes (JPEG 0.36 MB, depth 0.07 MB, masks and classes), measured on
+#: canopy-plant scenes; other sizes scale it by their pixel count, and once scenes exist their
+#: own mean is used instead.
+BYTES_PER_VIEW_720P = 0.46e6
+#: Bytes one view takes in the observation cache (224 x 224 x 4 uint8, :mod:`davis_ag.benchmark.cache`).
+CACHE_BYTES_PER_VIEW = 224 * 224 * 4
+#: Room left free beyond the estimate, for models, results and the estimate's error.
+DISK_MARGIN = 1.1
+
 #: Which snapshot of each A2C run is evaluated: the best on the train split
 #: (:mod:`davis_ag.benchmark.selection`).
 KEEP = "best-train"
@@ -76,16 +85,16 @@ def configurations_table() -> str:
     """docs/benchmark.md's table of :data:`CONFIGS`, written from them so the page follows the code.
 
     Returns:
-        A Markdown table: scenes, grid, image size and A2C steps of each configuration.
+        A Markdown table: scenes, grid, image size, A2C steps and disk space of each configuration.
     """
-    rows = ["| configuration | SP strawberry | MP vine | images | A2C steps (SP / MP) | beside Table 4 |",
-            "|---|---|---|---|---|---|"]
+    rows = ["| configuration | SP strawberry | MP vine | images | A2C steps (SP / MP) | disk (views and caches) "
+            "| beside Table 4 |", "|---|---|---|---|---|---|---|"]
     for config in CONFIGS.values():
         grid = (f"{config.mp_extent[0]:g} x {config.mp_extent[1]:g} m grid" if config.mp_extent
                 else "the paper's 7 x 3 m grid")
         scenes = (config.sp_scenes, config.mp_scenes)
         if scenes == PAPER_SCENES and config.size == (1280, 720):
-            verdict = "Table 3's scenes and images; days on a 2-core machine"
+            verdict = "Table 3's scenes and images"
         elif config.mp_extent is None and (config.sp_timesteps, config.mp_timesteps) == (300_000, 300_000):
             verdict = (f"grids, protocol and training as the paper's; {sum(scenes)} scenes instead of "
                        f"{sum(PAPER_SCENES)}, {config.size[0]}x{config.size[1]} images")
@@ -93,7 +102,8 @@ def configurations_table() -> str:
             verdict = "not comparable: a smoke test of every stage"
         rows.append(f"| `{config.name}` | {config.sp_scenes} scenes | {config.mp_scenes} scenes, {grid} | "
                     f"{config.size[0]}x{config.size[1]} | {config.sp_timesteps // 1000}K / "
-                    f"{config.mp_timesteps // 1000}K | {verdict} |")
+                    f"{config.mp_timesteps // 1000}K | {disk_needed(config) / 1e9:.1f} GB "
+                    f"| {verdict} |")
     return "\n".join(rows)
 
 
@@ -106,6 +116,70 @@ def load_state(path: Path) -> dict[str, Any]:
         return json.loads(path.read_text())
     except (OSError, ValueError):
         return {}
+
+
+def disk_needed(config: ReproduceConfig, root: Path | None = None,
+                pairs: list[tuple[str, str]] | tuple[tuple[str, str], ...] = SCENARIO_CROPS) -> int:
+    """Bytes the run still has to write under its dataset ``root``: the scenes not yet complete
+    and the observation caches not yet built.
+
+    Args:
+        config: The size of the run.
+        root: The dataset root (``OUT/dataset``); what is complete there is not counted. None
+            for a run not started.
+        pairs: ``(scenario, crop)`` pairs to run.
+
+    Returns:
+        An estimate in bytes, the measured per-view size of finished scenes where there are some.
+    """
+    from davis_ag.benchmark.cache import CACHE_FOLDER
+    from davis_ag.generate.dataset_files import complete_scenes
+    from davis_ag.generate.one_scene import SceneRequest
+    from davis_ag.scene.camera import Camera
+    from davis_ag.scene.specs import crop_spec, scenario_spec
+    from davis_ag.scene.view_grid import views_per_scene
+
+    root = root or Path("/nonexistent")
+    done = set(complete_scenes(root))
+    written = [p for scene in done for p in (root / scene).rglob("*") if p.is_file()]
+    done_views = sum(1 for p in written if p.suffix == ".jpeg")
+    width, height = config.size
+    per_view = (sum(p.stat().st_size for p in written) / done_views if done_views
+                else BYTES_PER_VIEW_720P * width * height / (1280 * 720))
+    needed = 0.0
+    for scenario_name, crop_name in pairs:
+        crop = crop_spec(crop_name)
+        scenario = scenario_spec(scenario_name, crop)
+        if scenario_name == "mp" and config.mp_extent:
+            scenario = replace(scenario, extent=tuple(config.mp_extent))
+        views = views_per_scene(scenario, crop)
+        n = config.sp_scenes if scenario_name == "sp" else config.mp_scenes
+        for i in range(n):
+            folder = SceneRequest(scenario, crop, i, config.seed, Camera(width, height)).folder
+            if folder not in done:
+                needed += views * per_view
+            if not (root / CACHE_FOLDER / folder).is_dir():
+                needed += views * CACHE_BYTES_PER_VIEW
+    return int(needed)
+
+
+def check_disk(config: ReproduceConfig, out: Path,
+               pairs: list[tuple[str, str]] | tuple[tuple[str, str], ...] = SCENARIO_CROPS) -> None:
+    """Refuse, before anything is written, a run whose files the disk under ``out`` cannot hold.
+
+    Raises:
+        UserError: when the free space is below :func:`disk_needed` with a 10 % margin.
+    """
+    import shutil
+
+    from davis_ag.errors import UserError
+
+    needed = disk_needed(config, out / "dataset", pairs) * DISK_MARGIN
+    probe = out if out.exists() else next(p for p in out.parents if p.exists())
+    free = shutil.disk_usage(probe).free
+    if free < needed:
+        raise UserError(f"reproduce --config {config.name} needs about {needed / 1e9:.1f} GB more under {out} "
+                        f"and the disk has {free / 1e9:.1f} GB free: free space, or pass --out on a larger disk")
 
 
 def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
@@ -134,6 +208,7 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
     from davis_ag.workflows.results_page import write_results_md
     from davis_ag.workflows.results_policies import model_path
 
+    check_disk(config, Path(out).expanduser().absolute(), pairs)
     out = prove_writable_folder(out)  # absolute at once: Helios moves the working directory
     results_md = prove_writable_file(results_md, "--results")
     root = out / "dataset"
