@@ -134,9 +134,7 @@ def disk_needed(config: ReproduceConfig, root: Path | None = None,
     """
     from davis_ag.benchmark.cache import CACHE_FOLDER
     from davis_ag.generate.dataset_files import complete_scenes
-    from davis_ag.generate.one_scene import SceneRequest
-    from davis_ag.scene.camera import Camera
-    from davis_ag.scene.specs import crop_spec, scenario_spec
+    from davis_ag.scene.specs import crop_spec, group_name, scenario_spec
     from davis_ag.scene.view_grid import views_per_scene
 
     root = root or Path("/nonexistent")
@@ -154,13 +152,18 @@ def disk_needed(config: ReproduceConfig, root: Path | None = None,
             scenario = replace(scenario, extent=tuple(config.mp_extent))
         views = views_per_scene(scenario, crop)
         n = config.sp_scenes if scenario_name == "sp" else config.mp_scenes
-        for i in range(n):
-            folder = SceneRequest(scenario, crop, i, config.seed, Camera(width, height)).folder
-            if folder not in done:
-                needed += views * per_view
-            if not (root / CACHE_FOLDER / folder).is_dir():
-                needed += views * CACHE_BYTES_PER_VIEW
+        group = group_name(scenario, crop)
+        cache_folders = [f"{group}/{p.name}" for p in (root / CACHE_FOLDER / group).glob("*")]
+        made = sum(_among_first(folder, group, n) for folder in done)
+        cached = sum(_among_first(folder, group, n) for folder in cache_folders)
+        needed += views * (per_view * (n - made) + CACHE_BYTES_PER_VIEW * (n - cached))
     return int(needed)
+
+
+def _among_first(folder: str, group: str, n: int) -> bool:
+    """Whether a scene folder is one of a run's ``n`` scenes of ``group`` (``GROUP/000`` to ``n - 1``)."""
+    name, _, index = folder.partition("/")
+    return name == group and index.isdigit() and int(index) < n
 
 
 def check_disk(config: ReproduceConfig, out: Path,
