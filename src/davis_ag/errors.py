@@ -1,8 +1,32 @@
-"""The one exception type the command line turns into a one-line message."""
+"""The exceptions the command line turns into a one-line message, each class with its exit status.
+
+docs/errors.md lists the classes and their exit statuses: bad input 2, a failure of the machine 1,
+a stop asked for by a signal 128 + the signal's number.
+"""
 
 
 class UserError(Exception):
     """Bad input or an unusable environment: the message says what, where and how to fix it.
 
-    The command line prints it as a single line and exits non-zero, never with a traceback.
+    The command line prints it as a single line and exits with status 2, never with a traceback.
     """
+
+
+class MachineError(UserError):
+    """The machine failed the run (a full disk, a folder gone), not its input: one line naming
+    what was kept and where, exit status 1."""
+
+
+class Stopped(KeyboardInterrupt):
+    """SIGTERM (or SIGINT) asked the run to stop: raised in the main thread by the command line's
+    handler, so every ``finally`` and ``with`` unwinds (locks released, temporaries removed,
+    worker processes ended) before the one line that says what was kept. A KeyboardInterrupt, so
+    code that stops cleanly on Ctrl-C (Stable-Baselines3, the worker pool) does so on SIGTERM too.
+
+    Args:
+        signal_number: The signal that asked.
+    """
+
+    def __init__(self, signal_number: int) -> None:
+        super().__init__(signal_number)
+        self.signal_number = signal_number
