@@ -100,6 +100,10 @@ def run_dataset(requests: Sequence[SceneRequest], root: Path, options: RunOption
     options = options or RunOptions()
     if options.executor != "ray":  # Ray's drivers draw nothing; its workers check for themselves
         require_native_helios()  # before any scene, not as each scene's failure
+    else:  # before the folder or dataset.json is made
+        from davis_ag.generate.ray_executor import require_ray
+
+        require_ray()
     root = Path(root).expanduser().absolute()
     _precheck(root)
     root.mkdir(parents=True, exist_ok=True)
