@@ -8,7 +8,7 @@ import signal
 import sys
 from typing import Any
 
-from davis_ag.errors import MachineError, Stopped, UserError
+from davis_ag.errors import MachineError, Stopped, UserError, stop
 from davis_ag.provenance import code_version
 
 # Each name is a module of davis_ag.commands defining HELP, DESCRIPTION, add_arguments(parser),
@@ -103,15 +103,15 @@ def _stop_on_signals() -> dict[int, Any]:
     unwinds (locks, temporaries, worker processes) and says what it kept; returns the handlers
     it replaced. A second signal while unwinding is ignored, so the cleanup is not cut short."""
 
-    def stop(number: int, frame: Any) -> None:
+    def on_signal(number: int, frame: Any) -> None:
         for each in (signal.SIGTERM, signal.SIGINT):
             signal.signal(each, signal.SIG_IGN)
-        raise Stopped(number)
+        stop(number)  # raises Stopped, at once or when a step that must not be cut (stops_held) ends
 
     previous = {}
     for number in (signal.SIGTERM, signal.SIGINT):
         try:
-            previous[number] = signal.signal(number, stop)
+            previous[number] = signal.signal(number, on_signal)
         except ValueError:  # not the main thread (main() called from a thread): leave them
             break
     return previous
