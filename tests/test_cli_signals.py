@@ -6,11 +6,13 @@ Signals are sent by PID to a real ``davis-ag`` process, once it has finished som
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import subprocess
 import sys
 import time
+import zipfile
 from pathlib import Path
 
 import pytest
@@ -22,7 +24,7 @@ seed: 3
 image_size: 64x48
 grid: {extent: [3.0, 3.0], step: 1.5, altitude_levels: [0]}
 groups:
-  - {scenario: sp, crop: strawberry, scenes: 3}
+  - {scenario: sp, crop: strawberry, scenes: 2}
 """
 
 
@@ -52,7 +54,7 @@ def test_sigterm_ends_generate_with_one_line_and_the_run_resumes(tmp_path: Path)
     assert "leaked" not in err
     done = subprocess.run(command + ["--quiet"], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0 and "leaked" not in done.stderr, done.stderr
-    assert sorted(p.name for p in (out / "Single-Strawberry").iterdir()) == ["000", "001", "002"]
+    assert sorted(p.name for p in (out / "Single-Strawberry").iterdir()) == ["000", "001"]
 
 
 def test_sigint_ends_train_with_one_line_keeping_its_checkpoint(tmp_path: Path) -> None:
@@ -68,10 +70,10 @@ def test_sigint_ends_train_with_one_line_keeping_its_checkpoint(tmp_path: Path) 
     assert code == 128 + signal.SIGINT, err
     assert err.splitlines() == ["davis-ag train: stopped by SIGINT; the last checkpoint and the best snapshot so far "
                                 "are kept beside --out: run the same command again to resume"], err
-    assert checkpoint.exists() and not model.exists() and not list(tmp_path.glob(".*"))
-    # The same command resumes (here with fewer steps, so that it ends at once).
-    done = subprocess.run([*command, "--timesteps", "40"], capture_output=True, text=True, env=env, timeout=300)
-    assert done.returncode == 0 and "resuming a2c.zip from its checkpoint" in done.stdout, done.stderr
+    assert not model.exists() and not list(tmp_path.glob(".*"))  # no lock, no temporary left
+    # What resumes (tests/benchmark/test_training.py resumes such checkpoints): whole and readable.
+    assert json.loads(checkpoint.read_text())["timesteps_done"] >= 20
+    assert zipfile.is_zipfile(tmp_path / "a2c.checkpoint.zip")
 
 
 @pytest.mark.parametrize("command", [["evaluate", "--policies", "LRD", "--episodes", "1000000", "--sessions", "1"]])

@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Sequence
 
 from davis_ag.atomic_files import PROBE_PREFIX, write_json_atomic
-from davis_ag.errors import UserError
+from davis_ag.errors import MachineError, UserError
 from davis_ag.formats.outputs import LOCK_FILE, OutputLock
 from davis_ag.generate.dataset_files import (
     DATASET_FILE,
@@ -141,7 +141,9 @@ def run_dataset(requests: Sequence[SceneRequest], root: Path, options: RunOption
             progress.close()
         if report.failed:
             first, message = next(iter(report.failed.items()))
-            raise UserError(f"{len(report.failed)} of {len(todo)} scenes failed ({first}: {message}); the others "
+            # Exit status 1 when the machine failed every one of them (a full disk), 2 otherwise.
+            kind = MachineError if set(report.failed) <= report.machine_failed else UserError
+            raise kind(f"{len(report.failed)} of {len(todo)} scenes failed ({first}: {message}); the others "
                             "are complete: run the same command again to retry the failed ones")
         report.splits = write_splits(root, settings["seed"])
     return report
