@@ -9,6 +9,7 @@ what a killed run left.
 
 from __future__ import annotations
 
+import errno
 import json
 import os
 import tempfile
@@ -17,7 +18,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import IO, Any, Callable, Iterator
 
-from davis_ag.errors import UserError
+from davis_ag.errors import MachineError, UserError
 
 
 def temporary_sibling(path: Path) -> Path:
@@ -87,9 +88,19 @@ def save_figure_atomic(figure: Any, path: str | os.PathLike[str], dpi: float | N
         with atomic_output(out, "wb") as handle:
             figure.savefig(handle, format=fmt, **({} if dpi is None else {"dpi": dpi}))
     except OSError as error:
-        raise UserError(f"{out}: cannot write the figure ({error.strerror or error}); choose "
-                        "another output path") from None
+        kind = MachineError if is_machine_failure(error) else UserError
+        raise kind(f"{out}: cannot write the figure ({error.strerror or error}); free the space or choose "
+                   "another output path") from None
     return out
+
+
+#: errno values that mean the machine failed the write (space, quota, the device), not the path.
+MACHINE_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EIO, errno.EROFS, errno.ENODEV, errno.ESTALE})
+
+
+def is_machine_failure(error: OSError) -> bool:
+    """Whether an ``OSError`` is the machine's (a full disk, a failing device), exit status 1."""
+    return error.errno in MACHINE_ERRNOS
 
 
 def write_marked_section(doc: str | os.PathLike[str], marker: str, text: str) -> None:
@@ -219,7 +230,7 @@ def write_or_rescue(path: str | os.PathLike[str], write: Callable[[Path], None],
         ``path`` when written there.
 
     Raises:
-        UserError: naming the failure and the file the result was kept in instead.
+        MachineError: naming the failure and the file the result was kept in instead.
     """
     target = Path(path)
     try:
@@ -231,7 +242,7 @@ def write_or_rescue(path: str | os.PathLike[str], write: Callable[[Path], None],
     try:
         write(kept)
     except OSError as error:
-        raise UserError(f"cannot write {what} to {target} ({reason}) nor to {kept} "
-                        f"({error.strerror or error}): {what} is lost; free space and run again") from None
-    raise UserError(f"cannot write {what} to {target} ({reason}); it was kept in {kept}: move it "
-                    "where you want it")
+        raise MachineError(f"cannot write {what} to {target} ({reason}) nor to {kept} "
+                           f"({error.strerror or error}): {what} is lost; free space and run again") from None
+    raise MachineError(f"cannot write {what} to {target} ({reason}); it was kept in {kept}: move it "
+                       "where you want it")

@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import signal
 import sys
+from typing import Any
 
-from davis_ag.errors import UserError
+from davis_ag.errors import MachineError, Stopped, UserError, stop
 from davis_ag.provenance import code_version
 
 # Each name is a module of davis_ag.commands defining HELP, DESCRIPTION, add_arguments(parser),
@@ -14,6 +16,18 @@ from davis_ag.provenance import code_version
 # makes the sub-parsers from them, so that every command's is made the same way.
 COMMANDS = ["generate", "validate", "train", "evaluate", "preview", "demo", "reproduce", "stats", "plot",
             "view", "export", "transfer"]
+
+
+#: What a stopped command keeps, for its last line (every command resumes by being run again).
+KEPT_WHEN_STOPPED = {
+    "generate": "finished scenes are kept and a scene in progress resumes from its views",
+    "demo": "finished scenes are kept",
+    "reproduce": "finished stages, scenes and training checkpoints are kept",
+    "train": "the last checkpoint and the best snapshot so far are kept beside --out",
+    "evaluate": "nothing half-written was left",
+    "export": "the files already exported are kept",
+    "transfer": "finished stages are kept",
+}
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -55,11 +69,16 @@ def add_command(subparsers: argparse._SubParsersAction, name: str) -> argparse.A
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the command line; a :class:`UserError` becomes one line on stderr and exit code 2, an
-    operating-system failure (``OSError``: disk full, folder removed) one line and exit code 1."""
+    """Run the command line: each failure class becomes one line on stderr and its exit status
+    (docs/errors.md): a :class:`UserError` 2, a :class:`MachineError` or an operating-system failure
+    (``OSError``: disk full, folder removed) 1, SIGINT 130 and SIGTERM 143."""
     args = build_parser().parse_args(argv)
+    previous = _stop_on_signals()
     try:
         return int(args.func(args) or 0)
+    except MachineError as error:
+        print(f"davis-ag {args.command}: error: {error}", file=sys.stderr)
+        return 1
     except UserError as error:
         print(f"davis-ag {args.command}: error: {error}", file=sys.stderr)
         return 2
@@ -68,9 +87,34 @@ def main(argv: list[str] | None = None) -> int:
         print(f"davis-ag {args.command}: error: {where}{error.strerror or error}; nothing finished was "
               "lost: free the space or fix the path and run the same command again", file=sys.stderr)
         return 1
-    except KeyboardInterrupt:
-        print(f"davis-ag {args.command}: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as error:
+        number = error.signal_number if isinstance(error, Stopped) else signal.SIGINT
+        kept = KEPT_WHEN_STOPPED.get(args.command, "nothing half-written was left")
+        print(f"davis-ag {args.command}: stopped by {signal.Signals(number).name}; {kept}: run the same "
+              "command again to resume", file=sys.stderr)
+        return 128 + int(number)
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+
+
+def _stop_on_signals() -> dict[int, Any]:
+    """Turn SIGTERM and SIGINT into :class:`Stopped` in the main thread, so a stopped command
+    unwinds (locks, temporaries, worker processes) and says what it kept; returns the handlers
+    it replaced. A second signal while unwinding is ignored, so the cleanup is not cut short."""
+
+    def on_signal(number: int, frame: Any) -> None:
+        for each in (signal.SIGTERM, signal.SIGINT):
+            signal.signal(each, signal.SIG_IGN)
+        stop(number)  # raises Stopped, at once or when a step that must not be cut (stops_held) ends
+
+    previous = {}
+    for number in (signal.SIGTERM, signal.SIGINT):
+        try:
+            previous[number] = signal.signal(number, on_signal)
+        except ValueError:  # not the main thread (main() called from a thread): leave them
+            break
+    return previous
 
 
 if __name__ == "__main__":

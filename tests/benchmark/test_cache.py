@@ -103,3 +103,17 @@ def test_steps_never_decode(root: Path, monkeypatch: pytest.MonkeyPatch) -> None
         _, _, terminated, _, _ = env.step(int(rng.integers(env.action_space.n)))
         if terminated:
             env.reset()
+
+
+def test_a_view_cut_short_after_the_cache_was_built_is_noticed(tmp_path: Path) -> None:
+    """Issue 33 case 9: a JPEG truncated after the observation cache was built went unnoticed (the
+    cache served the old pixels). Now the cache is stale and its rebuild names the file."""
+    from davis_ag.errors import UserError
+
+    data = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2, size=(64, 48))
+    TVMEnv(data, "sp", "all")
+    cache_module._OPEN.clear()  # as a new process would
+    image = data / "Single-Strawberry" / "000" / "images" / "0002.jpeg"
+    image.write_bytes(image.read_bytes()[:300])
+    with pytest.raises(UserError, match=f"{image}: cannot decode"):
+        TVMEnv(data, "sp", "all")

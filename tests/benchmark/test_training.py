@@ -10,7 +10,9 @@ from kill_callback import KillAfter
 from layout_factory import write_tiny_dataset
 from stable_baselines3 import A2C
 
-from davis_ag.benchmark.training import checkpoint_paths, train_a2c, training_record_path
+from davis_ag.benchmark.selection import snapshot_path
+from davis_ag.benchmark.training import check_device, checkpoint_paths, train_a2c, training_record_path
+from davis_ag.errors import MachineError, UserError
 from davis_ag.provenance import code_version
 
 
@@ -51,8 +53,11 @@ def test_a_checkpoint_of_another_dataset_is_not_resumed(tmp_path: Path, one_thre
                   device="cpu", checkpoint_every=20, callback=KillAfter(60))
     saved = json.loads(checkpoint_paths(out)[1].read_text())
     assert saved["dataset"] == str(Path(first).absolute())
+    with pytest.raises(UserError, match="checkpoint of another run .*another dataset.*--force"):
+        train_a2c(second, "sp", total_timesteps=100, seed=1, out_path=out, n_envs=2, arch="pooled",
+                  device="cpu", checkpoint_every=20)  # never discarded without a word
     train_a2c(second, "sp", total_timesteps=100, seed=1, out_path=out, n_envs=2, arch="pooled",
-              device="cpu", checkpoint_every=20)
+              device="cpu", checkpoint_every=20, force=True)
     assert "resuming" not in capsys.readouterr().out
 
 
@@ -78,8 +83,11 @@ def test_other_settings_never_resume_a_checkpoint(tmp_path: Path, one_thread: No
     with pytest.raises(KeyboardInterrupt):
         train_a2c(root, "sp", total_timesteps=200, seed=1, out_path=out, n_envs=2, arch="pooled",
                   device="cpu", checkpoint_every=20, callback=KillAfter(60))
+    with pytest.raises(UserError, match="seed 1, not 2"):
+        train_a2c(root, "sp", total_timesteps=100, seed=2, out_path=out, n_envs=2, arch="pooled",
+                  device="cpu", checkpoint_every=20)
     path = train_a2c(root, "sp", total_timesteps=100, seed=2, out_path=out, n_envs=2, arch="pooled",
-                     device="cpu", checkpoint_every=20)
+                     device="cpu", checkpoint_every=20, force=True)
     assert "resuming" not in capsys.readouterr().out
     assert A2C.load(path, device="cpu").num_timesteps == 100
 
@@ -115,7 +123,6 @@ def test_the_record_keeps_the_settings_and_a_learning_curve_across_sittings(
 def test_settings_choose_the_sb3_defaults_or_refuse_unknown_ones(tmp_path: Path, one_thread: None,
                                                                  capsys: pytest.CaptureFixture[str]) -> None:
     from davis_ag.benchmark.training import SB3_DEFAULT_SETTINGS
-    from davis_ag.errors import UserError
 
     root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2)
     out = tmp_path / "a2c.zip"
@@ -134,5 +141,74 @@ def test_settings_choose_the_sb3_defaults_or_refuse_unknown_ones(tmp_path: Path,
     del saved["a2c_settings"], saved["start_rule"]
     settings_file.write_text(json.dumps(saved))
     train_a2c(root, "sp", total_timesteps=200, seed=1, out_path=out, n_envs=2, arch="pooled",
-              device="cpu", checkpoint_every=0, settings="ours")
+              device="cpu", checkpoint_every=0, settings="ours", force=True)
     assert "resuming" not in capsys.readouterr().out
+
+
+def test_a_damaged_checkpoint_offers_both_ways_on(tmp_path: Path, one_thread: None) -> None:
+    """Issue 33 case 4: a checkpoint that is no zip ended in a chained traceback."""
+    root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2)
+    out = tmp_path / "a2c.zip"
+    kwargs = dict(total_timesteps=60, seed=1, out_path=out, n_envs=2, arch="pooled", device="cpu",
+                  checkpoint_every=20, keep="last")
+    with pytest.raises(KeyboardInterrupt):
+        train_a2c(root, "sp", callback=KillAfter(40), **kwargs)
+    model_file = checkpoint_paths(out)[0]
+    model_file.write_bytes(model_file.read_bytes()[:100])  # cut short, as a full disk or a bad copy leaves it
+    with pytest.raises(UserError) as refused:
+        train_a2c(root, "sp", **kwargs)
+    line = str(refused.value)
+    assert "\n" not in line and "damaged" in line and "--force" in line and "stop here" in line
+    assert model_file.read_bytes()[:2] == b"PK"  # left as it was
+    assert train_a2c(root, "sp", force=True, **kwargs) == out and A2C.load(out, device="cpu").num_timesteps == 60
+
+
+@pytest.mark.parametrize("keep", ["best-train", "last"])
+def test_a_full_disk_at_the_end_never_loses_the_model(tmp_path: Path, one_thread: None, keep: str,
+                                                       monkeypatch: pytest.MonkeyPatch) -> None:
+    """Issue 33 case 3: with --keep best-train a full disk at the final write kept no model anywhere,
+    though the line said nothing finished was lost. Every write after the disk fills fails
+    (``os.fsync``, as a write-back of a full disk does); the line names a file that holds a model."""
+    import errno
+    import os
+
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    import davis_ag.atomic_files as atomic_files
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2)
+    out = tmp_path / "a2c.zip"
+    full = {"now": False}
+    real_fsync = os.fsync
+
+    def fsync(fd: int) -> None:
+        if full["now"]:
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        real_fsync(fd)
+
+    class DiskFillsAt(BaseCallback):
+        def _on_step(self) -> bool:
+            full["now"] = full["now"] or self.model.num_timesteps >= 50
+            return True
+
+    monkeypatch.setattr(atomic_files.os, "fsync", fsync)
+    with pytest.raises(MachineError) as stopped:
+        train_a2c(root, "sp", total_timesteps=60, seed=1, out_path=out, n_envs=2, arch="pooled", device="cpu",
+                  checkpoint_every=20, keep=keep, select_every=20, callback=DiskFillsAt())
+    line = str(stopped.value)
+    assert "No space left on device" in line and "\n" not in line and "is kept in" in line
+    kept = Path(line.split("is kept in ")[1].split(":")[0])
+    assert kept.is_file() and A2C.load(kept, device="cpu").num_timesteps in (20, 40)
+    if keep == "best-train":
+        assert kept == snapshot_path(out, A2C.load(kept, device="cpu").num_timesteps)
+
+
+def test_a_cuda_device_the_machine_lacks_is_refused() -> None:
+    """Issue 33 case 9: --device cuda:7 trained on the CPU without a word."""
+    import torch
+
+    count = torch.cuda.device_count() if torch.cuda.is_available() else 0
+    with pytest.raises(UserError, match=f"--device cuda:{count + 6}: this machine has"):
+        check_device(f"cuda:{count + 6}")
+    check_device("cpu")

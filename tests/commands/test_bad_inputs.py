@@ -25,10 +25,11 @@ def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
     return code, out, err
 
 
-def refused(capsys: pytest.CaptureFixture[str], *argv: str) -> str:
-    """Run expecting a refusal: status 2 and exactly one line on stderr, which is returned."""
+def refused(capsys: pytest.CaptureFixture[str], *argv: str, status: int = 2) -> str:
+    """Run expecting a refusal: ``status`` (2, bad input; 1, the machine) and exactly one line on
+    stderr, which is returned."""
     code, out, err = run(capsys, *argv)
-    assert code == 2, (out, err)
+    assert code == status, (out, err)
     lines = err.splitlines()
     assert len(lines) == 1 and lines[0].startswith("davis-ag"), err
     return lines[0]
@@ -169,7 +170,7 @@ def test_evaluate_keeps_its_results_when_the_final_write_fails(capsys: pytest.Ca
 
     monkeypatch.setattr(evaluation, "write_json", disk_full_at_out)
     line = refused(capsys, "evaluate", "--dataset", str(sp_root), "--scenario", "sp", "--episodes", "3",
-                   "--sessions", "1", "--out", str(out))
+                   "--sessions", "1", "--out", str(out), status=1)  # the machine's failure: exit 1
     assert "No space left on device" in line
     kept = Path(line.split("it was kept in ")[1].split(":")[0])
     assert json.loads(kept.read_text())["protocol"]["episodes"] == 3

@@ -135,6 +135,15 @@ def test_view_command_refuses_a_bad_port(served: tuple[Path, int], capsys: pytes
     assert "cannot listen" in err and "\n" not in err
 
 
+def test_view_command_refuses_an_unknown_scene_at_start(served: tuple[Path, int],
+                                                        capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 33 case 9: ``view --scene nope/123`` was accepted, and the page found nothing."""
+    root, _ = served
+    assert cli.main(["view", str(root), "--port", "0", "--scene", "nope/123"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "no scene 'nope/123'" in err and "\n" not in err
+
+
 def _with_depth(real_root: Path, folder: Path) -> Path:
     """A copy of the real dataset with a depth image (uint16 mm) beside every view."""
     copy = folder / "with-depth"

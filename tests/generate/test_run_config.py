@@ -5,6 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from davis_ag.errors import UserError
 from davis_ag.generate.one_scene import scene_seed
@@ -101,6 +103,14 @@ def test_only_picks_scenes_and_groups() -> None:
      "image_size: 99999x99999: each side must be from 16 to 8192 pixels (the renderer's limit)"),
     ("seed: 4294967296\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "seed: must be a whole number from 0 to"),
     ("renderer: vulkan\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "renderer: must be 'opengl' or 'helios'"),
+    # Issue 33 case 2: a step of 1e-9 m grew until the kernel killed the run at 24 GB.
+    ("grid: {step: 1e-9}\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n",
+     "grid: step 1e-09 m over [3.0, 3.0] m gives up to 27,000,000,018,000,000,003 views a scene, more than 10,000"),
+    ("grid: {step: 0.01}\ngroups: [{scenario: mp, crop: vine, scenes: 1}]\n", "views a scene, more than 10,000"),
+    ("groups: [{scenario: sp, crop: tomato, scenes: 1, grid: {step: 0.001}}]\n",
+     "groups.0.grid: step 0.001 m over"),
+    ("grid: {extent: [1000, 3]}\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n",
+     "grid.extent.0: must be less than or equal to 100"),
 ])
 def test_bad_configs_name_file_key_and_problem(text: str, message: str) -> None:
     with pytest.raises(UserError) as caught:
@@ -115,6 +125,32 @@ def test_missing_config_lists_presets(tmp_path: Path) -> None:
         load_dataset_config("papr")
     with pytest.raises(UserError, match="is a folder"):
         load_dataset_config(tmp_path)
+    # Issue 33 case 9: --config /dev/zero was called a folder (and a read would never end).
+    with pytest.raises(UserError, match="/dev/zero is not a regular file"):
+        load_dataset_config("/dev/zero")
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.recursive(st.none() | st.booleans() | st.integers() | st.floats() | st.text(max_size=12),
+                    lambda inner: st.lists(inner, max_size=4) | st.dictionaries(
+                        st.sampled_from(["groups", "grid", "step", "extent", "scenes", "crop", "scenario",
+                                         "seed", "image_size", "headings", "first", "x"]), inner, max_size=5),
+                    max_leaves=20))
+def test_any_yaml_value_is_a_config_or_one_line(value: object) -> None:
+    """Whatever the file holds, the parser gives a config whose grids respect the bounds, or one line."""
+    import yaml
+
+    from davis_ag.formats.models import MAX_VIEWS_PER_SCENE
+    from davis_ag.scene.view_grid import lattice_shape
+
+    try:
+        config = parse_dataset_config(yaml.safe_dump(value), "fuzz.yaml")
+    except UserError as error:
+        assert str(error).startswith("fuzz.yaml") and "\n" not in str(error)
+        return
+    for group in config.groups:
+        nx, ny = lattice_shape(group.scenario)
+        assert nx * ny * len(group.scenario.altitude_levels) * group.scenario.headings <= MAX_VIEWS_PER_SCENE
 
 
 def test_single_group_from_flags() -> None:
@@ -166,3 +202,31 @@ def test_generate_flag_takes_the_readme_altitudes(capsys: pytest.CaptureFixture,
     with pytest.raises(SystemExit) as stopped:
         cli.main(["generate", "--strawberry-altitudes", "fig2", "--out", str(tmp_path)])
     assert stopped.value.code == 2 and "invalid choice: 'fig2'" in capsys.readouterr().err
+
+
+def test_a_config_bomb_is_refused_before_anything_is_written(tmp_path: Path,
+                                                             capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 33 case 2: ``grid: {step: 1e-9}`` wrote dataset.json, then ate the machine."""
+    from davis_ag.cli import main
+
+    bomb = tmp_path / "bomb.yaml"
+    bomb.write_text("grid: {step: 1e-9}\ngroups: [{scenario: sp, crop: strawberry, scenes: 2}]\n")
+    assert main(["generate", "--config", str(bomb), "--out", str(tmp_path / "data")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "views a scene, more than 10,000" in err
+    assert not (tmp_path / "data").exists()
+
+
+def test_ray_missing_is_refused_before_anything_is_written(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                           capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 33 case 9: --executor ray without Ray wrote the out folder and dataset.json first."""
+    import sys
+
+    from davis_ag.cli import main
+
+    monkeypatch.setitem(sys.modules, "ray", None)  # as where Ray is not installed
+    out = tmp_path / "data"
+    assert main(["generate", "--config", "mini", "--executor", "ray", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--executor ray needs Ray" in err
+    assert not out.exists()

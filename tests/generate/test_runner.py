@@ -19,7 +19,7 @@ from typing import Any
 import pytest
 
 from davis_ag.cli import main
-from davis_ag.errors import UserError
+from davis_ag.errors import MachineError, UserError
 from davis_ag.formats.splits import split_group
 from davis_ag.generate.dataset_files import write_splits
 from davis_ag.generate.run_config import load_dataset_config
@@ -248,17 +248,22 @@ def test_a_full_disk_midway_leaves_no_half_scene_and_the_next_run_redoes_it(
     save, calls = Image.Image.save, itertools.count()
 
     def filling(self: Image.Image, *args: Any, **kwargs: Any) -> None:
-        if next(calls) == 2:  # the disk fills up at the third image, mid-way through the views
+        if next(calls) % 1000 == 2:  # the disk fills up at the third image, mid-way through the views
             raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
         save(self, *args, **kwargs)
 
     monkeypatch.setattr(Image.Image, "save", filling)
     root = tmp_path / "data"
     requests = load_dataset_config(tiny_config).requests(["Single-Strawberry/000"])
-    with pytest.raises(UserError, match="1 of 1 scenes failed .*No space left on device.*run the same command again"):
+    with pytest.raises(MachineError, match="1 of 1 scenes failed .*No space left on device.*run the same command again"):
         run_dataset(requests, root, RunOptions(workers=1, progress=False))
     assert not list((root / "Single-Strawberry").iterdir())  # no half scene, visible or hidden
     assert not (root / "splits.json").exists()
+    # Issue 33 case 9: the command exited 2 (bad input) where docs/errors.md says the machine's 1.
+    calls = itertools.count(1000)
+    assert main(["generate", "--config", str(tiny_config), "--only", "Single-Strawberry/000", "--out", str(root),
+                 "--workers", "1", "--quiet"]) == 1
+    assert not list((root / "Single-Strawberry").iterdir())
 
     monkeypatch.undo()  # space again
     report = run_dataset(requests, root, RunOptions(workers=1, progress=False))

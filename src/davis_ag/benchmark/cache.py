@@ -35,7 +35,7 @@ import numpy as np
 from PIL import Image
 
 from davis_ag.data.safe_read import check_inside
-from davis_ag.formats.layout import ANNOTATIONS
+from davis_ag.formats.layout import ANNOTATIONS, IMAGES
 from davis_ag.errors import UserError
 from davis_ag.scene.specs import ALL_ACTIONS
 
@@ -100,7 +100,10 @@ _TABLES = ("pointers", "fruit_ids", "box_index", "box_view", "box_fruit", "box_x
 
 
 def scene_fingerprint(scene: Any, root: Path) -> str:
-    """Hash what the cache is derived from: the scene's annotations.json and the cache format.
+    """Hash what the cache is derived from: the scene's annotations.json, the name, size and
+    modification time of every file in its ``images/`` folder (a view replaced or cut short after
+    the cache was built makes it stale, so the rebuild reads, and reports, the damaged file), and
+    the cache format.
 
     Args:
         scene: A reader scene (``davis_ag.data.reader.Scene``).
@@ -115,6 +118,13 @@ def scene_fingerprint(scene: Any, root: Path) -> str:
         digest.update(path.read_bytes())
     except OSError as error:
         raise UserError(f"cannot read {path}: {error.strerror}; check the dataset copy") from error
+    try:
+        with os.scandir(path.parent / IMAGES) as entries:
+            files = sorted((e.name, e.stat(follow_symlinks=False)) for e in entries)
+    except OSError:  # no images folder: the build reports the missing views
+        files = []
+    for name, stat in files:
+        digest.update(f"{name}\0{stat.st_size}\0{stat.st_mtime_ns}\n".encode())
     return digest.hexdigest()
 
 

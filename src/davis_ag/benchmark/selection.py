@@ -115,7 +115,11 @@ class KeepBestOnTrain(BaseCallback):
         entry = {"step": step, **train_split_score(self.model, self.env, self.episodes)}
         self.scores.append(entry)
         if self.best is entry:
-            self.save(self.model, snapshot_path(self.final, step))
+            try:
+                self.save(self.model, snapshot_path(self.final, step))
+            except BaseException:  # a full disk: the best stays the last one saved, whose file is there
+                self.scores.remove(entry)
+                raise
         if self.prune_at_once:
             self.prune()
         print(f"train-split score at {step} steps: OER_tau {entry['oer_tau']:.3f}"

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import json
 import os
-import shutil
 import time
 from pathlib import Path
 from typing import Any
@@ -25,7 +24,7 @@ from davis_ag.benchmark import TVMEnv
 from davis_ag.benchmark.networks import ARCHITECTURES
 from davis_ag.benchmark.selection import KeepBestOnTrain, check_keep, snapshot_path
 from davis_ag.benchmark.tvm import as_dataset
-from davis_ag.errors import UserError
+from davis_ag.errors import MachineError, UserError
 from davis_ag.formats.models import check_seed
 from davis_ag.provenance import code_version
 
@@ -220,7 +219,7 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
               arch: str = "paper", device: str = "auto", verbose: int = 0,
               callback: Any = None, checkpoint_every: int = CHECKPOINT_EVERY,
               settings: str | dict[str, Any] = "ours", keep: str = "best-train",
-              select_every: int = SELECT_EVERY) -> Path:
+              select_every: int = SELECT_EVERY, force: bool = False) -> Path:
     """Train the paper's A2C agent on the train split and save it; resume a killed run.
 
     Hyperparameters (the paper gives none) are Stable-Baselines3's A2C defaults, learning rate
@@ -256,12 +255,16 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
         keep: ``best-train`` (default): save the snapshot with the best train-split OER_tau,
             scored every ``select_every`` steps and at the end; ``last``: the last one.
         select_every: Environment steps between train-split scores (``best-train`` only).
+        force: Discard a checkpoint beside ``out_path`` that cannot be resumed (another run's,
+            or a damaged one) instead of refusing (:func:`check_checkpoint`).
 
     Returns:
         The saved model's path.
 
     Raises:
-        UserError: for a bad dataset, scenario, split or architecture.
+        UserError: for a bad dataset, scenario, split or architecture, or a checkpoint that cannot
+            be resumed without ``force``.
+        MachineError: when the machine fails the run (a full disk), naming what survives where.
     """
     from stable_baselines3 import A2C
 
@@ -281,13 +284,13 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
     settings = {"dataset": str(Path(root).expanduser().absolute()), "scenario": scenario, "crop": crop,
                 "seed": seed, "n_envs": n_envs, "arch": arch, "algorithm": "A2C",
                 "a2c_settings": a2c_settings, "start_rule": "pairs", "keep": keep}
+    resumed = check_checkpoint(settings_file, model_file, settings, force)
     opened = as_dataset(dataset)
     env = make_vec_tvm(opened, scenario, n_envs, seed, "train", crop, cache_dir)
-    resumed = _resumable(settings_file, model_file, settings)
     scores: list[dict[str, Any]] = []
     if resumed is not None:
         done, earlier, points, scores = resumed
-        model = A2C.load(model_file, env=env, device=device)
+        model = load_checkpoint(model_file, env, device)
         print(f"resuming {final.name} from its checkpoint at {done} of {total_timesteps} steps", flush=True)
     else:
         model = A2C("CnnPolicy", env, seed=seed, device=device, verbose=verbose,
@@ -304,27 +307,31 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
     if checkpoint_every:
         callbacks.append(_Checkpoint(checkpoint_every, model_file, settings_file, settings, sittings, curve,
                                      selection))
-    if total_timesteps > done:
-        model.learn(total_timesteps=total_timesteps - done, callback=callbacks or None,
-                    reset_num_timesteps=done == 0)
-    env.close()
-    curve.flush(int(model.num_timesteps))
-    extra: dict[str, Any] = {}
-    if selection is None:
-        saved = write_or_rescue(final, lambda path: save_model(model, path), "the trained model")
-    else:
-        selection.score_now()  # the last snapshot competes too
-        best = snapshot_path(final, selection.best["step"])
-        saved = write_or_rescue(final, lambda path: _copy_atomic(best, path), "the trained model")
-        extra["selection"] = selection.record()
-        print(f"kept the snapshot at {selection.best['step']} steps (train-split OER_tau "
-              f"{selection.best['oer_tau']:.3f}, the best of {len(selection.scores)})", flush=True)
-    record = sittings.upto(int(model.num_timesteps))
-    seconds = sum(s["seconds"] for s in record)
-    write_json_atomic(training_record_path(final), {
-        **settings, "timesteps": int(model.num_timesteps), "sittings": record, "seconds": round(seconds, 1),
-        "steps_per_second": round((int(model.num_timesteps) - record[0]["from_step"]) / max(seconds, 1e-9), 1),
-        "curve": curve.points, **extra})
+    try:
+        if total_timesteps > done:
+            model.learn(total_timesteps=total_timesteps - done, callback=callbacks or None,
+                        reset_num_timesteps=done == 0)
+        env.close()
+        curve.flush(int(model.num_timesteps))
+        extra: dict[str, Any] = {}
+        if selection is None:
+            saved = write_or_rescue(final, lambda path: save_model(model, path), "the trained model")
+        else:
+            selection.score_now()  # the last snapshot competes too
+            # A rename, not a copy: it needs no space, so a full disk cannot lose the best snapshot.
+            saved = final
+            os.replace(snapshot_path(final, selection.best["step"]), final)
+            extra["selection"] = selection.record()
+            print(f"kept the snapshot at {selection.best['step']} steps (train-split OER_tau "
+                  f"{selection.best['oer_tau']:.3f}, the best of {len(selection.scores)})", flush=True)
+        record = sittings.upto(int(model.num_timesteps))
+        seconds = sum(s["seconds"] for s in record)
+        write_json_atomic(training_record_path(final), {
+            **settings, "timesteps": int(model.num_timesteps), "sittings": record, "seconds": round(seconds, 1),
+            "steps_per_second": round((int(model.num_timesteps) - record[0]["from_step"]) / max(seconds, 1e-9), 1),
+            "curve": curve.points, **extra})
+    except OSError as error:  # a full disk at any point: say which finished snapshot survives, and where
+        raise MachineError(what_survives(error, final, selection, model_file)) from None
     model_file.unlink(missing_ok=True)
     settings_file.unlink(missing_ok=True)
     if selection is not None:
@@ -332,10 +339,87 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
     return saved
 
 
-def _copy_atomic(source: Path, path: Path) -> None:
-    """Copy ``source`` to ``path`` through a temporary sibling."""
-    with open(source, "rb") as src, atomic_output(path, "wb") as handle:
-        shutil.copyfileobj(src, handle)
+def what_survives(error: OSError, final: Path, selection: KeepBestOnTrain | None, model_file: Path) -> str:
+    """The one line of a training run that a failure of the machine (a full disk) ended: what
+    failed, and which finished model survives where (the final model, the best snapshot so far,
+    or the last checkpoint), so nothing finished is lost or claimed where it is not."""
+    reason = f"{error.filename}: " if error.filename else ""
+    reason += error.strerror or str(error)
+    best = selection.best if selection is not None else None
+    if final.is_file() and (best is None or not snapshot_path(final, best["step"]).is_file()):
+        kept = f"the trained model is saved in {final} (its training record is not)"
+    elif best is not None and snapshot_path(final, best["step"]).is_file():
+        kept = (f"the best snapshot so far ({best['step']} steps, train-split OER_tau {best['oer_tau']:.3f}) "
+                f"is kept in {snapshot_path(final, best['step'])}")
+    elif model_file.is_file():
+        kept = f"the last checkpoint is kept in {model_file}"
+    else:
+        kept = "no snapshot was finished yet"
+    return f"training stopped: {reason}; {kept}: free the space and run the same command again to finish"
+
+
+def check_checkpoint(settings_file: Path, model_file: Path, settings: dict[str, Any],
+                     force: bool) -> tuple[int, list, list, list] | None:
+    """What to resume from a checkpoint beside the output, by the output rule: the same run's is
+    resumed; one of another run, or a damaged one, is discarded only with ``force``.
+
+    Returns:
+        As :func:`_resumable`, or None to start afresh (no checkpoint, or ``force`` discarded one).
+
+    Raises:
+        UserError: for a damaged checkpoint or one of other settings, without ``force``: one line
+            with both ways on (start over with --force, or keep it).
+    """
+    if not settings_file.exists() and not model_file.exists():
+        return None
+    problem = _checkpoint_problem(settings_file, model_file, settings)
+    if problem is None:
+        return _resumable(settings_file, model_file, settings)
+    if not force:
+        raise UserError(f"{model_file}: {problem}: run again with --force to discard it and start over, "
+                        "or stop here to keep it")
+    print(f"note: {model_file.name}: {problem}; --force: starting over", flush=True)
+    model_file.unlink(missing_ok=True)
+    settings_file.unlink(missing_ok=True)
+    return None
+
+
+def _checkpoint_problem(settings_file: Path, model_file: Path, settings: dict[str, Any]) -> str | None:
+    """Why a checkpoint cannot be resumed by a run of ``settings``, or None when it can."""
+    import zipfile
+
+    if not model_file.is_file() or not zipfile.is_zipfile(model_file):
+        return "the checkpoint is damaged (its model is missing or not a zip file), so it cannot be resumed"
+    if _resumable(settings_file, model_file, settings) is not None:
+        return None
+    try:
+        saved = json.loads(settings_file.read_text())
+    except (OSError, ValueError):
+        return f"the checkpoint is damaged ({settings_file.name} is unreadable), so it cannot be resumed"
+    if not isinstance(saved, dict):
+        return f"the checkpoint is damaged ({settings_file.name} is not a record), so it cannot be resumed"
+    differ = [f"{key} {saved.get(key)!r}, not {settings[key]!r}" for key in settings
+              if key in saved and saved[key] != settings[key] and key != "dataset"]
+    differ += ["another dataset"] if saved.get("dataset") not in (settings["dataset"], "/", None) else []
+    return f"it is the checkpoint of another run ({'; '.join(differ[:3]) or 'older settings'}), which this one cannot resume"
+
+
+def load_checkpoint(model_file: Path, env: Any, device: str) -> Any:
+    """Load a checkpoint's model, a damaged one as one line with both ways on.
+
+    Raises:
+        UserError: when SB3 cannot read it.
+    """
+    from stable_baselines3 import A2C
+
+    try:
+        return A2C.load(model_file, env=env, device=device)
+    except Exception as error:  # zipfile, pickle, torch and SB3 each raise their own
+        if isinstance(error, (MemoryError, OSError)):
+            raise
+        raise UserError(f"{model_file}: the checkpoint is damaged ({type(error).__name__}: {error}), so it "
+                        "cannot be resumed: run again with --force to discard it and start over, or stop "
+                        "here to keep it") from None
 
 
 def resolve_settings(settings: str | dict[str, Any]) -> dict[str, Any]:
@@ -363,6 +447,12 @@ def check_device(device: str) -> None:
     if device == "auto":
         return
     try:
-        torch.device(device)
+        chosen = torch.device(device)
     except (RuntimeError, ValueError, TypeError):
         raise UserError(f"--device {device!r} is not a torch device: use auto, cpu or cuda") from None
+    if chosen.type == "cuda":  # SB3 would fall back to the CPU without a word
+        count = torch.cuda.device_count() if torch.cuda.is_available() else 0
+        if count == 0 or (chosen.index or 0) >= count:
+            have = f"cuda:0 to cuda:{count - 1}" if count else "no CUDA device"
+            raise UserError(f"--device {device}: this machine has {have}: use auto, cpu"
+                            + (" or one of those" if count else ""))

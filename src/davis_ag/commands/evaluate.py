@@ -4,10 +4,12 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from davis_ag.atomic_files import write_or_rescue
 from davis_ag.commands import arguments
-from davis_ag.errors import UserError
+from davis_ag.errors import MachineError, UserError
+from davis_ag.formats.outputs import claim_output
 
 HELP = "benchmark LRD, UDD, Rand, Oracle (and a trained A2C) as in Table 4"
 DESCRIPTION = ("Run every policy on the same episodes of the test split (sessions x episodes, fixed seeds), "
@@ -48,13 +50,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", type=arguments.path, required=True, metavar="RESULTS.json", help="results file")
     parser.add_argument("--plot", type=arguments.path, default=None, metavar="PNG",
                         help="bar chart (default: the --out path with .png)")
+    parser.add_argument("--force", action="store_true", help="replace an existing --out and --plot")
 
 
 def run(args: argparse.Namespace) -> int:
     """Evaluate, print the table, write JSON and PNG."""
-    from davis_ag.benchmark.evaluation import format_table, write_json
-    from davis_ag.figures.result_charts import plot_results
-
     continuous = args.env == "continuous"
     allowed = CONTINUOUS_POLICIES if continuous else POLICIES
     names = list(args.policies or (("LR", "UD", "Rand", "Greedy") if continuous else ("LRD", "UDD", "Rand", "Oracle")))
@@ -70,6 +70,16 @@ def run(args: argparse.Namespace) -> int:
         raise UserError(f"--plot and --out are both {out}: give the chart another name")
     if args.cache_dir is not None:
         arguments.prove_writable_folder(args.cache_dir, "--cache-dir")
+    with claim_output(out, force=args.force, also=[(plot, "--plot")]):  # the output rule
+        return _evaluate(args, names, out, plot)
+
+
+def _evaluate(args: argparse.Namespace, names: list[str], out: Path, plot: Path) -> int:
+    """Evaluate ``names`` on the claimed outputs ``out`` and ``plot``."""
+    from davis_ag.benchmark.evaluation import format_table, write_json
+    from davis_ag.figures.result_charts import plot_results
+
+    continuous = args.env == "continuous"
     if continuous:
         from davis_ag.live.evaluation import evaluate_continuous
         from davis_ag.live.policies import build_policies
@@ -101,7 +111,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         plot_results(results, plot)
     except OSError as error:
-        raise UserError(f"the results are in {out}, but the chart could not be written to {plot} "
+        raise MachineError(f"the results are in {out}, but the chart could not be written to {plot} "
                         f"({error.strerror or error}): run again with another --plot") from None
     print(f"wrote {out} and {plot}")
     return 0

@@ -4,10 +4,12 @@ or as point clouds (PLY) from its depth images."""
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 from davis_ag.commands import arguments
 from davis_ag.errors import UserError
+from davis_ag.formats.outputs import LOCK_FILE, claim_output
 
 HELP = "write a dataset as COCO (RLE masks) or YOLO (ultralytics) detection data, or point clouds"
 DESCRIPTION = ("Export a DAVIS-Ag dataset for detectors, one set per split (splits.json, else the benchmark's "
@@ -18,6 +20,10 @@ DESCRIPTION = ("Export a DAVIS-Ag dataset for detectors, one set per split (spli
 
 #: What an export folder may already hold (a previous export, which is refreshed in place).
 _OURS = {"coco": {"annotations"}, "yolo": {"images", "labels", "data.yaml"}, "pointcloud": set()}
+#: Marks an export that has not finished: the same command carries on without --force.
+UNFINISHED = ".davis_ag-export-unfinished"
+#: What a killed export leaves (hidden working folders, temporary files), removed by the next run.
+LEFT_BY_A_KILL = ("annotations/.coco-*", "**/.*.tmp")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -31,6 +37,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         sub.add_argument("out", type=arguments.path, metavar="OUT", help="export folder (new, or a previous export)")
         sub.add_argument("--split", choices=("train", "test", "both"), default="both",
                          help="which split to write (default both)")
+        sub.add_argument("--force", action="store_true", help="replace a finished export in OUT")
         sub.add_argument("--organs", action="store_true",
                          help="also the organ classes (soil, fruit, leaf, stem, trunk) as semantic masks, from "
                               "the views' NNNN_class.png" + (" (with --task segment)" if name == "yolo" else
@@ -49,6 +56,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                     "recorded intrinsics and the pose, with colour, organ class and fruit id.")
     cloud.add_argument("dir", type=arguments.path, metavar="DIR", help="dataset root, group folder or scene folder")
     cloud.add_argument("out", type=arguments.path, metavar="OUT", help="export folder (new, or a previous export)")
+    cloud.add_argument("--force", action="store_true", help="replace a finished export in OUT")
     cloud.add_argument("--fuse", action="store_true", help="one cloud per scene, all its views joined")
     cloud.add_argument("--max-depth", type=arguments.positive_float, default=5.0, metavar="M",
                        help="drop points farther than this from the camera, m (default 5; the far soil "
@@ -64,7 +72,7 @@ def check_out(out: Path, fmt: str) -> None:
     if out.is_dir():
         from davis_ag.scene.specs import parse_group_name
 
-        foreign = sorted(p.name for p in out.iterdir() if p.name not in _OURS[fmt]
+        foreign = sorted(p.name for p in out.iterdir() if p.name not in _OURS[fmt] | {UNFINISHED, LOCK_FILE}
                          and not (fmt == "pointcloud" and p.is_dir() and parse_group_name(p.name)))
         if foreign:
             raise UserError(f"{out}: holds {', '.join(foreign[:3])}{' ...' if len(foreign) > 3 else ''}, "
@@ -76,14 +84,18 @@ def run(args: argparse.Namespace) -> int:
     from davis_ag.data.reader import open_dataset
 
     open_dataset(args.dir)  # a bad DIR is reported before anything is created
-    if args.format == "pointcloud":
-        return run_point_clouds(args)
-    splits = ("train", "test") if args.split == "both" else (args.split,)
     check_out(args.out, args.format)
-    try:
-        args.out.mkdir(parents=True, exist_ok=True)
-    except OSError as error:
-        raise UserError(f"{args.out}: cannot create the export folder ({error.strerror}); pick a writable path") from None
+    unfinished = (args.out / UNFINISHED).exists()  # a stopped export: the same command carries on
+    with claim_output(args.out, force=args.force or unfinished, folder=True, temporaries=LEFT_BY_A_KILL):
+        (args.out / UNFINISHED).touch()
+        code = run_point_clouds(args) if args.format == "pointcloud" else _export(args)
+        (args.out / UNFINISHED).unlink()
+    return code
+
+
+def _export(args: argparse.Namespace) -> int:
+    """Write the COCO or YOLO export of ``args.dir`` into the claimed ``args.out``."""
+    splits = ("train", "test") if args.split == "both" else (args.split,)
     if args.format == "coco":
         from davis_ag.detection.coco_export import export_coco
 
@@ -100,16 +112,19 @@ def run(args: argparse.Namespace) -> int:
             shift_folder(args.out / "images", args.appearance_shift)
     for split, c in counts.items():
         print(f"{split}: {c['images']} images, {c[unit]} {unit}")
+    clipped, dropped = (sum(c.get(key, 0) for c in counts.values()) for key in ("clipped", "dropped"))
+    if clipped or dropped:
+        print(f"note: {clipped} box(es) reaching outside their image were cut to it and {dropped} with no pixel "
+              "inside were left out; `davis-ag validate` lists them", file=sys.stderr)
     where = args.out / "annotations" if args.format == "coco" else args.out / "data.yaml"
     print(f"wrote {where}")
     return 0
 
 
 def run_point_clouds(args: argparse.Namespace) -> int:
-    """Write the PLY point clouds of ``args.dir`` under ``args.out``; prints the counts."""
+    """Write the PLY point clouds of ``args.dir`` under the claimed ``args.out``; prints the counts."""
     from davis_ag.data.point_cloud import export_point_clouds
 
-    check_out(args.out, "pointcloud")
     voxel = args.voxel if args.voxel is not None else (0.005 if args.fuse else 0.0)
     counts = export_point_clouds(args.dir, args.out, args.fuse, args.max_depth, voxel)
     print(f"{counts['scenes']} scenes: {counts['files']} PLY files, {counts['points']:,} points; wrote {args.out}")

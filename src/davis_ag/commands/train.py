@@ -37,21 +37,26 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--checkpoint-every", type=arguments.whole, default=10_000, metavar="N",
                         help="save a checkpoint beside --out every N steps (0: never); running the same "
                              "command again resumes from it (default: 10000)")
+    parser.add_argument("--force", action="store_true",
+                        help="replace an existing model at --out, and discard a checkpoint beside it that cannot "
+                             "be resumed (another run's, or a damaged one)")
     parser.add_argument("--verbose", type=int, choices=(0, 1, 2), default=1, help="SB3 verbosity (default: 1)")
 
 
 def run(args: argparse.Namespace) -> int:
     """Train and save; prints the model's path."""
-    from davis_ag.benchmark.training import check_device, train_a2c
+    from davis_ag.benchmark.training import check_device, model_path, train_a2c
+    from davis_ag.formats.outputs import claim_output
 
     check_device(args.device)
     arguments.prove_writable_file(args.out)
     if args.cache_dir is not None:
         arguments.prove_writable_folder(args.cache_dir, "--cache-dir")
-    path = train_a2c(args.dataset, args.scenario, total_timesteps=args.timesteps, seed=args.seed,
-                     out_path=args.out, n_envs=args.n_envs, crop=args.crop,
-                     cache_dir=args.cache_dir, arch=args.arch, device=args.device,
-                     verbose=args.verbose, checkpoint_every=args.checkpoint_every,
-                     settings=args.a2c_settings, keep=args.keep)
+    with claim_output(model_path(args.out), force=args.force):  # the output rule
+        path = train_a2c(args.dataset, args.scenario, total_timesteps=args.timesteps, seed=args.seed,
+                         out_path=args.out, n_envs=args.n_envs, crop=args.crop,
+                         cache_dir=args.cache_dir, arch=args.arch, device=args.device,
+                         verbose=args.verbose, checkpoint_every=args.checkpoint_every,
+                         settings=args.a2c_settings, keep=args.keep, force=args.force)
     print(f"saved {path}")
     return 0

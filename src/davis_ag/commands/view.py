@@ -29,8 +29,11 @@ def run(args: argparse.Namespace) -> int:
     """Serve until interrupted."""
     from urllib.parse import quote
 
+    from davis_ag.data.reader import open_dataset
     from davis_ag.figures.viewer_server import server_url, start_server
 
+    if args.scene:  # refused at start, not as a blank page in the browser
+        args.scene = open_dataset(args.dataset).scene(args.scene).id
     server = start_server(args.dataset, args.port)
     url = server_url(server) + (f"#scene={quote(args.scene, safe='')}" if args.scene else "")
     print(f"viewing {args.dataset} at {url}  (open it in a browser; Ctrl-C stops)", flush=True)

@@ -41,6 +41,10 @@ from davis_ag.detection.instances import (
 from davis_ag.detection.organ_export import ORGAN_CATEGORY_BASE, coco_organ_categories, organ_masks
 
 
+#: Name prefix of a split's hidden working folder beside its file (a killed run's is removed by the next).
+WORK_PREFIX = ".coco-"
+
+
 def rle_of(mask: np.ndarray) -> dict[str, Any]:
     """pycocotools' compressed RLE of a bool mask, with ``counts`` as text (JSON-ready)."""
     from pycocotools import mask as mask_utils
@@ -113,19 +117,19 @@ def write_coco_split(scenes: list[Scene], root: Path, target: Path, split: str,
         organs: Add the organ classes' semantic masks.
 
     Returns:
-        ``{"images": n, "annotations": m}``.
+        ``{"images": n, "annotations": m, "clipped": boxes cut to their image, "dropped": boxes left out}``.
     """
     from tqdm import tqdm
 
 
-    counts = {"images": 0, "annotations": 0}
+    counts = {"images": 0, "annotations": 0, "clipped": 0, "dropped": 0}
     header = {"info": {"description": f"DAVIS-Ag {split} split, exported by davis-ag",
                        "image_root": str(root), "split": split, "scenes": [s.id for s in scenes]},
               "licenses": [],
               "categories": [{"id": i + 1, "name": name, "supercategory": "fruit"}
                              for i, name in enumerate(CATEGORIES)]
               + (coco_organ_categories() if organs else [])}
-    with tempfile.TemporaryDirectory(dir=target.parent, prefix=".coco-") as tmp:
+    with tempfile.TemporaryDirectory(dir=target.parent, prefix=WORK_PREFIX) as tmp:
         images_path, annotations_path = Path(tmp) / "images", Path(tmp) / "annotations"
         with open(images_path, "w") as images, open(annotations_path, "w") as annotations:
             first_image = first_annotation = True
@@ -139,6 +143,8 @@ def write_coco_split(scenes: list[Scene], root: Path, target: Path, split: str,
                 first_annotation = _write_array_items(annotations, entries, first_annotation)
                 counts["images"] += 1
                 counts["annotations"] += len(entries)
+                counts["clipped"] += item.clipped
+                counts["dropped"] += item.dropped
                 bar.update()
             bar.close()
         with atomic_output(target, "w") as out:

@@ -7,14 +7,16 @@ the category of each crop and the pixels of each instance. Nothing here holds a 
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
 from davis_ag.benchmark.splits import dataset_splits
 from davis_ag.data.reader import Box, Dataset, Scene, View
+from davis_ag.data.safe_read import check_inside
 from davis_ag.errors import UserError
 
 #: One category per crop; ids are fixed so every split and every export agrees (COCO counts from 1).
@@ -47,6 +49,17 @@ def scenes_by_split(dataset: Dataset) -> dict[str, list[Scene]]:
     """
     splits = dataset_splits(dataset)
     keep = {split: set(splits[split]) for split in EXPORT_SPLITS}
+    on_disk = {s.id for s in dataset.scenes}
+    listed = keep["train"] | keep["test"]
+    unlisted = sorted(on_disk - listed)
+    if unlisted and listed - on_disk:  # a scene folder renamed: it would silently leave its split
+        missing = sorted(listed - on_disk)
+        raise UserError(f"{dataset.root}: splits.json names {len(missing)} scene(s) not there (e.g. {missing[0]}) and "
+                        f"{len(unlisted)} scene folder(s) are in no split (e.g. {unlisted[0]}): rename the folders "
+                        "back, or regenerate splits.json")
+    if unlisted:
+        print(f"note: {len(unlisted)} scene(s) of {dataset.root} are in no split of its splits.json and are not "
+              f"exported (e.g. {unlisted[0]})", file=sys.stderr)
     return {split: [s for s in dataset.scenes if s.id in keep[split]] for split in EXPORT_SPLITS}
 
 
@@ -83,6 +96,8 @@ class LabelledView:
         height: Image height in pixels.
         instances: Its fruits, in annotation order.
         depth: Path of its depth image, or ``None`` where there is none.
+        clipped: Boxes that reached outside the image, cut to it.
+        dropped: Boxes with no pixel inside the image, left out.
     """
 
     view: View
@@ -90,50 +105,86 @@ class LabelledView:
     height: int
     instances: tuple[Instance, ...]
     depth: Path | None
+    clipped: int = 0
+    dropped: int = 0
 
 
-def image_size(path: Path) -> tuple[int, int]:
-    """``(width, height)`` read from the file's header, without decoding its pixels.
+def image_size(path: Path, root: Path | None = None) -> tuple[int, int]:
+    """``(width, height)`` of an image inside the dataset, after proving that it decodes whole.
+
+    An export copies or links the file and hands it to trainers: a file that points outside the
+    dataset, or a JPEG cut short (which Pillow may be told to pad silently), must stop it first.
+
+    Args:
+        path: The image.
+        root: The dataset root it must lie in (None: no check).
 
     Raises:
-        UserError: when the file is missing or not an image.
+        UserError: when the file is outside the dataset, missing, not an image or truncated.
     """
     from PIL import Image, UnidentifiedImageError
 
+    check_inside(path, root)
     try:
         with Image.open(path) as im:
-            return im.size
+            size, kind = im.size, im.format
+            im.load()
+        if kind == "JPEG":  # Pillow pads a truncated JPEG when ImageFile.LOAD_TRUNCATED_IMAGES is set
+            with open(path, "rb") as handle:
+                handle.seek(-2, 2)
+                if handle.read(2) != b"\xff\xd9":
+                    raise OSError("the JPEG ends before its end marker (truncated)")
+        return size
     except FileNotFoundError:
         raise UserError(f"{path}: image file missing; re-download or regenerate the scene") from None
-    except (OSError, UnidentifiedImageError) as error:
-        raise UserError(f"{path}: cannot read ({error}); re-download or regenerate the scene") from None
+    except (OSError, UnidentifiedImageError, ValueError) as error:
+        raise UserError(f"{path}: cannot decode ({error}); re-download or regenerate the scene") from None
+
+
+def clip_box(box: Box, width: int, height: int) -> Box | None:
+    """A box cut to the image (inclusive pixel extents), or None when no pixel of it is inside."""
+    x0, y0 = max(box.xmin, 0), max(box.ymin, 0)
+    x1, y1 = min(box.xmin + box.width, width), min(box.ymin + box.height, height)
+    if x1 <= x0 or y1 <= y0:
+        return None
+    return replace(box, xmin=x0, ymin=y0, width=x1 - x0, height=y1 - y0)
 
 
 def label_view(view: View, with_masks: bool = True) -> LabelledView:
-    """Collect one view's instances.
+    """Collect one view's instances; boxes reaching outside the image are cut to it (or left out
+    when nothing is inside) and counted.
 
     Args:
         view: A view of a scene whose group names its crop.
         with_masks: Decode the ``_seg.png`` into one mask per instance.
 
     Raises:
-        UserError: for an unknown crop, unreadable files, or a mask whose size differs from the image's.
+        UserError: for an unknown crop, unreadable files or files outside the dataset, or a mask
+            whose size differs from the image's.
     """
     scene = view.scene
     category = category_id(scene.crop)
-    width, height = image_size(view.image_path)
+    width, height = image_size(view.image_path, scene.root)
     seg = view.mask() if with_masks else None
     if seg is not None and seg.shape != (height, width):
         raise UserError(f"{view.mask_path}: mask is {seg.shape[1]}x{seg.shape[0]}, image {width}x{height}; "
                         "run `davis-ag validate` on the scene")
     fractions = ((scene.metadata or {}).get("visible_fraction") or {}).get(view.name, {})
-    instances = []
-    for box in view.boxes:
+    instances, clipped, dropped = [], 0, 0
+    for published in view.boxes:
+        box = clip_box(published, width, height)
+        if box is None:
+            dropped += 1
+            continue
+        clipped += box != published
         fraction = fractions.get(str(box.fruit_id))
         instances.append(Instance(box, category, None if fraction is None else float(fraction),
                                   None if seg is None else seg == box.fruit_id))
     depth = view.depth_path
-    return LabelledView(view, width, height, tuple(instances), depth if depth.is_file() else None)
+    if depth.is_file():
+        check_inside(depth, scene.root)
+    return LabelledView(view, width, height, tuple(instances), depth if depth.is_file() else None,
+                        clipped, dropped)
 
 
 def iter_split_views(scenes: list[Scene], with_masks: bool = True) -> Iterator[LabelledView]:

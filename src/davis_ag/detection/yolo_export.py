@@ -23,11 +23,11 @@ from pathlib import Path
 
 import numpy as np
 
-from davis_ag.atomic_files import write_text_atomic
+from davis_ag.atomic_files import atomic_output, temporary_sibling, write_text_atomic
 from davis_ag.data.reader import Scene, open_dataset
 from davis_ag.detection.instances import CATEGORIES, LabelledView, count_views, iter_split_views, scenes_by_split
 from davis_ag.detection.organ_export import organ_masks, yolo_organ_class, yolo_organ_names
-from davis_ag.errors import UserError
+from davis_ag.errors import MachineError, UserError
 
 TASKS = ("detect", "segment")
 
@@ -87,12 +87,25 @@ def organ_lines(item: LabelledView) -> list[str]:
 
 
 def place_image(source: Path, target: Path) -> None:
-    """Hard-link ``source`` to ``target`` (a copy where links are impossible); replaces ``target``."""
-    target.unlink(missing_ok=True)
+    """Hard-link ``source`` to ``target`` (a copy where links are impossible), through a temporary
+    sibling, so ``target`` is whole or absent whatever happens (a full disk, a kill).
+
+    Raises:
+        MachineError: naming ``target`` when it cannot be written.
+    """
+    tmp = temporary_sibling(target)
+    tmp.unlink(missing_ok=True)
     try:
-        os.link(source, target)
-    except OSError:
-        shutil.copy2(source, target)
+        try:
+            os.link(source, tmp)
+            os.replace(tmp, target)
+        except OSError:
+            tmp.unlink(missing_ok=True)
+            with open(source, "rb") as src, atomic_output(target, "wb") as handle:
+                shutil.copyfileobj(src, handle)
+    except OSError as error:
+        raise MachineError(f"{target}: cannot write the image ({error.strerror or error}); the files already "
+                           "exported are kept: free the space and run the same command again") from None
 
 
 def write_yolo_split(scenes: list[Scene], out_dir: Path, split: str, task: str = "detect",
@@ -100,14 +113,14 @@ def write_yolo_split(scenes: list[Scene], out_dir: Path, split: str, task: str =
     """Write one split's images and labels.
 
     Returns:
-        ``{"images": n, "instances": m}``.
+        ``{"images": n, "instances": m, "clipped": boxes cut to their image, "dropped": boxes left out}``.
     """
     from tqdm import tqdm
 
     images, labels = out_dir / "images" / split, out_dir / "labels" / split
     images.mkdir(parents=True, exist_ok=True)
     labels.mkdir(parents=True, exist_ok=True)
-    counts = {"images": 0, "instances": 0}
+    counts = {"images": 0, "instances": 0, "clipped": 0, "dropped": 0}
     bar = tqdm(total=count_views(scenes), desc=f"yolo {split}", unit="view", disable=not progress)
     for item in iter_split_views(scenes, with_masks=task == "segment"):
         name = flat_name(f"{item.view.scene.id}/{item.view.name}")
@@ -118,6 +131,8 @@ def write_yolo_split(scenes: list[Scene], out_dir: Path, split: str, task: str =
         place_image(item.view.image_path, images / f"{name}.jpeg")
         counts["images"] += 1
         counts["instances"] += len(lines)
+        counts["clipped"] += item.clipped
+        counts["dropped"] += item.dropped
         bar.update()
     bar.close()
     return counts

@@ -47,6 +47,12 @@ MIN_IMAGE_SIDE = 16
 MAX_IMAGE_SIDE = 8192
 #: Scene folders are numbered NNN.
 MAX_SCENES = 1000
+#: Most views one scene may have: four times the paper's largest grid (MP, 7 x 3 m at 0.5 m, two
+#: altitudes, 12 headings: 2,520 views). A step of 1e-9 m would ask for 10^19 views and grow until
+#: the machine kills the run; the bound refuses it in one line before anything is written.
+MAX_VIEWS_PER_SCENE = 10_000
+#: Largest grid side, m (the paper's grids are at most 7 m).
+MAX_GRID_EXTENT = 100.0
 #: Fruit ids fit the uint8 mask, whose 255 means no fruit.
 MAX_FRUIT_ID = 254
 
@@ -158,9 +164,9 @@ class _Model(BaseModel):
 class GridOverride(_Model):
     """A change to the scenario's Table 2 grid (smaller scenes for quick looks and tests)."""
 
-    extent: tuple[Annotated[float, Field(gt=0, allow_inf_nan=False)],
-                  Annotated[float, Field(gt=0, allow_inf_nan=False)]] | None = None
-    step: Annotated[float, Field(gt=0, allow_inf_nan=False)] | None = None
+    extent: tuple[Annotated[float, Field(gt=0, le=MAX_GRID_EXTENT, allow_inf_nan=False)],
+                  Annotated[float, Field(gt=0, le=MAX_GRID_EXTENT, allow_inf_nan=False)]] | None = None
+    step: Annotated[float, Field(gt=0, le=MAX_GRID_EXTENT, allow_inf_nan=False)] | None = None
     altitude_levels: list[Literal[0, 1, 2]] | None = None
     headings: whole(1, 360) | None = None
 

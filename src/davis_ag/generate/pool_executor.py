@@ -21,7 +21,7 @@ from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 from typing import Any, Sequence
 
-from davis_ag.errors import UserError
+from davis_ag.errors import UserError, stops_held
 from davis_ag.generate.one_scene import SceneRequest, generate_scene
 from davis_ag.generate.run_progress import Progress, RunOptions, RunReport, record_failure
 
@@ -56,10 +56,11 @@ def run_on_pool(todo: Sequence[SceneRequest], root: Path, options: RunOptions, p
         started: set[str] = set()
         # A fresh queue per pool: a process killed while writing may leave a queue's lock held.
         events = context.Queue()
-        pool = ProcessPoolExecutor(options.workers, mp_context=context, initializer=_init_worker,
-                                   initargs=(events, mesa_threads(options.workers), os.getpid()))
-        try:
+        with stops_held():  # a stop mid-spawn would cut a child's start short (its traceback on stderr)
+            pool = ProcessPoolExecutor(options.workers, mp_context=context, initializer=_init_worker,
+                                       initargs=(events, mesa_threads(options.workers), os.getpid()))
             futures = {pool.submit(_pool_scene, request, str(root)): request for request in pending}
+        try:
             pending = []
             while futures:
                 done, _ = wait(futures, timeout=0.25, return_when=FIRST_COMPLETED)
@@ -93,6 +94,8 @@ def run_on_pool(todo: Sequence[SceneRequest], root: Path, options: RunOptions, p
             raise
         finally:
             pool.shutdown(wait=True, cancel_futures=True)
+            events.close()  # its feeder thread and semaphores go with it: no leaked-resource warning
+            events.join_thread()
 
 
 def _drain(events: Any, progress: Progress, started: set[str]) -> None:

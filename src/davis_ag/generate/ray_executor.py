@@ -58,6 +58,23 @@ def ray_scene(request: SceneRequest, root: str, box: Any) -> dict:
     return stats
 
 
+def require_ray() -> None:
+    """Refuse ``--executor ray`` where Ray is not installed, before anything is written.
+
+    Raises:
+        UserError: saying how to install it.
+    """
+    import importlib.util
+
+    try:
+        found = importlib.util.find_spec("ray") is not None
+    except (ImportError, ValueError):  # a broken or shadowed installation
+        found = False
+    if not found:
+        raise UserError("--executor ray needs Ray: pip install 'davis-ag[ray]' (on every machine of the "
+                        "cluster)")
+
+
 def connect(address: str | None):
     """Import Ray and join the cluster (or start a local one when no address is given).
 

@@ -43,11 +43,19 @@ from typing import Any
 from pydantic import ValidationError
 
 from davis_ag.errors import UserError
-from davis_ag.formats.models import MAX_SCENES, DatasetConfigFile, check_image_size, check_seed, one_line
+from davis_ag.formats.models import (
+    MAX_SCENES,
+    MAX_VIEWS_PER_SCENE,
+    DatasetConfigFile,
+    check_image_size,
+    check_seed,
+    one_line,
+)
 from davis_ag.generate.one_scene import SceneRequest, SceneSettings
 from davis_ag.render.backends import DEFAULT_RENDERER, resolve_look
 from davis_ag.scene.appearance import resolve_appearance
 from davis_ag.scene.camera import Camera
+from davis_ag.scene.view_grid import lattice_shape
 from davis_ag.scene.specs import (
     DEFAULT_PLANTS,
     CropSpec,
@@ -204,8 +212,11 @@ def load_dataset_config(name_or_path: str | Path) -> DatasetConfig:
     if text_name in presets:
         text = (resources.files("davis_ag") / "generate" / "presets" / f"{text_name}.yaml").read_text()
         return parse_dataset_config(text, f"preset {text_name}", default_name=text_name)
-    if path.exists():
+    if path.is_dir():
         raise UserError(f"{path} is a folder: give a YAML file or a preset ({', '.join(presets)})")
+    if path.exists():  # a device such as /dev/zero, a pipe or a socket: never read it
+        raise UserError(f"{path} is not a regular file (a device, pipe or socket): give a YAML file or a "
+                        f"preset ({', '.join(presets)})")
     raise UserError(f"no config file {text_name!r} and no preset of that name: give a YAML file "
                     f"or one of the presets {', '.join(presets)}")
 
@@ -285,7 +296,14 @@ def apply_grid(scenario: ScenarioSpec, changes: dict[str, Any], where: str) -> S
         raise UserError(f"{where}.headings: the single-plant camera always faces the plant: only 1")
     if scenario.headings > 1 and changes.get("headings", 2) < 2:
         raise UserError(f"{where}.headings: multi plant needs 2, 3, 4, 6 or 12")
-    return dataclasses.replace(scenario, **changes)
+    changed = dataclasses.replace(scenario, **changes)
+    nx, ny = lattice_shape(changed)  # counted, not built: a tiny step must not fill the memory first
+    views = nx * ny * len(changed.altitude_levels) * changed.headings
+    if views > MAX_VIEWS_PER_SCENE:
+        raise UserError(f"{where}: step {step} m over {list(extent)} m gives up to {views:,} views a scene, more "
+                        f"than {MAX_VIEWS_PER_SCENE:,} (the paper's largest grid has 2,520): use a larger step "
+                        "or a smaller extent")
+    return changed
 
 
 def grid_settings(scenario: ScenarioSpec, crop: CropSpec | None = None) -> dict[str, Any]:

@@ -18,7 +18,7 @@ from typing import Sequence
 import numpy as np
 from tqdm import tqdm
 
-from davis_ag.errors import UserError
+from davis_ag.errors import MachineError, UserError
 from davis_ag.generate.one_scene import SceneRequest
 from davis_ag.scene.specs import CropSpec, ScenarioSpec
 from davis_ag.scene.view_grid import build_view_grid
@@ -74,6 +74,7 @@ class RunReport:
         made: Scene ids made by this run.
         skipped: Scene ids that were already complete.
         failed: Scene id to error message.
+        machine_failed: The failed scenes whose failure was the machine's (a full disk, a lost mount).
         splits: splits.json, when written.
         stats: Scene id to the timing statistics of each scene made by this run.
     """
@@ -82,6 +83,7 @@ class RunReport:
     made: list[str] = field(default_factory=list)
     skipped: list[str] = field(default_factory=list)
     failed: dict[str, str] = field(default_factory=dict)
+    machine_failed: set[str] = field(default_factory=set)
     splits: Path | None = None
     stats: dict[str, dict] = field(default_factory=dict)
 
@@ -191,6 +193,8 @@ def record_failure(report: RunReport, progress: Progress, request: SceneRequest,
     disk, a lost mount: the machine, not a bug), which get one line."""
     message = str(error) if isinstance(error, UserError) else f"{type(error).__name__}: {error}"
     report.failed[request.folder] = message
+    if isinstance(error, (OSError, MachineError)):
+        report.machine_failed.add(request.folder)
     if not isinstance(error, (UserError, OSError)):
         progress.write("".join(traceback.format_exception(error)).rstrip(), always=True)
     progress.write(f"{request.folder}: failed: {message}", always=True)

@@ -1,0 +1,127 @@
+"""The output rule (issue 33 cases 1, 5 and 7): nothing written inside a dataset, nothing replaced
+without --force, one run per output, temporaries of a killed run cleaned by the next."""
+
+from __future__ import annotations
+
+import hashlib
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from layout_factory import write_tiny_dataset
+
+from davis_ag import cli
+from davis_ag.errors import UserError
+from davis_ag.formats.outputs import LOCK_FILE, claim_output, dataset_holding, file_lock_path
+
+
+def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
+    """``davis-ag ARGV`` in this process: exit status, stdout, stderr (never a traceback)."""
+    try:
+        code = cli.main(list(argv))
+    except SystemExit as exit_:
+        code = int(exit_.code or 0)
+    out, err = capsys.readouterr()
+    assert "Traceback" not in out + err
+    return code, out, err
+
+
+def one_line(capsys: pytest.CaptureFixture[str], *argv: str, status: int = 2) -> str:
+    code, out, err = run(capsys, *argv)
+    assert code == status and len(err.splitlines()) == 1, (code, out, err)
+    return err.strip()
+
+
+def digest(root: Path) -> str:
+    """One hash over every file of a folder, names and bytes (a dataset left exactly as it was)."""
+    sha = hashlib.sha256()
+    for path in sorted(p for p in root.rglob("*") if p.is_file()):
+        sha.update(str(path.relative_to(root)).encode() + path.read_bytes())
+    return sha.hexdigest()
+
+
+@pytest.fixture()
+def data(tmp_path: Path) -> Path:
+    return write_tiny_dataset(tmp_path / "DATA", "sp", "strawberry", scenes=2, size=(64, 48))
+
+
+def test_the_dataset_and_its_scenes_are_recognised(data: Path, tmp_path: Path) -> None:
+    scene = data / "Single-Strawberry" / "000"
+    assert dataset_holding(scene / "annotations.json") == scene
+    assert dataset_holding(scene / "images" / "0001_seg.png") == scene
+    assert dataset_holding(data / "splits.json") == data
+    assert dataset_holding(data / "results" / "r.json") == data
+    assert dataset_holding(tmp_path / "results" / "r.json") is None
+
+
+@pytest.mark.parametrize("where", [("Single-Strawberry/000/annotations.json", "--out"), ("splits.json", "--out"),
+                                   ("Single-Strawberry/000/images/0001_seg.png", "--plot")])
+def test_evaluate_never_writes_into_a_dataset(where: tuple[str, str], data: Path, tmp_path: Path,
+                                              capsys: pytest.CaptureFixture[str]) -> None:
+    """Case 1: evaluate --out DATA/.../annotations.json replaced a scene's labels with results."""
+    before = digest(data)
+    path, flag = where
+    target = str(data / path)
+    argv = ["evaluate", "--dataset", str(data), "--scenario", "sp", "--episodes", "2", "--sessions", "1",
+            "--policies", "LRD", "--out", target if flag == "--out" else str(tmp_path / "r.json")]
+    if flag == "--plot":
+        argv += ["--plot", target]
+    line = one_line(capsys, *argv)
+    assert f"{flag} {target} lies in" in line and "only davis-ag generate writes there" in line
+    assert digest(data) == before
+
+
+def test_an_existing_result_is_replaced_only_with_force(data: Path, tmp_path: Path,
+                                                        capsys: pytest.CaptureFixture[str]) -> None:
+    """Case 5: a second evaluate to an existing --out replaced the earlier results without a word."""
+    out = tmp_path / "r.json"
+    argv = ["evaluate", "--dataset", str(data), "--scenario", "sp", "--episodes", "2", "--sessions", "1",
+            "--policies", "LRD", "--out", str(out)]
+    assert run(capsys, *argv)[0] == 0
+    first = out.read_bytes()
+    (tmp_path / ".r.png.tmp").write_bytes(b"")  # case 7: what a killed run leaves
+    line = one_line(capsys, *argv, "--seed", "7")
+    assert f"--out {out} already exists: give --force" in line
+    assert out.read_bytes() == first and not (tmp_path / ".r.png.tmp").exists()
+    assert run(capsys, *argv, "--seed", "7", "--force")[0] == 0 and out.read_bytes() != first
+    assert not list(tmp_path.glob(".*"))  # no lock, no temporary left behind
+
+
+def test_a_second_run_on_one_output_is_refused(tmp_path: Path, data: Path,
+                                               capsys: pytest.CaptureFixture[str]) -> None:
+    """Case 5: two train or export runs on one output raced on one temporary file."""
+    model, export = tmp_path / "m.zip", tmp_path / "coco"
+    export.mkdir()
+    holder = subprocess.Popen([sys.executable, "-c", (
+        "import sys, time\n"
+        "from pathlib import Path\n"
+        "from davis_ag.formats.outputs import claim_output\n"
+        f"with claim_output(Path({str(model)!r})), claim_output(Path({str(export)!r}), folder=True):\n"
+        "    print('claimed', flush=True); time.sleep(60)\n")], stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "claimed"
+        line = one_line(capsys, "train", "--dataset", str(data), "--scenario", "sp", "--timesteps", "8",
+                        "--n-envs", "2", "--arch", "pooled", "--device", "cpu", "--out", str(model))
+        assert f"{model} is being written by another davis-ag run (PID {holder.pid})" in line
+        line = one_line(capsys, "export", "coco", str(data), str(export))
+        assert f"{export} is being written by another davis-ag run (PID {holder.pid})" in line
+    finally:
+        holder.kill()
+        holder.wait()
+    assert not model.exists() and sorted(p.name for p in export.iterdir()) == [LOCK_FILE]
+    with claim_output(model) as claimed:  # the kernel dropped the dead holder's lock
+        assert claimed == model and file_lock_path(model).exists()
+    assert not file_lock_path(model).exists()
+
+
+def test_a_claim_refuses_before_creating_anything(data: Path, tmp_path: Path) -> None:
+    with pytest.raises(UserError, match="which is a scene folder"):
+        with claim_output(data / "Single-Strawberry" / "001" / "model.zip"):
+            pass
+    (tmp_path / "old.json").write_text("mine")
+    with pytest.raises(UserError, match="already exists"):
+        with claim_output(tmp_path / "old.json"):
+            pass
+    assert (tmp_path / "old.json").read_text() == "mine"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["DATA", "old.json"]
