@@ -28,7 +28,7 @@ groups:
 """
 
 
-def stop_when(process: subprocess.Popen, ready: "callable", number: int, limit: float = 120) -> tuple[int, str]:
+def stop_when(process: subprocess.Popen, ready: callable, number: int, limit: float = 120) -> tuple[int, str]:
     """Send ``number`` to ``process`` once ``ready()`` holds; its exit status and stderr's lines
     that are no progress bar."""
     deadline = time.monotonic() + limit
