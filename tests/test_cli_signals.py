@@ -28,7 +28,7 @@ groups:
 """
 
 
-def stop_when(process: subprocess.Popen, ready: "callable", number: int, limit: float = 120) -> tuple[int, str]:
+def stop_when(process: subprocess.Popen, ready: callable, number: int, limit: float = 120) -> tuple[int, str]:
     """Send ``number`` to ``process`` once ``ready()`` holds; its exit status and stderr's lines
     that are no progress bar."""
     deadline = time.monotonic() + limit
@@ -42,6 +42,7 @@ def stop_when(process: subprocess.Popen, ready: "callable", number: int, limit: 
     return process.returncode, "\n".join(lines)
 
 
+@pytest.mark.slow
 def test_sigterm_ends_generate_with_one_line_and_the_run_resumes(tmp_path: Path) -> None:
     config, out = tmp_path / "tiny.yaml", tmp_path / "data"
     config.write_text(TINY)

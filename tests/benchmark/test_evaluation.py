@@ -119,7 +119,7 @@ def test_commands(sp_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture[s
     assert "Best fixed action: always" in printed and "OER_tau exact" in printed
     args = _parser().parse_args(
         ["evaluate", "--dataset", str(sp_root), "--scenario", "sp", "--model", str(model), "--deterministic",
-         "--policies", "LRD", "--episodes", "3", "--sessions", "1", "--out", str(out)])
+         "--policies", "LRD", "--episodes", "3", "--sessions", "1", "--out", str(out), "--force"])
     assert args.func(args) == 0
     assert json.loads(out.read_text())["policies"]["A2C"]["play"] == "deterministic"
     assert out.with_suffix(".png").is_file()

@@ -11,7 +11,12 @@ from layout_factory import write_tiny_dataset
 from stable_baselines3 import A2C
 
 from davis_ag.benchmark.selection import snapshot_path
-from davis_ag.benchmark.training import check_device, checkpoint_paths, train_a2c, training_record_path
+from davis_ag.benchmark.training import (
+    check_device,
+    checkpoint_paths,
+    train_a2c,
+    training_record_path,
+)
 from davis_ag.errors import MachineError, UserError
 from davis_ag.provenance import code_version
 

@@ -13,7 +13,12 @@ from layout_factory import write_tiny_dataset
 
 from davis_ag import cli
 from davis_ag.errors import UserError
-from davis_ag.formats.outputs import LOCK_FILE, claim_output, dataset_holding, file_lock_path
+from davis_ag.formats.outputs import (
+    LOCK_FILE,
+    claim_output,
+    dataset_holding,
+    file_lock_path,
+)
 
 
 def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:

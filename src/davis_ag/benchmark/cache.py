@@ -35,8 +35,8 @@ import numpy as np
 from PIL import Image
 
 from davis_ag.data.safe_read import check_inside
-from davis_ag.formats.layout import ANNOTATIONS, IMAGES
 from davis_ag.errors import UserError
+from davis_ag.formats.layout import ANNOTATIONS, IMAGES
 from davis_ag.scene.specs import ALL_ACTIONS
 
 #: Side of the square observation image (section IV-C: 224x224).

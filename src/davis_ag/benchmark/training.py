@@ -19,7 +19,12 @@ from typing import Any
 import torch
 from stable_baselines3.common.callbacks import BaseCallback
 
-from davis_ag.atomic_files import atomic_output, prove_writable_file, write_json_atomic, write_or_rescue
+from davis_ag.atomic_files import (
+    atomic_output,
+    prove_writable_file,
+    write_json_atomic,
+    write_or_rescue,
+)
 from davis_ag.benchmark import TVMEnv
 from davis_ag.benchmark.networks import ARCHITECTURES
 from davis_ag.benchmark.selection import KeepBestOnTrain, check_keep, snapshot_path

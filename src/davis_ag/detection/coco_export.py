@@ -37,9 +37,13 @@ from davis_ag.detection.instances import (
     count_views,
     iter_split_views,
     scenes_by_split,
+    tally,
 )
-from davis_ag.detection.organ_export import ORGAN_CATEGORY_BASE, coco_organ_categories, organ_masks
-
+from davis_ag.detection.organ_export import (
+    ORGAN_CATEGORY_BASE,
+    coco_organ_categories,
+    organ_masks,
+)
 
 #: Name prefix of a split's hidden working folder beside its file (a killed run's is removed by the next).
 WORK_PREFIX = ".coco-"
@@ -141,10 +145,7 @@ def write_coco_split(scenes: list[Scene], root: Path, target: Path, split: str,
                 if organs:
                     entries += organ_annotations(item, image_id, counts["annotations"] + 1 + len(entries))
                 first_annotation = _write_array_items(annotations, entries, first_annotation)
-                counts["images"] += 1
-                counts["annotations"] += len(entries)
-                counts["clipped"] += item.clipped
-                counts["dropped"] += item.dropped
+                tally(counts, item, "annotations", len(entries))
                 bar.update()
             bar.close()
         with atomic_output(target, "w") as out:

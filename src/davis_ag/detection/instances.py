@@ -187,6 +187,15 @@ def label_view(view: View, with_masks: bool = True) -> LabelledView:
                         clipped, dropped)
 
 
+def tally(counts: dict[str, int], item: LabelledView, unit: str, found: int) -> None:
+    """Count one exported view into an export's ``counts``: the image, its ``found`` instances
+    (under ``unit``) and its boxes cut to the image or left out."""
+    counts["images"] += 1
+    counts[unit] += found
+    counts["clipped"] = counts.get("clipped", 0) + item.clipped
+    counts["dropped"] = counts.get("dropped", 0) + item.dropped
+
+
 def iter_split_views(scenes: list[Scene], with_masks: bool = True) -> Iterator[LabelledView]:
     """Every view of the scenes, scene by scene, labelled (one view's pixels in memory at a time)."""
     for scene in scenes:

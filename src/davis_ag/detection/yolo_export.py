@@ -25,8 +25,19 @@ import numpy as np
 
 from davis_ag.atomic_files import atomic_output, temporary_sibling, write_text_atomic
 from davis_ag.data.reader import Scene, open_dataset
-from davis_ag.detection.instances import CATEGORIES, LabelledView, count_views, iter_split_views, scenes_by_split
-from davis_ag.detection.organ_export import organ_masks, yolo_organ_class, yolo_organ_names
+from davis_ag.detection.instances import (
+    CATEGORIES,
+    LabelledView,
+    count_views,
+    iter_split_views,
+    scenes_by_split,
+    tally,
+)
+from davis_ag.detection.organ_export import (
+    organ_masks,
+    yolo_organ_class,
+    yolo_organ_names,
+)
 from davis_ag.errors import MachineError, UserError
 
 TASKS = ("detect", "segment")
@@ -129,10 +140,7 @@ def write_yolo_split(scenes: list[Scene], out_dir: Path, split: str, task: str =
             lines += organ_lines(item)
         write_text_atomic(labels / f"{name}.txt", "".join(f"{line}\n" for line in lines))
         place_image(item.view.image_path, images / f"{name}.jpeg")
-        counts["images"] += 1
-        counts["instances"] += len(lines)
-        counts["clipped"] += item.clipped
-        counts["dropped"] += item.dropped
+        tally(counts, item, "instances", len(lines))
         bar.update()
     bar.close()
     return counts

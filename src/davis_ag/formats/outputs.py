@@ -25,9 +25,18 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Iterator, Sequence
 
-from davis_ag.atomic_files import prove_writable_file, prove_writable_folder, temporary_sibling
+from davis_ag.atomic_files import (
+    prove_writable_file,
+    prove_writable_folder,
+    temporary_sibling,
+)
 from davis_ag.errors import UserError
-from davis_ag.formats.layout import ANNOTATIONS, DATASET_FILE, SCENE_METADATA, SPLITS_FILE
+from davis_ag.formats.layout import (
+    ANNOTATIONS,
+    DATASET_FILE,
+    SCENE_METADATA,
+    SPLITS_FILE,
+)
 
 #: The lock file in a locked folder (a dataset being generated, an export being written).
 LOCK_FILE = ".davis_ag.lock"
@@ -56,7 +65,7 @@ class OutputLock:
             return self.path.parent
         return self.path.with_name(name[1:].removesuffix(".lock"))
 
-    def __enter__(self) -> "OutputLock":
+    def __enter__(self) -> OutputLock:
         while True:
             fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
             try:

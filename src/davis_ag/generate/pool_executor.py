@@ -23,7 +23,12 @@ from typing import Any, Sequence
 
 from davis_ag.errors import UserError, stops_held
 from davis_ag.generate.one_scene import SceneRequest, generate_scene
-from davis_ag.generate.run_progress import Progress, RunOptions, RunReport, record_failure
+from davis_ag.generate.run_progress import (
+    Progress,
+    RunOptions,
+    RunReport,
+    record_failure,
+)
 
 
 def mesa_threads(workers: int) -> int | None:

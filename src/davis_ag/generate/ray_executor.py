@@ -14,7 +14,12 @@ from typing import Any, Sequence
 
 from davis_ag.errors import UserError
 from davis_ag.generate.one_scene import SceneRequest, generate_scene
-from davis_ag.generate.run_progress import Progress, RunOptions, RunReport, record_failure
+from davis_ag.generate.run_progress import (
+    Progress,
+    RunOptions,
+    RunReport,
+    record_failure,
+)
 
 
 class ProgressBox:

@@ -55,7 +55,6 @@ from davis_ag.generate.one_scene import SceneRequest, SceneSettings
 from davis_ag.render.backends import DEFAULT_RENDERER, resolve_look
 from davis_ag.scene.appearance import resolve_appearance
 from davis_ag.scene.camera import Camera
-from davis_ag.scene.view_grid import lattice_shape
 from davis_ag.scene.specs import (
     DEFAULT_PLANTS,
     CropSpec,
@@ -66,7 +65,7 @@ from davis_ag.scene.specs import (
     scenario_spec,
     with_strawberry_altitudes,
 )
-
+from davis_ag.scene.view_grid import lattice_shape
 
 
 @dataclass(frozen=True)
