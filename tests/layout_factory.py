@@ -105,7 +105,7 @@ def _grow(sc: ScenarioSpec, cr: CropSpec, rng: np.random.Generator) -> tuple[lis
                       height * rng.uniform(0.25, 0.75)]
             radius = _FRUIT_RADIUS * rng.uniform(0.8, 1.2)
             fruits.append({"id": len(fruits), "plant": p, "center": [round(c, 5) for c in centre],
-                           "size": round(2 * radius, 5)})
+                           "size": [round(2 * radius, 5)] * 3})
         for _ in range(_LEAVES_PER_PLANT):
             angle, reach = rng.uniform(0, 2 * math.pi), rng.uniform(0.08, 0.22)
             centre = [px + reach * math.cos(angle), py + reach * math.sin(angle),
@@ -132,7 +132,7 @@ def _render(camera: _Camera, view: Viewpoint, crop: str, fruits: list, leaves: l
         u, v, d = camera.project(view, np.asarray(fruit["center"]))
         if d <= 0.05:
             continue
-        r = camera.fx * fruit["size"] / 2 / d
+        r = camera.fx * fruit["size"][0] / 2 / d
         dist = np.hypot(uu - u, vv - v)
         cover = (dist <= r) & (d < depth)
         full_area[fruit["id"]] = math.pi * r * r
@@ -203,7 +203,7 @@ def write_tiny_scene(scene_dir: Path, scenario: str = "sp", crop: str = "strawbe
         visible_fraction[view.image_name] = {str(k): v for k, v in sorted(visible.items())}
     (scene_dir / "annotations.json").write_text(json.dumps(annotations, indent=1))
     metadata = {
-        "seed": seed, "generator": "tests/layout_factory.py", "scenario": sc.name, "crop": cr.name,
+        "seed": seed, "generator": {"name": "tests/layout_factory.py"}, "scenario": sc.name, "crop": cr.name,
         "camera": camera.as_json,
         "grid": {"extent": list(sc.extent), "step": sc.step, "headings": sc.headings,
                  "altitudes": [cr.altitudes[i] for i in sc.altitude_levels],

@@ -59,8 +59,8 @@ def test_scene_properties(ours: Path) -> None:
     names = list(sp.views)
     assert names[0] == "0001.jpeg" and names == sorted(names) and len(sp) == len(names)
     assert sp.view("0001") is sp.view("0001.jpeg") is sp.view(1)
-    assert sp.metadata is not None and sp.metadata["camera"]["width"] == 128
-    assert set(sp.metadata["visible_fraction"]) == set(names)
+    assert sp.metadata is not None and sp.metadata.camera.width == 128
+    assert set(sp.metadata.visible_fraction) == set(names)
     assert ds.splits == {"seed": 0, "train": ["Single-Strawberry/000", "Multi-Vine/000"],
                          "test": ["Single-Strawberry/001"]}
 

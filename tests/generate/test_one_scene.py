@@ -15,6 +15,7 @@ from davis_ag import cli
 from davis_ag.data.reader import open_dataset
 from davis_ag.data.validate import validate_dataset
 from davis_ag.errors import UserError
+from davis_ag.formats.scene_file import read_scene_file
 from davis_ag.generate.one_scene import ROOT_EXTRAS, SceneRequest, generate_scene
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.plants import Phenotype, in_table_range, require_native_helios
@@ -90,6 +91,8 @@ def test_scene_json_records_what_the_annotations_leave_out(generated: tuple[Path
     _, scene_dir, _ = generated
     meta = json.loads((scene_dir / "scene.json").read_text())
     annotations = json.loads((scene_dir / "annotations.json").read_text())
+    # Written through its model and read back through it unchanged, key order included.
+    assert json.dumps(read_scene_file(scene_dir / "scene.json").as_written()) == json.dumps(meta)
     assert meta["seed"] == REQUEST.seed and meta["dataset_seed"] == 0
     assert (meta["scenario"], meta["crop"], meta["scene"]) == ("sp", "strawberry", "Single-Strawberry/000")
     assert meta["camera"] == CAMERA.intrinsics()

@@ -162,8 +162,8 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
         """Visible pixels a start target needs: scene.json's threshold if the scene has one
         (what its boxes were made with), else the crop's, scaled to the image area."""
         metadata = scene.metadata
-        if metadata and isinstance(metadata.get("min_fruit_pixels"), (int, float)):
-            return float(metadata["min_fruit_pixels"])
+        if metadata is not None and metadata.min_fruit_pixels is not None:
+            return float(metadata.min_fruit_pixels)
         crop = scene_crop(scene)
         if crop is None:
             return 0.0

@@ -37,6 +37,7 @@ from pydantic import ValidationError
 from davis_ag.formats.layout import ANNOTATIONS, IMAGES, SCENE_METADATA, read_depth, view_file, view_stem
 from davis_ag.formats.layout import SPLITS_FILE as SPLITS
 from davis_ag.formats.models import SplitsFile, one_line
+from davis_ag.formats.scene_file import SceneFile, parse_scene_file
 from davis_ag.errors import UserError
 from davis_ag.scene import specs as config
 
@@ -275,22 +276,19 @@ class Scene:
         return self.views[key]
 
     @cached_property
-    def metadata(self) -> dict[str, Any] | None:
-        """Our scene.json as a plain dict (seed, camera, plants, fruits, visible_fraction...).
+    def metadata(self) -> SceneFile | None:
+        """Our scene.json (seed, camera, plants, fruits, visible_fraction...), read through its model.
 
         Returns:
             ``None`` where the scene has none (the original download never has).
 
         Raises:
-            UserError: when scene.json exists but is not a JSON object.
+            UserError: when scene.json exists but does not fit :class:`~davis_ag.formats.scene_file.SceneFile`.
         """
         path = self.path / SCENE_METADATA
         if not path.is_file():
             return None
-        data = read_json(check_inside(path, self.root), "scene metadata")
-        if not isinstance(data, dict):
-            raise UserError(f"{path}: must hold a JSON object, got {type(data).__name__}; regenerate the scene")
-        return data
+        return parse_scene_file(read_json(check_inside(path, self.root), "scene metadata"), path)
 
     def __len__(self) -> int:
         return len(self.views)

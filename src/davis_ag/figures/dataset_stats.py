@@ -84,8 +84,8 @@ def fruit_statistics(dataset: Dataset, with_oer: bool = True) -> dict[str, Any]:
         by_group.setdefault(scene.group, []).append(scene)
     out: dict[str, Any] = {}
     for group, scenes in by_group.items():
-        per_plant = [p["fruit_count"] for s in scenes for p in (s.metadata or {}).get("plants", [])
-                     if isinstance(p, dict) and "fruit_count" in p]
+        per_plant = [p.fruit_count for s in scenes for p in (s.metadata.plants if s.metadata else [])
+                     if p.fruit_count is not None]
         boxed = [len({b.fruit_id for v in s.views.values() for b in v.boxes}) for s in scenes]
         per_view = [len(v.boxes) for s in scenes for v in s.views.values()]
         entry: dict[str, Any] = {

@@ -18,6 +18,7 @@ import numpy as np
 
 from davis_ag.formats.layout import SCENE_METADATA
 from davis_ag.formats.models import AnnotationEntry
+from davis_ag.formats.scene_file import SCENE_FORMAT, SceneFile, read_scene_file
 from davis_ag.provenance import code_version
 from davis_ag.atomic_files import PROBE_PREFIX, prove_writable_folder
 from davis_ag.errors import UserError
@@ -38,8 +39,6 @@ from davis_ag.scene.specs import (
     plant_centres,
 )
 from davis_ag.scene.view_grid import build_view_grid
-
-SCENE_FORMAT = "davis-ag-scene/1"
 
 CONVENTIONS = {
     "units": {"length": "m", "angle": "deg"},
@@ -144,19 +143,16 @@ def scene_seed(dataset_seed: int, scenario: ScenarioSpec, crop: CropSpec, index:
 def read_scene_seed(scene_dir: Path) -> int | None:
     """The seed a finished scene was made with, or None when it carries no scene.json of ours."""
     try:
-        with open(scene_dir / SCENE_METADATA) as handle:
-            return int(json.load(handle)["seed"])
-    except (OSError, ValueError, KeyError, TypeError):
+        return read_scene_file(scene_dir / SCENE_METADATA).seed
+    except UserError:
         return None
 
 
 def read_scene_size(scene_dir: Path) -> tuple[int, int] | None:
     """The image size a finished scene was drawn at, or None when its scene.json does not say."""
     try:
-        with open(scene_dir / SCENE_METADATA) as handle:
-            camera = json.load(handle)["camera"]
-        return int(camera["width"]), int(camera["height"])
-    except (OSError, ValueError, KeyError, TypeError):
+        return read_scene_file(scene_dir / SCENE_METADATA).image_size()
+    except UserError:
         return None
 
 
@@ -250,10 +246,9 @@ def draw_scene(request: SceneRequest, model, grid, root: Path, on_view: Callable
                     on_view(done, len(viewpoints))
             writer.wait()  # every image written before the Visualizer's teardown moves the cwd
         drawn = time.perf_counter()
-        metadata = scene_metadata(request, model, grid, visible)
-        metadata["timing_s"] = {"grow": round(grow_s, 3), "draw_and_label": round(drawn - grown, 3),
-                                "views_from_an_earlier_run": len(writer.done)}
-        writer.finish(metadata)
+        timing = {"grow": round(grow_s, 3), "draw_and_label": round(drawn - grown, 3),
+                  "views_from_an_earlier_run": len(writer.done)}
+        writer.finish(scene_metadata(request, model, grid, visible, timing))
     except Exception:
         writer.abort()  # an error (a full disk, a bug): give the space back; the next run redoes it
         raise
@@ -275,46 +270,54 @@ def resume_key(request: SceneRequest, viewpoints: list) -> dict:
                                   "views": [view.image_name for view in viewpoints]}, default=str))
 
 
-def scene_metadata(request: SceneRequest, model, grid, visible: dict) -> dict:
-    """Our scene.json: everything the published annotations leave out."""
+def scene_metadata(request: SceneRequest, model, grid, visible: dict, timing: dict | None = None) -> SceneFile:
+    """Our scene.json: everything the published annotations leave out.
+
+    Args:
+        request, model, grid: The scene as asked for, grown and laid out.
+        visible: Per view name, per fruit id (text), the fruit's visible fraction.
+        timing: Seconds spent growing and drawing.
+    """
     import pyhelios
 
-    return {
-        "format": SCENE_FORMAT,
-        "generator": {"name": "davis-ag", "version": code_version(), "pyhelios3d": pyhelios.__version__,
-                      "python": platform.python_version()},
-        "seed": request.seed,
-        "dataset_seed": request.dataset_seed,
-        "scenario": request.scenario.name,
-        "crop": request.crop.name,
-        "scene": request.folder,
-        "plant_generator": model.plant_generator,
-        "conventions": CONVENTIONS,
-        "camera": request.camera.intrinsics(),
-        "renderer": {"name": request.renderer, "look": resolve_look(request.renderer, request.look),
-                     "antialiasing": ANTIALIASING_DESCRIPTIONS[request.antialiasing]
-                     if request.renderer == "opengl" else "Helios Visualizer, 4x multisampled colour"},
-        "depth": {"file": "images/NNNN_depth.png", "dtype": "uint16", "unit": "mm",
-                  "axis": "optical (camera-space z)", "no_hit": 0} if request.depth else None,
-        "classes": {"file": "images/NNNN_class.png", "dtype": "uint8", "table": list(ORGAN_NAMES)}
+    lighting = model.lighting
+    return SceneFile(
+        format=SCENE_FORMAT,
+        generator={"name": "davis-ag", "version": code_version(), "pyhelios3d": pyhelios.__version__,
+                   "python": platform.python_version()},
+        seed=request.seed,
+        dataset_seed=request.dataset_seed,
+        scenario=request.scenario.name,
+        crop=request.crop.name,
+        scene=request.folder,
+        plant_generator=model.plant_generator,
+        conventions=CONVENTIONS,
+        camera=request.camera.intrinsics(),
+        renderer={"name": request.renderer, "look": resolve_look(request.renderer, request.look),
+                  "antialiasing": ANTIALIASING_DESCRIPTIONS[request.antialiasing]
+                  if request.renderer == "opengl" else "Helios Visualizer, 4x multisampled colour"},
+        depth={"file": "images/NNNN_depth.png", "dtype": "uint16", "unit": "mm",
+               "axis": "optical (camera-space z)", "no_hit": 0} if request.depth else None,
+        classes={"file": "images/NNNN_class.png", "dtype": "uint8", "table": list(ORGAN_NAMES)}
         if request.classes else None,
-        "appearance": draw_appearance(request.appearance, request.seed).summary(),
-        "lighting": {"model": "phong_shadowed", "sun_elevation_deg": model.lighting.sun_elevation,
-                     "sun_azimuth_deg": model.lighting.sun_azimuth, "sun_direction": model.lighting.direction,
-                     "sun_strength": model.lighting.sun_strength, "exposure": model.lighting.exposure,
-                     "white_balance": list(model.lighting.white_balance),
-                     "sky_texture": Path(model.lighting.sky_texture).name if model.lighting.sky_texture else None},
-        "grid": {"extent_m": list(request.scenario.extent), "step_m": request.scenario.step,
-                 "altitudes_m": [request.crop.altitudes[i] for i in request.scenario.altitude_levels],
-                 "headings": request.scenario.headings, "exclusion_radius_m": request.crop.exclusion_radius,
-                 "aim_height_m": model.aim_height, "views": len(grid.viewpoints)},
-        "min_fruit_pixels": request.min_fruit_pixels,
-        "plants": [plant.summary() for plant in model.plants],
-        "fruits": [fruit.summary() for fruit in model.fruits],
-        "views": {v.image_name: {"grid": [v.ix, v.iy, v.level, v.heading], "nominal": list(v.nominal)}
-                  for v in grid.viewpoints},
-        "visible_fraction": visible,
-    }
+        appearance=draw_appearance(request.appearance, request.seed).summary(),
+        lighting={"model": "phong_shadowed", "sun_elevation_deg": lighting.sun_elevation,
+                  "sun_azimuth_deg": lighting.sun_azimuth, "sun_direction": lighting.direction,
+                  "sun_strength": lighting.sun_strength, "exposure": lighting.exposure,
+                  "white_balance": list(lighting.white_balance),
+                  "sky_texture": Path(lighting.sky_texture).name if lighting.sky_texture else None},
+        grid={"extent_m": list(request.scenario.extent), "step_m": request.scenario.step,
+              "altitudes_m": [request.crop.altitudes[i] for i in request.scenario.altitude_levels],
+              "headings": request.scenario.headings, "exclusion_radius_m": request.crop.exclusion_radius,
+              "aim_height_m": model.aim_height, "views": len(grid.viewpoints)},
+        min_fruit_pixels=request.min_fruit_pixels,
+        plants=[plant.summary() for plant in model.plants],
+        fruits=[fruit.summary() for fruit in model.fruits],
+        views={v.image_name: {"grid": [v.ix, v.iy, v.level, v.heading], "nominal": list(v.nominal)}
+               for v in grid.viewpoints},
+        visible_fraction=visible,
+        **({"timing_s": timing} if timing is not None else {}),
+    )
 
 
 # ---------------------------------------------------------------------------------------------

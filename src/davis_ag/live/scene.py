@@ -70,8 +70,8 @@ def exposure_rates(labels_boxes: list[list[int]], visible_pixels: dict[int, int]
 def min_pixels_for(settings: SceneSettings, width: int, height: int) -> int:
     """The box threshold at an image size: scene.json's at its own size, else the crop's scaled."""
     if (width, height) == (settings.camera.width, settings.camera.height) \
-            and isinstance(settings.metadata.get("min_fruit_pixels"), int):
-        return int(settings.metadata["min_fruit_pixels"])
+            and settings.metadata.min_fruit_pixels is not None:
+        return settings.metadata.min_fruit_pixels
     return max(1, round(settings.crop.min_fruit_pixels * width * height / REFERENCE_PIXELS))
 
 
