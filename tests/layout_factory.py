@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
+from davis_ag.formats.layout import published_pointers, view_file_name, view_name
 from davis_ag.scene import specs as config
 from davis_ag.scene.specs import CropSpec, ScenarioSpec
 from davis_ag.scene.view_grid import Viewpoint, build_view_grid
@@ -195,12 +196,12 @@ def write_tiny_scene(scene_dir: Path, scenario: str = "sp", crop: str = "strawbe
     for view in grid.viewpoints:
         rgb, owner, visible = _render(camera, view, cr.name, fruits, leaves)
         boxes, mask = _boxes_and_mask(owner)
-        stem = view.image_name.removesuffix(".jpeg")
-        Image.fromarray(rgb).save(images / view.image_name, "JPEG", quality=95)
-        Image.fromarray(mask).save(images / f"{stem}_seg.png")
-        annotations[view.image_name] = {"bounding_boxes": boxes, "pose": [round(p, 5) for p in view.pose],
-                                        **grid.pointers(view.index)}
-        visible_fraction[view.image_name] = {str(k): v for k, v in sorted(visible.items())}
+        name = view_name(view.number)
+        Image.fromarray(rgb).save(images / name, "JPEG", quality=95)
+        Image.fromarray(mask).save(images / view_file_name(name, "mask"))
+        annotations[name] = {"bounding_boxes": boxes, "pose": [round(p, 5) for p in view.pose],
+                             **published_pointers(grid, view.index)}
+        visible_fraction[name] = {str(k): v for k, v in sorted(visible.items())}
     (scene_dir / "annotations.json").write_text(json.dumps(annotations, indent=1))
     metadata = {
         "seed": seed, "generator": {"name": "tests/layout_factory.py"}, "scenario": sc.name, "crop": cr.name,

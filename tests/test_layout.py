@@ -22,7 +22,7 @@ PACKAGE = Path(davis_ag.__file__).parent
 #: The pipeline, earliest first; a module may import its own stage and those before it.
 STAGES: tuple[tuple[str, ...], ...] = (
     # helpers every stage may use, and the environments' ids (registered by name, nothing imported)
-    ("errors", "atomic_files", "stage_timer", "provenance", "environments"),
+    ("errors", "atomic_files", "stage_timer", "provenance", "seeds", "environments"),
     ("scene",),
     ("formats",),  # the dataset's files, split rule and schemas: shared by writer, reader and benchmark
     ("render",),

@@ -16,7 +16,8 @@ from davis_ag.data.reader import open_dataset
 from davis_ag.data.validate import validate_dataset
 from davis_ag.errors import UserError
 from davis_ag.formats.scene_file import read_scene_file
-from davis_ag.generate.one_scene import ROOT_EXTRAS, SceneRequest, generate_scene
+from davis_ag.formats.layout import ROOT_FILES
+from davis_ag.generate.one_scene import SceneRequest, generate_scene
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.plants import Phenotype, in_table_range, require_native_helios
 from davis_ag.scene.specs import CROPS, SCENARIOS, SP_ACTIONS
@@ -264,7 +265,7 @@ def test_a_scene_made_with_another_seed_is_not_overwritten(
     line = refused(capsys, "--out", str(root), "--seed", "1", "--size", "96x54")
     assert "already holds a scene made with other settings" in line
     assert snapshot(root / "Single-Strawberry") == before
-    assert {p.name for p in root.iterdir()} <= {"Single-Strawberry", *ROOT_EXTRAS}
+    assert {p.name for p in root.iterdir()} <= {"Single-Strawberry", *ROOT_FILES}
 
 
 def test_mock_pyhelios_is_a_clear_error(monkeypatch: pytest.MonkeyPatch) -> None:

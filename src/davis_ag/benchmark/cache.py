@@ -35,7 +35,7 @@ import numpy as np
 from PIL import Image
 
 from davis_ag.data.safe_read import check_inside
-from davis_ag.formats.layout import ANNOTATIONS
+from davis_ag.formats.layout import ANNOTATIONS, CACHE_FOLDER
 from davis_ag.errors import UserError
 from davis_ag.scene.specs import ALL_ACTIONS
 
@@ -43,8 +43,6 @@ from davis_ag.scene.specs import ALL_ACTIONS
 OBS_SIZE = 224
 #: Bumped whenever the files' meaning changes, so that old caches are rebuilt.
 CACHE_VERSION = 2
-#: Folder under the dataset root that holds the default caches.
-CACHE_FOLDER = ".davis_ag_cache"
 
 
 @dataclass(frozen=True)

@@ -27,6 +27,7 @@ from davis_ag.atomic_files import atomic_output
 from davis_ag.data.annotation_schema import NO_FRUIT
 from davis_ag.data.reader import Scene, View, open_dataset
 from davis_ag.errors import UserError
+from davis_ag.formats.layout import view_number
 
 #: Organ value of points whose scene has no class images.
 NO_CLASS = 255
@@ -126,7 +127,7 @@ def view_points(view: View, pinhole: Pinhole, max_depth: float | None = None) ->
         points[name] = colour[:, channel]
     points["organ"] = classes[keep] if classes is not None else NO_CLASS
     points["fruit_id"] = mask[keep] if mask is not None else NO_FRUIT
-    points["view"] = int(view.name.removesuffix(".jpeg")) if view.name.removesuffix(".jpeg").isdigit() else 0
+    points["view"] = view_number(view.name) or 0
     return points
 
 

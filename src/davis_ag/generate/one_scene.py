@@ -16,10 +16,11 @@ from typing import Any, Callable
 
 import numpy as np
 
-from davis_ag.formats.layout import SCENE_METADATA
+from davis_ag.formats.layout import ROOT_FILES, SCENE_METADATA, published_pointers, view_name
 from davis_ag.formats.models import AnnotationEntry
 from davis_ag.formats.scene_file import SCENE_FORMAT, SceneFile, read_scene_file
 from davis_ag.provenance import code_version
+from davis_ag.seeds import derived_seed
 from davis_ag.atomic_files import PROBE_PREFIX, prove_writable_folder
 from davis_ag.errors import UserError
 from davis_ag.generate.scene_writer import SceneWriter
@@ -124,9 +125,8 @@ class SceneRequest(SceneSettings):
 
     @property
     def min_fruit_pixels(self) -> int:
-        """The crop's box threshold, defined at 1280x720 and scaled with the image area."""
-        scale = self.camera.width * self.camera.height / (1280 * 720)
-        return max(1, round(self.crop.min_fruit_pixels * scale))
+        """The crop's box threshold at this image size (:meth:`CropSpec.min_fruit_pixels_at`)."""
+        return self.crop.min_fruit_pixels_at(self.camera.width, self.camera.height)
 
     @property
     def folder(self) -> str:
@@ -137,7 +137,7 @@ class SceneRequest(SceneSettings):
 def scene_seed(dataset_seed: int, scenario: ScenarioSpec, crop: CropSpec, index: int) -> int:
     """Derive a scene's seed from the dataset seed; independent streams for every scene."""
     keys = [dataset_seed, list(SCENARIOS).index(scenario.name), list(CROPS).index(crop.name), index]
-    return int(np.random.SeedSequence(keys).generate_state(1, dtype=np.uint32)[0])
+    return derived_seed(*keys)
 
 
 def read_scene_seed(scene_dir: Path) -> int | None:
@@ -225,7 +225,7 @@ def draw_scene(request: SceneRequest, model, grid, root: Path, on_view: Callable
         with open_renderer(request.renderer, model.context, camera, model.lighting, look,
                            request.antialiasing) as renderer:
             for done, view in enumerate(viewpoints, 1):
-                if view.image_name in writer.done:
+                if view_name(view.number) in writer.done:
                     if on_view:
                         on_view(done, len(viewpoints))
                     continue
@@ -237,10 +237,10 @@ def draw_scene(request: SceneRequest, model, grid, root: Path, on_view: Callable
                     if draw_silhouette else None
                 fractions = visible_fractions(camera, view, labels, polygons, silhouette)
                 entry = AnnotationEntry(bounding_boxes=labels.boxes, pose=[round(v, 5) for v in view.pose],
-                                        **grid.pointers(view.index)).to_json()
-                visible[view.image_name] = {str(k): v for k, v in fractions.items()}
-                writer.add_view(view.image_name, colour, labels.segmentation, entry,
-                                depth if request.depth else None, {"visible": visible[view.image_name]},
+                                        **published_pointers(grid, view.index)).to_json()
+                visible[view_name(view.number)] = {str(k): v for k, v in fractions.items()}
+                writer.add_view(view_name(view.number), colour, labels.segmentation, entry,
+                                depth if request.depth else None, {"visible": visible[view_name(view.number)]},
                                 classes=classes)
                 if on_view:
                     on_view(done, len(viewpoints))
@@ -267,7 +267,7 @@ def resume_key(request: SceneRequest, viewpoints: list) -> dict:
     draw differently, so its views are not mixed with this one's).
     """
     return json.loads(json.dumps({"request": asdict(request), "seed": request.seed, "code": code_version(),
-                                  "views": [view.image_name for view in viewpoints]}, default=str))
+                                  "views": [view_name(view.number) for view in viewpoints]}, default=str))
 
 
 def scene_metadata(request: SceneRequest, model, grid, visible: dict, timing: dict | None = None) -> SceneFile:
@@ -313,7 +313,7 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict, timing: di
         min_fruit_pixels=request.min_fruit_pixels,
         plants=[plant.summary() for plant in model.plants],
         fruits=[fruit.summary() for fruit in model.fruits],
-        views={v.image_name: {"grid": [v.ix, v.iy, v.level, v.heading], "nominal": list(v.nominal)}
+        views={view_name(v.number): {"grid": [v.ix, v.iy, v.level, v.heading], "nominal": list(v.nominal)}
                for v in grid.viewpoints},
         visible_fraction=visible,
         **({"timing_s": timing} if timing is not None else {}),
@@ -322,10 +322,6 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict, timing: di
 
 # ---------------------------------------------------------------------------------------------
 # Output folder checks
-
-#: Names a dataset root may hold besides group folders.
-ROOT_EXTRAS = {"splits.json", "dataset.json", ".davis_ag_cache", ".davis_ag.lock", "reports"}
-
 
 def check_output_root(root: Path) -> None:
     """Refuse an output folder we could damage or cannot write.
@@ -340,7 +336,7 @@ def check_output_root(root: Path) -> None:
         raise UserError(f"{root} is a file, not a folder: choose another --out")
     if root.is_dir():
         strangers = [p.name for p in root.iterdir()
-                     if p.name not in ROOT_EXTRAS and not p.name.startswith(PROBE_PREFIX)
+                     if p.name not in ROOT_FILES and not p.name.startswith(PROBE_PREFIX)
                      and not (p.is_dir() and parse_group_name(p.name))]
         if strangers:
             raise UserError(f"{root} holds other things ({', '.join(sorted(strangers)[:3])}): "

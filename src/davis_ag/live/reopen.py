@@ -25,7 +25,7 @@ from typing import TypeVar
 import numpy as np
 
 from davis_ag.atomic_files import atomic_output
-from davis_ag.formats.layout import ANNOTATIONS, SCENE_METADATA
+from davis_ag.formats.layout import ANNOTATIONS, SCENE_METADATA, view_name
 from davis_ag.formats.scene_file import SCENE_FORMAT, GeneratorRecord, RendererRecord, SceneFile, read_scene_file
 from davis_ag.errors import UserError
 from davis_ag.scene.camera import Camera
@@ -216,7 +216,7 @@ def check_grid(settings: SceneSettings, views: list[Viewpoint]) -> None:
         annotations = json.loads(path.read_text())
     except (OSError, ValueError) as error:
         raise UserError(f"{path}: cannot be read ({error})") from None
-    poses = {v.image_name: [round(x, 5) for x in v.pose] for v in views}
+    poses = {view_name(v.number): [round(x, 5) for x in v.pose] for v in views}
     for name, entry in annotations.items():
         if poses.get(name) != entry.get("pose"):
             raise UserError(f"{path}: view {name} has pose {entry.get('pose')}, the regrown grid "

@@ -19,6 +19,7 @@ from davis_ag.benchmark.exact import BEST_FIXED
 from davis_ag.benchmark.paired import CONFIDENCE, PAIRED_KEY
 from davis_ag.formats.layout import SCENE_METADATA
 from davis_ag.formats.scene_file import CameraRecord, RendererRecord, read_scene_file_or_empty
+from davis_ag.scene.specs import PAPER_TABLE3
 from davis_ag.workflows.results_policies import (
     cell,
     learning_curve_section,
@@ -376,7 +377,9 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
         f"network of section V-B, {config.n_envs} environments; its settings under each scenario) for {config.sp_timesteps:,} (SP) and "
         f"{config.mp_timesteps:,} (MP) environment steps; evaluation {config.sessions} sessions x "
         f"{config.episodes} episodes, seed {config.seed}, A2C {_a2c_play(state)}.",
-        "- **Paper**: 86 SP strawberry and 44 MP vine scenes at 1280x720 (Table 3), A2C for 300K "
+        f"- **Paper**: {PAPER_TABLE3['sp', 'strawberry'][0]} SP strawberry and {PAPER_TABLE3['mp', 'vine'][0]} "
+        "MP vine scenes at 1280x720 "
+        "(Table 3), A2C for 300K "
         "steps, 3 sessions x 200 episodes on the test split.",
         f"- **Machine**: {machine_description()}.",
         "",
