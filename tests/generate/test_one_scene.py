@@ -304,7 +304,7 @@ def test_depth_images_are_written_read_and_checked(generated: tuple[Path, Path, 
     fruits = {f["id"]: np.array(f["center"]) for f in meta["fruits"]}
     checked = 0
     for view in scene:
-        depth, mask = view.depth, view.mask()
+        depth, mask = view.depth(), view.mask()
         raw = np.asarray(Image.open(view.depth_path))
         assert raw.dtype == np.uint16 and depth.dtype == np.float32 and depth.shape == (CAMERA.height, CAMERA.width)
         assert (depth[0] == 0).all() and depth.max() > 0  # sky on the top row, ground below
@@ -325,7 +325,7 @@ def test_depth_images_are_written_read_and_checked(generated: tuple[Path, Path, 
         path.unlink()
     meta["depth"] = None
     (copied / "scene.json").write_text(json.dumps(meta))
-    assert all(view.depth is None for view in open_dataset(copy).scenes[0])
+    assert all(view.depth() is None for view in open_dataset(copy).scenes[0])
     assert validate_dataset(copy).ok
 
     # Depth that disagrees with the fruit's 3-D centres, or has the wrong size, is reported.
@@ -369,7 +369,7 @@ def test_organ_classes_come_from_the_same_pass_as_the_masks(generated: tuple[Pat
     (scene,) = open_dataset(root).scenes
     seen: set[int] = set()
     for view in scene:
-        classes, mask, depth = view.classes, view.mask(), view.depth
+        classes, mask, depth = view.classes(), view.mask(), view.depth()
         assert classes.dtype == np.uint8 and classes.shape == (CAMERA.height, CAMERA.width)
         assert (classes[mask != 255] == FRUIT).all()  # every fruit pixel of the instance mask
         assert ((classes == SKY) == (depth == 0)).all()  # nothing hit: sky, in both images
@@ -385,9 +385,9 @@ def test_organ_classes_come_from_the_same_pass_as_the_masks(generated: tuple[Pat
     for path in images.glob("*_class.png"):
         if path.name != boxed.class_path.name:
             path.unlink()
-    assert all(v.classes is None for v in open_dataset(copy).scenes[0] if v.name != boxed.name)
+    assert all(v.classes() is None for v in open_dataset(copy).scenes[0] if v.name != boxed.name)
     assert validate_dataset(copy).ok
-    wrong = np.where(boxed.mask() != 255, LEAF, boxed.classes).astype(np.uint8)
+    wrong = np.where(boxed.mask() != 255, LEAF, boxed.classes()).astype(np.uint8)
     Image.fromarray(wrong, mode="L").save(images / boxed.class_path.name)
     problems = [str(p) for p in validate_dataset(copy).problems]
     assert len(problems) == 1 and boxed.class_path.name in problems[0] and "not class 2 (fruit)" in problems[0]

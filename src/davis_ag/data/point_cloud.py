@@ -106,7 +106,7 @@ def view_points(view: View, pinhole: Pinhole, max_depth: float | None = None) ->
     Raises:
         UserError: when the view has no depth image or no pose.
     """
-    depth = view.depth
+    depth = view.depth()
     if depth is None:
         raise UserError(f"{view.depth_path}: missing; point clouds need depth images (generate without --no-depth)")
     if view.pose is None:
@@ -119,7 +119,7 @@ def view_points(view: View, pinhole: Pinhole, max_depth: float | None = None) ->
         keep &= depth <= max_depth
     world = unproject(depth, pinhole, view.pose)[keep]
     colour = view.image()[keep]
-    classes, mask = view.classes, view.mask()
+    classes, mask = view.classes(), view.mask()
     points = np.empty(len(world), dtype=POINT_DTYPE)
     for axis, name in enumerate("xyz"):
         points[name] = world[:, axis]

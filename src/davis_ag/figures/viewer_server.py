@@ -235,7 +235,7 @@ def make_handler(viewer: Viewer, page: bytes) -> type[BaseHTTPRequestHandler]:
             if layer == "classes":
                 if viewer.file(scene, view.class_path.name) is None:
                     return self._missing("no organ classes")
-                return self._send(HTTPStatus.OK, classes_overlay(view.classes), "image/png", cache=True)
+                return self._send(HTTPStatus.OK, classes_overlay(view.classes()), "image/png", cache=True)
             path = viewer.file(scene, view.depth_path.name)
             if path is None:
                 return self._missing("no depth")
