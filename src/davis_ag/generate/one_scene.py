@@ -233,8 +233,8 @@ def draw_scene(request: SceneRequest, model, grid, root: Path, on_view: Callable
                 classes = class_of_id[primitive_ids] if class_of_id is not None else None
                 labels = label_view(primitive_ids, lookup, request.min_fruit_pixels)
                 draw_silhouette = getattr(renderer, "silhouette_pixels", None)
-                silhouette = (lambda fruit_id, view=view: draw_silhouette(view, fruit_id, fruit_uuids[fruit_id])) \
-                    if draw_silhouette else None
+                silhouette = (lambda fruit_id, view=view, draw=draw_silhouette:
+                              draw(view, fruit_id, fruit_uuids[fruit_id])) if draw_silhouette else None
                 fractions = visible_fractions(camera, view, labels, polygons, silhouette)
                 entry = AnnotationEntry(bounding_boxes=labels.boxes, pose=[round(v, 5) for v in view.pose],
                                         **published_pointers(grid, view.index)).to_json()

@@ -23,11 +23,9 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, replace
 
-import numpy as np
-
 from davis_ag.errors import UserError
-from davis_ag.seeds import APPEARANCE_STREAM, stream_rng
 from davis_ag.scene.lighting import Lighting
+from davis_ag.seeds import APPEARANCE_STREAM, stream_rng
 
 APPEARANCES = ("paper", "random")
 DEFAULT_APPEARANCE = "paper"
