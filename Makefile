@@ -33,7 +33,7 @@ lint: $(STAMP)
 	$(BIN)/mypy src
 
 bench: $(STAMP)
-	$(BIN)/python tools/bench.py --out $(OUT)/bench.json --doc docs/performance.md
+	$(BIN)/davis-ag bench --out $(OUT)/bench.json --doc docs/performance.md
 
 reproduce: $(STAMP)
 	$(BIN)/davis-ag reproduce --out $(OUT)/reproduce --results docs/results.md

@@ -13,7 +13,7 @@ from davis_ag.provenance import code_version
 # run(args) and maybe FORMATTER_CLASS (the package's docstring says what each is); add_command alone
 # makes the sub-parsers from them, so that every command's is made the same way.
 COMMANDS = ["generate", "validate", "train", "evaluate", "preview", "demo", "reproduce", "stats", "plot",
-            "view", "export", "transfer"]
+            "view", "export", "transfer", "bench", "scene-stats"]
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -41,12 +41,12 @@ def add_command(subparsers: argparse._SubParsersAction, name: str) -> argparse.A
 
     Args:
         subparsers: what the parser's ``add_subparsers()`` returned.
-        name: the command, the name of its module (one of :data:`COMMANDS`).
+        name: the command, the name of its module with ``_`` for ``-`` (one of :data:`COMMANDS`).
 
     Returns:
         The sub-command's parser, its ``func`` default the module's ``run``.
     """
-    module = importlib.import_module(f"davis_ag.commands.{name}")
+    module = importlib.import_module(f"davis_ag.commands.{name.replace('-', '_')}")
     parser = subparsers.add_parser(name, help=module.HELP, description=module.DESCRIPTION,
                                    formatter_class=getattr(module, "FORMATTER_CLASS", argparse.HelpFormatter))
     module.add_arguments(parser)
