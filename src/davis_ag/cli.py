@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import re
 import sys
 
 from davis_ag.errors import UserError
@@ -28,12 +29,24 @@ class OneLineParser(argparse.ArgumentParser):
 
 def build_parser() -> argparse.ArgumentParser:
     """Build the top-level parser with every sub-command registered."""
-    parser = OneLineParser(prog="davis-ag", description=__doc__)
+    parser = OneLineParser(prog="davis-ag", description=plain_text(__doc__))
     parser.add_argument("--version", action="version", version=f"davis-ag {code_version()}")
     subparsers = parser.add_subparsers(dest="command", required=True)
     for name in COMMANDS:
         add_command(subparsers, name)
     return parser
+
+
+def plain_text(docstring: str | None) -> str | None:
+    """A docstring as help text: Sphinx markup (````code````, ``:mod:`name```` and friends) as plain text.
+
+    The command modules' docstrings are both their API documentation and their ``--help``; only
+    the first may carry markup.
+    """
+    if docstring is None:
+        return None
+    text = re.sub(r":(?:mod|func|class|meth|data|attr|exc):`~?([^`]+)`", r"\1", docstring)
+    return text.replace("``", "")
 
 
 def add_command(subparsers: argparse._SubParsersAction, name: str) -> argparse.ArgumentParser:
@@ -47,7 +60,7 @@ def add_command(subparsers: argparse._SubParsersAction, name: str) -> argparse.A
         The sub-command's parser, its ``func`` default the module's ``run``.
     """
     module = importlib.import_module(f"davis_ag.commands.{name.replace('-', '_')}")
-    parser = subparsers.add_parser(name, help=module.HELP, description=module.DESCRIPTION,
+    parser = subparsers.add_parser(name, help=plain_text(module.HELP), description=plain_text(module.DESCRIPTION),
                                    formatter_class=getattr(module, "FORMATTER_CLASS", argparse.HelpFormatter))
     module.add_arguments(parser)
     parser.set_defaults(func=module.run)
