@@ -17,12 +17,14 @@ def test_views_are_measured_beside_table_3_and_written_into_the_pages(tmp_path: 
     shutil.copytree(DOCS, docs, ignore=shutil.ignore_patterns("images", "transfer"))
     (docs / "data" / "scenes-views.json").unlink()
     assert cli.main(["scene-stats", "views", "--docs", str(docs)]) == 0
-    page = (docs / "scenes.md").read_text()
     # Table 3: 24,510 images over 86 SP strawberry scenes, 79,200 over 44 MP vine scenes.
-    assert "| SP, paper (Table 3) | 285 |" in page and "| MP, paper (Table 3) | 1,128 | 1,800 | 1,800 |" in page
-    assert "| SP, ours | 285 | 348 | 348 |" in page
-    # The marked table of dataset-format.md is the same table, written by the same code.
-    assert (docs / "dataset-format.md").read_text().count("| SP, ours | 285 | 348 | 348 |") == 1
+    table = (docs / "dataset-format.md").read_text()
+    assert "| SP, paper (Table 3) | 285 |" in table and "| MP, paper (Table 3) | 1,128 | 1,800 | 1,800 |" in table
+    assert "| SP, ours | 285 | 348 | 348 |" in table
+    # Each generated table once: scenes.md links to the page that holds it.
+    assert "In [dataset-format.md](dataset-format.md)." in (docs / "scenes.md").read_text()
+    for marked in ("| SP, ours |", "| crop | plants | fruit per plant"):
+        assert sum(page.read_text().count(marked) for page in docs.glob("*.md")) == 1, marked
 
 
 def test_a_folder_that_is_no_docs_folder_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

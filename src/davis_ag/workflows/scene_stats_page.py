@@ -182,23 +182,32 @@ def skewness(values: np.ndarray) -> float:
 
 
 def render_markdown(docs: Path) -> str:
-    """docs/scenes.md from the saved measurements."""
+    """docs/scenes.md from the saved measurements: each table once, so a table another page holds
+    between its ``<!-- scene-stats:NAME -->`` markers is a link here (:func:`update_docs_pages`)."""
     lines = ["# Our scenes beside the paper's", "",
              "Written by `davis-ag scene-stats` from its measurements (docs/data/scenes-*.json); "
              "do not edit by hand.", ""]
-    if views := views_table(docs):
-        lines += ["## Images per scene (Table 3)", "", *views, ""]
-    if plants := plants_table(docs):
-        lines += ["## Fruit per plant", "", *plants, ""]
-    if refused := refused_table(docs):
-        lines += ["## Moves the benchmark refuses from its episode starts", "", *refused, ""]
-    if findings := findings_table(docs):
-        lines += ["## The paper's findings on single-plant strawberry scenes", "", *findings]
-    if recipes := recipes_table(docs):
-        lines += ["## PlantArchitecture strawberry recipes tried for Fig. 2 and the OER share together", "",
-                  *recipes]
-    return "\n".join(lines)
+    sections = [("views", "Images per scene (Table 3)", views_table(docs)),
+                ("plants", "Fruit per plant", plants_table(docs)),
+                ("refused", "Moves the benchmark refuses from its episode starts", refused_table(docs)),
+                ("findings", "The paper's findings on single-plant strawberry scenes", findings_table(docs)),
+                ("recipes", "PlantArchitecture strawberry recipes tried for Fig. 2 and the OER share together",
+                 recipes_table(docs))]
+    for name, title, table in sections:
+        if not table:
+            continue
+        holder = page_holding(docs, name)
+        body = [f"In [{holder.name}]({holder.name}).", ""] if holder else [*table, ""]
+        lines += [f"## {title}", "", *body]
+    return "\n".join(lines).rstrip() + "\n"
 
+
+def page_holding(docs: Path, name: str) -> Path | None:
+    """The docs page (other than scenes.md) that holds the table ``name`` between its markers."""
+    for page in sorted(docs.glob("*.md")):
+        if page.name != "scenes.md" and f"<!-- scene-stats:{name} -->" in page.read_text():
+            return page
+    return None
 
 
 def update_docs_pages(docs: Path, blocks: dict[str, list[str]]) -> None:
