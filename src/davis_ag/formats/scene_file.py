@@ -15,7 +15,7 @@ import json
 from pathlib import Path
 from typing import Any, Union
 
-from pydantic import BaseModel, ConfigDict, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from davis_ag.errors import UserError
 from davis_ag.formats.models import one_line
@@ -37,9 +37,9 @@ class _Record(BaseModel):
 class GeneratorRecord(_Record):
     """Which code wrote the scene."""
 
-    name: str | None = None
-    version: str | None = None
-    pyhelios3d: str | None = None
+    name: str | None = Field(None, description="davis-ag for our generator")
+    version: str | None = Field(None, description="davis-ag's version and git commit")
+    pyhelios3d: str | None = Field(None, description="the pyhelios3d version that grew the plants")
     python: str | None = None
 
 
@@ -47,23 +47,27 @@ class CameraRecord(_Record):
     """The pinhole the views were drawn with (OpenCV convention, pixel centres at +0.5)."""
 
     model: str | None = None
+    #: Image size, pixels.
     width: int | None = None
     height: int | None = None
+    #: Focal lengths and principal point, pixels.
     fx: Number | None = None
     fy: Number | None = None
     cx: Number | None = None
     cy: Number | None = None
+    #: Fields of view, degrees.
     vfov_deg: Number | None = None
     hfov_deg: Number | None = None
+    #: OpenCV's k1, k2, p1, p2, k3: all 0 for our pinhole.
     distortion: list[Number] | None = None
 
 
 class RendererRecord(_Record):
     """How the views were drawn (:mod:`davis_ag.render.backends`' names)."""
 
-    name: str | None = None
-    look: str | None = None
-    antialiasing: str | None = None
+    name: str | None = Field(None, description="opengl (ours) or helios")
+    look: str | None = Field(None, description="default or helios")
+    antialiasing: str | None = Field(None, description="the mode's description (ANTIALIASING_DESCRIPTIONS)")
 
 
 class GridRecord(_Record):
@@ -72,9 +76,11 @@ class GridRecord(_Record):
     extent_m: list[Number] | None = None
     step_m: Number | None = None
     altitudes_m: list[Number] | None = None
+    #: Camera headings per position (1: always aimed at the plant).
     headings: int | None = None
     exclusion_radius_m: Number | None = None
     aim_height_m: Number | None = None
+    #: Views on the grid.
     views: int | None = None
 
 
@@ -84,26 +90,28 @@ class PlantRecord(_Record):
     index: int | None = None
     seed: int | None = None
     position: list[Number] | None = None
+    #: Table 1's phenotype drawn for the plant, and the one measured on it, metres.
     phenotype_target: dict[str, Any] | None = None
     phenotype_measured: dict[str, Any] | None = None
     fruit_count: int | None = None
+    #: Builds it took (regrowths for too few fruit included).
     builds: int | None = None
 
 
 class FruitRecord(_Record):
     """One fruit (:meth:`davis_ag.scene.build.Fruit.summary`): its id, plant and 3-D extent."""
 
-    id: int | None = None
-    plant: int | None = None
-    center: list[Number] | None = None
-    size: list[Number] | None = None
+    id: int | None = Field(None, description="the fruit id of the masks and boxes")
+    plant: int | None = Field(None, description="the index of the plant bearing it")
+    center: list[Number] | None = Field(None, description="world x, y, z, metres")
+    size: list[Number] | None = Field(None, description="extent along x, y, z, metres")
 
 
 class ViewPlace(_Record):
     """A view's place on the grid and its pose before slip."""
 
-    grid: list[int] | None = None
-    nominal: list[Number] | None = None
+    grid: list[int] | None = Field(None, description="column, row, altitude level, heading")
+    nominal: list[Number] | None = Field(None, description="the pose before slip")
 
 
 class SceneFile(_Record):
@@ -128,11 +136,14 @@ class SceneFile(_Record):
     crop: str | None = None
     scene: str | None = None
     plant_generator: str | None = None
+    #: Units, frames and encodings in words.
     conventions: dict[str, Any] | None = None
+    #: How the views were drawn.
     camera: CameraRecord | None = None
     renderer: RendererRecord | None = None
     depth: dict[str, Any] | None = None
     classes: dict[str, Any] | None = None
+    #: The scene's look: soil, sun, sky, exposure, white balance.
     appearance: dict[str, Any] | None = None
     lighting: dict[str, Any] | None = None
     grid: GridRecord | None = None
