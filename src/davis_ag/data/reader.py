@@ -306,12 +306,8 @@ class Scene(Sequence["View"]):
     def __getitem__(self, position: slice) -> Sequence[View]: ...
 
     def __getitem__(self, position: int | slice) -> View | Sequence[View]:
-        """The view at a position from 0 (``scene[0]`` is ``0001.jpeg``), or a slice of them.
-
-        Raises:
-            IndexError: past the last view (a scene of N views takes -N .. N-1).
-            TypeError: for a name: look names up with :meth:`view`.
-        """
+        """The view at a position from 0 (``scene[0]`` is ``0001.jpeg``), or a slice of them; a name
+        raises TypeError (names go to :meth:`view`), a position past the last view IndexError."""
         if isinstance(position, str):
             raise TypeError(f"scene[{position!r}]: positions are numbers from 0; use scene.view({position!r})")
         try:
@@ -324,9 +320,6 @@ class Scene(Sequence["View"]):
 
     def __iter__(self) -> Iterator[View]:
         return iter(self.views.values())
-
-    def __contains__(self, view: object) -> bool:
-        return isinstance(view, View) and view.scene is self and self.views.get(view.name) is view
 
     def __repr__(self) -> str:
         return f"Scene({self.id!r}, path={str(self.path)!r})"
