@@ -5,12 +5,14 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-$(shell cat pyproject.toml | cksum | cut -d' ' -f1)
 OUT ?= out
 
-.PHONY: setup demo test bench reproduce clean
+.PHONY: setup demo test lint bench reproduce clean
 
 setup: $(STAMP)
 
 # torch first, pinned: 2.13.0 is a CPU build already on this machine's disk, where an open
-# range would download a multi-GB CUDA build.
+# range would download a multi-GB CUDA build. PyPI's torchvision 0.28.0 is a CUDA build whose
+# compiled operators do not load beside it: docs/detection.md ("torchvision on a CPU-only torch")
+# says what works (PyTorch's CPU index where reachable, else prepare_ultralytics()).
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install -q --upgrade pip
@@ -25,8 +27,13 @@ demo: $(STAMP)
 test: $(STAMP)
 	$(BIN)/python -m pytest -q
 
+# ruff (pyflakes, pycodestyle, bugbear) over the code and tests, mypy over src/ (pyproject.toml).
+lint: $(STAMP)
+	$(BIN)/ruff check src tests
+	$(BIN)/mypy src
+
 bench: $(STAMP)
-	$(BIN)/python tools/bench.py --out $(OUT)/bench.json --doc docs/performance.md
+	$(BIN)/davis-ag bench --out $(OUT)/bench.json --doc docs/performance.md
 
 reproduce: $(STAMP)
 	$(BIN)/davis-ag reproduce --out $(OUT)/reproduce --results docs/results.md

@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
+from davis_ag.formats.layout import published_pointers, view_file_name, view_name
 from davis_ag.scene import specs as config
 from davis_ag.scene.specs import CropSpec, ScenarioSpec
 from davis_ag.scene.view_grid import Viewpoint, build_view_grid
@@ -105,7 +106,7 @@ def _grow(sc: ScenarioSpec, cr: CropSpec, rng: np.random.Generator) -> tuple[lis
                       height * rng.uniform(0.25, 0.75)]
             radius = _FRUIT_RADIUS * rng.uniform(0.8, 1.2)
             fruits.append({"id": len(fruits), "plant": p, "center": [round(c, 5) for c in centre],
-                           "size": round(2 * radius, 5)})
+                           "size": [round(2 * radius, 5)] * 3})
         for _ in range(_LEAVES_PER_PLANT):
             angle, reach = rng.uniform(0, 2 * math.pi), rng.uniform(0.08, 0.22)
             centre = [px + reach * math.cos(angle), py + reach * math.sin(angle),
@@ -132,7 +133,7 @@ def _render(camera: _Camera, view: Viewpoint, crop: str, fruits: list, leaves: l
         u, v, d = camera.project(view, np.asarray(fruit["center"]))
         if d <= 0.05:
             continue
-        r = camera.fx * fruit["size"] / 2 / d
+        r = camera.fx * fruit["size"][0] / 2 / d
         dist = np.hypot(uu - u, vv - v)
         cover = (dist <= r) & (d < depth)
         full_area[fruit["id"]] = math.pi * r * r
@@ -195,15 +196,15 @@ def write_tiny_scene(scene_dir: Path, scenario: str = "sp", crop: str = "strawbe
     for view in grid.viewpoints:
         rgb, owner, visible = _render(camera, view, cr.name, fruits, leaves)
         boxes, mask = _boxes_and_mask(owner)
-        stem = view.image_name.removesuffix(".jpeg")
-        Image.fromarray(rgb).save(images / view.image_name, "JPEG", quality=95)
-        Image.fromarray(mask).save(images / f"{stem}_seg.png")
-        annotations[view.image_name] = {"bounding_boxes": boxes, "pose": [round(p, 5) for p in view.pose],
-                                        **grid.pointers(view.index)}
-        visible_fraction[view.image_name] = {str(k): v for k, v in sorted(visible.items())}
+        name = view_name(view.number)
+        Image.fromarray(rgb).save(images / name, "JPEG", quality=95)
+        Image.fromarray(mask).save(images / view_file_name(name, "mask"))
+        annotations[name] = {"bounding_boxes": boxes, "pose": [round(p, 5) for p in view.pose],
+                             **published_pointers(grid, view.index)}
+        visible_fraction[name] = {str(k): v for k, v in sorted(visible.items())}
     (scene_dir / "annotations.json").write_text(json.dumps(annotations, indent=1))
     metadata = {
-        "seed": seed, "generator": "tests/layout_factory.py", "scenario": sc.name, "crop": cr.name,
+        "seed": seed, "generator": {"name": "tests/layout_factory.py"}, "scenario": sc.name, "crop": cr.name,
         "camera": camera.as_json,
         "grid": {"extent": list(sc.extent), "step": sc.step, "headings": sc.headings,
                  "altitudes": [cr.altitudes[i] for i in sc.altitude_levels],

@@ -122,6 +122,13 @@ def pools_for(command: str, out: str) -> tuple[list[str], dict[str, st.SearchStr
     if command == "export":
         return [], {"--split": ANY, "--task": st.sampled_from(["detect", "segment", "x"]),
                     "--appearance-shift": ANY}, []
+    if command == "bench":  # measures for minutes: the --out given last is never writable
+        return [], {"--crops": ANY, "--repeats": ANY, "--antialiasing": ANY,
+                    "--only": st.sampled_from(["all", "continuous", "x"]),
+                    "--doc": st.sampled_from(["missing", "a-file", "/proc/x"])}, ["--out"]
+    if command == "scene-stats":  # grows plants: no folder given is a docs folder, so it always refuses
+        return [], {"--count": ANY, "--size": ANY, "--crops": ANY, "--generators": ANY, "--step": ANY,
+                    "--docs": st.sampled_from(["data", "empty", "missing", "a-file", "/proc/x"])}, []
     if command == "transfer":  # trains detectors: the --out given last is never writable
         paths = st.sampled_from(["data", "empty", "missing", "a-file", "/proc/x"])
         return [], {"--pretrain": paths, "--real": paths, "--real-images": paths, "--splits": small,
@@ -133,7 +140,7 @@ def pools_for(command: str, out: str) -> tuple[list[str], dict[str, st.SearchStr
 
 #: The commands the property drives; a new command must be added here (and to pools_for).
 COVERED = ("generate", "demo", "reproduce", "preview", "train", "evaluate", "validate", "stats", "plot", "view",
-           "export", "transfer")
+           "export", "transfer", "bench", "scene-stats")
 
 
 def test_every_command_is_covered() -> None:

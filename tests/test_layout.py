@@ -1,12 +1,16 @@
 """The package's layout is its pipeline: stages import only earlier stages, with no import cycles.
 
 Every import counts, at module level or inside a function: a late import still ties a stage to a
-later one. The order is docs/architecture.md's "Layout" section.
+later one. The order is docs/architecture.md's "Layout" section, and each stage package's docstring opens
+with its number there ("Stage 3, formats: ...").
 """
 
 from __future__ import annotations
 
 import ast
+import re
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -17,7 +21,8 @@ PACKAGE = Path(davis_ag.__file__).parent
 
 #: The pipeline, earliest first; a module may import its own stage and those before it.
 STAGES: tuple[tuple[str, ...], ...] = (
-    ("errors", "atomic_files", "stage_timer", "provenance"),  # helpers every stage may use
+    # helpers every stage may use, and the environments' ids (registered by name, nothing imported)
+    ("errors", "atomic_files", "stage_timer", "provenance", "seeds", "environments"),
     ("scene",),
     ("formats",),  # the dataset's files, split rule and schemas: shared by writer, reader and benchmark
     ("render",),
@@ -79,9 +84,10 @@ def test_every_module_belongs_to_a_stage_and_says_what_it_is() -> None:
         assert doc and len(doc.splitlines()[0]) > 10, f"{path}: its first line should say what it is"
 
 
-@pytest.mark.parametrize("name", [n for n in MODULES if n != "davis_ag"])
+@pytest.mark.parametrize("name", list(MODULES))
 def test_imports_point_to_earlier_stages(name: str) -> None:
-    rank = RANK[stage(name)]
+    # The root __init__ runs before any stage is imported, so it may use the helpers only.
+    rank = RANK[stage(name)] if name != "davis_ag" else 0
     for module, line, _ in imports(MODULES[name]):
         if module.startswith("davis_ag.") and stage(module) in RANK:
             assert RANK[stage(module)] <= rank, (
@@ -135,3 +141,37 @@ def test_the_layout_reads_as_the_pipeline() -> None:
     folders = {p.name for p in PACKAGE.iterdir() if p.is_dir() and (p / "__init__.py").exists()}
     assert {"scene", "render", "labels", "generate", "data", "benchmark", "figures", "workflows",
             "commands", "detection"} <= folders
+
+
+ARCHITECTURE = PACKAGE.parents[1] / "docs" / "architecture.md"
+
+
+def test_stage_numbers_agree_in_the_package_docstrings_and_architecture_md() -> None:
+    """One list of stages: STAGES here, "N. `name/`" in docs/architecture.md, "Stage N, " atop each package."""
+    layout = ARCHITECTURE.read_text().split("## Layout", 1)[1].split("\n## ", 1)[0]
+    listed = {int(number): names for number, names in re.findall(r"^(\d+)\. (.+?):", layout, re.MULTILINE)}
+    assert sorted(listed) == list(range(1, len(STAGES) + 1)), "docs/architecture.md: number the stages 1..N"
+    for rank, names in enumerate(STAGES):
+        for name in names:
+            assert f"`{name}" in listed[rank + 1], f"docs/architecture.md: stage {rank + 1} should list {name}"
+            package = PACKAGE / name / "__init__.py"
+            if package.exists():
+                doc = ast.get_docstring(ast.parse(package.read_text())) or ""
+                assert doc.startswith(f"Stage {rank + 1}, "), f"{package}: its docstring should open 'Stage {rank + 1}, '"
+
+
+def test_importing_the_specs_loads_neither_gymnasium_nor_torch() -> None:
+    """``import davis_ag`` is light: the environments are registered by name, not by importing them."""
+    code = ("import sys, davis_ag.scene.specs, davis_ag.formats.layout; "
+            "print(sorted(m for m in ('gymnasium', 'torch', 'davis_ag.benchmark', 'pyhelios') if m in sys.modules))")
+    loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                            env={"PYTHONPATH": str(PACKAGE.parent), "PATH": "/usr/bin:/bin"}).stdout.strip()
+    assert loaded == "[]"
+
+
+def test_the_environments_are_made_by_name_after_importing_gymnasium_then_davis_ag() -> None:
+    code = ("import gymnasium, davis_ag, sys; from davis_ag.environments import ENTRY_POINTS; "
+            "print([gymnasium.spec(i).entry_point for i in ENTRY_POINTS], 'davis_ag.benchmark' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         env={"PYTHONPATH": str(PACKAGE.parent), "PATH": "/usr/bin:/bin"}).stdout.strip()
+    assert out == "['davis_ag.benchmark.tvm:TVMEnv', 'davis_ag.live.tvm_continuous:TVMContinuousEnv'] False"

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import re
 import signal
 import sys
 from typing import Any
@@ -15,7 +16,7 @@ from davis_ag.provenance import code_version
 # run(args) and maybe FORMATTER_CLASS (the package's docstring says what each is); add_command alone
 # makes the sub-parsers from them, so that every command's is made the same way.
 COMMANDS = ["generate", "validate", "train", "evaluate", "preview", "demo", "reproduce", "stats", "plot",
-            "view", "export", "transfer"]
+            "view", "export", "transfer", "bench", "scene-stats"]
 
 
 #: What a stopped command keeps, for its last line (every command resumes by being run again).
@@ -42,7 +43,7 @@ class OneLineParser(argparse.ArgumentParser):
 
 def build_parser() -> argparse.ArgumentParser:
     """Build the top-level parser with every sub-command registered."""
-    parser = OneLineParser(prog="davis-ag", description=__doc__)
+    parser = OneLineParser(prog="davis-ag", description=plain_text(__doc__))
     parser.add_argument("--version", action="version", version=f"davis-ag {code_version()}")
     subparsers = parser.add_subparsers(dest="command", required=True)
     for name in COMMANDS:
@@ -50,18 +51,30 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def plain_text(docstring: str | None) -> str | None:
+    """A docstring as help text: Sphinx markup (````code````, ``:mod:`name```` and friends) as plain text.
+
+    The command modules' docstrings are both their API documentation and their ``--help``; only
+    the first may carry markup.
+    """
+    if docstring is None:
+        return None
+    text = re.sub(r":(?:mod|func|class|meth|data|attr|exc):`~?([^`]+)`", r"\1", docstring)
+    return text.replace("``", "")
+
+
 def add_command(subparsers: argparse._SubParsersAction, name: str) -> argparse.ArgumentParser:
     """Add the sub-command ``name``, its parser made from its module in :mod:`davis_ag.commands`.
 
     Args:
         subparsers: what the parser's ``add_subparsers()`` returned.
-        name: the command, the name of its module (one of :data:`COMMANDS`).
+        name: the command, the name of its module with ``_`` for ``-`` (one of :data:`COMMANDS`).
 
     Returns:
         The sub-command's parser, its ``func`` default the module's ``run``.
     """
-    module = importlib.import_module(f"davis_ag.commands.{name}")
-    parser = subparsers.add_parser(name, help=module.HELP, description=module.DESCRIPTION,
+    module = importlib.import_module(f"davis_ag.commands.{name.replace('-', '_')}")
+    parser = subparsers.add_parser(name, help=plain_text(module.HELP), description=plain_text(module.DESCRIPTION),
                                    formatter_class=getattr(module, "FORMATTER_CLASS", argparse.HelpFormatter))
     module.add_arguments(parser)
     parser.set_defaults(func=module.run)

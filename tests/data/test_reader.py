@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -22,6 +23,7 @@ from davis_ag.data.reader import (
     parse_pose,
 )
 from davis_ag.errors import UserError
+from davis_ag.formats.models import SplitsFile
 from davis_ag.scene.specs import INVERSE_ACTION, MP_ACTIONS, SP_ACTIONS
 
 
@@ -59,10 +61,17 @@ def test_scene_properties(ours: Path) -> None:
     names = list(sp.views)
     assert names[0] == "0001.jpeg" and names == sorted(names) and len(sp) == len(names)
     assert sp.view("0001") is sp.view("0001.jpeg") is sp.view(1)
-    assert sp.metadata is not None and sp.metadata["camera"]["width"] == 128
-    assert set(sp.metadata["visible_fraction"]) == set(names)
-    assert ds.splits == {"seed": 0, "train": ["Single-Strawberry/000", "Multi-Vine/000"],
-                         "test": ["Single-Strawberry/001"]}
+    # A scene is the sequence of its views: by position from 0 (view(1) is the first), slices, len.
+    assert isinstance(sp, Sequence) and sp[0] is sp.view(1) and sp[-1].name == names[-1]
+    assert [v.name for v in sp[1:3]] == names[1:3] and list(sp) == list(sp.views.values())
+    assert sp.index(sp[2]) == 2 and sp[2] in sp
+    with pytest.raises(IndexError, match=f"has {len(sp)} views"):
+        sp[len(sp)]
+    assert sp.metadata is not None and sp.metadata.camera.width == 128
+    assert set(sp.metadata.visible_fraction) == set(names)
+    assert ds.splits == SplitsFile(seed=0, train=["Single-Strawberry/000", "Multi-Vine/000"],
+                                   test=["Single-Strawberry/001"])
+    assert ds.splits.train == ["Single-Strawberry/000", "Multi-Vine/000"]
 
 
 def test_lookup_errors_are_user_and_key_errors(ours: Path) -> None:

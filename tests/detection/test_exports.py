@@ -50,7 +50,7 @@ def test_coco_masks_and_boxes_round_trip(dataset: Path, tmp_path: Path) -> None:
             seg = view.mask()
             anns = coco.loadAnns(coco.getAnnIds(imgIds=image["id"]))
             assert [a["attributes"]["fruit_id"] for a in anns] == [b.fruit_id for b in view.boxes]
-            fractions = view.scene.metadata["visible_fraction"][view.name]
+            fractions = view.scene.metadata.visible_in(view.name)
             for ann, box in zip(anns, view.boxes):
                 decoded = coco.annToMask(ann).astype(bool)
                 assert np.array_equal(decoded, seg == box.fruit_id)

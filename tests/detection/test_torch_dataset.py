@@ -40,7 +40,7 @@ def test_items_follow_the_detection_convention(dataset: Path) -> None:
         for box, xyxy, mask in zip(view.boxes, target["boxes"], target["masks"]):
             assert xyxy.tolist() == [box.xmin, box.ymin, box.xmin + box.width, box.ymin + box.height]
             assert torch.equal(mask.bool(), torch.from_numpy(seg == box.fruit_id))
-        fractions = scene.metadata["visible_fraction"][view.name]
+        fractions = scene.metadata.visible_in(view.name)
         assert [round(v, 4) for v in target["visible_fraction"].tolist()] == [
             fractions[str(b.fruit_id)] for b in view.boxes]
         if view.name == "0003.jpeg":

@@ -90,8 +90,8 @@ def test_phenotypes_give_one_row_per_plant_of_scene_json(tiny_root: Path) -> Non
     scenes = open_dataset(tiny_root).scenes
     header, rows = phenotype_rows(scenes)
     assert header[:3] == ["scene", "plant", "fruit"]
-    assert len(rows) == sum(len(scene.metadata["plants"]) for scene in scenes) > 0
-    assert [row[0] for row in rows] == [s.id for s in scenes for _ in s.metadata["plants"]]
+    assert len(rows) == sum(len(scene.metadata.plants) for scene in scenes) > 0
+    assert [row[0] for row in rows] == [s.id for s in scenes for _ in s.metadata.plants]
     assert all(len(row) == len(header) for row in rows)
 
 

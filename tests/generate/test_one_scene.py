@@ -15,7 +15,9 @@ from davis_ag import cli
 from davis_ag.data.reader import open_dataset
 from davis_ag.data.validate import validate_dataset
 from davis_ag.errors import UserError
-from davis_ag.generate.one_scene import ROOT_EXTRAS, SceneRequest, generate_scene
+from davis_ag.formats.scene_file import read_scene_file
+from davis_ag.formats.layout import ROOT_FILES
+from davis_ag.generate.one_scene import SceneRequest, generate_scene
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.plants import Phenotype, in_table_range, require_native_helios
 from davis_ag.scene.specs import CROPS, SCENARIOS, SP_ACTIONS
@@ -90,6 +92,8 @@ def test_scene_json_records_what_the_annotations_leave_out(generated: tuple[Path
     _, scene_dir, _ = generated
     meta = json.loads((scene_dir / "scene.json").read_text())
     annotations = json.loads((scene_dir / "annotations.json").read_text())
+    # Written through its model and read back through it unchanged, key order included.
+    assert json.dumps(read_scene_file(scene_dir / "scene.json").as_written()) == json.dumps(meta)
     assert meta["seed"] == REQUEST.seed and meta["dataset_seed"] == 0
     assert (meta["scenario"], meta["crop"], meta["scene"]) == ("sp", "strawberry", "Single-Strawberry/000")
     assert meta["camera"] == CAMERA.intrinsics()
@@ -261,7 +265,7 @@ def test_a_scene_made_with_another_seed_is_not_overwritten(
     line = refused(capsys, "--out", str(root), "--seed", "1", "--size", "96x54")
     assert "already holds a scene made with other settings" in line
     assert snapshot(root / "Single-Strawberry") == before
-    assert {p.name for p in root.iterdir()} <= {"Single-Strawberry", *ROOT_EXTRAS}
+    assert {p.name for p in root.iterdir()} <= {"Single-Strawberry", *ROOT_FILES}
 
 
 def test_mock_pyhelios_is_a_clear_error(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -300,7 +304,7 @@ def test_depth_images_are_written_read_and_checked(generated: tuple[Path, Path, 
     fruits = {f["id"]: np.array(f["center"]) for f in meta["fruits"]}
     checked = 0
     for view in scene:
-        depth, mask = view.depth, view.mask()
+        depth, mask = view.depth(), view.mask()
         raw = np.asarray(Image.open(view.depth_path))
         assert raw.dtype == np.uint16 and depth.dtype == np.float32 and depth.shape == (CAMERA.height, CAMERA.width)
         assert (depth[0] == 0).all() and depth.max() > 0  # sky on the top row, ground below
@@ -321,7 +325,7 @@ def test_depth_images_are_written_read_and_checked(generated: tuple[Path, Path, 
         path.unlink()
     meta["depth"] = None
     (copied / "scene.json").write_text(json.dumps(meta))
-    assert all(view.depth is None for view in open_dataset(copy).scenes[0])
+    assert all(view.depth() is None for view in open_dataset(copy).scenes[0])
     assert validate_dataset(copy).ok
 
     # Depth that disagrees with the fruit's 3-D centres, or has the wrong size, is reported.
@@ -365,7 +369,7 @@ def test_organ_classes_come_from_the_same_pass_as_the_masks(generated: tuple[Pat
     (scene,) = open_dataset(root).scenes
     seen: set[int] = set()
     for view in scene:
-        classes, mask, depth = view.classes, view.mask(), view.depth
+        classes, mask, depth = view.classes(), view.mask(), view.depth()
         assert classes.dtype == np.uint8 and classes.shape == (CAMERA.height, CAMERA.width)
         assert (classes[mask != 255] == FRUIT).all()  # every fruit pixel of the instance mask
         assert ((classes == SKY) == (depth == 0)).all()  # nothing hit: sky, in both images
@@ -381,9 +385,9 @@ def test_organ_classes_come_from_the_same_pass_as_the_masks(generated: tuple[Pat
     for path in images.glob("*_class.png"):
         if path.name != boxed.class_path.name:
             path.unlink()
-    assert all(v.classes is None for v in open_dataset(copy).scenes[0] if v.name != boxed.name)
+    assert all(v.classes() is None for v in open_dataset(copy).scenes[0] if v.name != boxed.name)
     assert validate_dataset(copy).ok
-    wrong = np.where(boxed.mask() != 255, LEAF, boxed.classes).astype(np.uint8)
+    wrong = np.where(boxed.mask() != 255, LEAF, boxed.classes()).astype(np.uint8)
     Image.fromarray(wrong, mode="L").save(images / boxed.class_path.name)
     problems = [str(p) for p in validate_dataset(copy).problems]
     assert len(problems) == 1 and boxed.class_path.name in problems[0] and "not class 2 (fruit)" in problems[0]

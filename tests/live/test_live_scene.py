@@ -31,7 +31,7 @@ def test_a_grid_pose_drawn_live_is_the_stored_view(live_root: Path, live_scene: 
         assert live.visible_fraction == {int(k): v for k, v in stored["visible_fraction"][view.name].items()}
         jpeg = np.asarray(Image.open(scene.path / "images" / view.name)).astype(np.int64)
         assert np.abs(jpeg - live.colour).mean() < 4.0  # JPEG quality, not the drawing
-        assert np.abs(live.depth - view.depth).max() <= 0.0006  # stored as whole millimetres
+        assert np.abs(live.depth - view.depth()).max() <= 0.0006  # stored as whole millimetres
         checked += len(live.boxes)
     assert checked > 0
 

@@ -7,10 +7,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from davis_ag.benchmark.tvm import REFERENCE_PIXELS, TVMEnv
+from davis_ag.benchmark.tvm import TVMEnv
 from davis_ag.generate.one_scene import SceneRequest
 from davis_ag.scene.camera import Camera
-from davis_ag.scene.specs import CROPS, SCENARIOS, SLIP_SIGMA
+from davis_ag.scene.specs import CROPS, PAPER_PIXELS, SCENARIOS, SLIP_SIGMA
 
 #: Table 1, in centimetres as printed: plant/trunk height, fruit radius, leaf length, altitudes.
 TABLE_1_CM = {
@@ -61,7 +61,8 @@ def test_box_thresholds_scale_with_image_area(crop: str, size: tuple[int, int], 
     request = SceneRequest(SCENARIOS["sp"], CROPS[crop], 0, 0, Camera(*size))
     # A whole number of pixels: the paper's threshold times the area ratio, rounded (at least 1).
     assert abs(request.min_fruit_pixels - max(1.0, MIN_PIXELS_1280x720[crop] * area_ratio)) <= 0.5
-    assert REFERENCE_PIXELS == 1280 * 720
+    assert PAPER_PIXELS == 1280 * 720
+    assert request.min_fruit_pixels == CROPS[crop].min_fruit_pixels_at(*size)
 
 
 def test_environment_threshold_without_scene_json_scales_the_same_way() -> None:
@@ -74,5 +75,5 @@ def test_environment_threshold_without_scene_json_scales_the_same_way() -> None:
     class Cache:
         image_size = (640, 360)
 
-    assert TVMEnv._min_pixels(Scene(), Cache()) == pytest.approx(240 / 4)
+    assert TVMEnv._min_pixels(Scene(), Cache()) == pytest.approx(240 / 4) == CROPS["tomato"].min_fruit_pixels_at(640, 360)
     assert np.isclose(TVMEnv._min_pixels(Scene(), type("C", (), {"image_size": (1280, 720)})()), 240)

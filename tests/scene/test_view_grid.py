@@ -10,6 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from davis_ag.formats.layout import published_pointers, view_name
 from davis_ag.scene.specs import (
     CROPS,
     INVERSE_ACTION,
@@ -244,7 +245,7 @@ def test_multi_plant_headings_are_30_degrees_apart_and_rotation_only_turns(crop:
 @given(grids())
 def test_image_names_are_unique_and_numbered_from_0001(case: tuple[ScenarioSpec, CropSpec, ViewGrid]) -> None:
     _, _, grid = case
-    names = [v.image_name for v in grid.viewpoints]
+    names = [view_name(v.number) for v in grid.viewpoints]
     assert names == [f"{i:04d}.jpeg" for i in range(1, len(names) + 1)]
     assert [v.index for v in grid.viewpoints] == list(range(len(names)))
     # Altitude first, then y, then x, then heading.
@@ -258,21 +259,21 @@ def test_pointers_name_images_and_give_empty_string_for_invalid_moves(
     case: tuple[ScenarioSpec, CropSpec, ViewGrid],
 ) -> None:
     scenario, _, grid = case
-    names = {v.image_name for v in grid.viewpoints}
+    names = {view_name(v.number) for v in grid.viewpoints}
     for view in grid.viewpoints:
-        pointers = grid.pointers(view.index)
+        pointers = published_pointers(grid, view.index)
         assert tuple(pointers) == scenario.actions
         for action, name in pointers.items():
             target = grid.pointer(view.index, action)
             if target is None:
                 assert name == ""
             else:
-                assert name in names and name == grid.viewpoints[target].image_name
+                assert name in names and name == view_name(grid.viewpoints[target].number)
 
 
 def test_grid_edges_and_exclusion_give_empty_pointers() -> None:
     grid = make_grid(scenario_spec("sp", CROPS["strawberry"]), CROPS["strawberry"])
-    pointers = [grid.pointers(v.index) for v in grid.viewpoints]
+    pointers = [published_pointers(grid, v.index) for v in grid.viewpoints]
     for action in ("forward", "backward", "left", "right", "up", "down"):
         assert any(p[action] == "" for p in pointers), action
         assert any(p[action] != "" for p in pointers), action

@@ -1,4 +1,4 @@
-"""DAVIS-Ag as a Gymnasium environment: target visibility maximisation (``davis_ag/TVM-v0``).
+"""Stage 8, the benchmark: DAVIS-Ag as a Gymnasium environment, target visibility maximisation (``davis_ag/TVM-v0``).
 
 Importing this package registers the environment::
 
@@ -6,8 +6,8 @@ Importing this package registers the environment::
     env = gymnasium.make("davis_ag/TVM-v0", dataset="data/", scenario="sp", split="train")
 
 Beside it, ``davis_ag/TVMContinuous-v0`` (:mod:`davis_ag.live.tvm_continuous`): the same task with
-a continuous camera pose, drawn live from regrown scenes. It is registered here by name only, so
-nothing of it (Helios, the renderer) loads until it is made.
+a continuous camera pose, drawn live from regrown scenes. Both are registered by name
+(:mod:`davis_ag.environments`), so nothing of it (Helios, the renderer) loads until it is made.
 """
 
 from __future__ import annotations
@@ -16,24 +16,15 @@ import time
 
 import gymnasium as gym
 import numpy as np
-from gymnasium.envs.registration import register, registry
 
 from davis_ag.benchmark.cache import OBS_SIZE, SceneCache, load_scene_cache
 from davis_ag.benchmark.tvm import MAX_START_OER, TVMEnv
+from davis_ag.environments import CONTINUOUS_ID, TVM_ID, register_environments
 
-#: The id every davis-ag environment is registered under.
-TVM_ID = "davis_ag/TVM-v0"
 #: All grid environments this package registers (tests parametrize over it).
 ENV_IDS: tuple[str, ...] = (TVM_ID,)
-#: The continuous-pose environment (a later stage, :mod:`davis_ag.live`, implements it).
-CONTINUOUS_ID = "davis_ag/TVMContinuous-v0"
 
-if TVM_ID not in registry:
-    # No max_episode_steps: the environment ends its own episodes at tau with terminated=True
-    # (a TimeLimit would report truncated and make learners bootstrap past the final reward).
-    register(id=TVM_ID, entry_point="davis_ag.benchmark.tvm:TVMEnv")
-if CONTINUOUS_ID not in registry:
-    register(id=CONTINUOUS_ID, entry_point="davis_ag.live.tvm_continuous:TVMContinuousEnv")
+register_environments()
 
 
 def benchmark_steps(env: gym.Env, n: int = 20_000, seed: int = 0) -> float:

@@ -36,15 +36,13 @@ from PIL import Image
 
 from davis_ag.data.safe_read import check_inside
 from davis_ag.errors import UserError
-from davis_ag.formats.layout import ANNOTATIONS, IMAGES
+from davis_ag.formats.layout import ANNOTATIONS, CACHE_FOLDER, IMAGES
 from davis_ag.scene.specs import ALL_ACTIONS
 
 #: Side of the square observation image (section IV-C: 224x224).
 OBS_SIZE = 224
 #: Bumped whenever the files' meaning changes, so that old caches are rebuilt.
 CACHE_VERSION = 2
-#: Folder under the dataset root that holds the default caches.
-CACHE_FOLDER = ".davis_ag_cache"
 
 
 @dataclass(frozen=True)

@@ -50,8 +50,8 @@ def dataset_splits(dataset: Any) -> dict[str, list[str]]:
         ``{"train": [...], "test": [...]}``.
     """
     splits = getattr(dataset, "splits", None)
-    if splits:
-        return {split: [str(i) for i in splits.get(split, [])] for split in ("train", "test")}
+    if splits is not None:
+        return {"train": [str(i) for i in splits.train], "test": [str(i) for i in splits.test]}
     return split_scenes((s.id for s in dataset.scenes), recorded_seed(dataset.root))
 
 

@@ -61,8 +61,6 @@ def can_start(oer: Any, max_start_oer: float = MAX_START_OER) -> Any:
 def episode_reward(oer_0: float, oer_end: float) -> float:
     """Section IV-C's reward at an episode's end: ``max(OER_end - OER_0, 0) ** 2``."""
     return float(max(oer_end - oer_0, 0.0) ** 2)
-#: Image area that the crops' ``min_fruit_pixels`` (section III-C) refer to.
-REFERENCE_PIXELS = 1280 * 720
 #: How ``reset`` draws a start: ``pairs`` uniform over every eligible (scene, view, target),
 #: ``scene`` uniform over scenes, then views, then targets (see the module docstring).
 START_RULES = ("pairs", "scene")
@@ -160,15 +158,14 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
     @staticmethod
     def _min_pixels(scene: Any, cache: SceneCache) -> float:
         """Visible pixels a start target needs: scene.json's threshold if the scene has one
-        (what its boxes were made with), else the crop's, scaled to the image area."""
+        (what its boxes were made with), else the crop's at the image size (the generator's rule)."""
         metadata = scene.metadata
-        if metadata and isinstance(metadata.get("min_fruit_pixels"), (int, float)):
-            return float(metadata["min_fruit_pixels"])
+        if metadata is not None and metadata.min_fruit_pixels is not None:
+            return float(metadata.min_fruit_pixels)
         crop = scene_crop(scene)
         if crop is None:
             return 0.0
-        area = cache.image_size[0] * cache.image_size[1]
-        return crop_spec(crop).min_fruit_pixels * area / REFERENCE_PIXELS
+        return float(crop_spec(crop).min_fruit_pixels_at(*cache.image_size))
 
     @staticmethod
     def _eligible(cache: SceneCache, min_pixels: float, max_oer: float) -> _Starts:

@@ -164,7 +164,7 @@ def add_renderer_flags(parser: argparse.ArgumentParser) -> None:
                              "Helios's frames, several times slower without a GPU) or none; ids exact in every mode")
     parser.add_argument("--plants", choices=PLANT_GENERATORS,
                         help="canopy: Helios's Canopy Generator plants, as the paper's (default); architecture: "
-                             "pyhelios3d's PlantArchitecture plants bent towards them (our generator before 2026-11-24)")
+                             "pyhelios3d's PlantArchitecture plants bent towards them")
 
 
 def add_dataset_flags(parser: argparse.ArgumentParser, verb: str) -> None:

@@ -14,6 +14,7 @@ from PIL import Image, ImageDraw
 from davis_ag.atomic_files import atomic_output
 from davis_ag.commands import arguments
 from davis_ag.errors import UserError
+from davis_ag.formats.layout import IMAGE_SUFFIX, JPEG_QUALITY, view_name, view_stem
 from davis_ag.generate.one_scene import SceneRequest
 from davis_ag.generate.run_progress import count_views
 from davis_ag.labels.fruit_labels import fruit_lookup, label_view, visible_fractions
@@ -66,17 +67,17 @@ def run(args: argparse.Namespace) -> int:
             colour, primitive_ids, _ = renderer.render(view, depth=False)
             labels = label_view(primitive_ids, lookup, request.min_fruit_pixels)
             fractions = visible_fractions(request.camera, view, labels, polygons)
-            stem = f"{crop.name}-{scenario.name}-{args.index:03d}-{number:04d}"
-            with atomic_output(args.out / f"{stem}.jpeg") as handle:
-                Image.fromarray(colour).save(handle, format="JPEG", quality=95)
+            stem = f"{crop.name}-{scenario.name}-{args.index:03d}-{view_stem(view_name(number))}"
+            with atomic_output(args.out / f"{stem}{IMAGE_SUFFIX}") as handle:
+                Image.fromarray(colour).save(handle, format="JPEG", quality=JPEG_QUALITY)
             boxed = Image.fromarray(colour)
             draw = ImageDraw.Draw(boxed)
             for x, y, w, h, fruit_id, _ in labels.boxes:
                 draw.rectangle([x, y, x + w - 1, y + h - 1], outline=(255, 220, 0), width=2)
                 draw.text((x, max(0, y - 12)), f"{fruit_id}: {fractions[fruit_id]:.2f}", fill=(255, 220, 0))
-            with atomic_output(args.out / f"{stem}-boxes.jpeg") as handle:
-                boxed.save(handle, format="JPEG", quality=90)
-            print(f"{args.out / stem}.jpeg: {len(labels.boxes)} fruit boxed, pose {view.pose}")
+            with atomic_output(args.out / f"{stem}-boxes{IMAGE_SUFFIX}") as handle:
+                boxed.save(handle, format="JPEG", quality=JPEG_QUALITY)
+            print(f"{args.out / stem}{IMAGE_SUFFIX}: {len(labels.boxes)} fruit boxed, pose {view.pose}")
     return 0
 
 

@@ -1,2 +1,2 @@
-"""Stage 5, reading: the published DAVIS-Ag layout (ours and the original download), its schema and
+"""Stage 7, reading: the published DAVIS-Ag layout (ours and the original download), its schema and
 validation."""

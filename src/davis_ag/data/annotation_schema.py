@@ -14,10 +14,11 @@ from typing import Any
 
 import numpy as np
 
+from davis_ag.formats.layout import IMAGE_SUFFIX, view_name
 from davis_ag.scene import specs as config
 from davis_ag.scene.specs import NO_FRUIT
 
-_IMAGE_SUFFIXES = (".jpeg", ".jpg")
+_IMAGE_SUFFIXES = (IMAGE_SUFFIX, ".jpg")
 #: Box values beyond this are damage, not pixels.
 BOX_LIMIT = 2**20
 
@@ -77,7 +78,7 @@ def normalise_view_name(name: str | int) -> str:
     if isinstance(name, int):
         if name < 1:
             raise ValueError(f"view numbers start at 1, got {name}")
-        return f"{name:04d}.jpeg"
+        return view_name(name)
     name = name.strip()
     if not name:
         return ""
@@ -89,7 +90,7 @@ def normalise_view_name(name: str | int) -> str:
             break
     if not name or "." in name:
         raise ValueError(f"image name {name!r} is not a .jpeg name like 0001.jpeg")
-    return f"{name}.jpeg"
+    return name + IMAGE_SUFFIX
 
 
 def _number(value: Any, what: str) -> float:

@@ -12,11 +12,11 @@ here, so ``from davis_ag.data.reader import Box, exposure_rate`` works.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
-from typing import Any
+from typing import Any, overload
 
 import numpy as np
 
@@ -37,6 +37,7 @@ from pydantic import ValidationError
 from davis_ag.formats.layout import ANNOTATIONS, IMAGES, SCENE_METADATA, read_depth, view_file, view_stem
 from davis_ag.formats.layout import SPLITS_FILE as SPLITS
 from davis_ag.formats.models import SplitsFile, one_line
+from davis_ag.formats.scene_file import SceneFile, parse_scene_file
 from davis_ag.errors import UserError
 from davis_ag.scene import specs as config
 
@@ -62,7 +63,11 @@ def _view_order(name: str) -> tuple[int, str]:
 
 @dataclass(eq=False)
 class View:
-    """One camera view of a scene: its annotation and lazy access to its pixels.
+    """One camera view of a scene: its annotation, and its pixels decoded on each call.
+
+    The pixels are methods of one kind: :meth:`image`, :meth:`mask`, :meth:`depth` and
+    :meth:`classes` each decode their file when called and keep nothing, so a pass over a whole
+    dataset holds one view's pixels at a time.
 
     Attributes:
         name: Image name, e.g. ``"0001.jpeg"``.
@@ -93,9 +98,8 @@ class View:
         """Where the depth image is (``images/0001_depth.png``), whether or not it exists."""
         return view_file(self.scene.path, self.name, "depth")
 
-    @property
     def depth(self) -> np.ndarray | None:
-        """The depth image, decoded: ``H x W`` float32 metres along the optical axis, 0 where nothing
+        """Decode the depth image: ``H x W`` float32 metres along the optical axis, 0 where nothing
         is hit; ``None`` where the dataset has no depth (the original download, ``--no-depth``).
 
         Raises:
@@ -110,9 +114,8 @@ class View:
         """Where the organ class image is (``images/0001_class.png``), whether or not it exists."""
         return view_file(self.scene.path, self.name, "classes")
 
-    @property
     def classes(self) -> np.ndarray | None:
-        """The organ class image: ``H x W`` uint8, one value per class of
+        """Decode the organ class image: ``H x W`` uint8, one value per class of
         :data:`davis_ag.scene.organs.ORGAN_NAMES` (0 sky, 1 soil, 2 fruit, 3 leaf, 4 stem, 5 trunk);
         ``None`` where the dataset has none (the original download, datasets made before it).
 
@@ -180,8 +183,11 @@ class View:
 
 
 @dataclass(eq=False)
-class Scene:
+class Scene(Sequence["View"]):
     """One scene folder (``<group>/<NNN>``); its annotations load on first use.
+
+    A scene is the sequence of its views in image order: ``scene[0]`` is the first view
+    (``scene.view(1)``, ``0001.jpeg``), ``len(scene)`` counts them, ``for view in scene`` walks them.
 
     Attributes:
         path: The scene folder.
@@ -275,22 +281,39 @@ class Scene:
         return self.views[key]
 
     @cached_property
-    def metadata(self) -> dict[str, Any] | None:
-        """Our scene.json as a plain dict (seed, camera, plants, fruits, visible_fraction...).
+    def metadata(self) -> SceneFile | None:
+        """Our scene.json (seed, camera, plants, fruits, visible_fraction...), read through its model.
 
         Returns:
             ``None`` where the scene has none (the original download never has).
 
         Raises:
-            UserError: when scene.json exists but is not a JSON object.
+            UserError: when scene.json exists but does not fit :class:`~davis_ag.formats.scene_file.SceneFile`.
         """
         path = self.path / SCENE_METADATA
         if not path.is_file():
             return None
-        data = read_json(check_inside(path, self.root), "scene metadata")
-        if not isinstance(data, dict):
-            raise UserError(f"{path}: must hold a JSON object, got {type(data).__name__}; regenerate the scene")
-        return data
+        return parse_scene_file(read_json(check_inside(path, self.root), "scene metadata"), path)
+
+    @cached_property
+    def _ordered(self) -> tuple[View, ...]:
+        return tuple(self.views.values())
+
+    @overload
+    def __getitem__(self, position: int) -> View: ...
+
+    @overload
+    def __getitem__(self, position: slice) -> Sequence[View]: ...
+
+    def __getitem__(self, position: int | slice) -> View | Sequence[View]:
+        """The view at a position from 0 (``scene[0]`` is ``0001.jpeg``), or a slice of them; a name
+        raises TypeError (names go to :meth:`view`), a position past the last view IndexError."""
+        if isinstance(position, str):
+            raise TypeError(f"scene[{position!r}]: positions are numbers from 0; use scene.view({position!r})")
+        try:
+            return self._ordered[position]
+        except IndexError:
+            raise IndexError(f"scene {self.id} has {len(self)} views: no position {position}") from None
 
     def __len__(self) -> int:
         return len(self.views)
@@ -328,18 +351,18 @@ class Dataset:
         raise NotFoundError(f"{self.root}: no scene {scene_id!r} (scenes: {known or 'none'})")
 
     @cached_property
-    def splits(self) -> dict[str, Any] | None:
-        """Our splits.json (``{"seed", "train": [ids], "test": [ids]}``), or ``None`` without one.
+    def splits(self) -> SplitsFile | None:
+        """Our splits.json as its model (``seed``, ``train`` and ``test`` scene ids), or ``None`` without one.
 
         Raises:
-            UserError: when the file exists but is not a JSON object.
+            UserError: when the file exists but does not fit :class:`~davis_ag.formats.models.SplitsFile`.
         """
         path = self.root / SPLITS
         if not path.is_file():
             return None
         data = read_json(check_inside(path, self.root), "splits")
         try:
-            return SplitsFile.model_validate(data).to_json()
+            return SplitsFile.model_validate(data)
         except ValidationError as error:
             raise UserError(f"{one_line(error, str(path))}; fix or delete it (a list of scene ids like "
                             "\"Single-Strawberry/000\" for train and for test)") from None

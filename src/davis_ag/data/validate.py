@@ -25,6 +25,7 @@ from typing import Any
 from pydantic import BaseModel, ValidationError
 
 from davis_ag.data.class_checks import class_problems
+from davis_ag.formats.scene_file import SceneFile, scene_file_from
 from davis_ag.data.reader import (
     ANNOTATIONS,
     NO_FRUIT,
@@ -136,13 +137,17 @@ def validate_scene(scene: Scene, quick: bool = False, box_tolerance: int | None 
         flag(ann_path, error or "unreadable")
         return report
 
-    metadata = None
+    metadata: SceneFile | None = None
     if (scene.path / SCENE_METADATA).is_file():
-        metadata, error = (None, outside) if (outside := _outside(scene.path / SCENE_METADATA, scene.root)) \
+        raw_metadata, error = (None, outside) if (outside := _outside(scene.path / SCENE_METADATA, scene.root)) \
             else _read_json(scene.path / SCENE_METADATA)
-        if error or not isinstance(metadata, dict):
-            flag(scene.path / SCENE_METADATA, error or "must hold a JSON object")
-            metadata = None
+        if error is None:
+            try:
+                metadata = scene_file_from(raw_metadata)
+            except ValueError as problem:
+                error = str(problem)
+        if error:
+            flag(scene.path / SCENE_METADATA, error)
     tolerance = box_tolerance if box_tolerance is not None else (0 if metadata is not None else 1)
 
     records: dict[str, ViewRecord] = {}
@@ -188,7 +193,7 @@ def validate_scene(scene: Scene, quick: bool = False, box_tolerance: int | None 
         if not mask.is_file():
             flag(mask, f"missing: the instance mask of {record.name}")
         depth = view_file(scene.path, record.name, "depth")
-        if isinstance(metadata, dict) and metadata.get("depth") and not depth.is_file():
+        if metadata is not None and metadata.depth and not depth.is_file():
             flag(depth, f"missing: scene.json records depth images but {record.name} has none")
         if quick:
             size = _camera_size(metadata)
@@ -248,11 +253,8 @@ def _box_schema_problems(record: ViewRecord) -> list[str]:
     return problems
 
 
-def _camera_size(metadata: dict | None) -> tuple[int, int] | None:
-    camera = (metadata or {}).get("camera")
-    if isinstance(camera, dict) and isinstance(camera.get("width"), int) and isinstance(camera.get("height"), int):
-        return camera["width"], camera["height"]
-    return None
+def _camera_size(metadata: SceneFile | None) -> tuple[int, int] | None:
+    return metadata.image_size() if metadata is not None else None
 
 
 def _boxes_inside(record: ViewRecord, size: tuple[int, int]) -> list[str]:
@@ -262,7 +264,7 @@ def _boxes_inside(record: ViewRecord, size: tuple[int, int]) -> list[str]:
 
 
 def _pixel_problems(record: ViewRecord, ann_path: Path, image: Path, mask_path: Path | None,
-                    metadata: dict | None, tolerance: int) -> list[tuple[Path, str]]:
+                    metadata: SceneFile | None, tolerance: int) -> list[tuple[Path, str]]:
     import numpy as np
     from PIL import Image
 
@@ -313,7 +315,8 @@ DEPTH_NEAR_MM = 50
 DEPTH_SLACK_M = 0.02
 
 
-def depth_problems(record: ViewRecord, depth_path: Path, mask_path: Path | None, metadata: dict | None) -> list[str]:
+def depth_problems(record: ViewRecord, depth_path: Path, mask_path: Path | None,
+                   metadata: SceneFile | None) -> list[str]:
     """Check a depth image: 16-bit, the image's size, a plausible range, and agreement with the
     3-D centres of the fruit scene.json records (where a fruit is boxed in the view).
 
@@ -343,9 +346,9 @@ def depth_problems(record: ViewRecord, depth_path: Path, mask_path: Path | None,
         problems.append("holds no surface at all (every pixel 0)")
     elif int(depth[hit].min()) < DEPTH_NEAR_MM:
         problems.append(f"holds a surface {int(depth[hit].min())} mm from the camera, nearer than any renderer draws")
-    if mask_path is None or not isinstance(metadata, dict) or record.pose is None:
+    if mask_path is None or metadata is None or record.pose is None:
         return problems
-    fruits = {f.get("id"): f for f in metadata.get("fruits", []) if isinstance(f, dict)}
+    fruits = {f.id: f for f in metadata.fruits if f.center is not None}
     try:
         with Image.open(mask_path) as im:
             mask = np.asarray(im)
@@ -361,9 +364,9 @@ def depth_problems(record: ViewRecord, depth_path: Path, mask_path: Path | None,
         pixels = (mask == box.fruit_id) & hit
         if fruit is None or not pixels.any():
             continue
-        expected = float(np.dot(np.subtract(fruit["center"], (x, y, z)), forward))
+        expected = float(np.dot(np.subtract(fruit.center, (x, y, z)), forward))  # type: ignore[arg-type]
         seen = float(np.median(depth[pixels])) / 1000.0
-        allowed = 0.5 * float(np.linalg.norm(fruit.get("size", (0.0, 0.0, 0.0)))) + DEPTH_SLACK_M
+        allowed = 0.5 * float(np.linalg.norm(fruit.size or (0.0, 0.0, 0.0))) + DEPTH_SLACK_M
         if abs(seen - expected) > allowed:
             problems.append(f"fruit {box.fruit_id} lies at {seen:.3f} m in the depth image but its centre is "
                             f"{expected:.3f} m from the camera (scene.json), more than {allowed:.3f} m apart")

@@ -1,1 +1,1 @@
-"""Sim-to-real: DAVIS-Ag as detection data (COCO and YOLO exports, a PyTorch dataset) and detectors."""
+"""Stage 10, sim-to-real: DAVIS-Ag as detection data (COCO and YOLO exports, a PyTorch dataset) and detectors."""

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from davis_ag.atomic_files import write_bytes_atomic
+from davis_ag.formats.layout import JPEG_QUALITY
 
 #: Image file suffixes that are shifted.
 IMAGE_SUFFIXES = (".jpeg", ".jpg", ".png")
@@ -71,6 +72,6 @@ def shift_folder(images_dir: Path, seed: int = 0, progress: bool = True) -> int:
             rgb = np.asarray(im.convert("RGB"))
         shifted = Image.fromarray(shift_image(rgb, np.random.default_rng([seed, index])))
         buffer = io.BytesIO()
-        shifted.save(buffer, "PNG" if path.suffix.lower() == ".png" else "JPEG", quality=95)
+        shifted.save(buffer, "PNG" if path.suffix.lower() == ".png" else "JPEG", quality=JPEG_QUALITY)
         write_bytes_atomic(path, buffer.getvalue())
     return len(paths)

@@ -169,7 +169,7 @@ def label_view(view: View, with_masks: bool = True) -> LabelledView:
     if seg is not None and seg.shape != (height, width):
         raise UserError(f"{view.mask_path}: mask is {seg.shape[1]}x{seg.shape[0]}, image {width}x{height}; "
                         "run `davis-ag validate` on the scene")
-    fractions = ((scene.metadata or {}).get("visible_fraction") or {}).get(view.name, {})
+    fractions = scene.metadata.visible_in(view.name) if scene.metadata else {}
     instances, clipped, dropped = [], 0, 0
     for published in view.boxes:
         box = clip_box(published, width, height)

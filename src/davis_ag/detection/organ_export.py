@@ -37,7 +37,7 @@ def coco_organ_categories() -> list[dict[str, Any]]:
 def organ_masks(view: View) -> list[tuple[int, np.ndarray]]:
     """``(class value, bool mask)`` of every exported organ class present in the view, in class
     order; empty without a class image."""
-    classes = view.classes
+    classes = view.classes()
     if classes is None:
         return []
     masks = [(value, classes == value) for value in EXPORTED]

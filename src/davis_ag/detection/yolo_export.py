@@ -33,19 +33,16 @@ from davis_ag.detection.instances import (
     scenes_by_split,
     tally,
 )
-from davis_ag.detection.organ_export import (
-    organ_masks,
-    yolo_organ_class,
-    yolo_organ_names,
-)
+from davis_ag.detection.organ_export import organ_masks, yolo_organ_class, yolo_organ_names
 from davis_ag.errors import MachineError, UserError
+from davis_ag.formats.layout import IMAGE_SUFFIX, view_stem
 
 TASKS = ("detect", "segment")
 
 
 def flat_name(view_id: str) -> str:
     """``Single-Strawberry/000`` + ``0001.jpeg`` -> ``Single-Strawberry_000_0001`` (no suffix)."""
-    return view_id.replace("/", "_").removesuffix(".jpeg")
+    return view_stem(view_id.replace("/", "_"))
 
 
 def mask_polygon(mask: np.ndarray) -> np.ndarray:
@@ -139,7 +136,7 @@ def write_yolo_split(scenes: list[Scene], out_dir: Path, split: str, task: str =
         if organs:
             lines += organ_lines(item)
         write_text_atomic(labels / f"{name}.txt", "".join(f"{line}\n" for line in lines))
-        place_image(item.view.image_path, images / f"{name}.jpeg")
+        place_image(item.view.image_path, images / f"{name}{IMAGE_SUFFIX}")
         tally(counts, item, "instances", len(lines))
         bar.update()
     bar.close()

@@ -15,14 +15,8 @@ import numpy as np
 from davis_ag.data.reader import Dataset
 from davis_ag.errors import UserError
 from davis_ag.figures.scene_numbers import box_oers, visible_fractions
-from davis_ag.scene.specs import CROPS, SCENARIOS, parse_group_name
+from davis_ag.scene.specs import CROPS, PAPER_TABLE3, SCENARIOS, parse_group_name
 
-#: Table 3 of the paper: (scenario, crop) -> (scenes, images).
-PAPER_TABLE3: dict[tuple[str, str], tuple[int, int]] = {
-    ("sp", "strawberry"): (86, 24_510), ("mp", "strawberry"): (77, 86_856),
-    ("sp", "tomato"): (130, 45_240), ("mp", "tomato"): (113, 203_400),
-    ("sp", "vine"): (182, 63_336), ("mp", "vine"): (44, 79_200),
-}
 #: Where the OER distribution is summarised (section V-C starts episodes below 0.4).
 OER_EDGES = np.linspace(0.0, 1.0, 11)
 
@@ -84,8 +78,8 @@ def fruit_statistics(dataset: Dataset, with_oer: bool = True) -> dict[str, Any]:
         by_group.setdefault(scene.group, []).append(scene)
     out: dict[str, Any] = {}
     for group, scenes in by_group.items():
-        per_plant = [p["fruit_count"] for s in scenes for p in (s.metadata or {}).get("plants", [])
-                     if isinstance(p, dict) and "fruit_count" in p]
+        per_plant = [p.fruit_count for s in scenes for p in (s.metadata.plants if s.metadata else [])
+                     if p.fruit_count is not None]
         boxed = [len({b.fruit_id for v in s.views.values() for b in v.boxes}) for s in scenes]
         per_view = [len(v.boxes) for s in scenes for v in s.views.values()]
         entry: dict[str, Any] = {

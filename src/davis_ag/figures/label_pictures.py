@@ -30,7 +30,7 @@ def draw_organ_classes(view: View, out_path: Path) -> Path:
     """The view's colour image beside its organ classes, with the class legend."""
     from matplotlib.patches import Patch
 
-    image, classes = view.image(), view.classes
+    image, classes = view.image(), view.classes()
     if classes is None:
         raise SystemExit(f"{view.class_path}: missing; generate the scene with this version")
     height, width = classes.shape

@@ -34,10 +34,9 @@ def measured(scene: Scene) -> dict[str, float]:
     Returns:
         Key to value in metres; empty without scene.json.
     """
-    plants = (scene.metadata or {}).get("plants") or []
     values: dict[str, list[float]] = {}
-    for plant in plants:
-        for key, value in (plant.get("phenotype_measured") or {}).items():
+    for plant in scene.metadata.plants if scene.metadata else []:
+        for key, value in (plant.phenotype_measured or {}).items():
             if isinstance(value, (int, float)):
                 values.setdefault(key, []).append(float(value))
     return {k: float(np.mean(v)) for k, v in values.items()}

@@ -79,12 +79,12 @@ def phenotype_rows(scenes: list[Scene]) -> tuple[list[str], list[list[Any]]]:
     keys: list[str] = []
     plants = []
     for scene in scenes:
-        for plant in (scene.metadata or {}).get("plants", []):
-            measured = plant.get("phenotype_measured") or {}
+        for plant in scene.metadata.plants if scene.metadata else []:
+            measured = plant.phenotype_measured or {}
             keys += [k for k in measured if k not in keys]
             plants.append((scene.id, plant, measured))
     header = ["scene", "plant", "fruit", *keys]
-    rows = [[sid, plant.get("index", ""), plant.get("fruit_count", ""),
+    rows = [[sid, "" if plant.index is None else plant.index, "" if plant.fruit_count is None else plant.fruit_count,
              *[_fmt(measured.get(k, "")) for k in keys]] for sid, plant, measured in plants]
     return header, rows
 

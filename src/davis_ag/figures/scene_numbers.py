@@ -83,9 +83,8 @@ def altitudes(scene: Scene) -> list[float]:
 
 def scene_fruit_count(scene: Scene) -> int:
     """How many fruit the scene holds: scene.json's list, else every id boxed in some view."""
-    fruits = (scene.metadata or {}).get("fruits")
-    if isinstance(fruits, list) and fruits:
-        return len(fruits)
+    if scene.metadata and scene.metadata.fruits:
+        return len(scene.metadata.fruits)
     return len({b.fruit_id for v in scene.views.values() for b in v.boxes})
 
 
@@ -212,6 +211,6 @@ def box_oers(scenes: list[Scene]) -> tuple[np.ndarray, int]:
 def visible_fractions(scenes: list[Scene]) -> np.ndarray:
     """Every box's visible fraction from scene.json (ours only; empty for the original download)."""
     values = [float(f) for s in scenes
-              for per_view in ((s.metadata or {}).get("visible_fraction") or {}).values()
+              for per_view in (s.metadata.visible_fraction.values() if s.metadata else ())
               for f in per_view.values()]
     return np.asarray(values, dtype=float)

@@ -64,8 +64,8 @@ def scene_payload(scene: Scene) -> dict[str, Any]:
             "depth": view.depth_path.is_file(),
             "classes": view.class_path.is_file(),
         }
-    camera = (scene.metadata or {}).get("camera") or {}
-    size = [camera.get("width"), camera.get("height")] if camera.get("width") else None
+    image_size = scene.metadata.image_size() if scene.metadata else None
+    size = list(image_size) if image_size else None
     return {"id": scene.id, "actions": list(scene.actions), "order": list(scene.views),
             "altitudes": altitudes(scene) if any(v["pose"] for v in views.values()) else [],
             "plants": [list(p) for p in plant_xy(scene)], "size": size, "views": views}
@@ -235,7 +235,7 @@ def make_handler(viewer: Viewer, page: bytes) -> type[BaseHTTPRequestHandler]:
             if layer == "classes":
                 if viewer.file(scene, view.class_path.name) is None:
                     return self._missing("no organ classes")
-                return self._send(HTTPStatus.OK, classes_overlay(view.classes), "image/png", cache=True)
+                return self._send(HTTPStatus.OK, classes_overlay(view.classes()), "image/png", cache=True)
             path = viewer.file(scene, view.depth_path.name)
             if path is None:
                 return self._missing("no depth")

@@ -40,9 +40,9 @@ def plant_xy(scene: Scene) -> list[tuple[float, float]]:
     Returns:
         ``(x, y)`` per plant; empty for a folder name that is no DAVIS-Ag group and no scene.json.
     """
-    plants = (scene.metadata or {}).get("plants")
-    if isinstance(plants, list) and plants:
-        return [tuple(float(c) for c in (p.get("position") or [0, 0])[:2]) for p in plants]  # type: ignore[misc]
+    plants = scene.metadata.plants if scene.metadata else []
+    if plants:
+        return [(float(p.position[0]), float(p.position[1])) if p.position else (0.0, 0.0) for p in plants]
     if scene.scenario and scene.crop:
         return plant_positions(scenario_spec(scene.scenario), crop_spec(scene.crop))
     return []

@@ -3,9 +3,9 @@
 One module owns the names the writer, reader, validator, viewer, exports and the PyTorch dataset
 use, so a name or an encoding changes in one place::
 
-    <root>/dataset.json, splits.json
+    <root>/dataset.json, splits.json, .davis_ag_cache/ (benchmark caches), .davis_ag.lock
     <root>/<Group>/<NNN>/annotations.json, scene.json
-    <root>/<Group>/<NNN>/images/NNNN.jpeg          colour, JPEG quality 95
+    <root>/<Group>/<NNN>/images/NNNN.jpeg          colour, JPEG quality 95, NNNN from 0001
     <root>/<Group>/<NNN>/images/NNNN_seg.png       uint8 fruit id per pixel, 255 = no fruit
     <root>/<Group>/<NNN>/images/NNNN_depth.png     uint16 mm along the optical axis, 0 = nothing hit
     <root>/<Group>/<NNN>/images/NNNN_class.png     uint8 organ class per pixel
@@ -17,15 +17,25 @@ A new per-view image is one more entry in :data:`VIEW_FILES` (its suffix and wha
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from davis_ag.errors import UserError
 
+if TYPE_CHECKING:
+    from davis_ag.scene.view_grid import ViewGrid
+
 ANNOTATIONS = "annotations.json"
 SCENE_METADATA = "scene.json"
 DATASET_FILE = "dataset.json"
 SPLITS_FILE = "splits.json"
+#: Folder under the dataset root that holds the benchmark's default observation caches.
+CACHE_FOLDER = ".davis_ag_cache"
+#: The generator's lock, held for a whole run.
+LOCK_FILE = ".davis_ag.lock"
+#: Every name a dataset root may hold besides its group folders.
+ROOT_FILES = (DATASET_FILE, SPLITS_FILE, CACHE_FOLDER, LOCK_FILE)
 IMAGES = "images"
 IMAGE_SUFFIX = ".jpeg"
 JPEG_QUALITY = 95
@@ -42,9 +52,26 @@ VIEW_FILES: dict[str, tuple[str, str]] = {
 }
 
 
+def view_name(number: int) -> str:
+    """A view's image name from its 1-based number: ``view_name(1)`` is ``"0001.jpeg"``."""
+    return f"{number:04d}{IMAGE_SUFFIX}"
+
+
 def view_stem(name: str) -> str:
     """``"0001.jpeg"`` -> ``"0001"``."""
     return name.removesuffix(IMAGE_SUFFIX)
+
+
+def view_number(name: str) -> int | None:
+    """``"0001.jpeg"`` -> 1; None for a name that is no number (the original download may have some)."""
+    stem = view_stem(name)
+    return int(stem) if stem.isdigit() else None
+
+
+def published_pointers(grid: ViewGrid, index: int) -> dict[str, str]:
+    """The published pointer dictionary of a grid's view: action to image name, "" where invalid."""
+    return {action: "" if (target := grid.pointer(index, action)) is None else view_name(target + 1)
+            for action in grid.actions}
 
 
 def view_file_name(name: str, kind: str) -> str:

@@ -34,12 +34,11 @@ from davis_ag.errors import UserError
 from davis_ag.formats.layout import (
     ANNOTATIONS,
     DATASET_FILE,
+    LOCK_FILE,
     SCENE_METADATA,
     SPLITS_FILE,
 )
 
-#: The lock file in a locked folder (a dataset being generated, an export being written).
-LOCK_FILE = ".davis_ag.lock"
 #: Files that mark a folder as a dataset root, and those that mark a scene folder.
 DATASET_MARKS = (DATASET_FILE, SPLITS_FILE)
 SCENE_MARKS = (ANNOTATIONS, SCENE_METADATA)

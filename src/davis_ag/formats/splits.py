@@ -15,10 +15,10 @@ import json
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
-import numpy as np
 
 from davis_ag.formats.layout import DATASET_FILE
 from davis_ag.scene.specs import CROPS, SCENARIOS, parse_group_name
+from davis_ag.seeds import SPLIT_STREAM, stream_rng
 
 #: Share of each group's scenes in the training split (section V-C).
 TRAIN_FRACTION = 0.7
@@ -38,7 +38,7 @@ def split_group(scene_ids: Sequence[str], seed: int) -> dict[str, list[str]]:
     parsed = parse_group_name(ids[0].split("/")[0]) if ids else None
     stream = [list(SCENARIOS).index(parsed[0].name), list(CROPS).index(parsed[1].name)] if parsed else [0, 0]
     # A stream of its own (the trailing 1) so the split never correlates with any scene seed.
-    order = np.random.default_rng(np.random.SeedSequence([seed, *stream, 1])).permutation(len(ids))
+    order = stream_rng(seed, *stream, SPLIT_STREAM).permutation(len(ids))
     n_train = int(round(TRAIN_FRACTION * len(ids)))
     if len(ids) >= 2:
         n_train = min(max(n_train, 1), len(ids) - 1)

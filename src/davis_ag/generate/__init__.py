@@ -1,2 +1,2 @@
-"""Stage 4, generation: one scene end to end and whole datasets (run configs, presets, the runner,
+"""Stage 6, generation: one scene end to end and whole datasets (run configs, presets, the runner,
 local pool and Ray executors, dataset-level files), written in the published layout."""

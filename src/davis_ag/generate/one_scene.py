@@ -16,9 +16,11 @@ from typing import Any, Callable
 
 import numpy as np
 
-from davis_ag.formats.layout import SCENE_METADATA
+from davis_ag.formats.layout import ROOT_FILES, SCENE_METADATA, published_pointers, view_name
 from davis_ag.formats.models import AnnotationEntry
+from davis_ag.formats.scene_file import SCENE_FORMAT, SceneFile, read_scene_file
 from davis_ag.provenance import code_version
+from davis_ag.seeds import derived_seed
 from davis_ag.atomic_files import PROBE_PREFIX, prove_writable_folder
 from davis_ag.errors import UserError
 from davis_ag.generate.scene_writer import SceneWriter
@@ -38,8 +40,6 @@ from davis_ag.scene.specs import (
     plant_centres,
 )
 from davis_ag.scene.view_grid import build_view_grid
-
-SCENE_FORMAT = "davis-ag-scene/1"
 
 CONVENTIONS = {
     "units": {"length": "m", "angle": "deg"},
@@ -125,9 +125,8 @@ class SceneRequest(SceneSettings):
 
     @property
     def min_fruit_pixels(self) -> int:
-        """The crop's box threshold, defined at 1280x720 and scaled with the image area."""
-        scale = self.camera.width * self.camera.height / (1280 * 720)
-        return max(1, round(self.crop.min_fruit_pixels * scale))
+        """The crop's box threshold at this image size (:meth:`CropSpec.min_fruit_pixels_at`)."""
+        return self.crop.min_fruit_pixels_at(self.camera.width, self.camera.height)
 
     @property
     def folder(self) -> str:
@@ -138,25 +137,22 @@ class SceneRequest(SceneSettings):
 def scene_seed(dataset_seed: int, scenario: ScenarioSpec, crop: CropSpec, index: int) -> int:
     """Derive a scene's seed from the dataset seed; independent streams for every scene."""
     keys = [dataset_seed, list(SCENARIOS).index(scenario.name), list(CROPS).index(crop.name), index]
-    return int(np.random.SeedSequence(keys).generate_state(1, dtype=np.uint32)[0])
+    return derived_seed(*keys)
 
 
 def read_scene_seed(scene_dir: Path) -> int | None:
     """The seed a finished scene was made with, or None when it carries no scene.json of ours."""
     try:
-        with open(scene_dir / SCENE_METADATA) as handle:
-            return int(json.load(handle)["seed"])
-    except (OSError, ValueError, KeyError, TypeError):
+        return read_scene_file(scene_dir / SCENE_METADATA).seed
+    except UserError:
         return None
 
 
 def read_scene_size(scene_dir: Path) -> tuple[int, int] | None:
     """The image size a finished scene was drawn at, or None when its scene.json does not say."""
     try:
-        with open(scene_dir / SCENE_METADATA) as handle:
-            camera = json.load(handle)["camera"]
-        return int(camera["width"]), int(camera["height"])
-    except (OSError, ValueError, KeyError, TypeError):
+        return read_scene_file(scene_dir / SCENE_METADATA).image_size()
+    except UserError:
         return None
 
 
@@ -229,7 +225,7 @@ def draw_scene(request: SceneRequest, model, grid, root: Path, on_view: Callable
         with open_renderer(request.renderer, model.context, camera, model.lighting, look,
                            request.antialiasing) as renderer:
             for done, view in enumerate(viewpoints, 1):
-                if view.image_name in writer.done:
+                if view_name(view.number) in writer.done:
                     if on_view:
                         on_view(done, len(viewpoints))
                     continue
@@ -237,23 +233,22 @@ def draw_scene(request: SceneRequest, model, grid, root: Path, on_view: Callable
                 classes = class_of_id[primitive_ids] if class_of_id is not None else None
                 labels = label_view(primitive_ids, lookup, request.min_fruit_pixels)
                 draw_silhouette = getattr(renderer, "silhouette_pixels", None)
-                silhouette = (lambda fruit_id, view=view: draw_silhouette(view, fruit_id, fruit_uuids[fruit_id])) \
-                    if draw_silhouette else None
+                silhouette = (lambda fruit_id, view=view, draw=draw_silhouette:
+                              draw(view, fruit_id, fruit_uuids[fruit_id])) if draw_silhouette else None
                 fractions = visible_fractions(camera, view, labels, polygons, silhouette)
                 entry = AnnotationEntry(bounding_boxes=labels.boxes, pose=[round(v, 5) for v in view.pose],
-                                        **grid.pointers(view.index)).to_json()
-                visible[view.image_name] = {str(k): v for k, v in fractions.items()}
-                writer.add_view(view.image_name, colour, labels.segmentation, entry,
-                                depth if request.depth else None, {"visible": visible[view.image_name]},
+                                        **published_pointers(grid, view.index)).to_json()
+                visible[view_name(view.number)] = {str(k): v for k, v in fractions.items()}
+                writer.add_view(view_name(view.number), colour, labels.segmentation, entry,
+                                depth if request.depth else None, {"visible": visible[view_name(view.number)]},
                                 classes=classes)
                 if on_view:
                     on_view(done, len(viewpoints))
             writer.wait()  # every image written before the Visualizer's teardown moves the cwd
         drawn = time.perf_counter()
-        metadata = scene_metadata(request, model, grid, visible)
-        metadata["timing_s"] = {"grow": round(grow_s, 3), "draw_and_label": round(drawn - grown, 3),
-                                "views_from_an_earlier_run": len(writer.done)}
-        writer.finish(metadata)
+        timing = {"grow": round(grow_s, 3), "draw_and_label": round(drawn - grown, 3),
+                  "views_from_an_earlier_run": len(writer.done)}
+        writer.finish(scene_metadata(request, model, grid, visible, timing))
     except Exception:
         writer.abort()  # an error (a full disk, a bug): give the space back; the next run redoes it
         raise
@@ -272,57 +267,61 @@ def resume_key(request: SceneRequest, viewpoints: list) -> dict:
     draw differently, so its views are not mixed with this one's).
     """
     return json.loads(json.dumps({"request": asdict(request), "seed": request.seed, "code": code_version(),
-                                  "views": [view.image_name for view in viewpoints]}, default=str))
+                                  "views": [view_name(view.number) for view in viewpoints]}, default=str))
 
 
-def scene_metadata(request: SceneRequest, model, grid, visible: dict) -> dict:
-    """Our scene.json: everything the published annotations leave out."""
+def scene_metadata(request: SceneRequest, model, grid, visible: dict, timing: dict | None = None) -> SceneFile:
+    """Our scene.json: everything the published annotations leave out.
+
+    Args:
+        request, model, grid: The scene as asked for, grown and laid out.
+        visible: Per view name, per fruit id (text), the fruit's visible fraction.
+        timing: Seconds spent growing and drawing.
+    """
     import pyhelios
 
-    return {
-        "format": SCENE_FORMAT,
-        "generator": {"name": "davis-ag", "version": code_version(), "pyhelios3d": pyhelios.__version__,
-                      "python": platform.python_version()},
-        "seed": request.seed,
-        "dataset_seed": request.dataset_seed,
-        "scenario": request.scenario.name,
-        "crop": request.crop.name,
-        "scene": request.folder,
-        "plant_generator": model.plant_generator,
-        "conventions": CONVENTIONS,
-        "camera": request.camera.intrinsics(),
-        "renderer": {"name": request.renderer, "look": resolve_look(request.renderer, request.look),
-                     "antialiasing": ANTIALIASING_DESCRIPTIONS[request.antialiasing]
-                     if request.renderer == "opengl" else "Helios Visualizer, 4x multisampled colour"},
-        "depth": {"file": "images/NNNN_depth.png", "dtype": "uint16", "unit": "mm",
-                  "axis": "optical (camera-space z)", "no_hit": 0} if request.depth else None,
-        "classes": {"file": "images/NNNN_class.png", "dtype": "uint8", "table": list(ORGAN_NAMES)}
+    lighting = model.lighting
+    return SceneFile(
+        format=SCENE_FORMAT,
+        generator={"name": "davis-ag", "version": code_version(), "pyhelios3d": pyhelios.__version__,
+                   "python": platform.python_version()},
+        seed=request.seed,
+        dataset_seed=request.dataset_seed,
+        scenario=request.scenario.name,
+        crop=request.crop.name,
+        scene=request.folder,
+        plant_generator=model.plant_generator,
+        conventions=CONVENTIONS,
+        camera=request.camera.intrinsics(),
+        renderer={"name": request.renderer, "look": resolve_look(request.renderer, request.look),
+                  "antialiasing": ANTIALIASING_DESCRIPTIONS[request.antialiasing]
+                  if request.renderer == "opengl" else "Helios Visualizer, 4x multisampled colour"},
+        depth={"file": "images/NNNN_depth.png", "dtype": "uint16", "unit": "mm",
+               "axis": "optical (camera-space z)", "no_hit": 0} if request.depth else None,
+        classes={"file": "images/NNNN_class.png", "dtype": "uint8", "table": list(ORGAN_NAMES)}
         if request.classes else None,
-        "appearance": draw_appearance(request.appearance, request.seed).summary(),
-        "lighting": {"model": "phong_shadowed", "sun_elevation_deg": model.lighting.sun_elevation,
-                     "sun_azimuth_deg": model.lighting.sun_azimuth, "sun_direction": model.lighting.direction,
-                     "sun_strength": model.lighting.sun_strength, "exposure": model.lighting.exposure,
-                     "white_balance": list(model.lighting.white_balance),
-                     "sky_texture": Path(model.lighting.sky_texture).name if model.lighting.sky_texture else None},
-        "grid": {"extent_m": list(request.scenario.extent), "step_m": request.scenario.step,
-                 "altitudes_m": [request.crop.altitudes[i] for i in request.scenario.altitude_levels],
-                 "headings": request.scenario.headings, "exclusion_radius_m": request.crop.exclusion_radius,
-                 "aim_height_m": model.aim_height, "views": len(grid.viewpoints)},
-        "min_fruit_pixels": request.min_fruit_pixels,
-        "plants": [plant.summary() for plant in model.plants],
-        "fruits": [fruit.summary() for fruit in model.fruits],
-        "views": {v.image_name: {"grid": [v.ix, v.iy, v.level, v.heading], "nominal": list(v.nominal)}
-                  for v in grid.viewpoints},
-        "visible_fraction": visible,
-    }
+        appearance=draw_appearance(request.appearance, request.seed).summary(),
+        lighting={"model": "phong_shadowed", "sun_elevation_deg": lighting.sun_elevation,
+                  "sun_azimuth_deg": lighting.sun_azimuth, "sun_direction": lighting.direction,
+                  "sun_strength": lighting.sun_strength, "exposure": lighting.exposure,
+                  "white_balance": list(lighting.white_balance),
+                  "sky_texture": Path(lighting.sky_texture).name if lighting.sky_texture else None},
+        grid={"extent_m": list(request.scenario.extent), "step_m": request.scenario.step,
+              "altitudes_m": [request.crop.altitudes[i] for i in request.scenario.altitude_levels],
+              "headings": request.scenario.headings, "exclusion_radius_m": request.crop.exclusion_radius,
+              "aim_height_m": model.aim_height, "views": len(grid.viewpoints)},
+        min_fruit_pixels=request.min_fruit_pixels,
+        plants=[plant.summary() for plant in model.plants],
+        fruits=[fruit.summary() for fruit in model.fruits],
+        views={view_name(v.number): {"grid": [v.ix, v.iy, v.level, v.heading], "nominal": list(v.nominal)}
+               for v in grid.viewpoints},
+        visible_fraction=visible,
+        **({"timing_s": timing} if timing is not None else {}),
+    )
 
 
 # ---------------------------------------------------------------------------------------------
 # Output folder checks
-
-#: Names a dataset root may hold besides group folders.
-ROOT_EXTRAS = {"splits.json", "dataset.json", ".davis_ag_cache", ".davis_ag.lock", "reports"}
-
 
 def check_output_root(root: Path) -> None:
     """Refuse an output folder we could damage or cannot write.
@@ -337,7 +336,7 @@ def check_output_root(root: Path) -> None:
         raise UserError(f"{root} is a file, not a folder: choose another --out")
     if root.is_dir():
         strangers = [p.name for p in root.iterdir()
-                     if p.name not in ROOT_EXTRAS and not p.name.startswith(PROBE_PREFIX)
+                     if p.name not in ROOT_FILES and not p.name.startswith(PROBE_PREFIX)
                      and not (p.is_dir() and parse_group_name(p.name))]
         if strangers:
             raise UserError(f"{root} holds other things ({', '.join(sorted(strangers)[:3])}): "

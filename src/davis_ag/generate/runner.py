@@ -29,7 +29,8 @@ from typing import Sequence
 
 from davis_ag.atomic_files import PROBE_PREFIX, write_json_atomic
 from davis_ag.errors import MachineError, UserError
-from davis_ag.formats.outputs import LOCK_FILE, OutputLock
+from davis_ag.formats.layout import LOCK_FILE, ROOT_FILES
+from davis_ag.formats.outputs import OutputLock
 from davis_ag.generate.dataset_files import (
     DATASET_FILE,
     SPLITS_FILE,
@@ -38,7 +39,6 @@ from davis_ag.generate.dataset_files import (
     write_splits,
 )
 from davis_ag.generate.one_scene import (
-    ROOT_EXTRAS,
     SceneRequest,
     check_output_root,
     check_scene_slot,
@@ -152,7 +152,7 @@ def run_dataset(requests: Sequence[SceneRequest], root: Path, options: RunOption
 def _precheck(root: Path) -> None:
     """Refuse a folder we could damage before creating anything in it; our own temporary files,
     which a killed run may have left, are cleared later under the lock."""
-    if root.is_dir() and not any(p.name not in ROOT_EXTRAS and p.name not in TEMPORARY_FILES
+    if root.is_dir() and not any(p.name not in ROOT_FILES and p.name not in TEMPORARY_FILES
                                  and not p.name.startswith(PROBE_PREFIX)
                                  and not (p.is_dir() and parse_group_name(p.name)) for p in root.iterdir()):
         return

@@ -25,6 +25,7 @@ import numpy as np
 
 from davis_ag.atomic_files import write_json_atomic
 from davis_ag.formats.layout import ANNOTATIONS, IMAGES, SCENE_METADATA, view_file_name, write_view_files
+from davis_ag.formats.scene_file import SceneFile
 
 #: In the hidden folder only: the views written so far (JSON lines) and what they were made for.
 JOURNAL = "views.jsonl"
@@ -119,7 +120,7 @@ class SceneWriter:
         """Block until every queued image is on disk (call before a renderer is closed)."""
         self._drain()
 
-    def finish(self, scene_metadata: dict) -> Path:
+    def finish(self, scene_metadata: SceneFile) -> Path:
         """Write annotations.json and scene.json, then move the scene into place.
 
         Returns:
@@ -132,7 +133,7 @@ class SceneWriter:
         (self.tmp_dir / JOURNAL).unlink(missing_ok=True)  # not part of the published layout
         (self.tmp_dir / RESUME_KEY).unlink(missing_ok=True)
         write_json_atomic(self.tmp_dir / ANNOTATIONS, self.annotations)
-        write_json_atomic(self.tmp_dir / SCENE_METADATA, scene_metadata)
+        write_json_atomic(self.tmp_dir / SCENE_METADATA, scene_metadata.as_written())
         _fsync_dir(self.tmp_dir / IMAGES)
         os.replace(self.tmp_dir, self.scene_dir)
         _fsync_dir(self.scene_dir.parent)

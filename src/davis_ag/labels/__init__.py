@@ -1,1 +1,1 @@
-"""Stage 3, labels: fruit masks, boxes and visible fractions from a rendered primitive-id image."""
+"""Stage 5, labels: fruit masks, boxes and visible fractions from a rendered primitive-id image."""

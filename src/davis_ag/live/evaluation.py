@@ -63,7 +63,7 @@ def evaluate_continuous(env: Any, agents: list[Any], episodes: int = 200, sessio
     results: dict[str, Any] = {
         "protocol": {"environment": "davis_ag/TVMContinuous-v0", "scenario": inner.scenario, "split": inner.split,
                      "tau": inner.tau, "episodes": episodes, "sessions": sessions, "seed": seed, "aim": inner.aim,
-                     "scenes": [s.settings.metadata["scene"] for s in inner.scenes],
+                     "scenes": [s.settings.metadata.scene for s in inner.scenes],
                      "actions": ["dx", "dy", "dz", "dyaw", "dpitch"][: inner.action_space.shape[0]]},
         "policies": {},
     }

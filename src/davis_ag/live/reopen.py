@@ -20,17 +20,20 @@ import json
 import sys
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 
 from davis_ag.atomic_files import atomic_output
-from davis_ag.formats.layout import ANNOTATIONS, SCENE_METADATA
+from davis_ag.formats.layout import ANNOTATIONS, SCENE_METADATA, view_name
+from davis_ag.formats.scene_file import SCENE_FORMAT, GeneratorRecord, RendererRecord, SceneFile, read_scene_file
 from davis_ag.errors import UserError
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.lighting import Lighting
 from davis_ag.scene.specs import DEFAULT_PLANTS, CropSpec, ScenarioSpec, check_plants, crop_spec, scenario_spec
 from davis_ag.scene.view_grid import Viewpoint
 
+T = TypeVar("T")
 CACHE_FILE = "live_geometry.npz"
 #: Bump when the cache's content changes.
 CACHE_VERSION = 1
@@ -52,7 +55,7 @@ class SceneSettings:
     """
 
     folder: Path
-    metadata: dict
+    metadata: SceneFile
     scenario: ScenarioSpec
     crop: CropSpec
     index: int
@@ -69,22 +72,30 @@ class SceneSettings:
         """Digest of everything that shapes the grown geometry and the grid."""
         meta = self.metadata
         keyed = {"version": CACHE_VERSION, "seed": self.seed, "dataset_seed": self.dataset_seed,
-                 "scenario": meta["scenario"], "crop": meta["crop"], "scene": meta["scene"],
-                 "grid": meta["grid"], "generator": meta["generator"], "plants": self.plants}
+                 "scenario": meta.scenario, "crop": meta.crop, "scene": meta.scene,
+                 "grid": meta.grid.as_written() if meta.grid else None,
+                 "generator": meta.generator.as_written() if meta.generator else None, "plants": self.plants}
         return hashlib.sha256(json.dumps(keyed, sort_keys=True).encode()).hexdigest()[:20]
 
 
-def antialiasing_of(renderer: dict) -> str:
+def antialiasing_of(renderer: RendererRecord) -> str:
     """The antialiasing mode a scene.json's renderer entry names: its description (as
     :data:`~davis_ag.render.backends.ANTIALIASING_DESCRIPTIONS` writes it), Helios's Visualizer
     (4x multisampling), or an earlier version's 4x / 1x wording."""
     from davis_ag.render.backends import ANTIALIASING_DESCRIPTIONS
 
-    text = str(renderer.get("antialiasing", ""))
+    text = renderer.antialiasing or ""
     by_description = {description: mode for mode, description in ANTIALIASING_DESCRIPTIONS.items()}
     if text in by_description:
         return by_description[text]
-    return "msaa" if text.startswith("4x") or renderer.get("name") == "helios" else "none"
+    return "msaa" if text.startswith("4x") or renderer.name == "helios" else "none"
+
+
+def _needed(value: T | None, key: str) -> T:
+    """``value``, or a ValueError naming the scene.json key it should have come from."""
+    if value is None:
+        raise ValueError(f"no {key}")
+    return value
 
 
 def read_settings(scene_dir: str | Path) -> SceneSettings:
@@ -93,37 +104,29 @@ def read_settings(scene_dir: str | Path) -> SceneSettings:
     Raises:
         UserError: when the folder holds no scene made by davis-ag generate, or scene.json is damaged.
     """
-    from davis_ag.generate.one_scene import SCENE_FORMAT
-
     folder = Path(scene_dir)
     path = folder / SCENE_METADATA
-    try:
-        metadata = json.loads(path.read_text())
-    except FileNotFoundError:
-        raise UserError(f"{path}: missing; only scenes made by `davis-ag generate` can be reopened live") from None
-    except (OSError, ValueError) as error:
-        raise UserError(f"{path}: cannot be read ({error}); generate the scene again") from None
-    generator = metadata.get("generator") if isinstance(metadata, dict) else None
-    if not (isinstance(generator, dict) and generator.get("name") == "davis-ag"
-            and metadata.get("format") == SCENE_FORMAT):
+    if not path.is_file():
+        raise UserError(f"{path}: missing; only scenes made by `davis-ag generate` can be reopened live")
+    metadata = read_scene_file(path)
+    if not metadata.ours:
         raise UserError(f"{path}: not a scene.json written by `davis-ag generate` ({SCENE_FORMAT}); "
                         "only our own scenes can be regrown")
     try:
-        crop = crop_spec(metadata["crop"])
-        grid = metadata["grid"]
-        levels = tuple(crop.altitudes.index(a) for a in grid["altitudes_m"])
-        scenario = replace(scenario_spec(metadata["scenario"], crop), extent=tuple(grid["extent_m"]),
-                           step=float(grid["step_m"]), altitude_levels=levels)
-        camera_info = metadata["camera"]
-        camera = Camera(int(camera_info["width"]), int(camera_info["height"]), float(camera_info["vfov_deg"]))
-        renderer = metadata["renderer"]
-        antialiasing = antialiasing_of(renderer)
-        settings = SceneSettings(folder, metadata, scenario, crop, int(metadata["scene"].rsplit("/", 1)[1]),
-                                 int(metadata["seed"]), int(metadata["dataset_seed"]), camera,
-                                 str(renderer["name"]), str(renderer["look"]),
-                                 antialiasing, check_plants(str(metadata.get("plant_generator", "architecture"))))
-    except (KeyError, ValueError, TypeError, IndexError, AttributeError, UserError) as error:
-        raise UserError(f"{path}: lacks or mangles a setting needed to regrow the scene ({error!r}); "
+        grid, renderer = _needed(metadata.grid, "grid"), _needed(metadata.renderer, "renderer")
+        crop = crop_spec(_needed(metadata.crop, "crop"))
+        levels = tuple(crop.altitudes.index(a) for a in _needed(grid.altitudes_m, "grid.altitudes_m"))
+        scenario = replace(scenario_spec(_needed(metadata.scenario, "scenario"), crop),
+                           extent=tuple(_needed(grid.extent_m, "grid.extent_m")),
+                           step=float(_needed(grid.step_m, "grid.step_m")), altitude_levels=levels)
+        width, height = _needed(metadata.image_size(), "camera.width and height")
+        camera = Camera(width, height, float(_needed(metadata.camera.vfov_deg, "camera.vfov_deg")))  # type: ignore[union-attr]
+        settings = SceneSettings(folder, metadata, scenario, crop, _needed(metadata.index, "scene"),
+                                 _needed(metadata.seed, "seed"), _needed(metadata.dataset_seed, "dataset_seed"),
+                                 camera, str(renderer.name), str(renderer.look), antialiasing_of(renderer),
+                                 check_plants(metadata.plant_generator or "architecture"))
+    except (ValueError, TypeError, UserError) as error:
+        raise UserError(f"{path}: lacks or mangles a setting needed to regrow the scene ({error}); "
                         "generate the scene again") from None
     return settings
 
@@ -182,13 +185,15 @@ def regrow(settings: SceneSettings) -> SceneAssets:
                            settings.camera, renderer=settings.renderer, look=settings.look, plants=settings.plants)
     if request.seed != settings.seed:
         raise UserError(f"{settings.folder}/scene.json: seed {settings.seed} does not follow from dataset seed "
-                        f"{settings.dataset_seed} and scene {settings.metadata['scene']}; the file was edited")
+                        f"{settings.dataset_seed} and scene {settings.metadata.scene}; the file was edited")
     model, grid = grow_scene(request)
     stored = settings.metadata
-    version = f"pyhelios3d {stored['generator'].get('pyhelios3d')}, davis-ag {stored['generator'].get('version')}"
+    generator = stored.generator or GeneratorRecord()
+    version = f"pyhelios3d {generator.pyhelios3d}, davis-ag {generator.version}"
     regrown_fruit = json.loads(json.dumps([f.summary() for f in model.fruits]))
     regrown_plants = json.loads(json.dumps([p.summary() for p in model.plants]))
-    if regrown_fruit != stored.get("fruits") or regrown_plants != stored.get("plants"):
+    if regrown_fruit != [f.as_written() for f in stored.fruits] \
+            or regrown_plants != [p.as_written() for p in stored.plants]:
         raise UserError(f"{settings.folder}: regrowing from the seed gave other plants than scene.json records "
                         f"(made with {version}); reopen it with those versions")
     check_grid(settings, list(grid.viewpoints))
@@ -211,7 +216,7 @@ def check_grid(settings: SceneSettings, views: list[Viewpoint]) -> None:
         annotations = json.loads(path.read_text())
     except (OSError, ValueError) as error:
         raise UserError(f"{path}: cannot be read ({error})") from None
-    poses = {v.image_name: [round(x, 5) for x in v.pose] for v in views}
+    poses = {view_name(v.number): [round(x, 5) for x in v.pose] for v in views}
     for name, entry in annotations.items():
         if poses.get(name) != entry.get("pose"):
             raise UserError(f"{path}: view {name} has pose {entry.get('pose')}, the regrown grid "

@@ -22,14 +22,12 @@ from pathlib import Path
 
 import numpy as np
 
+from davis_ag.formats.layout import view_name
 from davis_ag.labels.fruit_labels import fruit_lookup, label_view, visible_fractions
 from davis_ag.live.reopen import SceneAssets, SceneSettings, read_settings, reopen_assets
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import plant_centres
 from davis_ag.scene.view_grid import Viewpoint
-
-#: Image area the crops' ``min_fruit_pixels`` (section III-C) refer to.
-REFERENCE_PIXELS = 1280 * 720
 
 
 @dataclass(frozen=True)
@@ -70,9 +68,9 @@ def exposure_rates(labels_boxes: list[list[int]], visible_pixels: dict[int, int]
 def min_pixels_for(settings: SceneSettings, width: int, height: int) -> int:
     """The box threshold at an image size: scene.json's at its own size, else the crop's scaled."""
     if (width, height) == (settings.camera.width, settings.camera.height) \
-            and isinstance(settings.metadata.get("min_fruit_pixels"), int):
-        return int(settings.metadata["min_fruit_pixels"])
-    return max(1, round(settings.crop.min_fruit_pixels * width * height / REFERENCE_PIXELS))
+            and settings.metadata.min_fruit_pixels is not None:
+        return settings.metadata.min_fruit_pixels
+    return settings.crop.min_fruit_pixels_at(width, height)
 
 
 def merge_ground(geometry):
@@ -124,7 +122,7 @@ class LiveScene:
         self.settings, self.assets = settings, assets
         self.lookup = fruit_lookup(assets.fruit_uuids, assets.uuid_count)
         self._renderers: dict[tuple, object] = {}
-        self._names = {v.image_name: v for v in assets.grid_views}
+        self._names = {view_name(v.number): v for v in assets.grid_views}
 
     # ------------------------------------------------------------------------------ poses
 

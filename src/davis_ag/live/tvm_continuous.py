@@ -331,7 +331,7 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
     def _info(self) -> dict[str, Any]:
         return {"oer_0": self._oer_0, "oer_t": self.oer, "path": [list(p) for p in self._path],
                 "refused": self._refused, "target_fruit": self._target,
-                "scene": self.scene.settings.metadata["scene"], "steps": self._t}
+                "scene": self.scene.settings.metadata.scene, "steps": self._t}
 
     def render(self) -> np.ndarray | None:
         """``rgb_array``: the current view with the target's box outlined in red."""

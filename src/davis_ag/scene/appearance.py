@@ -23,10 +23,9 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, replace
 
-import numpy as np
-
 from davis_ag.errors import UserError
 from davis_ag.scene.lighting import Lighting
+from davis_ag.seeds import APPEARANCE_STREAM, stream_rng
 
 APPEARANCES = ("paper", "random")
 DEFAULT_APPEARANCE = "paper"
@@ -41,8 +40,6 @@ SUN_STRENGTH = (0.45, 1.35)
 EXPOSURE = (0.6, 1.6)
 WHITE_BALANCE_SHIFT = 0.12
 NOISE_SIGMA = (0.5, 4.0)
-#: Stream of the scene's seed the appearance is drawn from (the scene itself uses the seed directly).
-APPEARANCE_STREAM = 2
 
 
 @dataclass(frozen=True)
@@ -116,7 +113,7 @@ def draw_appearance(mode: str, scene_seed: int) -> Appearance:
     mode = resolve_appearance(mode)
     if mode == "paper":
         return Appearance("paper", seed=scene_seed)
-    rng = np.random.default_rng(np.random.SeedSequence([scene_seed, APPEARANCE_STREAM]))
+    rng = stream_rng(scene_seed, APPEARANCE_STREAM)
     shift = float(rng.uniform(-WHITE_BALANCE_SHIFT, WHITE_BALANCE_SHIFT))
     return Appearance(
         mode="random",

@@ -29,6 +29,17 @@ INVERSE_ACTION: dict[str, str] = {
 }
 
 
+#: The paper's image size (section III-C), at which the crops' box thresholds are given.
+PAPER_IMAGE_SIZE = (1280, 720)
+PAPER_PIXELS = PAPER_IMAGE_SIZE[0] * PAPER_IMAGE_SIZE[1]
+#: Table 3 of the paper: (scenario, crop) -> (scenes, images).
+PAPER_TABLE3: dict[tuple[str, str], tuple[int, int]] = {
+    ("sp", "strawberry"): (86, 24_510), ("mp", "strawberry"): (77, 86_856),
+    ("sp", "tomato"): (130, 45_240), ("mp", "tomato"): (113, 203_400),
+    ("sp", "vine"): (182, 63_336), ("mp", "vine"): (44, 79_200),
+}
+
+
 @dataclass(frozen=True)
 class CropSpec:
     """One crop's Table 1 defaults and the settings that follow from them.
@@ -47,7 +58,8 @@ class CropSpec:
             Helios's canopygenerator plug-in): Table 1's 2.5 cm makes a strawberry 2.5 cm wide.
         leaf_length: Leaf length (Table 1), m.
         altitudes: The three camera altitudes, low to high (Table 1), m.
-        min_fruit_pixels: Visible pixels a fruit needs to get a box (section III-C).
+        min_fruit_pixels: Visible pixels a fruit needs to get a box (section III-C), at the paper's
+            1280x720 (:meth:`min_fruit_pixels_at` scales it to another size).
         exclusion_radius: Cameras at most this far from a plant's stem, measured horizontally,
             are not placed, m (section III-C: "<75cm for strawberry and <100cm for others").
         centre_height: Height of the plant's centre, which single-plant cameras aim at: half
@@ -78,6 +90,11 @@ class CropSpec:
     sp_extent: tuple[float, float] = (3.0, 3.0)
     mp_extent: tuple[float, float] = (7.0, 3.0)
     fruit_size_per_radius: float = 1.0
+
+    def min_fruit_pixels_at(self, width: int, height: int) -> int:
+        """The box threshold at an image size: :attr:`min_fruit_pixels` scaled by the image area
+        over the paper's 1280x720, at least 1 pixel."""
+        return max(1, round(self.min_fruit_pixels * width * height / PAPER_PIXELS))
 
 
 # Why the grids differ by crop. Table 2 gives 3 x 3 m (SP) and 7 x 3 m (MP) grids, but Table 3's

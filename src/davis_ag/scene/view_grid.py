@@ -55,7 +55,8 @@ class Viewpoint:
     """One camera pose of the grid.
 
     Attributes:
-        index: Position in the grid's view list; the image is ``f"{index + 1:04d}.jpeg"``.
+        index: Position in the grid's view list; the image is numbered ``index + 1``
+            (:func:`davis_ag.formats.layout.view_name` names it).
         ix, iy: Grid column and row.
         level: Altitude level, 0 = lowest used by the scenario.
         heading: Heading index (always 0 in the single-plant scenario).
@@ -76,9 +77,9 @@ class Viewpoint:
     pitch: float
 
     @property
-    def image_name(self) -> str:
-        """The published image file name, numbered from 1."""
-        return f"{self.index + 1:04d}.jpeg"
+    def number(self) -> int:
+        """The view's published number, from 1 (its image name is :func:`davis_ag.formats.layout.view_name`'s)."""
+        return self.index + 1
 
     @property
     def pose(self) -> list[float]:
@@ -114,13 +115,6 @@ class ViewGrid:
         """The view reached from view ``index`` by ``action``, or ``None`` where the move is invalid."""
         target = int(self.next_view[index, self.actions.index(action)])
         return None if target < 0 else target
-
-    def pointers(self, index: int) -> dict[str, str]:
-        """The published pointer dictionary of a view: action to image name, "" where invalid."""
-        return {
-            action: "" if (t := self.pointer(index, action)) is None else self.viewpoints[t].image_name
-            for action in self.actions
-        }
 
 
 def lattice_size(extent: float, step: float) -> int:

@@ -1,1 +1,1 @@
-"""Stage 8, workflows: ``demo`` and ``reproduce`` composed from the stages before."""
+"""Stage 12, workflows: ``demo`` and ``reproduce`` composed from the stages before."""

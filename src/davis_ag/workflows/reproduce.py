@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from davis_ag.atomic_files import write_json_atomic
+from davis_ag.scene.specs import PAPER_IMAGE_SIZE, PAPER_TABLE3
 
 
 @dataclass(frozen=True)
@@ -54,12 +55,14 @@ class ReproduceConfig:
 #: sees 224x224 either way; the 70/30 split leaves 3 test scenes of each), a few hours on such a
 #: machine, resumable across sittings.
 #: ``paper-scale``: Table 3's scene counts at 1280x720 and 300K A2C steps (days on such a machine).
+#: Scene counts of Table 3 (SP strawberry, MP vine), what a configuration is measured against.
+PAPER_SCENES = (PAPER_TABLE3["sp", "strawberry"][0], PAPER_TABLE3["mp", "vine"][0])
 CONFIGS: dict[str, ReproduceConfig] = {
     "small": ReproduceConfig("small", (640, 360), sp_scenes=3, mp_scenes=2, mp_extent=(3.0, 2.0),
                              sp_timesteps=30_000, mp_timesteps=15_000),
     "medium": ReproduceConfig("medium", (640, 360), sp_scenes=10, mp_scenes=10, mp_extent=None,
                               sp_timesteps=300_000, mp_timesteps=300_000),
-    "paper-scale": ReproduceConfig("paper-scale", (1280, 720), sp_scenes=86, mp_scenes=44,
+    "paper-scale": ReproduceConfig("paper-scale", PAPER_IMAGE_SIZE, sp_scenes=PAPER_SCENES[0], mp_scenes=PAPER_SCENES[1],
                                    mp_extent=None, sp_timesteps=300_000, mp_timesteps=300_000),
 }
 
@@ -77,8 +80,6 @@ DISK_MARGIN = 1.1
 KEEP = "best-train"
 #: Marker of docs/benchmark.md's table of the configurations (:func:`configurations_table`).
 CONFIGS_MARKER = "reproduce-configs"
-#: Scene counts of Table 3 (SP strawberry, MP vine), what a configuration is measured against.
-PAPER_SCENES = (86, 44)
 
 
 def configurations_table() -> str:

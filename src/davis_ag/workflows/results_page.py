@@ -18,10 +18,11 @@ from typing import Any
 from davis_ag.benchmark.exact import BEST_FIXED
 from davis_ag.benchmark.paired import CONFIDENCE, PAIRED_KEY
 from davis_ag.formats.layout import SCENE_METADATA
+from davis_ag.formats.scene_file import CameraRecord, RendererRecord, read_scene_file_or_empty
+from davis_ag.scene.specs import PAPER_TABLE3
 from davis_ag.workflows.results_policies import (
     cell,
     learning_curve_section,
-    load_json_object,
     ordered,
     policy_sections,
     signed,
@@ -130,20 +131,26 @@ def scene_provenance(dataset: Path, scenes: list[str]) -> list[str]:
     """One line per fact about how a group's scenes were made, from their scene.json files."""
     versions, plants, renderers, sizes = Counter(), Counter(), Counter(), Counter()
     for scene in scenes:
-        meta = load_json_object(dataset / scene / SCENE_METADATA)
-        versions[meta.get("generator", {}).get("version", "unrecorded")] += 1
+        meta = read_scene_file_or_empty(dataset / scene / SCENE_METADATA)
+        versions[(meta.generator.version if meta.generator else None) or "unrecorded"] += 1
         # Scenes from before the Canopy Generator plants record no generator: PlantArchitecture's.
-        plants[f"`--plants {meta.get('plant_generator', 'architecture')}`"] += 1
-        renderer = meta.get("renderer", {})
-        renderers[f"{renderer.get('name', '?')} renderer, {renderer.get('look', '?')} look, antialiasing: "
-                  f"{renderer.get('antialiasing', '?')}"] += 1
-        camera = meta.get("camera", {})
-        sizes[f"{camera.get('width', '?')}x{camera.get('height', '?')}"] += 1
+        plants[f"`--plants {meta.plant_generator or 'architecture'}`"] += 1
+        renderer = meta.renderer or RendererRecord()
+        renderers[f"{renderer.name or '?'} renderer, {renderer.look or '?'} look, antialiasing: "
+                  f"{renderer.antialiasing or '?'}"] += 1
+        camera = meta.camera or CameraRecord()
+        sizes[f"{camera.width or '?'}x{camera.height or '?'}"] += 1
     lines = [f"code: {_counted(versions)}"
              + (" — made by more than one version of the code" if len(versions) > 1 else ""),
              f"plants grown by {_counted(plants)}",
              f"drawn with the {_counted(renderers)}", f"image size {_counted(sizes)}"]
     return lines
+
+
+def _code_version(path: Path) -> str:
+    """The code version a scene.json records, or ``unrecorded``."""
+    generator = read_scene_file_or_empty(path).generator
+    return (generator.version if generator else None) or "unrecorded"
 
 
 def training_provenance(record: dict[str, Any]) -> str:
@@ -250,8 +257,8 @@ def stage_rows(state: dict[str, Any], out: Path | None) -> list[tuple[str, float
         key, _, step = stage.partition(": ")
         seconds, code, note = entry["seconds"], entry.get("code", "unrecorded"), entry["note"]
         if out is not None and step == "generate" and state.get("scene_folders", {}).get(key):
-            code = _counted(Counter(load_json_object(out / "dataset" / scene / SCENE_METADATA).get("generator", {})
-                                    .get("version", "unrecorded") for scene in state["scene_folders"][key]))
+            code = _counted(Counter(_code_version(out / "dataset" / scene / SCENE_METADATA)
+                                    for scene in state["scene_folders"][key]))
         record: dict[str, Any] = {}
         if step == "train A2C" and out is not None:  # only a training stage has a record
             record = training_record(out, key)
@@ -370,7 +377,9 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
         f"network of section V-B, {config.n_envs} environments; its settings under each scenario) for {config.sp_timesteps:,} (SP) and "
         f"{config.mp_timesteps:,} (MP) environment steps; evaluation {config.sessions} sessions x "
         f"{config.episodes} episodes, seed {config.seed}, A2C {_a2c_play(state)}.",
-        "- **Paper**: 86 SP strawberry and 44 MP vine scenes at 1280x720 (Table 3), A2C for 300K "
+        f"- **Paper**: {PAPER_TABLE3['sp', 'strawberry'][0]} SP strawberry and {PAPER_TABLE3['mp', 'vine'][0]} "
+        "MP vine scenes at 1280x720 "
+        "(Table 3), A2C for 300K "
         "steps, 3 sessions x 200 episodes on the test split.",
         f"- **Machine**: {machine_description()}.",
         "",

@@ -2,16 +2,9 @@
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
-
 import pytest
 
-# tools/ is not a package: the bench is a developer's script beside the package, loaded by path.
-_SPEC = importlib.util.spec_from_file_location("bench", Path(__file__).parents[2] / "tools" / "bench.py")
-bench = importlib.util.module_from_spec(_SPEC)
-_SPEC.loader.exec_module(bench)
-POOL_GAIN, projection = bench.POOL_GAIN, bench.projection
+from davis_ag.workflows.bench_report import POOL_GAIN, projection
 
 CROPS = ("strawberry", "tomato", "vine")
 

@@ -1,4 +1,4 @@
-"""``python tools/bench.py``: what a labelled view costs with our renderer, against pyhelios's
+"""``davis-ag bench`` (``make bench``): what a labelled view costs with our renderer, against pyhelios's
 documented path on a stock Helios Visualizer, and what the paper-scale dataset would take.
 
 For each crop (a single-plant strawberry and a single goblet vine, dataset seed 0, scene 0, at
@@ -26,7 +26,6 @@ With ``--doc docs/performance.md`` the tables are written into that file between
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import json
 import os
@@ -37,15 +36,13 @@ import time
 from pathlib import Path
 from typing import Callable
 
-from davis_ag.atomic_files import write_marked_section
 from davis_ag.errors import UserError
 from davis_ag.generate.one_scene import SceneRequest, draw_scene, grow_scene
-from davis_ag.generate.run_config import load_dataset_config
 from davis_ag.generate.run_progress import count_views
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import CROPS, SCENARIOS
+from davis_ag.workflows.bench_report import PAPER_HOURS_TARGET, SEED, TARGETS, continuous_table, projection, write_continuous
 
-SEED = 0
 CAMERA = Camera(1280, 720)
 #: Views timed per crop: the strawberry's grid every 0.5 m at the middle altitude, the others'
 #: every 1 m at the lowest (the first ``VIEWS`` of each).
@@ -53,14 +50,7 @@ GRIDS = {"strawberry": dataclasses.replace(SCENARIOS["sp"], extent=(2.5, 3.0), s
          "tomato": dataclasses.replace(SCENARIOS["sp"], step=1.0, altitude_levels=(0,)),
          "vine": dataclasses.replace(SCENARIOS["sp"], step=1.0, altitude_levels=(0,))}
 VIEWS = {"strawberry": 12, "tomato": 8, "vine": 8}
-TARGETS = {"strawberry": 10.0, "vine": 8.0}
 REPEATS = 3
-CLUSTER_MACHINES = 16
-#: Scene processes per machine like this one (one per core) and the throughput two of them were
-#: measured to give against one process drawing with both cores (docs/performance.md).
-POOL_SLOTS = 2
-POOL_GAIN = 1.18
-PAPER_HOURS_TARGET = 24.0
 
 
 def cpu_seconds() -> float:
@@ -167,46 +157,6 @@ def pool_gain(scratch: Path) -> dict:
             "gain": round(seconds[1] / seconds[2], 3)}
 
 
-def projection(per_view: dict[str, float], overhead: dict[str, float], floor: dict[str, float] | None = None,
-               grow: dict[str, float] | None = None, gain: float | None = None) -> dict:
-    """Hours to make the ``paper`` preset on one machine and on a cluster of such machines.
-
-    Each scene costs its views times the crop's seconds per view, plus the crop's per-scene
-    overhead (growing, renderer set-up) times the plants it grows. One process is what was
-    measured; the default ``--workers`` (one single-threaded process per core) is scaled by
-    :data:`POOL_GAIN`. A cluster machine runs ``POOL_SLOTS`` scenes at once, each slot taking the
-    longest scene left (longest-first list scheduling). With ``floor`` and ``grow`` (seconds per
-    view of the draw and read-back alone, seconds to grow one plant), also the hours that growing
-    plus drawing alone would take on one machine: what no work around the draw can go below.
-    ``gain`` replaces :data:`POOL_GAIN` with a measured one (:func:`pool_gain`).
-    """
-    gain = gain or POOL_GAIN
-    config = load_dataset_config("paper")
-    durations: list[float] = []
-    bound = 0.0
-    images = 0
-    for group in config.groups:
-        views = count_views(group.scenario, group.crop)
-        plants = 1 if group.scenario.name == "sp" else group.crop.mp_plants
-        images += views * group.scenes
-        durations += [views * per_view[group.crop.name] + overhead[group.crop.name] * plants] * group.scenes
-        if floor and grow:
-            bound += (views * floor[group.crop.name] + grow[group.crop.name] * plants) * group.scenes
-    slots = [0.0] * (CLUSTER_MACHINES * POOL_SLOTS)
-    for duration in sorted(durations, reverse=True):
-        slots[slots.index(min(slots))] += duration * POOL_SLOTS / gain
-    return {"images": images, "scenes": len(durations),
-            "hours_one_machine_one_process": round(sum(durations) / 3600, 1),
-            "hours_one_machine": round(sum(durations) / gain / 3600, 1),
-            f"hours_{CLUSTER_MACHINES}_machines": round(max(slots) / 3600, 1),
-            "target_hours_one_machine": PAPER_HOURS_TARGET,
-            **({"hours_one_machine_grow_and_draw_only": round(bound / gain / 3600, 1)} if bound else {}),
-            "assumptions": f"multi-plant views cost what single-plant views of the same crop cost (a lower "
-                           f"bound: they draw 3-5 plants); growing costs the measured single-plant time per "
-                           f"plant; {POOL_SLOTS} scene processes per machine make {gain:.2f}x the views of one "
-                           + ("process (measured by this bench with our renderer)" if gain != POOL_GAIN
-                              else "process (measured with Helios, docs/performance.md)")}
-
 
 def env_speed(dataset: Path, steps: int = 20_000) -> dict:
     """Steps per second of the TVM environment on a scene just drawn (cache built first)."""
@@ -273,39 +223,6 @@ def continuous_env_speed(scratch: Path, steps: int = 600) -> dict:
             "triangles_drawn": int(merge_ground(env.scenes[0].assets.geometry).triangle_count)}
 
 
-def continuous_table(result: dict, load: tuple[float, float]) -> str:
-    """The TVMContinuous-v0 rate as Markdown."""
-    met = "meets" if result["steps_per_second"] >= result["target_min"] else "misses"
-    return (f"224x224 observations, single-plant strawberry (seed {SEED}, scene 0, {result['triangles']:,} triangles, "
-            f"{result['triangles_drawn']:,} with the soil merged), "
-            f"uniformly random actions, resets included; load average {load[0]:.2f} at the start, "
-            f"{load[1]:.2f} at the end, {os.cpu_count()} CPUs.\n\n"
-            "| steps timed | resets | refused moves | views drawn per step (per reset) | render + labels, ms | "
-            "open + first reset, s | CPU ms/step | steps/s | target |\n"
-            "|---|---|---|---|---|---|---|---|---|\n"
-            f"| {result['steps']} | {result['resets']} | {result['refused_share']:.0%} | "
-            f"{result['draws_per_step']} ({result['draws_per_reset']}) | "
-            f"{result['render_and_label_ms']} | {result['open_and_first_reset_s']} | {result['cpu_ms_per_step']} | "
-            f"**{result['steps_per_second']}** | >= {result['target_min']:.0f} ({met}) |")
-
-
-def continuous_line(result: dict) -> str:
-    """The rate in one sentence, for docs/views-on-demand.md."""
-    return (f"Measured by `make bench` on this 2-core machine (shared, load average in docs/performance.md): "
-            f"**{result['steps_per_second']} steps/s** at 224x224 with random actions, resets included "
-            f"({result['render_and_label_ms']} ms to draw and label a view, {result['cpu_ms_per_step']} ms of CPU "
-            f"per step; target >= {result['target_min']:.0f}).")
-
-
-def write_continuous(result: dict, load: tuple[float, float], doc: Path | None) -> None:
-    """Write the TVMContinuous-v0 rate into the doc and, beside it, docs/views-on-demand.md."""
-    if doc:
-        write_marked_section(doc, "bench-continuous", continuous_table(result, load))
-        page = doc.absolute().parent / "views-on-demand.md"
-        if page.is_file() and "<!-- continuous-rate:start -->" in page.read_text():
-            write_marked_section(page, "continuous-rate", continuous_line(result))
-
-
 def run_continuous(out: Path, doc: Path | None) -> dict:
     """Only the TVMContinuous-v0 measurement (``--only continuous``): JSON, the doc's section and
     docs/views-on-demand.md's line."""
@@ -354,89 +271,3 @@ def run(out: Path, crops: list[str], repeats: int, antialiasing: str = "fxaa") -
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps(report, indent=1) + "\n")
     return report
-
-
-def table(report: dict) -> str:
-    """The human-readable summary (Markdown)."""
-    lines = [f"{report['image_size'][0]}x{report['image_size'][1]}, antialiasing {report['antialiasing']} (ours), "
-             f"seed {report['seed']}, scene 0 of each crop, "
-             f"median of {max(c['repeats'] for c in report['crops'].values())} interleaved repetitions; load "
-             f"average {report['machine']['load_average']['start'][0]} at the start, "
-             f"{report['machine']['load_average']['end'][0]} at the end, {report['machine']['cpus']} CPUs.", "",
-             "| crop | primitives | views timed | ours s/view | documented s/view | floor s/view | "
-             "documented / ours | target | ours / floor |",
-             "|---|---|---|---|---|---|---|---|---|"]
-    for crop, result in report["crops"].items():
-        spv = result["seconds_per_view"]
-        doc = f"{spv['documented']:.3f}" if "documented" in spv else "-"
-        ratio = f"**{result['documented_over_ours']:.1f}x**" if "documented_over_ours" in result else "-"
-        target = f">= {TARGETS[crop]:.0f}x" if crop in TARGETS else "-"
-        over = f"{result['ours_over_floor']:.2f}" if "ours_over_floor" in result else "-"
-        lines.append(f"| {crop} | {result['primitives']:,} | {result['views_timed']} x {result['repeats']} | "
-                     f"{spv['ours']:.3f} | {doc} | {spv['floor']:.3f} | {ratio} | {target} | {over} |")
-    p = report["paper_projection"]
-    lines += ["", f"The `paper` preset ({p['images']:,} images, {p['scenes']} scenes): "
-                  f"**{p['hours_one_machine']} h** on one machine like this one with the default workers "
-                  f"(target <= {PAPER_HOURS_TARGET:.0f} h; {p['hours_one_machine_one_process']} h in one process), "
-                  f"{p[f'hours_{CLUSTER_MACHINES}_machines']} h on {CLUSTER_MACHINES} such machines with Ray. "
-                  f"Per-scene overhead (growing, renderer set-up), s: "
-                  + ", ".join(f"{k} {v}" for k, v in report["scene_overhead_s"].items()) + ". "
-                  + p["assumptions"] + "."]
-    pool = report.get("pool")
-    if pool:
-        lines.append(f"\nTwo scene processes against one (the runner, {pool['scenes']} single-plant strawberry scenes, "
-                     f"{pool['views']} views, growing included): {pool['seconds_one_worker']} s with one worker, "
-                     f"{pool['seconds_two_workers']} s with two, a gain of **{pool['gain']:.2f}x**, used above.")
-    if "hours_one_machine_grow_and_draw_only" in p:
-        lines.append(f"\nGrowing the plants and our draw and read-back alone (the floor column, no labels, no "
-                     f"files) would take **{p['hours_one_machine_grow_and_draw_only']} h** on one such machine: "
-                     "the least any work around the draw could reach with these plants and this antialiasing.")
-    lines.append("\nOrgan class images (`NNNN_class.png`, from the id image of the same pass), ours s/view with "
-                 "and without: " + ", ".join(
-                     f"{crop} {r['seconds_per_view']['ours']:.3f} / {r['seconds_per_view']['no_classes']:.3f} "
-                     f"(**{r['classes_cost']:.3f}x**)" for crop, r in report["crops"].items()) + ".")
-    env = report.get("env_steps_per_second", {})
-    if "steps_per_second" in env:
-        lines.append(f"\nTVM environment on the strawberry scene: {env['steps_per_second']} steps/s.")
-    return "\n".join(lines)
-
-
-def main(argv: list[str] | None = None) -> int:
-    """Command line: ``python tools/bench.py --out out/bench.json [--doc docs/performance.md]``."""
-    parser = argparse.ArgumentParser(prog="python tools/bench.py", description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--out", type=Path, default=Path("out/bench.json"), help="JSON report")
-    parser.add_argument("--crops", default="strawberry,tomato,vine",
-                        help="crops to time (strawberry, tomato, vine); the documented path only where a target is set")
-    parser.add_argument("--repeats", type=int, default=REPEATS, help=f"interleaved repetitions (default {REPEATS})")
-    parser.add_argument("--antialiasing", choices=("fxaa", "msaa", "none"), default="fxaa",
-                        help="our renderer's antialiasing (default fxaa)")
-    parser.add_argument("--doc", type=Path, help="write the tables into this Markdown file's bench section")
-    parser.add_argument("--only", choices=("all", "continuous"), default="all",
-                        help="continuous: only TVMContinuous-v0's steps/s (about a minute)")
-    args = parser.parse_args(argv)
-    if args.only == "continuous":
-        run_continuous(args.out, args.doc)
-        print(f"written {args.out}" + (f" and {args.doc}" if args.doc else ""))
-        return 0
-    crops = [c for c in args.crops.split(",") if c]
-    for name in crops:
-        if name not in CROPS:
-            parser.error(f"--crops: {name!r} is not strawberry, tomato or vine")
-    if args.repeats < 1:
-        parser.error("--repeats must be at least 1")
-    report = run(args.out, crops, args.repeats, args.antialiasing)
-    text = table(report)
-    print(text)
-    if args.doc:
-        write_marked_section(args.doc, "bench", text)
-        if "continuous_env" in report:
-            load = report["machine"]["load_average"]
-            write_continuous(report["continuous_env"], (load["start"][0], load["end"][0]), args.doc)
-        print(f"written {args.doc}")
-    print(f"written {args.out}")
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

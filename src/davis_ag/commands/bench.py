@@ -1,0 +1,75 @@
+"""``davis-ag bench``: what a labelled view costs with our renderer against pyhelios's documented
+path, the environments' steps per second, and what the paper-scale dataset would take
+(:mod:`davis_ag.workflows.bench`). ``make bench`` runs it and writes docs/performance.md."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from davis_ag.commands import arguments
+
+HELP = "time our renderer against Helios's documented path and project the paper-scale run"
+DESCRIPTION = __doc__
+CROP_NAMES = ("strawberry", "tomato", "vine")
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add ``bench``'s arguments to its ``parser`` (see :mod:`davis_ag.commands`)."""
+    parser.add_argument("--out", type=arguments.path, default="out/bench.json", metavar="BENCH.json",
+                        help="the JSON report (default out/bench.json)")
+    parser.add_argument("--crops", type=arguments.name_list(CROP_NAMES), default=",".join(CROP_NAMES),
+                        help="crops to time, comma-separated (the documented path only where a target is set)")
+    parser.add_argument("--repeats", type=arguments.count, default=3, help="interleaved repetitions (default 3)")
+    parser.add_argument("--antialiasing", choices=("fxaa", "msaa", "none"), default="fxaa",
+                        help="our renderer's antialiasing (default fxaa)")
+    parser.add_argument("--doc", type=arguments.path, metavar="PAGE.md",
+                        help="write the tables into this Markdown file's bench section")
+    parser.add_argument("--only", choices=("all", "continuous"), default="all",
+                        help="continuous: only TVMContinuous-v0's steps/s (about a minute)")
+
+
+def _is_report(path: Path) -> bool:
+    """Whether a file is a report an earlier ``davis-ag bench`` wrote."""
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return False
+    return isinstance(data, dict) and bool({"machine", "continuous_env"} & set(data))
+
+
+def run(args: argparse.Namespace) -> int:
+    """Measure, print and write the report (and the doc's sections)."""
+    from davis_ag.atomic_files import write_marked_section
+    from davis_ag.workflows.bench import run as run_bench
+    from davis_ag.workflows.bench import run_continuous
+    from davis_ag.workflows.bench_report import table, write_continuous
+
+    from davis_ag.atomic_files import prove_writable_folder
+    from davis_ag.errors import UserError
+
+    # Minutes of measuring come before anything is written: refuse a bad output first, and never
+    # replace a file that is not an earlier report.
+    prove_writable_folder(args.out.parent)
+    if args.out.exists() and not _is_report(args.out):
+        raise UserError(f"--out {args.out}: holds something other than an earlier bench report; "
+                        "give a new .json path")
+    if args.doc is not None and not (args.doc.is_file() and "<!-- bench:start -->" in args.doc.read_text()):
+        raise UserError(f"--doc {args.doc}: not a Markdown page with <!-- bench:start --> and <!-- bench:end --> "
+                        "markers; give docs/performance.md or leave --doc out")
+    if args.only == "continuous":
+        run_continuous(args.out, args.doc)
+        print(f"written {args.out}" + (f" and {args.doc}" if args.doc else ""))
+        return 0
+    report = run_bench(args.out, args.crops, args.repeats, args.antialiasing)
+    text = table(report)
+    print(text)
+    if args.doc:
+        write_marked_section(args.doc, "bench", text)
+        if "continuous_env" in report:
+            load = report["machine"]["load_average"]
+            write_continuous(report["continuous_env"], (load["start"][0], load["end"][0]), args.doc)
+        print(f"written {args.doc}")
+    print(f"written {args.out}")
+    return 0

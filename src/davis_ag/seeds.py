@@ -1,0 +1,36 @@
+"""Every random stream of davis-ag, and how each follows from the one seed recorded with an output.
+
+Streams are NumPy ``SeedSequence`` keys, so two streams never share draws however many each takes:
+
+- a scene: ``[dataset seed, scenario's index, crop's index, scene index]`` gives the scene's own
+  seed (:func:`davis_ag.generate.one_scene.scene_seed`), which scene.json records; the plants, the
+  Helios seeds, the sun and the slip draw from ``default_rng(scene seed)`` in a fixed order;
+- a scene's random appearance: ``[scene seed, APPEARANCE_STREAM]``;
+- a group's train/test split: ``[split seed, scenario's index, crop's index, SPLIT_STREAM]``;
+- our renderer's per-view noise: ``[lighting's noise seed, view index]``;
+- evaluation session ``s``: ``[seed, s]`` for the environment's resets and ``[seed, s, AGENT_STREAM]``
+  for the agent's own draws (:mod:`davis_ag.benchmark.evaluation`).
+
+A new stream takes a new number here, never an old one.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+#: The split's stream after the group's keys.
+SPLIT_STREAM = 1
+#: A scene's random appearance, after the scene seed.
+APPEARANCE_STREAM = 2
+#: An evaluation session's agent draws, after ``[seed, session]``.
+AGENT_STREAM = 1
+
+
+def derived_seed(*keys: int) -> int:
+    """A 32-bit seed for the stream named by ``keys`` (what Helios, Gymnasium and SB3 take)."""
+    return int(np.random.SeedSequence(list(keys)).generate_state(1, dtype=np.uint32)[0])
+
+
+def stream_rng(*keys: int) -> np.random.Generator:
+    """A generator for the stream named by ``keys``."""
+    return np.random.default_rng(np.random.SeedSequence(list(keys)))
