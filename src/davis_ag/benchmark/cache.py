@@ -200,9 +200,8 @@ def _build(scene: Any, folder: Path, fingerprint: str) -> None:
         mask = view.mask()
         if mask is None:
             raise UserError(
-                f"scene {scene.id} view {view.name} has no segmentation mask "
-                f"(images/{Path(view.name).stem}_seg.png): the exposure rate needs masks; "
-                "use a download or generation that includes them")
+                f"{view.mask_path}: missing; scene {scene.id} view {view.name} has no segmentation "
+                "mask and the exposure rate needs masks: use a download or generation that includes them")
         resized, (width, height) = _resized_image(view)
         if mask.shape != (height, width):
             raise UserError(f"scene {scene.id} view {view.name}: mask is {mask.shape[1]}x"
