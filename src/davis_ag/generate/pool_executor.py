@@ -61,11 +61,13 @@ def run_on_pool(todo: Sequence[SceneRequest], root: Path, options: RunOptions, p
         started: set[str] = set()
         # A fresh queue per pool: a process killed while writing may leave a queue's lock held.
         events = context.Queue()
-        with stops_held():  # a stop mid-spawn would cut a child's start short (its traceback on stderr)
-            pool = ProcessPoolExecutor(options.workers, mp_context=context, initializer=_init_worker,
-                                       initargs=(events, mesa_threads(options.workers), os.getpid()))
-            futures = {pool.submit(_pool_scene, request, str(root)): request for request in pending}
+        pool = ProcessPoolExecutor(options.workers, mp_context=context, initializer=_init_worker,
+                                   initargs=(events, mesa_threads(options.workers), os.getpid()))
         try:
+            # A stop mid-spawn would cut a child's start short (its traceback on stderr): it waits
+            # until the children are started, then ends them below like any stop.
+            with stops_held():
+                futures = {pool.submit(_pool_scene, request, str(root)): request for request in pending}
             pending = []
             while futures:
                 done, _ = wait(futures, timeout=0.25, return_when=FIRST_COMPLETED)

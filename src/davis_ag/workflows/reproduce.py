@@ -277,7 +277,8 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
             start = time.perf_counter()
             train_a2c(root, scenario_name, total_timesteps=timesteps, seed=config.seed,
                       out_path=model, n_envs=config.n_envs, crop=crop_name, device="cpu",
-                      callback=_progress_callback(timesteps, key), keep=KEEP)
+                      callback=_progress_callback(timesteps, key), keep=KEEP,
+                      force=True)  # its own work folder: a checkpoint of other settings is redone, as said above
             seconds = time.perf_counter() - start
             write_json_atomic(stamp, {**wanted, "seconds": seconds})
             record(f"{key}: train A2C", seconds,
