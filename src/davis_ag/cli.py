@@ -12,7 +12,7 @@ from davis_ag.provenance import code_version
 # Each name is a module of davis_ag.commands defining HELP, DESCRIPTION, add_arguments(parser),
 # run(args) and maybe FORMATTER_CLASS (the package's docstring says what each is); add_command alone
 # makes the sub-parsers from them, so that every command's is made the same way.
-COMMANDS = ["generate", "validate", "train", "evaluate", "preview", "demo", "reproduce", "stats", "plot",
+COMMANDS = ["generate", "validate", "train", "evaluate", "compare", "preview", "demo", "reproduce", "stats", "plot",
             "view", "export", "transfer"]
 
 

@@ -5,6 +5,10 @@ Importing this package registers the environment::
     import gymnasium, davis_ag.benchmark
     env = gymnasium.make("davis_ag/TVM-v0", dataset="data/", scenario="sp", split="train")
 
+To score policies of your own beside the baselines (section V-C's protocol, any environment)::
+
+    results = davis_ag.benchmark.evaluate([my_policy], dataset="data/", scenario="sp")
+
 Beside it, ``davis_ag/TVMContinuous-v0`` (:mod:`davis_ag.live.tvm_continuous`): the same task with
 a continuous camera pose, drawn live from regrown scenes. It is registered here by name only, so
 nothing of it (Helios, the renderer) loads until it is made.
@@ -12,21 +16,19 @@ nothing of it (Helios, the renderer) loads until it is made.
 
 from __future__ import annotations
 
+import importlib
 import time
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
 from gymnasium.envs.registration import register, registry
 
 from davis_ag.benchmark.cache import OBS_SIZE, SceneCache, load_scene_cache
-from davis_ag.benchmark.tvm import MAX_START_OER, TVMEnv
+from davis_ag.benchmark.tvm import CONTINUOUS_ID, MAX_START_OER, TVM_ID, TVMEnv
 
-#: The id every davis-ag environment is registered under.
-TVM_ID = "davis_ag/TVM-v0"
 #: All grid environments this package registers (tests parametrize over it).
 ENV_IDS: tuple[str, ...] = (TVM_ID,)
-#: The continuous-pose environment (a later stage, :mod:`davis_ag.live`, implements it).
-CONTINUOUS_ID = "davis_ag/TVMContinuous-v0"
 
 if TVM_ID not in registry:
     # No max_episode_steps: the environment ends its own episodes at tau with terminated=True
@@ -60,5 +62,14 @@ def benchmark_steps(env: gym.Env, n: int = 20_000, seed: int = 0) -> float:
     return n / (time.perf_counter() - start)
 
 
+def __getattr__(name: str) -> Any:
+    """``evaluate`` (:func:`davis_ag.benchmark.evaluation.evaluate`), loaded when first used: importing
+    davis_ag registers the environments through this package, and the evaluation (pydantic, the
+    code version of :mod:`davis_ag.provenance`) is not needed for that."""
+    if name == "evaluate":
+        return importlib.import_module("davis_ag.benchmark.evaluation").evaluate
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
 __all__ = ["CONTINUOUS_ID", "ENV_IDS", "MAX_START_OER", "OBS_SIZE", "TVM_ID", "SceneCache", "TVMEnv",
-           "benchmark_steps", "load_scene_cache"]
+           "benchmark_steps", "evaluate", "load_scene_cache"]

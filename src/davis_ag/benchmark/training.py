@@ -46,7 +46,7 @@ SELECT_EVERY = 10_000
 #: from start to start with these settings, with SB3's defaults and with the bonus alone (which
 #: left the flattest policy and the lowest sampled score); these learnt a little faster early on.
 #: What made the evaluated A2C a fixed action was chiefly too little training played
-#: deterministically (see ``A2C_DETERMINISTIC`` in agents.py).
+#: deterministically (see ``DETERMINISTIC_PLAY`` in policies.py).
 A2C_SETTINGS: dict[str, Any] = {"ent_coef": 0.01, "normalize_advantage": True}
 #: Stable-Baselines3's own A2C defaults for the settings above (what ``--a2c-settings sb3`` trains).
 SB3_DEFAULT_SETTINGS: dict[str, Any] = {"ent_coef": 0.0, "normalize_advantage": False}

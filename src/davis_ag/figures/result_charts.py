@@ -19,7 +19,7 @@ def plot_results(results: dict[str, Any], path: str | os.PathLike[str]) -> Path:
     bars, saved as PNG.
 
     Args:
-        results: What :func:`evaluate_agents` returned.
+        results: What :func:`davis_ag.benchmark.evaluation.evaluate_policies` returned, as JSON.
         path: The PNG to write.
 
     Returns:
