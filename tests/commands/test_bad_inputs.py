@@ -102,7 +102,8 @@ def test_a_config_the_renderer_cannot_draw_is_refused_before_any_plant_grows(
 @pytest.mark.parametrize("extra, message", [
     (["--seed", "-1"], "--seed"), (["--policies", ","], "names nothing"),
     (["--policies", "LRD,Greedy"], "Greedy"), (["--episodes", "0"], "--episodes"),
-    (["--sessions", "x"], "--sessions"), (["--policies", "A2C"], "--model"),
+    (["--sessions", "x"], "--sessions"), (["--policies", "A2C"], "unknown name 'A2C'"),
+    (["--policy", "nowhere.py:act"], "no such file"), (["--name", "x"], "1 --name for 0 --policy"),
     (["--model", "missing.zip"], "no such model"), (["--crop", "banana"], "banana"),
     (["--crop", "tomato"], "no sp/tomato scenes"), (["--scenario", "mp"], "no mp scenes"),
 ])

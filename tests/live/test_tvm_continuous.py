@@ -188,3 +188,17 @@ def test_evaluate_command_takes_the_continuous_environment(live_root: Path, tmp_
     mine = json.loads(Path("r.json").read_text())["policies"]["climb"]
     assert mine["mean_abs_action"]["dz"] == pytest.approx(2 / 3, abs=1e-4) and mine["mean_abs_action"]["dx"] == 0
     assert "Rand" in mine["paired"]
+
+
+def test_the_docs_policy_file_runs_on_the_continuous_environment(live_root: Path, tmp_path: Path,
+                                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+    """docs/benchmark-your-method.md says its policy file scores here too."""
+    from test_benchmark_your_method import PAGE, blocks  # tests/ is on the path, as for layout_factory
+
+    monkeypatch.chdir(tmp_path)
+    name, body = next((n, b) for _, n, b in blocks(PAGE.read_text()) if n)
+    Path(name).write_text(body)
+    assert cli.main(["evaluate", "--env", "continuous", "--dataset", str(live_root), "--scenario", "sp", "--split",
+                     "all", "--episodes", "2", "--sessions", "1", "--policies", "Rand", "--out", "r.json",
+                     "--policy", f"{name}:toward_target"]) == 0
+    assert json.loads(Path("r.json").read_text())["policies"]["toward_target"]["length"]["mean"] == 3

@@ -181,7 +181,10 @@ class ModelPolicy:
         """
         if isinstance(model, (str, os.PathLike)):
             model = load_model(model, device)
-        self.model, self.deterministic = model, bool(deterministic)
+        # A Q-learner's policy is its greedy action: SB3's "sampled" DQN is epsilon-greedy with
+        # training's exploration rate, which is no distribution of the learnt policy.
+        greedy = hasattr(model, "q_net")
+        self.model, self.deterministic = model, bool(deterministic) or greedy
         self.name = name or type(model).__name__
 
     @property

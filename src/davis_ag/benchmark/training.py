@@ -1,4 +1,7 @@
-"""Train the paper's A2C agent (section IV-C) with Stable-Baselines3, checkpointed and resumable.
+"""Train an agent with Stable-Baselines3 on the train split, checkpointed and resumable: the paper's
+A2C (section IV-C), PPO or DQN (on the discrete moves), each with the paper's network as its
+features extractor, the same keep-best-train snapshot rule (:mod:`davis_ag.benchmark.selection`),
+checkpoints, training record and progress (a bar on a terminal, a line a minute in a log).
 
 A 300K-step run on a CPU takes hours, so training saves a checkpoint every few thousand steps
 (model, optimiser state and step count in SB3's zip, beside a small JSON of the run's settings)
@@ -13,6 +16,7 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -52,6 +56,20 @@ A2C_SETTINGS: dict[str, Any] = {"ent_coef": 0.01, "normalize_advantage": True}
 SB3_DEFAULT_SETTINGS: dict[str, Any] = {"ent_coef": 0.0, "normalize_advantage": False}
 #: Named setting sets of :func:`train_a2c`.
 SETTINGS_PRESETS: dict[str, dict[str, Any]] = {"ours": A2C_SETTINGS, "sb3": SB3_DEFAULT_SETTINGS}
+#: Seconds between progress lines in a log (on a terminal a bar is redrawn instead).
+PROGRESS_EVERY_S = 60.0
+#: The algorithms :func:`train_agent` trains (``davis-ag train --algo``).
+ALGORITHMS: tuple[str, ...] = ("a2c", "ppo", "dqn")
+#: PPO's and DQN's settings on top of Stable-Baselines3's defaults. PPO: none. DQN: SB3's replay
+#: buffer holds 1M transitions, which at 224x224x4 bytes per observation (twice: the next one
+#: too) is 300 GB; 10,000 keep it near 2 GB (one copy, ``optimize_memory_usage``, which needs
+#: ``handle_timeout_termination`` off: our episodes end with terminated, never truncated).
+#: Not tuned: the paper trains A2C only, and no change was measured on the train split.
+SB3_SETTINGS: dict[str, dict[str, Any]] = {
+    "ppo": {},
+    "dqn": {"buffer_size": 10_000, "optimize_memory_usage": True,
+            "replay_buffer_kwargs": {"handle_timeout_termination": False}},
+}
 #: SB3 A2C keyword arguments a setting set may change.
 TUNABLE = ("ent_coef", "normalize_advantage", "learning_rate", "n_steps", "gamma", "vf_coef",
            "max_grad_norm", "gae_lambda")
@@ -187,6 +205,59 @@ class _Checkpoint(BaseCallback):
         return True
 
 
+class TrainingProgress(BaseCallback):
+    """Training's progress over environment steps: a tqdm bar on a terminal (steps, rate, time
+    left, the last train-split score), and in a log (not a terminal) the same line once a minute.
+
+    A run resumed from a checkpoint starts at the checkpoint's step count, not at 0.
+    """
+
+    def __init__(self, total: int, label: str, selection: KeepBestOnTrain | None = None,
+                 every_s: float | None = None) -> None:
+        """Args:
+            total: The run's total environment steps.
+            label: What is trained (``PPO sp``), the bar's description.
+            selection: The snapshot scorer whose last score is shown.
+            every_s: Seconds between log lines when not on a terminal (default :data:`PROGRESS_EVERY_S`).
+        """
+        super().__init__()
+        self.total, self.label, self.selection = total, label, selection
+        self.every_s = PROGRESS_EVERY_S if every_s is None else every_s
+        self.steps, self._first, self._start, self._last, self.bar = 0, 0, 0.0, 0.0, None
+
+    def _on_training_start(self) -> None:
+        from tqdm import tqdm
+
+        self.steps = self._first = int(self.model.num_timesteps)
+        self._start = self._last = time.monotonic()
+        # disable=None: no bar where stderr is not a terminal (a log), the lines below instead.
+        self.bar = tqdm(total=self.total, initial=self.steps, desc=self.label, unit="step", mininterval=2,
+                        disable=None, dynamic_ncols=True)
+
+    def _score(self) -> str:
+        best = self.selection.scores[-1] if self.selection and self.selection.scores else None
+        return f"train OER_tau {best['oer_tau']:.3f} at {best['step']}" if best else "no train score yet"
+
+    def _on_step(self) -> bool:
+        from tqdm import tqdm
+
+        n = self.training_env.num_envs
+        self.steps += n
+        if not self.bar.disable:
+            self.bar.set_postfix_str(self._score(), refresh=False)
+            self.bar.update(n)
+        elif time.monotonic() - self._last >= self.every_s:
+            self._last = time.monotonic()
+            line = tqdm.format_meter(self.steps, self.total, self._last - self._start, prefix=self.label,
+                                     unit="step", initial=self._first, ncols=0)
+            print(f"{line} | {self._score()}", file=sys.stderr, flush=True)
+        return True
+
+    def _on_training_end(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+
 def _resumable(settings_file: Path, model_file: Path,
                settings: dict[str, Any]) -> tuple[int, list, list, list] | None:
     """Steps done, sittings, learning curve and snapshot scores so far of a checkpoint of a run
@@ -201,8 +272,9 @@ def _resumable(settings_file: Path, model_file: Path,
     sittings = saved.pop("sittings", [])
     curve = saved.pop("curve", [])
     scores = saved.pop("selection", [])
-    # Checkpoints from before settings were recorded trained with SB3's defaults.
-    saved.setdefault("a2c_settings", SB3_DEFAULT_SETTINGS)
+    # Checkpoints from before settings were recorded trained A2C with SB3's defaults.
+    if saved.get("algorithm", "A2C") == "A2C":
+        saved.setdefault("a2c_settings", SB3_DEFAULT_SETTINGS)
     saved.setdefault("start_rule", "scene")  # and drew starts scene first
     saved.setdefault("keep", "last")  # and kept the last snapshot
     if saved.get("dataset") == "/":
@@ -214,16 +286,24 @@ def _resumable(settings_file: Path, model_file: Path,
     return done, sittings, curve if isinstance(curve, list) else [], scores if isinstance(scores, list) else []
 
 
-def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed: int = 0,
-              out_path: str | os.PathLike[str] = "a2c.zip", n_envs: int = 8,
-              crop: str | None = None, cache_dir: str | os.PathLike[str] | None = None,
-              arch: str = "paper", device: str = "auto", verbose: int = 0,
-              callback: Any = None, checkpoint_every: int = CHECKPOINT_EVERY,
-              settings: str | dict[str, Any] = "ours", keep: str = "best-train",
-              select_every: int = SELECT_EVERY) -> Path:
-    """Train the paper's A2C agent on the train split and save it; resume a killed run.
+def train_a2c(dataset: Any, scenario: str, **kwargs: Any) -> Path:
+    """:func:`train_agent` with ``algo="a2c"``: the paper's agent."""
+    return train_agent(dataset, scenario, algo="a2c", **kwargs)
 
-    Hyperparameters (the paper gives none) are Stable-Baselines3's A2C defaults, learning rate
+
+def train_agent(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed: int = 0,
+                out_path: str | os.PathLike[str] = "a2c.zip", n_envs: int = 8,
+                crop: str | None = None, cache_dir: str | os.PathLike[str] | None = None,
+                arch: str = "paper", device: str = "auto", verbose: int = 0,
+                callback: Any = None, checkpoint_every: int = CHECKPOINT_EVERY,
+                settings: str | dict[str, Any] = "ours", keep: str = "best-train",
+                select_every: int = SELECT_EVERY, algo: str = "a2c", progress: bool = True) -> Path:
+    """Train an agent on the train split and save it; resume a killed run.
+
+    PPO and DQN: Stable-Baselines3's defaults changed only by :data:`SB3_SETTINGS` (``settings``
+    applies to A2C only), ``CnnPolicy`` with the same ``arch`` network as A2C; DQN acts on the
+    environment's discrete moves (``done`` included). Everything else below holds for all three.
+    A2C's hyperparameters (the paper gives none) are Stable-Baselines3's A2C defaults, learning rate
     7e-4, ``n_steps=5`` per environment and update, ``gamma=0.99``, ``gae_lambda=1``,
     ``vf_coef=0.5``, ``max_grad_norm=0.5``, RMSprop (alpha 0.99, eps 1e-5), changed by
     ``settings``: by default :data:`A2C_SETTINGS` (``ent_coef=0.01``, normalised advantages);
@@ -256,15 +336,20 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
         keep: ``best-train`` (default): save the snapshot with the best train-split OER_tau,
             scored every ``select_every`` steps and at the end; ``last``: the last one.
         select_every: Environment steps between train-split scores (``best-train`` only).
+        algo: ``a2c`` (default), ``ppo`` or ``dqn`` (:data:`ALGORITHMS`).
+        progress: Show progress (:class:`TrainingProgress`).
 
     Returns:
         The saved model's path.
 
     Raises:
-        UserError: for a bad dataset, scenario, split or architecture.
+        UserError: for a bad dataset, scenario, split, algorithm or architecture.
     """
-    from stable_baselines3 import A2C
+    import stable_baselines3
 
+    if algo not in ALGORITHMS:
+        raise UserError(f"unknown algorithm {algo!r}: choose one of {', '.join(ALGORITHMS)}")
+    algorithm = getattr(stable_baselines3, algo.upper())
     if arch not in ARCHITECTURES:
         raise UserError(f"unknown network {arch!r}: choose one of {', '.join(ARCHITECTURES)}")
     if total_timesteps < 1 or n_envs < 1 or checkpoint_every < 0 or select_every < 0:
@@ -272,26 +357,26 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
     check_keep(keep)
     check_seed(seed, "--seed")
     check_device(device)
-    a2c_settings = resolve_settings(settings)
+    chosen = resolve_settings(settings) if algo == "a2c" else resolve_sb3_settings(algo, settings)
     final = model_path(Path(out_path).expanduser().absolute())
     prove_writable_file(final)  # before hours of training, not after
     model_file, settings_file = checkpoint_paths(final)
     # A path names the dataset itself (a Path's own .root would be "/"); a reader's dataset, its root.
     root = dataset if isinstance(dataset, (str, os.PathLike)) else getattr(dataset, "root", dataset)
     settings = {"dataset": str(Path(root).expanduser().absolute()), "scenario": scenario, "crop": crop,
-                "seed": seed, "n_envs": n_envs, "arch": arch, "algorithm": "A2C",
-                "a2c_settings": a2c_settings, "start_rule": "pairs", "keep": keep}
+                "seed": seed, "n_envs": n_envs, "arch": arch, "algorithm": algo.upper(),
+                "a2c_settings" if algo == "a2c" else "sb3_settings": chosen, "start_rule": "pairs", "keep": keep}
     opened = as_dataset(dataset)
     env = make_vec_tvm(opened, scenario, n_envs, seed, "train", crop, cache_dir)
     resumed = _resumable(settings_file, model_file, settings)
     scores: list[dict[str, Any]] = []
     if resumed is not None:
         done, earlier, points, scores = resumed
-        model = A2C.load(model_file, env=env, device=device)
+        model = algorithm.load(model_file, env=env, device=device)
         print(f"resuming {final.name} from its checkpoint at {done} of {total_timesteps} steps", flush=True)
     else:
-        model = A2C("CnnPolicy", env, seed=seed, device=device, verbose=verbose,
-                    policy_kwargs=dict(ARCHITECTURES[arch]), **a2c_settings)
+        model = algorithm("CnnPolicy", env, seed=seed, device=device, verbose=verbose,
+                          policy_kwargs=dict(ARCHITECTURES[arch]), **chosen)
         done, earlier, points = 0, [], []
     sittings = _Sittings(earlier, done)
     curve = LearningCurve(CURVE_EVERY, points)
@@ -300,7 +385,8 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
         scoring_env = TVMEnv(opened, scenario, split="train", crop=crop, cache_dir=cache_dir)
         selection = KeepBestOnTrain(scoring_env, final, select_every, save_model, scores,
                                     prune_at_once=not checkpoint_every)
-    callbacks = [c for c in (callback, curve, selection) if c is not None]
+    shown = TrainingProgress(total_timesteps, f"{algo.upper()} {scenario}", selection) if progress else None
+    callbacks = [c for c in (callback, curve, selection, shown) if c is not None]
     if checkpoint_every:
         callbacks.append(_Checkpoint(checkpoint_every, model_file, settings_file, settings, sittings, curve,
                                      selection))
@@ -352,6 +438,28 @@ def resolve_settings(settings: str | dict[str, Any]) -> dict[str, Any]:
     if wrong:
         raise UserError(f"A2C setting {wrong[0]!r} cannot be changed here: use {', '.join(TUNABLE)}")
     return {**SB3_DEFAULT_SETTINGS, **settings}
+
+
+def resolve_sb3_settings(algo: str, settings: str | dict[str, Any]) -> dict[str, Any]:
+    """PPO's or DQN's settings: :data:`SB3_SETTINGS` (``"ours"``), or those with a dict of the
+    algorithm's own keyword arguments over them (short runs in tests: a shorter rollout).
+
+    Raises:
+        UserError: for an A2C preset other than ``ours``, or an argument the algorithm lacks.
+    """
+    import inspect
+
+    import stable_baselines3
+
+    if isinstance(settings, str):
+        if settings != "ours":
+            raise UserError(f"--a2c-settings {settings} is for --algo a2c; {algo} trains with SB3's defaults")
+        return dict(SB3_SETTINGS[algo])
+    known = inspect.signature(getattr(stable_baselines3, algo.upper())).parameters
+    wrong = [k for k in settings if k not in known or k in ("policy", "env", "seed", "device", "verbose")]
+    if wrong:
+        raise UserError(f"{algo.upper()} setting {wrong[0]!r} cannot be changed here")
+    return {**SB3_SETTINGS[algo], **settings}
 
 
 def check_device(device: str) -> None:

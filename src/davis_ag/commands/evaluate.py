@@ -60,7 +60,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Evaluate, print the table, write JSON and PNG."""
-    from davis_ag.benchmark.evaluation import evaluate, format_table
+    from davis_ag.benchmark.evaluation import evaluate, format_table, write_json
     from davis_ag.benchmark.policies import policy_from_spec
     from davis_ag.figures.result_charts import plot_results
 
@@ -85,7 +85,7 @@ def run(args: argparse.Namespace) -> int:
                        cache_dir=args.cache_dir)
     print(format_table(results))
     # The JSON is the result: keep it somewhere even when --out fails at the end.
-    write_or_rescue(out, results.write, "the results")
+    write_or_rescue(out, lambda path: write_json(results, path), "the results")
     try:
         plot_results(results.as_json(), plot)
     except OSError as error:
