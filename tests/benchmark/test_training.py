@@ -146,7 +146,7 @@ def test_ppo_and_dqn_train_resume_and_keep_the_best(algo: str, sp_root: Path, tm
     progress goes to the log as lines (not a terminal here)."""
     import stable_baselines3
 
-    from davis_ag.benchmark import training
+    from davis_ag.benchmark import algorithms, progress, training
     from davis_ag.benchmark.policies import model_algorithm
 
     out = tmp_path / algo
@@ -156,7 +156,7 @@ def test_ppo_and_dqn_train_resume_and_keep_the_best(algo: str, sp_root: Path, tm
     with pytest.raises(KeyboardInterrupt):
         training.train_agent(sp_root, "sp", callback=KillAfter(170), **kwargs)
     assert json.loads(checkpoint_paths(out)[1].read_text())["timesteps_done"] == 160
-    monkeypatch.setattr(training, "PROGRESS_EVERY_S", 0.0)  # a log line per step, not one a minute
+    monkeypatch.setattr(progress, "PROGRESS_EVERY_S", 0.0)  # a log line per step, not one a minute
     path = training.train_agent(sp_root, "sp", **kwargs)
     printed = capsys.readouterr()
     assert f"resuming {algo}.zip from its checkpoint at 160 of 240 steps" in printed.out
@@ -164,7 +164,7 @@ def test_ppo_and_dqn_train_resume_and_keep_the_best(algo: str, sp_root: Path, tm
     assert model_algorithm(path) == algo.upper()
     model = getattr(stable_baselines3, algo.upper()).load(path, device="cpu")
     record = json.loads(training_record_path(out).read_text())
-    assert record["algorithm"] == algo.upper() and record["sb3_settings"] == {**training.SB3_SETTINGS[algo], **short}
+    assert record["algorithm"] == algo.upper() and record["sb3_settings"] == {**algorithms.SB3_SETTINGS[algo], **short}
     assert [(s["from_step"], s["to_step"]) for s in record["sittings"]] == [(0, 160), (160, 240)]
     kept = record["selection"]
     assert kept["kept_step"] == max(kept["scores"], key=lambda s: (s["oer_tau"], -s["step"]))["step"]

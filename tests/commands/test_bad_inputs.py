@@ -117,6 +117,10 @@ def test_bad_values_of_evaluate(extra: list[str], message: str, capsys: pytest.C
 @pytest.mark.parametrize("extra, message", [
     (["--seed", "-1"], "--seed"), (["--timesteps", "0"], "--timesteps"), (["--n-envs", "0"], "--n-envs"),
     (["--device", "banana"], "--device"), (["--verbose", "7"], "--verbose"), (["--crop", "vine"], "no sp/vine"),
+    (["--algo", "sac"], "--algo"), (["--set", "n_steps"], "is not KEY=VALUE"),
+    (["--algo", "ppo", "--set", "n_stepz=8"], "PPO setting 'n_stepz' cannot be changed"),
+    (["--algo", "dqn", "--a2c-settings", "sb3"], "--a2c-settings is for --algo a2c"),
+    (["--set", "use_rms_prop=false"], "A2C setting 'use_rms_prop' cannot be changed"),
 ])
 def test_bad_values_of_train(extra: list[str], message: str, capsys: pytest.CaptureFixture[str],
                              sp_root: Path, tmp_path: Path) -> None:

@@ -10,7 +10,8 @@ from kill_callback import KillAfter
 from layout_factory import write_tiny_dataset
 from stable_baselines3.common.callbacks import CallbackList
 
-from davis_ag.benchmark.training import TrainingProgress, train_a2c
+from davis_ag.benchmark.progress import TrainingProgress
+from davis_ag.benchmark.training import train_a2c
 
 
 def test_progress_of_a_resumed_run_starts_at_its_checkpoint(tmp_path: Path, one_thread: None) -> None:

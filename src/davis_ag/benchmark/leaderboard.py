@@ -33,6 +33,7 @@ class Row:
     """One method of the leaderboard: its name, the file it comes from and its results."""
 
     name: str
+    base: str
     file: Path
     results: EvaluationResults
     policy: PolicyResult
@@ -112,12 +113,12 @@ def leaderboard(paths: list[str | os.PathLike[str]]) -> list[Row]:
     rows: list[Row] = []
     for path, results in files:
         for name, policy in results.policies.items():
-            same = [r for r in rows if r.name == name or r.name.startswith(f"{name} (")]
+            same = [r for r in rows if r.base == name]
             if any(r.policy.oer_tau == policy.oer_tau and r.policy.reward == policy.reward for r in same):
                 continue
             label = f"{name} ({path.name})" if same else name
             gaps = {b: _gap(results, policy, b, files) for b in PAIRED_BASELINES if b != name}
-            rows.append(Row(label, path, results, policy, gaps))
+            rows.append(Row(label, name, path, results, policy, gaps))
     return sorted(rows, key=lambda r: -r.policy.oer_tau.mean)
 
 
@@ -144,5 +145,5 @@ def format_leaderboard(rows: list[Row]) -> str:
         cells += [_gap_cell(row.gaps.get(b)) for b in baselines] + [row.file.name]
         lines.append("| " + " | ".join(cells) + " |")
     lines += ["", "Mean ± std over sessions. Gap: mean OER_tau minus the baseline's on the same episodes, with the "
-              "95 % bootstrap interval over episodes; `-` where the two did not play the same episodes."]
+              "95 % bootstrap interval over episodes; `-`: the baseline itself, or a method that did not play the same episodes."]
     return "\n".join(lines) + "\n"

@@ -16,7 +16,6 @@ from __future__ import annotations
 import json
 import os
 import shutil
-import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -26,7 +25,9 @@ from stable_baselines3.common.callbacks import BaseCallback
 
 from davis_ag.atomic_files import atomic_output, prove_writable_file, write_json_atomic, write_or_rescue
 from davis_ag.benchmark import TVMEnv
+from davis_ag.benchmark.algorithms import ALGORITHMS, resolve_sb3_settings
 from davis_ag.benchmark.networks import ARCHITECTURES
+from davis_ag.benchmark.progress import TrainingProgress
 from davis_ag.benchmark.selection import KeepBestOnTrain, check_keep, snapshot_path
 from davis_ag.benchmark.tvm import as_dataset
 from davis_ag.errors import UserError
@@ -56,20 +57,6 @@ A2C_SETTINGS: dict[str, Any] = {"ent_coef": 0.01, "normalize_advantage": True}
 SB3_DEFAULT_SETTINGS: dict[str, Any] = {"ent_coef": 0.0, "normalize_advantage": False}
 #: Named setting sets of :func:`train_a2c`.
 SETTINGS_PRESETS: dict[str, dict[str, Any]] = {"ours": A2C_SETTINGS, "sb3": SB3_DEFAULT_SETTINGS}
-#: Seconds between progress lines in a log (on a terminal a bar is redrawn instead).
-PROGRESS_EVERY_S = 60.0
-#: The algorithms :func:`train_agent` trains (``davis-ag train --algo``).
-ALGORITHMS: tuple[str, ...] = ("a2c", "ppo", "dqn")
-#: PPO's and DQN's settings on top of Stable-Baselines3's defaults. PPO: none. DQN: SB3's replay
-#: buffer holds 1M transitions, which at 224x224x4 bytes per observation (twice: the next one
-#: too) is 300 GB; 10,000 keep it near 2 GB (one copy, ``optimize_memory_usage``, which needs
-#: ``handle_timeout_termination`` off: our episodes end with terminated, never truncated).
-#: Not tuned: the paper trains A2C only, and no change was measured on the train split.
-SB3_SETTINGS: dict[str, dict[str, Any]] = {
-    "ppo": {},
-    "dqn": {"buffer_size": 10_000, "optimize_memory_usage": True,
-            "replay_buffer_kwargs": {"handle_timeout_termination": False}},
-}
 #: SB3 A2C keyword arguments a setting set may change.
 TUNABLE = ("ent_coef", "normalize_advantage", "learning_rate", "n_steps", "gamma", "vf_coef",
            "max_grad_norm", "gae_lambda")
@@ -205,59 +192,6 @@ class _Checkpoint(BaseCallback):
         return True
 
 
-class TrainingProgress(BaseCallback):
-    """Training's progress over environment steps: a tqdm bar on a terminal (steps, rate, time
-    left, the last train-split score), and in a log (not a terminal) the same line once a minute.
-
-    A run resumed from a checkpoint starts at the checkpoint's step count, not at 0.
-    """
-
-    def __init__(self, total: int, label: str, selection: KeepBestOnTrain | None = None,
-                 every_s: float | None = None) -> None:
-        """Args:
-            total: The run's total environment steps.
-            label: What is trained (``PPO sp``), the bar's description.
-            selection: The snapshot scorer whose last score is shown.
-            every_s: Seconds between log lines when not on a terminal (default :data:`PROGRESS_EVERY_S`).
-        """
-        super().__init__()
-        self.total, self.label, self.selection = total, label, selection
-        self.every_s = PROGRESS_EVERY_S if every_s is None else every_s
-        self.steps, self._first, self._start, self._last, self.bar = 0, 0, 0.0, 0.0, None
-
-    def _on_training_start(self) -> None:
-        from tqdm import tqdm
-
-        self.steps = self._first = int(self.model.num_timesteps)
-        self._start = self._last = time.monotonic()
-        # disable=None: no bar where stderr is not a terminal (a log), the lines below instead.
-        self.bar = tqdm(total=self.total, initial=self.steps, desc=self.label, unit="step", mininterval=2,
-                        disable=None, dynamic_ncols=True)
-
-    def _score(self) -> str:
-        best = self.selection.scores[-1] if self.selection and self.selection.scores else None
-        return f"train OER_tau {best['oer_tau']:.3f} at {best['step']}" if best else "no train score yet"
-
-    def _on_step(self) -> bool:
-        from tqdm import tqdm
-
-        n = self.training_env.num_envs
-        self.steps += n
-        if not self.bar.disable:
-            self.bar.set_postfix_str(self._score(), refresh=False)
-            self.bar.update(n)
-        elif time.monotonic() - self._last >= self.every_s:
-            self._last = time.monotonic()
-            line = tqdm.format_meter(self.steps, self.total, self._last - self._start, prefix=self.label,
-                                     unit="step", initial=self._first, ncols=0)
-            print(f"{line} | {self._score()}", file=sys.stderr, flush=True)
-        return True
-
-    def _on_training_end(self) -> None:
-        if self.bar is not None:
-            self.bar.close()
-
-
 def _resumable(settings_file: Path, model_file: Path,
                settings: dict[str, Any]) -> tuple[int, list, list, list] | None:
     """Steps done, sittings, learning curve and snapshot scores so far of a checkpoint of a run
@@ -300,9 +234,10 @@ def train_agent(dataset: Any, scenario: str, total_timesteps: int = 300_000, see
                 select_every: int = SELECT_EVERY, algo: str = "a2c", progress: bool = True) -> Path:
     """Train an agent on the train split and save it; resume a killed run.
 
-    PPO and DQN: Stable-Baselines3's defaults changed only by :data:`SB3_SETTINGS` (``settings``
-    applies to A2C only), ``CnnPolicy`` with the same ``arch`` network as A2C; DQN acts on the
-    environment's discrete moves (``done`` included). Everything else below holds for all three.
+    PPO and DQN: Stable-Baselines3's defaults changed only by
+    :data:`davis_ag.benchmark.algorithms.SB3_SETTINGS` (and a ``settings`` dict), ``CnnPolicy``
+    with the same ``arch`` network as A2C; DQN acts on the environment's discrete moves (``done``
+    included). Everything else below holds for all three.
     A2C's hyperparameters (the paper gives none) are Stable-Baselines3's A2C defaults, learning rate
     7e-4, ``n_steps=5`` per environment and update, ``gamma=0.99``, ``gae_lambda=1``,
     ``vf_coef=0.5``, ``max_grad_norm=0.5``, RMSprop (alpha 0.99, eps 1e-5), changed by
@@ -438,28 +373,6 @@ def resolve_settings(settings: str | dict[str, Any]) -> dict[str, Any]:
     if wrong:
         raise UserError(f"A2C setting {wrong[0]!r} cannot be changed here: use {', '.join(TUNABLE)}")
     return {**SB3_DEFAULT_SETTINGS, **settings}
-
-
-def resolve_sb3_settings(algo: str, settings: str | dict[str, Any]) -> dict[str, Any]:
-    """PPO's or DQN's settings: :data:`SB3_SETTINGS` (``"ours"``), or those with a dict of the
-    algorithm's own keyword arguments over them (short runs in tests: a shorter rollout).
-
-    Raises:
-        UserError: for an A2C preset other than ``ours``, or an argument the algorithm lacks.
-    """
-    import inspect
-
-    import stable_baselines3
-
-    if isinstance(settings, str):
-        if settings != "ours":
-            raise UserError(f"--a2c-settings {settings} is for --algo a2c; {algo} trains with SB3's defaults")
-        return dict(SB3_SETTINGS[algo])
-    known = inspect.signature(getattr(stable_baselines3, algo.upper())).parameters
-    wrong = [k for k in settings if k not in known or k in ("policy", "env", "seed", "device", "verbose")]
-    if wrong:
-        raise UserError(f"{algo.upper()} setting {wrong[0]!r} cannot be changed here")
-    return {**SB3_SETTINGS[algo], **settings}
 
 
 def check_device(device: str) -> None:
