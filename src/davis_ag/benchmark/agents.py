@@ -15,7 +15,8 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from davis_ag.benchmark.tvm import TVMEnv
+from davis_ag.benchmark.policies import SeededPolicy, baselines_by_name, unwrapped
+from davis_ag.benchmark.tvm import TVM_ID, TVMEnv
 from davis_ag.benchmark.exact import action_probabilities
 from davis_ag.errors import UserError
 
@@ -34,13 +35,10 @@ def tvm(env: gym.Env) -> TVMEnv:
     Raises:
         UserError: when ``env`` is not a TVM environment.
     """
-    inner = getattr(env, "unwrapped", env)
-    if not isinstance(inner, TVMEnv):
-        raise UserError(f"expected a davis_ag/TVM-v0 environment, got {type(inner).__name__}")
-    return inner
+    return unwrapped(env, TVMEnv, TVM_ID)
 
 
-class HeuristicAgent:
+class HeuristicAgent(SeededPolicy):
     """Uniformly random actions from a fixed set of action names (LRD, UDD, Rand)."""
 
     def __init__(self, name: str, actions: tuple[str, ...] | None, seed: int | None = None) -> None:
@@ -49,9 +47,9 @@ class HeuristicAgent:
             actions: Action names to draw from; ``None`` means every action of the environment.
             seed: Seed of the agent's generator until the next :meth:`reset` with a seed.
         """
+        super().__init__(seed)
         self.name = name
         self.actions = actions
-        self._rng = np.random.default_rng(seed)
         self._indices = np.zeros(0, dtype=np.int64)
 
     def prepare(self, env: gym.Env) -> None:
@@ -66,11 +64,6 @@ class HeuristicAgent:
         if missing:
             raise UserError(f"{self.name} needs actions {missing} that this environment lacks ({', '.join(names)})")
         self._indices = np.array([names.index(a) for a in wanted])
-
-    def reset(self, seed: int | None = None) -> None:
-        """Reseed the action draw (``None`` keeps the current stream)."""
-        if seed is not None:
-            self._rng = np.random.default_rng(seed)
 
     def act(self, observation: np.ndarray, info: dict[str, Any]) -> int:
         """Draw one action of the set, as an index of the environment :meth:`prepare` saw."""
@@ -195,8 +188,10 @@ class OracleAgent:
 
 
 #: Baseline names :func:`build_agents` accepts (trained models come from
-#: :func:`davis_ag.benchmark.policies.policy_from_spec`).
-AGENT_NAMES: tuple[str, ...] = ("LRD", "UDD", "Rand", "Oracle")
+#: :func:`davis_ag.benchmark.policies.policy_from_spec`), and what makes each.
+BASELINES: dict[str, Any] = {**{name: (lambda name=name: heuristic(name)) for name in HEURISTIC_ACTIONS},
+                             "Oracle": OracleAgent}
+AGENT_NAMES: tuple[str, ...] = tuple(BASELINES)
 
 
 def build_agents(names: list[str]) -> list[Any]:
@@ -205,15 +200,4 @@ def build_agents(names: list[str]) -> list[Any]:
     Raises:
         UserError: for an unknown name (a trained model is a ``--policy MODEL.zip``).
     """
-    agents: list[Any] = []
-    for name in names:
-        key = name.strip().lower()
-        if key == "oracle":
-            agents.append(OracleAgent())
-        elif key in {k.lower() for k in HEURISTIC_ACTIONS}:
-            agents.append(heuristic(key))
-        elif key in ("a2c", "model"):
-            raise UserError(f"{name} is not a baseline: give the trained model with --policy MODEL.zip")
-        else:
-            raise UserError(f"unknown policy {name!r}: choose from {', '.join(AGENT_NAMES)}")
-    return agents
+    return baselines_by_name(names, BASELINES)

@@ -63,6 +63,57 @@ class Policy(Protocol):
         """The action for ``observation`` (``info``: what the environment said with it)."""
 
 
+def unwrapped(env: Any, kind: type, env_id: str) -> Any:
+    """The environment of class ``kind`` under any wrappers (what a policy's ``prepare`` reads).
+
+    Raises:
+        UserError: when ``env`` is another environment.
+    """
+    inner = getattr(env, "unwrapped", env)
+    if not isinstance(inner, kind):
+        raise UserError(f"expected a {env_id} environment, got {type(inner).__name__}")
+    return inner
+
+
+class SeededPolicy:
+    """Base of the policies with a random stream of their own: ``reset(seed)`` reseeds it."""
+
+    def __init__(self, seed: int | None = None) -> None:
+        """Args:
+            seed: Seed of the policy's generator until :meth:`reset` gets one.
+        """
+        self._rng = np.random.default_rng(seed)
+
+    def reset(self, seed: int | None = None) -> None:
+        """Reseed the policy's draws (``None`` keeps the current stream)."""
+        if seed is not None:
+            self._rng = np.random.default_rng(seed)
+
+
+def baselines_by_name(names: list[str], makers: dict[str, Callable[[], Any]], kind: str = "") -> list[Any]:
+    """An environment's baselines by name, in the order given (any case).
+
+    Args:
+        names: The names asked for.
+        makers: Each baseline's name and a function making it.
+        kind: How error messages call the environment's policies (``"continuous "``).
+
+    Raises:
+        UserError: for an unknown name (a trained model is a ``--policy MODEL.zip``).
+    """
+    canonical = {k.lower(): k for k in makers}
+    made = []
+    for name in names:
+        key = name.strip().lower()
+        if key in canonical:
+            made.append(makers[canonical[key]]())
+        elif key in ("model", *(a.lower() for a in ALGORITHMS)):
+            raise UserError(f"{name} is not a baseline: give the trained model with --policy MODEL.zip")
+        else:
+            raise UserError(f"unknown {kind}policy {name!r}: choose from {', '.join(makers)}")
+    return made
+
+
 def prepare(policy: Any, env: Any) -> None:
     """Call the policy's optional ``prepare(env)`` (learn the environment, refuse a misfit)."""
     method = getattr(policy, "prepare", None)

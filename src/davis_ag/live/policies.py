@@ -19,6 +19,8 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+from davis_ag.benchmark.policies import SeededPolicy, baselines_by_name, unwrapped
+from davis_ag.benchmark.tvm import CONTINUOUS_ID
 from davis_ag.errors import UserError
 from davis_ag.live.tvm_continuous import TVMContinuousEnv
 
@@ -32,13 +34,10 @@ def continuous(env: gym.Env) -> TVMContinuousEnv:
     Raises:
         UserError: for another environment.
     """
-    inner = getattr(env, "unwrapped", env)
-    if not isinstance(inner, TVMContinuousEnv):
-        raise UserError(f"expected a davis_ag/TVMContinuous-v0 environment, got {type(inner).__name__}")
-    return inner
+    return unwrapped(env, TVMContinuousEnv, CONTINUOUS_ID)
 
 
-class RandomAxes:
+class RandomAxes(SeededPolicy):
     """Uniform random moves along some action components (LR, UD), or all of them (Rand)."""
 
     def __init__(self, name: str, axes: tuple[int, ...] | None, seed: int | None = None) -> None:
@@ -47,18 +46,13 @@ class RandomAxes:
             axes: Action components to draw (uniform in [-1, 1]); the rest stay 0. None: all.
             seed: Seed of the agent's generator until :meth:`reset` gets one.
         """
+        super().__init__(seed)
         self.name, self.axes = name, axes
-        self._rng = np.random.default_rng(seed)
         self._size = 0
 
     def prepare(self, env: gym.Env) -> None:
         """Read the action's size (3 with ``aim="plant"``, 5 with ``"free"``)."""
         self._size = continuous(env).action_space.shape[0]
-
-    def reset(self, seed: int | None = None) -> None:
-        """Reseed (None keeps the stream)."""
-        if seed is not None:
-            self._rng = np.random.default_rng(seed)
 
     def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         """One random action of the environment's shape."""
@@ -69,7 +63,7 @@ class RandomAxes:
         return action
 
 
-class Greedy:
+class Greedy(SeededPolicy):
     """Tries ``candidates`` random actions (without slip) and plays the best for the target's OER;
     stands still when none beats staying."""
 
@@ -78,18 +72,13 @@ class Greedy:
             candidates: Actions tried per step (one render each).
             seed: Seed of the candidate draw.
         """
+        super().__init__(seed)
         self.name, self.candidates = "Greedy", int(candidates)
-        self._rng = np.random.default_rng(seed)
         self._env: TVMContinuousEnv | None = None
 
     def prepare(self, env: gym.Env) -> None:
         """Keep the environment: its renders score the candidates."""
         self._env = continuous(env)
-
-    def reset(self, seed: int | None = None) -> None:
-        """Reseed (None keeps the stream)."""
-        if seed is not None:
-            self._rng = np.random.default_rng(seed)
 
     def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         """The best candidate action by the OER it would give."""
@@ -106,8 +95,11 @@ class Greedy:
 
 
 #: Baseline names :func:`build_policies` accepts (trained models come from
-#: :func:`davis_ag.benchmark.policies.policy_from_spec`).
-POLICY_NAMES: tuple[str, ...] = ("LR", "UD", "Rand", "Greedy")
+#: :func:`davis_ag.benchmark.policies.policy_from_spec`), and what makes each.
+BASELINES: dict[str, Any] = {
+    **{name: (lambda name=name, axes=axes: RandomAxes(name, axes)) for name, axes in HEURISTIC_AXES.items()},
+    "Greedy": Greedy}
+POLICY_NAMES: tuple[str, ...] = tuple(BASELINES)
 
 
 def build_policies(names: list[str]) -> list[Any]:
@@ -116,16 +108,4 @@ def build_policies(names: list[str]) -> list[Any]:
     Raises:
         UserError: for an unknown name (a trained model is a ``--policy MODEL.zip``).
     """
-    policies: list[Any] = []
-    for name in names:
-        key = name.strip().lower()
-        match = next((k for k in HEURISTIC_AXES if k.lower() == key), None)
-        if match:
-            policies.append(RandomAxes(match, HEURISTIC_AXES[match]))
-        elif key == "greedy":
-            policies.append(Greedy())
-        elif key in ("model", "a2c", "ppo", "sac"):
-            raise UserError(f"{name} is not a baseline: give the trained model with --policy MODEL.zip")
-        else:
-            raise UserError(f"unknown continuous policy {name!r}: choose from {', '.join(POLICY_NAMES)}")
-    return policies
+    return baselines_by_name(names, BASELINES, "continuous ")
