@@ -104,9 +104,13 @@ def pools_for(command: str, out: str) -> tuple[list[str], dict[str, st.SearchStr
                  "--sessions", "1"]
         return first, {"--dataset": ANY, "--scenario": ANY, "--crop": ANY, "--split": ANY,
                        "--model": st.sampled_from(["missing.zip", "a-file", "data", f"{out}/none.zip"]),
-                       "--policies": ANY, "--stochastic": FLAG, "--env": st.sampled_from(["grid", "continuous", "x"]), "--episodes": small, "--sessions": small,
+                       "--policy": st.sampled_from(["missing.zip", "a-file", "nope.py:act", "json:loads", "os:path",
+                                                    "a-file:x", "data"]),
+                       "--name": ANY, "--policies": ANY, "--deterministic": FLAG, "--env": st.sampled_from(["grid", "continuous", "x"]), "--episodes": small, "--sessions": small,
                        "--seed": ANY, "--cache-dir": cache, "--out": out_or_bad,
                        "--plot": st.sampled_from([f"{out}/p.png", "/proc/x/p.png", "data", f"{out}/r.json"])}, []
+    if command == "compare":
+        return [], {"--out": st.sampled_from([f"{out}/b.md", "/proc/x/b.md", "data", "a-file/sub"])}, []
     if command == "validate":
         return [], {"--quick": FLAG, "--box-tolerance": ANY}, []
     if command == "stats":
@@ -139,8 +143,8 @@ def pools_for(command: str, out: str) -> tuple[list[str], dict[str, st.SearchStr
 
 
 #: The commands the property drives; a new command must be added here (and to pools_for).
-COVERED = ("generate", "demo", "reproduce", "preview", "train", "evaluate", "validate", "stats", "plot", "view",
-           "export", "transfer", "bench", "scene-stats")
+COVERED = ("generate", "demo", "reproduce", "preview", "train", "evaluate", "compare", "validate", "stats", "plot",
+           "view", "export", "transfer", "bench", "scene-stats")
 
 
 def test_every_command_is_covered() -> None:
@@ -166,6 +170,9 @@ def test_no_traceback_and_nothing_outside_the_output_changes(command: str, data:
         argv[1:1] = [data.draw(st.sampled_from(["visibility", "altitude", "oer", "actions", "episode", "phenotypes",
                                                 "bogus"]), label="kind"),
                      data.draw(st.sampled_from(["data", "empty", "missing", "a-file"]), label="dir")]
+    elif command == "compare":
+        argv[1:1] = data.draw(st.lists(st.sampled_from(["missing.json", "a-file", "data", "empty", "/proc/x"]),
+                                       min_size=1, max_size=2), label="results")
     elif command == "view":
         argv.insert(1, data.draw(st.sampled_from(["empty", "missing", "a-file", "/proc/x"]), label="dir"))
     elif command == "export":

@@ -22,8 +22,9 @@ import time
 from pathlib import Path
 
 from davis_ag.benchmark import TVMEnv
-from davis_ag.benchmark.agents import A2CAgent, FixedActionAgent, heuristic
-from davis_ag.benchmark.evaluation import evaluate_agents
+from davis_ag.benchmark.agents import FixedActionAgent, heuristic
+from davis_ag.benchmark.policies import ModelPolicy
+from davis_ag.benchmark.evaluation import evaluate_policies
 from davis_ag.benchmark.training import train_a2c, training_record_path
 
 
@@ -89,15 +90,15 @@ def main() -> int:
                           arch=args.arch, device=args.device, checkpoint_every=0, settings=settings,
                           cache_dir=args.cache_dir, keep=args.keep)
         seconds = time.perf_counter() - start
-        deterministic = A2CAgent(model, deterministic=True, device=args.device)
+        deterministic = ModelPolicy(model, deterministic=True, device=args.device)
         deterministic.name = "A2C deterministic"
-        sampled = A2CAgent(model, deterministic=False, device=args.device)
+        sampled = ModelPolicy(model, deterministic=False, device=args.device)
         sampled.name = "A2C sampled"
         agents = [deterministic, sampled]
         if args.baselines:
             agents += [heuristic(n) for n in ("LRD", "UDD", "Rand")]
             agents += [FixedActionAgent(a) for a in env.action_names]
-        results = evaluate_agents(env, agents, episodes=200, sessions=3, seed=args.seed)
+        results = evaluate_policies(env, agents, episodes=200, sessions=3, seed=args.seed).as_json()
         record = json.loads(training_record_path(model).read_text())
         start_policy = policy_at_starts(deterministic.model, env)
         out = {"trial": name, "settings": record["a2c_settings"], "timesteps": args.timesteps,

@@ -23,10 +23,10 @@ from pathlib import Path
 import numpy as np
 
 from davis_ag.atomic_files import write_marked_section
-from davis_ag.benchmark.evaluation import format_table
-from davis_ag.live.evaluation import evaluate_continuous
+from davis_ag.benchmark.evaluation import evaluate_policies, format_table
+from davis_ag.benchmark.policies import ModelPolicy
 from davis_ag.figures.result_charts import plot_training_curve
-from davis_ag.live.policies import ModelAgent, build_policies
+from davis_ag.live.policies import build_policies
 from davis_ag.live.training import train_continuous
 from davis_ag.live.tvm_continuous import TVMContinuousEnv
 
@@ -54,8 +54,10 @@ def main() -> None:
                                                f"SP strawberry scene 0, {args.timesteps:,} steps", window=100)
         env = TVMContinuousEnv(scene_dir, "sp")
         try:
-            results = evaluate_continuous(env, [ModelAgent(model), *build_policies(["LR", "UD", "Rand", "Greedy"])],
-                                          episodes=args.episodes, sessions=3)
+            # deterministic: the mean action, as this page's numbers were measured
+            results = evaluate_policies(env, [ModelPolicy(model, deterministic=True),
+                                              *build_policies(["LR", "UD", "Rand", "Greedy"])],
+                                        episodes=args.episodes, sessions=3)
         finally:
             env.close()
     table = format_table(results)

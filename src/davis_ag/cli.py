@@ -15,8 +15,8 @@ from davis_ag.provenance import code_version
 # Each name is a module of davis_ag.commands defining HELP, DESCRIPTION, add_arguments(parser),
 # run(args) and maybe FORMATTER_CLASS (the package's docstring says what each is); add_command alone
 # makes the sub-parsers from them, so that every command's is made the same way.
-COMMANDS = ["generate", "validate", "train", "evaluate", "preview", "demo", "reproduce", "stats", "plot",
-            "view", "export", "transfer", "bench", "scene-stats"]
+COMMANDS = ["generate", "validate", "train", "evaluate", "compare", "preview", "demo", "reproduce", "stats",
+            "plot", "view", "export", "transfer", "bench", "scene-stats"]
 
 
 #: What a stopped command keeps, for its last line (every command resumes by being run again).
@@ -121,7 +121,7 @@ def _stop_on_signals() -> dict[int, Any]:
             signal.signal(each, signal.SIG_IGN)
         stop(number)  # raises Stopped, at once or when a step that must not be cut (stops_held) ends
 
-    previous = {}
+    previous: dict[int, Any] = {}
     for number in (signal.SIGTERM, signal.SIGINT):
         try:
             previous[number] = signal.signal(number, on_signal)

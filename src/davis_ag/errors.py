@@ -5,7 +5,7 @@ a stop asked for by a signal 128 + the signal's number.
 """
 
 from contextlib import contextmanager
-from typing import Iterator
+from typing import Any, Iterator
 
 
 class UserError(Exception):
@@ -36,7 +36,7 @@ class Stopped(KeyboardInterrupt):
 
 
 #: Stops asked for while held (:func:`stops_held`): the signal number of the first, or None.
-_held = {"depth": 0, "pending": None}
+_held: dict[str, Any] = {"depth": 0, "pending": None}
 
 
 def stop(signal_number: int) -> None:

@@ -10,14 +10,14 @@ from layout_factory import write_tiny_dataset
 
 from davis_ag.benchmark import TVMEnv
 from davis_ag.benchmark.agents import (
-    A2CAgent,
     HeuristicAgent,
     OracleAgent,
     build_agents,
     heuristic,
     oracle_plan,
 )
-from davis_ag.benchmark.evaluation import evaluate_agents, run_episode
+from davis_ag.benchmark.evaluation import evaluate_policies, run_episode
+from davis_ag.benchmark.policies import ModelPolicy
 from davis_ag.benchmark.training import train_a2c
 from davis_ag.errors import UserError
 
@@ -32,13 +32,14 @@ def test_heuristic_action_sets(scenario: str, sp_root: Path, mp_root: Path) -> N
     }
     for name, names in expected.items():
         agent = heuristic(name, seed=0)
-        drawn = {env.action_names[agent.act(None, env)] for _ in range(400)}
+        agent.prepare(env)
+        drawn = {env.action_names[agent.act(None, {})] for _ in range(400)}
         assert drawn == names, name
     if scenario == "mp":
         assert {"rotate_cw", "rotate_ccw"} <= expected["Rand"]
     a, b = heuristic("rand", seed=3), heuristic("Rand", seed=99)
-    a.reset(5), b.reset(5)
-    assert [a.act(None, env) for _ in range(20)] == [b.act(None, env) for _ in range(20)]
+    a.prepare(env), b.prepare(env), a.reset(5), b.reset(5)
+    assert [a.act(None, {}) for _ in range(20)] == [b.act(None, {}) for _ in range(20)]
 
 
 def _brute_force(next_view: np.ndarray, oer: np.ndarray, start: int, tau: int) -> tuple[float, int]:
@@ -76,7 +77,7 @@ def test_oracle_dominates_on_the_same_episodes(sp_root: Path, mp_root: Path) -> 
     for root, scenario in ((sp_root, "sp"), (mp_root, "mp")):
         env = TVMEnv(root, scenario, "all")
         agents = build_agents(["LRD", "UDD", "Rand", "Oracle"])
-        results = evaluate_agents(env, agents, episodes=40, sessions=2, keep_episodes=True)
+        results = evaluate_policies(env, agents, episodes=40, sessions=2, keep_episodes=True).as_json()
         oracle = results["policies"]["Oracle"]["episodes"]
         for name in ("LRD", "UDD", "Rand"):
             other = results["policies"][name]["episodes"]
@@ -99,10 +100,10 @@ def test_oracle_episode_length_counts_done(sp_root: Path) -> None:
 def test_build_agents_errors() -> None:
     with pytest.raises(UserError, match="unknown policy"):
         build_agents(["LRD", "Greedy"])
-    with pytest.raises(UserError, match="--model"):
+    with pytest.raises(UserError, match="--policy MODEL.zip"):
         build_agents(["A2C"])
     with pytest.raises(UserError, match="no such model"):
-        A2CAgent("/nonexistent/model.zip")
+        ModelPolicy("/nonexistent/model.zip")
     assert isinstance(build_agents(["udd"])[0], HeuristicAgent)
 
 
@@ -119,9 +120,9 @@ def _short_a2c_run(sp_root: Path, tmp_path: Path) -> None:
                      n_envs=4, arch="pooled", device="cpu")
     assert path.suffix == ".zip" and path.is_file()
     env = TVMEnv(sp_root, "sp", "train")
-    results = evaluate_agents(env, [A2CAgent(path), heuristic("Rand")], episodes=200, sessions=2)
+    results = evaluate_policies(env, [ModelPolicy(path), heuristic("Rand")], episodes=200, sessions=2).as_json()
     a2c, rand = (results["policies"][n]["reward"]["mean"] for n in ("A2C", "Rand"))
     assert a2c > rand, (a2c, rand)
     mp = write_tiny_dataset(tmp_path / "mp", "mp", "strawberry", scenes=1)
     with pytest.raises(UserError, match="actions"):  # an SP model cannot drive MP (9 actions)
-        run_episode(TVMEnv(mp, "mp", "all"), A2CAgent(path), 0)
+        run_episode(TVMEnv(mp, "mp", "all"), ModelPolicy(path), 0)

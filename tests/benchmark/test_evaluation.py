@@ -13,7 +13,7 @@ from davis_ag.benchmark import TVMEnv
 from davis_ag.benchmark.agents import build_agents
 from davis_ag.benchmark.evaluation import (
     episode_seeds,
-    evaluate_agents,
+    evaluate_policies,
     format_table,
     run_episode,
     write_json,
@@ -42,7 +42,7 @@ def test_episode_seeds_are_fixed_and_distinct() -> None:
 def test_protocol_and_summary(sp_root: Path) -> None:
     env = TVMEnv(sp_root, "sp", "test")
     agents = build_agents(["LRD", "UDD", "Rand", "Oracle"])
-    results = evaluate_agents(env, agents, episodes=30, sessions=3, seed=5, keep_episodes=True)
+    results = evaluate_policies(env, agents, episodes=30, sessions=3, seed=5, keep_episodes=True).as_json()
     assert results["protocol"]["scenes"] == ["Single-Strawberry/001"]  # the test split only
     policies = results["policies"]
     assert list(policies) == ["LRD", "UDD", "Rand", "Oracle"]
@@ -68,7 +68,7 @@ def test_protocol_and_summary(sp_root: Path) -> None:
     starts = {name: [(e["scene"], e["path"][0], e["target_fruit"]) for e in s["episodes"]]
               for name, s in policies.items()}
     assert all(v == starts["LRD"] for v in starts.values())  # same episodes for every policy
-    again = evaluate_agents(env, build_agents(["Rand"]), episodes=30, sessions=3, seed=5)
+    again = evaluate_policies(env, build_agents(["Rand"]), episodes=30, sessions=3, seed=5).as_json()
     assert again["policies"]["Rand"]["reward"] == {
         k: v for k, v in policies["Rand"]["reward"].items()}  # reproducible
 
@@ -82,7 +82,7 @@ def test_episode_length_counts_done(sp_root: Path) -> None:
 
 def test_table_json_and_plot(sp_root: Path, tmp_path: Path) -> None:
     env = TVMEnv(sp_root, "sp", "test")
-    results = evaluate_agents(env, build_agents(["LRD", "Rand"]), episodes=10, sessions=2)
+    results = evaluate_policies(env, build_agents(["LRD", "Rand"]), episodes=10, sessions=2).as_json()
     table = format_table(results)
     lines = table.splitlines()
     assert "LRD" in lines[0] and "Rand" in lines[0]
@@ -92,6 +92,7 @@ def test_table_json_and_plot(sp_root: Path, tmp_path: Path) -> None:
     assert ("OER_tau exact" in table) == ("exact: expectation" in table)
     blind = {**results, "policies": {n: {k: v for k, v in p.items() if k != "exact"}
                                      for n, p in results["policies"].items()}}
+    assert "1 SP scene(s) (Single-Strawberry/001)" in table and "eligible starts" in table
     assert "exact" not in format_table(blind)
     out = write_json(results, tmp_path / "r" / "results.json")
     assert json.loads(out.read_text())["policies"].keys() == {"LRD", "Rand"}
@@ -140,7 +141,7 @@ def test_evaluate_bad_values_are_refused_as_parsed(sp_root: Path, tmp_path: Path
 def test_a_continuous_policy_on_the_grid_is_refused(sp_root: Path, tmp_path: Path) -> None:
     args = _parser().parse_args(["evaluate", "--dataset", str(sp_root), "--scenario", "sp",
                                  "--out", str(tmp_path / "r.json"), "--policies", "LRD,Greedy"])
-    with pytest.raises(UserError, match="not a policy of --env grid"):
+    with pytest.raises(UserError, match="not a baseline of --env grid"):
         args.func(args)
     assert not (tmp_path / "r.json").exists()
 

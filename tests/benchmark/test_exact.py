@@ -10,7 +10,7 @@ import pytest
 
 from davis_ag.benchmark import TVMEnv
 from davis_ag.benchmark.agents import FixedActionAgent, build_agents, heuristic
-from davis_ag.benchmark.evaluation import BEST_FIXED, evaluate_agents, write_json
+from davis_ag.benchmark.evaluation import BEST_FIXED, evaluate_policies, write_json
 from davis_ag.benchmark.exact import (
     action_probabilities,
     expected_metrics,
@@ -61,8 +61,8 @@ def test_dynamic_programme_matches_every_action_sequence_played(sp_root: Path, p
 
 def test_sampled_means_fall_within_their_standard_errors_of_the_exact_values(sp_root: Path) -> None:
     env = TVMEnv(sp_root, "sp", split="train")
-    results = evaluate_agents(env, build_agents(["LRD", "UDD", "Rand"]), episodes=200, sessions=3,
-                              seed=3, best_fixed_action=True)
+    results = evaluate_policies(env, build_agents(["LRD", "UDD", "Rand"]), episodes=200, sessions=3,
+                              seed=3, best_fixed_action=True).as_json()
     for name in ("LRD", "UDD", "Rand", BEST_FIXED):
         summary = results["policies"][name]
         for key in ("oer_tau", "reward", "length"):
@@ -72,7 +72,7 @@ def test_sampled_means_fall_within_their_standard_errors_of_the_exact_values(sp_
             else:
                 assert abs(mean - exact) <= 3 * sem, (name, key, mean, exact, sem)
     # A policy that looks at the image (the Oracle) has no exact value here.
-    oracle = evaluate_agents(env, build_agents(["Oracle"]), episodes=5, sessions=1)
+    oracle = evaluate_policies(env, build_agents(["Oracle"]), episodes=5, sessions=1).as_json()
     assert "exact" not in oracle["policies"]["Oracle"]
 
 
@@ -108,8 +108,8 @@ def test_unknown_start_rule_is_refused(sp_root: Path) -> None:
 
 def test_best_fixed_action_row_and_histograms_in_the_json(sp_root: Path, tmp_path: Path) -> None:
     env = TVMEnv(sp_root, "sp", split="test")
-    results = evaluate_agents(env, build_agents(["LRD", "Rand"]), episodes=40, sessions=3,
-                              best_fixed_action=True)
+    results = evaluate_policies(env, build_agents(["LRD", "Rand"]), episodes=40, sessions=3,
+                              best_fixed_action=True).as_json()
     fixed = fixed_action_expectations(env)
     assert list(results["fixed_actions"]) == list(env.action_names)
     for action, values in fixed.items():

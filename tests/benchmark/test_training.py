@@ -217,3 +217,36 @@ def test_a_cuda_device_the_machine_lacks_is_refused() -> None:
     with pytest.raises(UserError, match=f"--device cuda:{count + 6}: this machine has"):
         check_device(f"cuda:{count + 6}")
     check_device("cpu")
+
+
+@pytest.mark.parametrize("algo", ["ppo", "dqn"])
+def test_ppo_and_dqn_train_resume_and_keep_the_best(algo: str, sp_root: Path, tmp_path: Path,
+                                                     one_thread: None, capsys: pytest.CaptureFixture[str],
+                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+    """The same record, checkpoints, resume and keep-best-train rule as A2C, for each algorithm;
+    progress goes to the log as lines (not a terminal here)."""
+    import stable_baselines3
+
+    from davis_ag.benchmark import algorithms, progress, training
+    from davis_ag.benchmark.policies import model_algorithm
+
+    out = tmp_path / algo
+    short = {"ppo": {"n_steps": 20, "batch_size": 20}, "dqn": {"learning_starts": 40}}[algo]  # SB3's: 4,096-step rollouts
+    kwargs = dict(total_timesteps=240, seed=1, out_path=out, n_envs=2, arch="pooled", device="cpu",
+                  checkpoint_every=80, select_every=120, algo=algo, settings=short)
+    with pytest.raises(KeyboardInterrupt):
+        training.train_agent(sp_root, "sp", callback=KillAfter(170), **kwargs)
+    assert json.loads(checkpoint_paths(out)[1].read_text())["timesteps_done"] == 160
+    monkeypatch.setattr(progress, "PROGRESS_EVERY_S", 0.0)  # a log line per step, not one a minute
+    path = training.train_agent(sp_root, "sp", **kwargs)
+    printed = capsys.readouterr()
+    assert f"resuming {algo}.zip from its checkpoint at 160 of 240 steps" in printed.out
+    assert f"{algo.upper()} sp: 100%" in printed.err and "step/s" in printed.err and "train OER_tau" in printed.err
+    assert model_algorithm(path) == algo.upper()
+    model = getattr(stable_baselines3, algo.upper()).load(path, device="cpu")
+    record = json.loads(training_record_path(out).read_text())
+    assert record["algorithm"] == algo.upper() and record["sb3_settings"] == {**algorithms.SB3_SETTINGS[algo], **short}
+    assert [(s["from_step"], s["to_step"]) for s in record["sittings"]] == [(0, 160), (160, 240)]
+    kept = record["selection"]
+    assert kept["kept_step"] == max(kept["scores"], key=lambda s: (s["oer_tau"], -s["step"]))["step"]
+    assert model.num_timesteps == kept["kept_step"]

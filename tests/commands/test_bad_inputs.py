@@ -103,7 +103,8 @@ def test_a_config_the_renderer_cannot_draw_is_refused_before_any_plant_grows(
 @pytest.mark.parametrize("extra, message", [
     (["--seed", "-1"], "--seed"), (["--policies", ","], "names nothing"),
     (["--policies", "LRD,Greedy"], "Greedy"), (["--episodes", "0"], "--episodes"),
-    (["--sessions", "x"], "--sessions"), (["--policies", "A2C"], "--model"),
+    (["--sessions", "x"], "--sessions"), (["--policies", "A2C"], "unknown name 'A2C'"),
+    (["--policy", "nowhere.py:act"], "no such file"), (["--name", "x"], "1 --name for 0 --policy"),
     (["--model", "missing.zip"], "no such model"), (["--crop", "banana"], "banana"),
     (["--crop", "tomato"], "no sp/tomato scenes"), (["--scenario", "mp"], "no mp scenes"),
 ])
@@ -117,6 +118,10 @@ def test_bad_values_of_evaluate(extra: list[str], message: str, capsys: pytest.C
 @pytest.mark.parametrize("extra, message", [
     (["--seed", "-1"], "--seed"), (["--timesteps", "0"], "--timesteps"), (["--n-envs", "0"], "--n-envs"),
     (["--device", "banana"], "--device"), (["--verbose", "7"], "--verbose"), (["--crop", "vine"], "no sp/vine"),
+    (["--algo", "sac"], "--algo"), (["--set", "n_steps"], "is not KEY=VALUE"),
+    (["--algo", "ppo", "--set", "n_stepz=8"], "PPO setting 'n_stepz' cannot be changed"),
+    (["--algo", "dqn", "--a2c-settings", "sb3"], "--a2c-settings is for --algo a2c"),
+    (["--set", "use_rms_prop=false"], "A2C setting 'use_rms_prop' cannot be changed"),
 ])
 def test_bad_values_of_train(extra: list[str], message: str, capsys: pytest.CaptureFixture[str],
                              sp_root: Path, tmp_path: Path) -> None:

@@ -13,8 +13,9 @@ import pytest
 from davis_ag import cli
 from davis_ag.benchmark import CONTINUOUS_ID
 from davis_ag.errors import UserError
-from davis_ag.live.evaluation import evaluate_continuous
-from davis_ag.live.policies import Greedy, ModelAgent, RandomAxes, build_policies
+from davis_ag.benchmark.evaluation import evaluate_policies
+from davis_ag.benchmark.policies import ModelPolicy
+from davis_ag.live.policies import Greedy, RandomAxes, build_policies
 from davis_ag.figures.result_charts import plot_training_curve
 from davis_ag.live.training import train_continuous
 from davis_ag.live.tvm_continuous import TVMContinuousEnv, steps_per_second
@@ -146,8 +147,9 @@ def test_moves_slip_and_turns_do_not(free_env: TVMContinuousEnv) -> None:
 
 def test_policies_play_the_same_starts(env: TVMContinuousEnv, tmp_path: Path) -> None:
     lr = RandomAxes("LR", (0,), seed=1)
-    assert np.count_nonzero(lr.act(None, env)[1:]) == 0
-    results = evaluate_continuous(env, [lr, Greedy(candidates=4)], episodes=3, sessions=1, keep_episodes=True)
+    lr.prepare(env)
+    assert np.count_nonzero(lr.act(None, {})[1:]) == 0
+    results = evaluate_policies(env, [lr, Greedy(candidates=4)], episodes=3, sessions=1, keep_episodes=True).as_json()
     starts = [[e["oer_0"] for e in results["policies"][name]["episodes"]] for name in ("LR", "Greedy")]
     assert starts[0] == starts[1]
     assert results["policies"]["Greedy"]["oer_tau"]["mean"] >= min(starts[0])
@@ -163,8 +165,8 @@ def test_ppo_trains_briefly_and_plays(live_scene_dir: Path, env: TVMContinuousEn
     assert "PPO: 48/48 steps" in capsys.readouterr().out
     assert len(records) >= 48 // env.tau - 1 and all(r["reward"] >= 0 for r in records)
     assert plot_training_curve(records, tmp_path / "curve.png", "PPO", window=4).stat().st_size > 0
-    agent = ModelAgent(path)
-    results = evaluate_continuous(env, [agent], episodes=2, sessions=1)
+    agent = ModelPolicy(path)
+    results = evaluate_policies(env, [agent], episodes=2, sessions=1).as_json()
     assert results["policies"]["PPO"]["length"]["mean"] == env.tau
 
 
@@ -179,4 +181,24 @@ def test_evaluate_command_takes_the_continuous_environment(live_root: Path, tmp_
     assert results["protocol"]["environment"] == CONTINUOUS_ID and set(results["policies"]) == {"LR", "Rand"}
     assert Path("r.png").is_file()
     assert cli.main(args[:-1] + ["Oracle"]) == 2
-    assert "not a policy of --env continuous" in capsys.readouterr().err
+    assert "not a baseline of --env continuous" in capsys.readouterr().err
+    # A policy file written with the grid's move names plays here too (named moves are unit moves).
+    Path("mine.py").write_text("def climb(observation, info):\n    return 'up' if info['steps'] < 2 else 'done'\n")
+    assert cli.main(args[:-2] + ["--policies", "Rand", "--policy", "mine.py:climb"]) == 0
+    mine = json.loads(Path("r.json").read_text())["policies"]["climb"]
+    assert mine["mean_abs_action"]["dz"] == pytest.approx(2 / 3, abs=1e-4) and mine["mean_abs_action"]["dx"] == 0
+    assert "Rand" in mine["paired"]
+
+
+def test_the_docs_policy_file_runs_on_the_continuous_environment(live_root: Path, tmp_path: Path,
+                                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+    """docs/benchmark-your-method.md says its policy file scores here too."""
+    from test_benchmark_your_method import PAGE, blocks  # tests/ is on the path, as for layout_factory
+
+    monkeypatch.chdir(tmp_path)
+    name, body = next((n, b) for _, n, b in blocks(PAGE.read_text()) if n)
+    Path(name).write_text(body)
+    assert cli.main(["evaluate", "--env", "continuous", "--dataset", str(live_root), "--scenario", "sp", "--split",
+                     "all", "--episodes", "2", "--sessions", "1", "--policies", "Rand", "--out", "r.json",
+                     "--policy", f"{name}:toward_target"]) == 0
+    assert json.loads(Path("r.json").read_text())["policies"]["toward_target"]["length"]["mean"] == 3

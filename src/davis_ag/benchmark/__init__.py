@@ -5,6 +5,10 @@ Importing this package registers the environment::
     import gymnasium, davis_ag.benchmark
     env = gymnasium.make("davis_ag/TVM-v0", dataset="data/", scenario="sp", split="train")
 
+To score policies of your own beside the baselines (section V-C's protocol, any environment)::
+
+    results = davis_ag.benchmark.evaluate([my_policy], dataset="data/", scenario="sp")
+
 Beside it, ``davis_ag/TVMContinuous-v0`` (:mod:`davis_ag.live.tvm_continuous`): the same task with
 a continuous camera pose, drawn live from regrown scenes. Both are registered by name
 (:mod:`davis_ag.environments`), so nothing of it (Helios, the renderer) loads until it is made.
@@ -12,7 +16,9 @@ a continuous camera pose, drawn live from regrown scenes. Both are registered by
 
 from __future__ import annotations
 
+import importlib
 import time
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
@@ -51,5 +57,14 @@ def benchmark_steps(env: gym.Env, n: int = 20_000, seed: int = 0) -> float:
     return n / (time.perf_counter() - start)
 
 
+def __getattr__(name: str) -> Any:
+    """``evaluate`` (:func:`davis_ag.benchmark.evaluation.evaluate`), loaded when first used: importing
+    davis_ag registers the environments through this package, and the evaluation (pydantic, the
+    code version of :mod:`davis_ag.provenance`) is not needed for that."""
+    if name == "evaluate":
+        return importlib.import_module("davis_ag.benchmark.evaluation").evaluate
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
 __all__ = ["CONTINUOUS_ID", "ENV_IDS", "MAX_START_OER", "OBS_SIZE", "TVM_ID", "SceneCache", "TVMEnv",
-           "benchmark_steps", "load_scene_cache"]
+           "benchmark_steps", "evaluate", "load_scene_cache"]

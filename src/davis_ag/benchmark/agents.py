@@ -1,24 +1,23 @@
-"""Policies for target visibility maximisation: the paper's baselines (section IV-B), an exact
-Oracle upper bound, and A2C (section IV-C) trained with Stable-Baselines3.
+"""The grid benchmark's baselines: the paper's heuristics (section IV-B), every fixed action, and
+an exact Oracle upper bound. Trained models are :class:`davis_ag.benchmark.policies.ModelPolicy`.
 
-Every agent has the same small interface (:class:`Agent`): ``reset(seed)`` at the start of an
-episode, then ``act(obs, env)`` once per step, returning an action index of ``env``. The
-environment is passed so that heuristics can map action *names* to indices (SP and MP number
-them differently) and so that the Oracle can read the episode's tables; learned agents only
-look at ``obs``.
+Every baseline is a :class:`davis_ag.benchmark.policies.Policy`: ``reset(seed)`` at the start of
+an episode, then ``act(observation, info)`` once per step, returning an action index of the
+environment. Their ``prepare(env)`` reads the environment's action names (SP and MP number them
+differently); the Oracle also keeps the environment to read the episode's tables. None of them
+looks at the image.
 """
 
 from __future__ import annotations
 
-import os
-from pathlib import Path
-from typing import Any, Protocol
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
-import torch
 
-from davis_ag.benchmark import TVMEnv
+from davis_ag.benchmark.policies import SeededPolicy, baselines_by_name, unwrapped
+from davis_ag.benchmark.tvm import TVMEnv
+from davis_ag.environments import TVM_ID
 from davis_ag.benchmark.exact import action_probabilities
 from davis_ag.errors import UserError
 
@@ -37,25 +36,10 @@ def tvm(env: gym.Env) -> TVMEnv:
     Raises:
         UserError: when ``env`` is not a TVM environment.
     """
-    inner = getattr(env, "unwrapped", env)
-    if not isinstance(inner, TVMEnv):
-        raise UserError(f"expected a davis_ag/TVM-v0 environment, got {type(inner).__name__}")
-    return inner
+    return unwrapped(env, TVMEnv, TVM_ID)
 
 
-class Agent(Protocol):
-    """What the evaluation loop needs from a policy."""
-
-    name: str
-
-    def reset(self, seed: int | None = None) -> None:
-        """Start an episode; ``seed`` fixes the agent's own randomness (if any)."""
-
-    def act(self, obs: np.ndarray, env: gym.Env) -> int:
-        """Choose an action index of ``env`` for the observation ``obs``."""
-
-
-class HeuristicAgent:
+class HeuristicAgent(SeededPolicy):
     """Uniformly random actions from a fixed set of action names (LRD, UDD, Rand)."""
 
     def __init__(self, name: str, actions: tuple[str, ...] | None, seed: int | None = None) -> None:
@@ -64,28 +48,27 @@ class HeuristicAgent:
             actions: Action names to draw from; ``None`` means every action of the environment.
             seed: Seed of the agent's generator until the next :meth:`reset` with a seed.
         """
+        super().__init__(seed)
         self.name = name
         self.actions = actions
-        self._rng = np.random.default_rng(seed)
-        self._indices: dict[tuple[str, ...], np.ndarray] = {}
+        self._indices = np.zeros(0, dtype=np.int64)
 
-    def reset(self, seed: int | None = None) -> None:
-        """Reseed the action draw (``None`` keeps the current stream)."""
-        if seed is not None:
-            self._rng = np.random.default_rng(seed)
+    def prepare(self, env: gym.Env) -> None:
+        """Map the action set to ``env``'s indices.
 
-    def act(self, obs: np.ndarray, env: gym.Env) -> int:
-        """Draw one action of the set, as an index of ``env``."""
+        Raises:
+            UserError: when the environment lacks one of the actions.
+        """
         names = tvm(env).action_names
-        indices = self._indices.get(names)
-        if indices is None:
-            wanted = names if self.actions is None else self.actions
-            missing = [a for a in wanted if a not in names]
-            if missing:
-                raise UserError(f"{self.name} needs actions {missing} that this environment "
-                                f"lacks ({', '.join(names)})")
-            indices = self._indices[names] = np.array([names.index(a) for a in wanted])
-        return int(indices[self._rng.integers(len(indices))])
+        wanted = names if self.actions is None else self.actions
+        missing = [a for a in wanted if a not in names]
+        if missing:
+            raise UserError(f"{self.name} needs actions {missing} that this environment lacks ({', '.join(names)})")
+        self._indices = np.array([names.index(a) for a in wanted])
+
+    def act(self, observation: np.ndarray, info: dict[str, Any]) -> int:
+        """Draw one action of the set, as an index of the environment :meth:`prepare` saw."""
+        return int(self._indices[self._rng.integers(len(self._indices))])
 
     def action_probabilities(self, env: gym.Env) -> np.ndarray:
         """Probability of each action index of ``env`` at every step (uniform over the set)."""
@@ -102,21 +85,25 @@ class FixedActionAgent:
         """
         self.action = action
         self.name = name or f"always {action}"
+        self._index = -1
 
     def reset(self, seed: int | None = None) -> None:
         """Nothing to reset: the policy has no randomness."""
 
-    def act(self, obs: np.ndarray, env: gym.Env) -> int:
-        """The action's index in ``env``.
+    def prepare(self, env: gym.Env) -> None:
+        """Find the action's index in ``env``.
 
         Raises:
             UserError: when the environment has no such action.
         """
         names = tvm(env).action_names
         if self.action not in names:
-            raise UserError(f"{self.name}: this environment has no action {self.action!r} "
-                            f"({', '.join(names)})")
-        return names.index(self.action)
+            raise UserError(f"{self.name}: this environment has no action {self.action!r} ({', '.join(names)})")
+        self._index = names.index(self.action)
+
+    def act(self, observation: np.ndarray, info: dict[str, Any]) -> int:
+        """The action's index."""
+        return self._index
 
     def action_probabilities(self, env: gym.Env) -> np.ndarray:
         """Probability 1 on the action, 0 elsewhere."""
@@ -179,14 +166,21 @@ class OracleAgent:
 
     def __init__(self) -> None:
         self._plan: list[int] = []
+        self._env: TVMEnv | None = None
+
+    def prepare(self, env: gym.Env) -> None:
+        """Keep the environment: its tables are the Oracle's plan."""
+        self._env = tvm(env)
 
     def reset(self, seed: int | None = None) -> None:
         """Forget the previous plan (the next :meth:`act` at step 0 plans anew)."""
         self._plan = []
 
-    def act(self, obs: np.ndarray, env: gym.Env) -> int:
+    def act(self, observation: np.ndarray, info: dict[str, Any]) -> int:
         """The next action of the plan; ``done`` once the plan is played out."""
-        inner = tvm(env)
+        inner = self._env
+        if inner is None:
+            raise UserError("the Oracle plays only after prepare(env): evaluate it with davis_ag.benchmark.evaluate")
         if inner.steps_taken == 0:
             next_view, oer = inner.move_table()
             self._plan = oracle_plan(next_view, oer, inner.current_view, inner.tau)
@@ -194,110 +188,17 @@ class OracleAgent:
         return self._plan[t] if t < len(self._plan) else inner.done_action
 
 
-#: How the benchmark's A2C plays (``davis-ag reproduce``): False samples each action from the
-#: policy. Played deterministically, a policy repeats a refused move for the rest of the episode
-#: (the observation after a refused move is the same image), and a policy whose most likely
-#: action is the same at every start is exactly a fixed action: on the train split
-#: (tools/a2c_trials.py) a short-trained policy played deterministically was "always forward"
-#: while sampling it scored higher; trained longer, deterministic play scored about one standard
-#: deviation higher than sampling. Sampling is kept as the safe default on unseen scenes, where
-#: the policy is least sure; the benchmark also reports the deterministic play as the row
-#: ``A2C (deterministic)``.
-A2C_DETERMINISTIC = False
+#: Baseline names :func:`build_agents` accepts (trained models come from
+#: :func:`davis_ag.benchmark.policies.policy_from_spec`), and what makes each.
+BASELINES: dict[str, Any] = {**{name: (lambda name=name: heuristic(name)) for name in HEURISTIC_ACTIONS},
+                             "Oracle": OracleAgent}
+AGENT_NAMES: tuple[str, ...] = tuple(BASELINES)
 
 
-class A2CAgent:
-    """A trained SB3 model (A2C or any SB3 algorithm with ``predict``) as an :class:`Agent`."""
-
-    name = "A2C"
-
-    def __init__(self, model: Any, deterministic: bool = True, device: str = "cpu") -> None:
-        """Args:
-            model: A loaded SB3 model, or the path of a saved A2C ``.zip``.
-            deterministic: Take the most likely action (default) instead of sampling.
-            device: Torch device to load a saved model on.
-
-        Raises:
-            UserError: when the file is missing or not an SB3 model.
-        """
-        if isinstance(model, (str, os.PathLike)):
-            from stable_baselines3 import A2C
-
-            path = Path(model)
-            if not path.is_file():
-                raise UserError(f"{path}: no such model file; train one with `davis-ag train`")
-            try:
-                model = A2C.load(path, device=device)
-            except Exception as error:  # noqa: BLE001 - any load failure is a bad file
-                raise UserError(f"{path}: not a Stable-Baselines3 A2C model ({error}); "
-                                "give the .zip `davis-ag train` wrote") from None
-        self.model = model
-        self.deterministic = deterministic
-
-    def reset(self, seed: int | None = None) -> None:
-        """Seed torch's sampling when acting stochastically (a no-op when deterministic)."""
-        if seed is not None and not self.deterministic:
-            torch.manual_seed(seed)
-
-    def check(self, env: gym.Env) -> None:
-        """Refuse an environment the model was not trained for, before any episode.
-
-        Raises:
-            UserError: when the model was trained for another action or observation space
-                (e.g. an SP model on MP: 7 actions against 9).
-        """
-        inner = tvm(env)
-        n = inner.action_space.n
-        if getattr(self.model.action_space, "n", n) != n:
-            raise UserError(f"the model has {self.model.action_space.n} actions, the {inner.scenario} "
-                            f"environment {n}: use a model trained on the same scenario")
-        shape = getattr(self.model.observation_space, "shape", None)
-        # SB3 stores image spaces channels-first.
-        if shape is not None and sorted(shape) != sorted(inner.observation_space.shape):
-            raise UserError(f"the model takes observations of shape {shape}, the environment gives "
-                            f"{inner.observation_space.shape}: use a model trained by davis-ag train")
-
-    def act(self, obs: np.ndarray, env: gym.Env) -> int:
-        """The model's action for ``obs``.
-
-        Raises:
-            UserError: when the model was trained for another action space (e.g. SP vs MP).
-        """
-        self.check(env)
-        action, _ = self.model.predict(obs, deterministic=self.deterministic)
-        return int(action)
-
-
-#: Policy names :func:`build_agents` accepts (A2C also needs a model).
-AGENT_NAMES: tuple[str, ...] = ("LRD", "UDD", "Rand", "Oracle", "A2C")
-
-
-def build_agents(names: list[str], model: str | os.PathLike[str] | None = None,
-                 deterministic: bool = True) -> list[Agent]:
-    """Agents by name, in the order given (case-insensitive; see :data:`AGENT_NAMES`).
-
-    Args:
-        names: Policy names.
-        model: Saved A2C model, required when ``A2C`` is among the names.
-        deterministic: Whether A2C takes its most likely action.
-
-    Returns:
-        The agents.
+def build_agents(names: list[str]) -> list[Any]:
+    """Baselines by name, in the order given (case-insensitive; see :data:`AGENT_NAMES`).
 
     Raises:
-        UserError: for an unknown name, or A2C without a model.
+        UserError: for an unknown name (a trained model is a ``--policy MODEL.zip``).
     """
-    agents: list[Agent] = []
-    for name in names:
-        key = name.strip().lower()
-        if key == "oracle":
-            agents.append(OracleAgent())
-        elif key == "a2c":
-            if model is None:
-                raise UserError("policy A2C needs a trained model: pass --model model.zip")
-            agents.append(A2CAgent(model, deterministic=deterministic))
-        else:
-            if key not in {k.lower() for k in HEURISTIC_ACTIONS}:
-                raise UserError(f"unknown policy {name!r}: choose from {', '.join(AGENT_NAMES)}")
-            agents.append(heuristic(key))
-    return agents
+    return baselines_by_name(names, BASELINES)

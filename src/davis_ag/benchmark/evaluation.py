@@ -1,42 +1,64 @@
-"""Benchmark policies as in section V-C and Table 4.
+"""Benchmark any set of policies as in section V-C and Table 4, on TVM-v0 or TVMContinuous-v0.
 
 Protocol: the test split; ``sessions`` (3) sessions of ``episodes`` (200) episodes. Episode
 ``e`` of session ``s`` resets the environment with a seed drawn from
 ``numpy.random.SeedSequence([seed, s])``, so every policy plays exactly the same episodes
-(same scene, view and target); an agent's own randomness is seeded from
+(same scene, view and target; on the continuous environment the same start pose, slip then
+follows the environment's generator); a policy's own randomness is seeded from
 ``SeedSequence([seed, s, 1])`` so that it never mirrors the environment's draws. Per policy
 and session the mean final OER (``OER_tau``), cumulative reward and episode length are taken;
 the table reports their mean and standard deviation (population, ``ddof=0``) over sessions.
 Beside them: the standard error of each mean over all episodes (``sem``: the per-episode
-standard deviation over the square root of the episode count), and, for the policies that
+standard deviation over the square root of the episode count), and, for the grid policies that
 ignore the image (LRD, UDD, Rand, fixed actions), the exact expectation over the split's starts
-(``exact``, :mod:`davis_ag.benchmark.exact`) that the sampled mean estimates. With
-``best_fixed_action`` the row :data:`BEST_FIXED` is added: of the policies that always play the
+(``exact``, :mod:`davis_ag.benchmark.exact`) that the sampled mean estimates. On the grid the
+row :data:`BEST_FIXED` is added (``best_fixed_action``): of the policies that always play the
 same action, the one with the highest exact OER_tau on this split, played on the same episodes,
-so that a learner that collapsed to one move is seen beside it.
+so that a learner that collapsed to one move is seen beside it. Every policy gets its paired
+gap (:mod:`davis_ag.benchmark.paired`) to each of :data:`PAIRED_BASELINES` present.
+
+Policies follow :class:`davis_ag.benchmark.policies.Policy`; a policy may answer with an action
+name, which the environment's ``action_for`` turns into its action.
 """
 
 from __future__ import annotations
 
 import os
+import traceback
+from dataclasses import asdict
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
-from davis_ag.atomic_files import write_json_atomic
-from davis_ag.benchmark import TVMEnv
-from davis_ag.benchmark.agents import Agent, FixedActionAgent
 from davis_ag.benchmark import exact
+from davis_ag.benchmark.agents import FixedActionAgent
+from davis_ag.benchmark.policies import prepare
+from davis_ag.benchmark.results import (
+    PROTOCOL_VERSION,
+    EvaluationResults,
+    PairedGap,
+    PolicyResult,
+    Protocol,
+    as_results,
+    identify_dataset,
+    signed_number,
+    split_text,
+    table_number,
+)
+from davis_ag.errors import UserError
+from davis_ag.provenance import code_version
 
 #: Table 4's metrics: key in the results, row label.
 METRICS: dict[str, str] = {"oer_tau": "OER_tau", "reward": "Cum. Reward", "length": "Ep. Length"}
 #: The row of the best policy that always plays one action (see the module docstring).
 BEST_FIXED = exact.BEST_FIXED
+#: The baselines every policy is compared with episode by episode, where the evaluation has them.
+PAIRED_BASELINES: tuple[str, ...] = (BEST_FIXED, "Rand")
 
 
 def episode_seeds(seed: int, session: int, episodes: int) -> tuple[list[int], list[int]]:
-    """Reset seeds and agent seeds of one session.
+    """Reset seeds and policy seeds of one session.
 
     Args:
         seed: The evaluation's base seed.
@@ -44,123 +66,86 @@ def episode_seeds(seed: int, session: int, episodes: int) -> tuple[list[int], li
         episodes: Episodes in the session.
 
     Returns:
-        ``(reset_seeds, agent_seeds)``, one each per episode.
+        ``(reset_seeds, policy_seeds)``, one each per episode.
     """
     env_seeds = np.random.SeedSequence([seed, session]).generate_state(episodes)
     agent_seeds = np.random.SeedSequence([seed, session, 1]).generate_state(episodes)
     return [int(s) for s in env_seeds], [int(s) for s in agent_seeds]
 
 
-def run_episode(env: TVMEnv, agent: Agent, reset_seed: int,
-                agent_seed: int | None = None) -> dict[str, Any]:
+def _action(env: Any, action: Any) -> Any:
+    """A policy's answer as the environment's action (a name through ``action_for``)."""
+    if isinstance(action, str):
+        return env.unwrapped.action_for(action)
+    return action
+
+
+def _act(policy: Any, observation: Any, info: dict[str, Any]) -> Any:
+    """The policy's answer; a policy that fails is one line naming where (its own code's last frame)."""
+    try:
+        return policy.act(observation, info)
+    except UserError:
+        raise
+    except Exception as error:  # noqa: BLE001 - any failure of someone else's code
+        frame = traceback.extract_tb(error.__traceback__)[-1]
+        raise UserError(f"act failed with {type(error).__name__}: {error} (at {frame.filename}:{frame.lineno}); "
+                        "fix the policy and evaluate again") from None
+
+
+def run_episode(env: Any, policy: Any, reset_seed: int, policy_seed: int | None = None) -> dict[str, Any]:
     """Play one episode.
 
     Args:
-        env: The environment (a :class:`TVMEnv`, wrapped or not).
-        agent: The policy.
-        reset_seed: Seed of ``env.reset``; fixes the scene, view and target.
-        agent_seed: Seed of the agent's own randomness.
+        env: A TVM-v0 or TVMContinuous-v0 environment (wrapped or not).
+        policy: The policy (its ``prepare(env)`` is called first).
+        reset_seed: Seed of ``env.reset``; fixes the scene, start and target.
+        policy_seed: Seed of the policy's own randomness.
 
     Returns:
-        ``{"oer_0", "oer_tau", "reward", "length", "scene", "target_fruit", "path",
-        "actions"}``.
+        ``{"oer_0", "oer_tau", "reward", "length", "scene", "target_fruit", "path", "actions"}``,
+        and ``"refused"`` (moves refused) where the environment reports them.
+
+    Raises:
+        UserError: when the policy answers with something that is not an action here.
     """
+    prepare(policy, env)
     obs, info = env.reset(seed=reset_seed)
-    agent.reset(agent_seed)
-    total, actions = 0.0, []
+    policy.reset(policy_seed)
+    total, actions, refused = 0.0, [], 0
     while True:
-        action = agent.act(obs, env)
-        actions.append(action)
-        obs, reward, terminated, truncated, info = env.step(action)
+        try:
+            action = _action(env, _act(policy, obs, info))
+            obs, reward, terminated, truncated, info = env.step(action)
+        except UserError as error:
+            raise UserError(f"policy {policy.name}: {error}") from None
+        discrete = hasattr(env.action_space, "n")
+        actions.append(int(np.asarray(action).reshape(())) if discrete
+                       else [round(float(a), 4) for a in np.asarray(action, dtype=float).reshape(-1)])
         total += float(reward)
+        refused += bool(info.get("refused"))
         if terminated or truncated:
             break
-    return {"oer_0": float(info["oer_0"]), "oer_tau": float(info["oer_t"]), "reward": total,
-            "length": len(actions), "scene": info["scene"], "target_fruit": int(info["target_fruit"]),
-            "path": list(info["path"]), "actions": [int(a) for a in actions]}
+    record = {"oer_0": float(info["oer_0"]), "oer_tau": float(info["oer_t"]), "reward": total,
+              "length": len(actions), "scene": info["scene"], "target_fruit": int(info["target_fruit"]),
+              "path": list(info["path"]), "actions": actions}
+    if "refused" in info:
+        record["refused"] = refused
+    return record
 
 
-def evaluate_agents(env: TVMEnv, agents: list[Agent], episodes: int = 200, sessions: int = 3,
-                    seed: int = 0, keep_episodes: bool = False,
-                    best_fixed_action: bool = False) -> dict[str, Any]:
-    """Run every agent on the same episodes and summarise as Table 4.
-
-    Args:
-        env: The (test split) environment.
-        agents: The policies; their ``name`` labels the results.
-        episodes: Episodes per session (200 in the paper).
-        sessions: Sessions (3 in the paper).
-        seed: Base seed of the episode draw.
-        keep_episodes: Also return every episode's record (what :func:`run_episode` returns
-            plus its ``session``): ``davis-ag plot actions`` and ``episode`` draw from them.
-        best_fixed_action: Add the :data:`BEST_FIXED` row (after ``agents``) and the exact
-            expectations of every fixed action (``"fixed_actions"``).
-
-    Returns:
-        ``{"protocol": {...}, "policies": {name: {metric: {"mean", "std", "sem",
-        "sessions"}}}}`` with metrics ``oer_tau``, ``reward``, ``length`` and ``oer_0``,
-        ``"action_counts"`` per policy (action name to times chosen, over every episode; the
-        protocol's ``"actions"`` lists the names in index order), ``"exact"`` (metric to
-        expectation) for the policies that ignore the image, ``"play"`` (``deterministic`` or
-        ``sampled``) for a learned policy, ``"action"`` for :data:`BEST_FIXED`, plus
-        ``"episodes"`` per policy when ``keep_episodes``; with ``best_fixed_action`` also
-        ``"fixed_actions"``: action name to its exact expectations.
-    """
-    inner = env.unwrapped if hasattr(env, "unwrapped") else env
-    for agent in agents:  # a model made for another scenario is refused before any episode runs
-        check = getattr(agent, "check", None)
-        if callable(check):
-            check(env)
-    results: dict[str, Any] = {
-        "protocol": {"scenario": inner.scenario, "split": inner.split, "tau": inner.tau,
-                     "episodes": episodes, "sessions": sessions, "seed": seed,
-                     "scenes": [s.id for s in inner.scenes], "dataset": str(inner.dataset.root),
-                     "actions": list(inner.action_names), "start_rule": inner.start_rule,
-                     "starts": int(len(inner.starts))},
-        "policies": {},
-    }
-    agents = list(agents)
-    if best_fixed_action:
-        fixed = exact.fixed_action_expectations(inner)
-        results["fixed_actions"] = fixed
-        agents.append(FixedActionAgent(exact.best_fixed_action(fixed), name=BEST_FIXED))
-    for agent in agents:
-        summary, records = play_sessions(env, agent, run_episode, (*METRICS, "oer_0"), seed, sessions, episodes)
-        chosen = np.bincount([a for r in records for a in r["actions"]],
-                             minlength=len(inner.action_names))
-        summary["action_counts"] = {n: int(c) for n, c in zip(inner.action_names, chosen)}
-        probs = exact.agent_probabilities(agent, inner)
-        if probs is not None:
-            summary["exact"] = exact.expected_metrics(inner, probs)
-        if isinstance(getattr(agent, "deterministic", None), bool):
-            summary["play"] = "deterministic" if agent.deterministic else "sampled"
-        if isinstance(agent, FixedActionAgent):
-            summary["action"] = agent.action
-        if keep_episodes:
-            summary["episodes"] = records
-        results["policies"][agent.name] = summary
-    return results
-
-
-def play_sessions(env: Any, agent: Any, play: Callable[..., dict[str, Any]], keys: tuple[str, ...], seed: int,
-                  sessions: int, episodes: int) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+def play_sessions(env: Any, policy: Any, keys: tuple[str, ...], seed: int, sessions: int,
+                  episodes: int) -> tuple[dict[str, Any], list[dict[str, Any]]]:
     """Play ``sessions`` x ``episodes`` seeded episodes (the same for every policy) and summarise.
-
-    Args:
-        env, agent: The environment and the policy.
-        play: ``play(env, agent, reset_seed, agent_seed) -> record`` for one episode.
-        keys: The record's numbers to average per session.
-        seed, sessions, episodes: The protocol.
 
     Returns:
         Per key the mean, std and per-session values over sessions and the standard error of the
-        mean over all episodes (``sem``); and every episode's record.
+        mean over all episodes (``sem``); and every episode's record with its ``session``.
     """
     per_session: dict[str, list[float]] = {k: [] for k in keys}
     records = []
     for session in range(sessions):
-        env_seeds, agent_seeds = episode_seeds(seed, session, episodes)
-        runs = [play(env, agent, r, a) for r, a in zip(env_seeds, agent_seeds)]
+        env_seeds, policy_seeds = episode_seeds(seed, session, episodes)
+        runs = [run_episode(env, policy, r, a) for r, a in zip(env_seeds, policy_seeds)]
         for key in per_session:
             per_session[key].append(float(np.mean([run[key] for run in runs])))
         records.extend({"session": session, **run} for run in runs)
@@ -170,47 +155,195 @@ def play_sessions(env: Any, agent: Any, play: Callable[..., dict[str, Any]], key
     return summary, records
 
 
-def _number(value: float) -> str:
-    """Table 4 style: three decimals, no leading zero below 1 (``.433``)."""
-    text = f"{value:.3f}"
-    return text[1:] if text.startswith("0.") else text.replace("-0.", "-.")
-
-
-def format_table(results: dict[str, Any]) -> str:
-    """Plain-text Table 4: one row per metric, one column per policy, ``mean ±std``.
+def evaluate_policies(env: Any, policies: list[Any], episodes: int = 200, sessions: int = 3, seed: int = 0,
+                      keep_episodes: bool = False, best_fixed_action: bool = False) -> EvaluationResults:
+    """Run every policy on the same episodes and summarise as Table 4 (see the module docstring).
 
     Args:
-        results: What :func:`evaluate_agents` returned.
+        env: The environment (TVM-v0 or TVMContinuous-v0, of the split to score on).
+        policies: :class:`davis_ag.benchmark.policies.Policy` objects; ``name`` labels the rows
+            (names must differ).
+        episodes: Episodes per session (200 in the paper).
+        sessions: Sessions (3 in the paper).
+        seed: Base seed of the episode draw.
+        keep_episodes: Keep every episode's record in the results (``davis-ag plot actions``,
+            ``episode`` and ``compare`` across files read them).
+        best_fixed_action: Add the :data:`BEST_FIXED` row (grid only) and the exact expectations
+            of every fixed action.
+
+    Returns:
+        The results (:class:`davis_ag.benchmark.results.EvaluationResults`).
+
+    Raises:
+        UserError: for two policies of one name, or a policy that does not fit the environment
+            (before any episode is played).
+    """
+    from davis_ag.benchmark.tvm import TVMEnv
+
+    inner = env.unwrapped if hasattr(env, "unwrapped") else env
+    grid = isinstance(inner, TVMEnv)
+    policies = list(policies)
+    fixed = None
+    if best_fixed_action and grid:
+        fixed = exact.fixed_action_expectations(inner)
+        policies.append(FixedActionAgent(exact.best_fixed_action(fixed), name=BEST_FIXED))
+    names = [p.name for p in policies]
+    if len(set(names)) != len(names):
+        twice = next(n for n in names if names.count(n) > 1)
+        raise UserError(f"two policies are named {twice!r}: give one another name (--name)")
+    for policy in policies:  # a policy made for another scenario is refused before any episode runs
+        prepare(policy, env)
+    described = inner.describe()
+    protocol = Protocol(version=PROTOCOL_VERSION, episodes=episodes, sessions=sessions, seed=seed, **described)
+    keys = (*METRICS, "oer_0") + (("refused",) if not grid else ())
+    rows: dict[str, dict[str, Any]] = {}
+    records: dict[str, list[dict[str, Any]]] = {}
+    for policy in policies:
+        summary, played = play_sessions(env, policy, keys, seed, sessions, episodes)
+        records[policy.name] = played
+        summary["source"] = getattr(policy, "source", None)
+        if grid:
+            chosen = np.bincount([a for r in played for a in r["actions"]], minlength=len(inner.action_names))
+            summary["action_counts"] = {n: int(c) for n, c in zip(inner.action_names, chosen)}
+            probs = exact.agent_probabilities(policy, inner)
+            if probs is not None:
+                summary["exact"] = exact.expected_metrics(inner, probs)
+        else:
+            moves = np.abs(np.array([a for r in played for a in r["actions"]], dtype=np.float64))
+            summary["mean_abs_action"] = dict(zip(protocol.actions, moves.mean(axis=0).round(4).tolist()))
+        if isinstance(getattr(policy, "play", None), str):
+            summary["play"] = policy.play
+        if isinstance(policy, FixedActionAgent):
+            summary["action"] = policy.action
+        if keep_episodes:
+            summary["episodes"] = played
+        rows[policy.name] = summary
+    for name, row in rows.items():
+        row["paired"] = paired_gaps(name, records, seed)
+    return EvaluationResults(protocol=protocol, dataset=identify_dataset(protocol.dataset), code=code_version(),
+                             policies={n: PolicyResult.model_validate(r) for n, r in rows.items()},
+                             fixed_actions=fixed)
+
+
+def paired_gaps(name: str, records: dict[str, list[dict[str, Any]]], seed: int) -> dict[str, PairedGap]:
+    """The paired gap of policy ``name`` to each of :data:`PAIRED_BASELINES` that played too."""
+    from davis_ag.benchmark.paired import paired_gap
+
+    return {baseline: PairedGap.model_validate(asdict(paired_gap(records[name], records[baseline], seed=seed)))
+            for baseline in PAIRED_BASELINES if baseline in records and baseline != name}
+
+
+def format_table(results: EvaluationResults | dict[str, Any]) -> str:
+    """Plain-text Table 4: one row per metric, one column per policy, ``mean ±std``, the paired
+    gaps, and what the numbers rest on (the split's scenes and eligible starts).
+
+    Args:
+        results: What :func:`evaluate_policies` returned (or its JSON).
 
     Returns:
         The table, lines joined by newlines.
     """
-    protocol, policies = results["protocol"], results["policies"]
+    results = as_results(results)
+    protocol, policies = results.protocol, results.policies
     names = list(policies)
-    label = f"{protocol['scenario'].upper()} ({protocol['split']})"
+    label = f"{protocol.scenario.upper()} ({protocol.split})"
     cells = [[label, "Metric", *names]]
     for key, title in METRICS.items():
         row = ["", title]
         for name in names:
-            stat = policies[name][key]
-            row.append(f"{_number(stat['mean'])} ±{_number(stat['std'])}")
+            stat = getattr(policies[name], key)
+            row.append(f"{table_number(stat.mean)} ±{table_number(stat.std)}")
         cells.append(row)
-    exact = any("exact" in policies[name] for name in names)
-    if exact:
+    has_exact = any(policies[name].exact for name in names)
+    if has_exact:
         for key, title in METRICS.items():
-            cells.append(["", f"{title} exact", *(_number(policies[n]["exact"][key]) if "exact" in policies[n]
-                                                  else "-" for n in names)])
+            cells.append(["", f"{title} exact", *(table_number(policies[n].exact[key]) if policies[n].exact else "-"
+                                                  for n in names)])
+    baselines = [b for b in PAIRED_BASELINES if b in policies]
+    for baseline in baselines:
+        row = ["", f"gap to {baseline}"]
+        for name in names:
+            gap = policies[name].paired.get(baseline)
+            row.append(f"{signed_number(gap.gap)} [{signed_number(gap.low)}, {signed_number(gap.high)}]" if gap else "-")
+        cells.append(row)
     widths = [max(len(row[i]) for row in cells) for i in range(len(cells[0]))]
     lines = ["  ".join(c.ljust(w) for c, w in zip(row, widths)).rstrip() for row in cells]
     lines.insert(1, "-" * len(lines[0]))
-    lines.append(f"mean ±std over {protocol['sessions']} sessions of {protocol['episodes']} "
-                 f"episodes, tau={protocol['tau']}" + ("; exact: expectation over the split's starts" if exact else ""))
+    lines.append(f"mean ±std over sessions; {split_text(protocol)}"
+                 + ("; exact: expectation over the split's starts" if has_exact else ""))
+    if baselines:
+        lines.append("gap: mean OER_tau minus the baseline's on the same episodes, [95 % bootstrap interval "
+                     "over episodes]")
     if BEST_FIXED in policies:
-        lines.append(f"{BEST_FIXED}: always {policies[BEST_FIXED]['action']}, the best single action "
+        lines.append(f"{BEST_FIXED}: always {policies[BEST_FIXED].action}, the best single action "
                      "by exact OER_tau on this split")
     return "\n".join(lines)
 
 
-def write_json(results: dict[str, Any], path: str | os.PathLike[str]) -> Path:
+def write_json(results: EvaluationResults | dict[str, Any], path: str | os.PathLike[str]) -> Path:
     """Write the results as indented JSON (atomically: temp file then rename)."""
-    return write_json_atomic(path, results, indent=2)
+    return as_results(results).write(path)
+
+
+def evaluate(policies: list[Any], dataset: Any, scenario: str = "sp", split: str = "test", sessions: int = 3,
+             episodes: int = 200, seed: int = 0, *, env: str = "grid", crop: str | None = None,
+             baselines: bool | list[str] = True, deterministic: bool | None = None,
+             cache_dir: str | os.PathLike[str] | None = None, keep_episodes: bool = True) -> EvaluationResults:
+    """Score policies beside the baselines with section V-C's protocol (``davis_ag.benchmark.evaluate``).
+
+    Args:
+        policies: Each a :class:`davis_ag.benchmark.policies.Policy`, a callable
+            ``(observation, info) -> action``, or a SPEC string (``MODEL.zip``, ``module:attr``,
+            ``path/to/file.py:attr``; :func:`davis_ag.benchmark.policies.policy_from_spec`).
+        dataset: A dataset root (or an opened dataset, on the grid).
+        scenario: ``sp`` or ``mp``.
+        split: ``test`` (default), ``train`` or ``all``.
+        sessions, episodes, seed: The protocol (3 x 200, seed 0 as in the paper's setting).
+        env: ``grid`` (TVM-v0) or ``continuous`` (TVMContinuous-v0).
+        crop: Keep one crop of the scenario.
+        baselines: True: the environment's baselines (grid: LRD, UDD, Rand, Oracle and the Best
+            fixed action; continuous: LR, UD, Rand, Greedy); False: none; or a list of names.
+        deterministic: How SPEC models play (default
+            :data:`davis_ag.benchmark.policies.DETERMINISTIC_PLAY`).
+        cache_dir: The grid's observation cache folder.
+        keep_episodes: Keep every episode in the results.
+
+    Returns:
+        The results, exactly what ``davis-ag evaluate --out`` writes.
+
+    Raises:
+        UserError: for a bad dataset, split, SPEC or a policy that does not fit the environment.
+    """
+    import gymnasium as gym
+
+    from davis_ag.environments import CONTINUOUS_ID, TVM_ID
+    from davis_ag.benchmark.policies import DETERMINISTIC_PLAY, as_policy, policy_from_spec
+
+    if env not in ENVIRONMENTS:
+        raise UserError(f"unknown env {env!r}: choose one of {', '.join(ENVIRONMENTS)}")
+    play = DETERMINISTIC_PLAY if deterministic is None else deterministic
+    chosen = [policy_from_spec(p, deterministic=play) if isinstance(p, (str, os.PathLike)) else as_policy(p)
+              for p in policies]
+    names, builder = ENVIRONMENTS[env]
+    if baselines:
+        build = gym.envs.registration.load_env_creator(builder)
+        chosen += build(list(names if baselines is True else baselines))
+    kwargs: dict[str, Any] = {"dataset": dataset, "scenario": scenario, "split": split, "crop": crop}
+    if env == "grid":
+        kwargs["cache_dir"] = cache_dir
+    made = gym.make(TVM_ID if env == "grid" else CONTINUOUS_ID, disable_env_checker=True, **kwargs)
+    try:
+        results = evaluate_policies(made, chosen, episodes=episodes, sessions=sessions, seed=seed,
+                                    keep_episodes=keep_episodes, best_fixed_action=env == "grid" and bool(baselines))
+    finally:
+        made.close()
+    results.protocol.crop = crop
+    return results
+
+
+#: The environments :func:`evaluate` knows: their baselines' names and the function (``module:attr``,
+#: loaded like a Gymnasium entry point, since the continuous one lives in a later stage) that builds them.
+ENVIRONMENTS: dict[str, tuple[tuple[str, ...], str]] = {
+    "grid": (("LRD", "UDD", "Rand", "Oracle"), "davis_ag.benchmark.agents:build_agents"),
+    "continuous": (("LR", "UD", "Rand", "Greedy"), "davis_ag.live.policies:build_policies"),
+}

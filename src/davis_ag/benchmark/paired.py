@@ -15,7 +15,6 @@ from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
-from scipy import stats
 
 from davis_ag.benchmark.exact import BEST_FIXED
 
@@ -63,8 +62,10 @@ class PairedGap:
 
 
 def _start(episode: dict[str, Any]) -> tuple:
-    """What makes two episodes the same: session, scene, start view and target fruit."""
-    return episode["session"], episode["scene"], episode["path"][0], episode["target_fruit"]
+    """What makes two episodes the same: session, scene, start (a view, or a pose) and target fruit."""
+    start = episode["path"][0]
+    return episode["session"], episode["scene"], tuple(start) if isinstance(start, list) else start, \
+        episode["target_fruit"]
 
 
 def paired_gap(first: list[dict[str, Any]], second: list[dict[str, Any]], seed: int = 0) -> PairedGap:
@@ -82,6 +83,8 @@ def paired_gap(first: list[dict[str, Any]], second: list[dict[str, Any]], seed: 
     """
     if not first or len(first) != len(second) or any(_start(a) != _start(b) for a, b in zip(first, second)):
         raise ValueError("the two policies did not play the same episodes")
+    from scipy import stats
+
     differences = np.array([a["oer_tau"] - b["oer_tau"] for a, b in zip(first, second)], dtype=float)
     if np.ptp(differences) == 0:  # no spread to resample: the interval is the point
         low = high = float(differences[0])
@@ -108,6 +111,8 @@ def a2c_against_best_fixed(results: dict[str, Any]) -> dict[str, Any] | None:
         The gap as a dict, or None when either policy or its episode records are missing.
     """
     policies = results.get("policies", {})
+    if kept := policies.get("A2C", {}).get("paired", {}).get(BEST_FIXED):  # the evaluation's own, same seed
+        return kept
     records = [policies.get(name, {}).get("episodes") for name in ("A2C", BEST_FIXED)]
     if not all(records):
         return None

@@ -1,4 +1,4 @@
-"""Which A2C snapshot a training run keeps: the last one, or the best one on the train split.
+"""Which snapshot a training run keeps: the last one, or the best one on the train split.
 
 Why: A2C with SB3's learning rate (7e-4, RMSprop) on the paper's 72M-parameter network moves a
 long way in a few updates. On SP strawberry (2026-11-24 ``medium`` run) the 300K-step snapshot put
@@ -54,16 +54,16 @@ def train_split_score(model: Any, env: Any, episodes: int = SELECT_EPISODES,
                       seed: int = SELECT_SEED) -> dict[str, float]:
     """Mean OER_tau and reward of ``model`` over ``episodes`` episodes of ``env`` (the train split).
 
-    Play is sampled or deterministic as in the benchmark (``A2C_DETERMINISTIC``). Torch's random
+    Play is sampled or deterministic as in the benchmark (``DETERMINISTIC_PLAY``). Torch's random
     state is restored afterwards, so scoring does not change the training run's own draws.
 
     Returns:
         ``{"oer_tau", "reward", "length"}``, means over the episodes.
     """
-    from davis_ag.benchmark.agents import A2C_DETERMINISTIC, A2CAgent
     from davis_ag.benchmark.evaluation import episode_seeds, run_episode
+    from davis_ag.benchmark.policies import DETERMINISTIC_PLAY, ModelPolicy
 
-    agent = A2CAgent(model, deterministic=A2C_DETERMINISTIC)
+    agent = ModelPolicy(model, deterministic=DETERMINISTIC_PLAY)
     resets, draws = episode_seeds(seed, 0, episodes)
     with torch.random.fork_rng(devices=[]):
         records = [run_episode(env, agent, r, d) for r, d in zip(resets, draws)]
@@ -141,6 +141,6 @@ class KeepBestOnTrain(BaseCallback):
 
 
 def _play() -> str:
-    from davis_ag.benchmark.agents import A2C_DETERMINISTIC
+    from davis_ag.benchmark.policies import DETERMINISTIC_PLAY
 
-    return "deterministic" if A2C_DETERMINISTIC else "sampled"
+    return "deterministic" if DETERMINISTIC_PLAY else "sampled"

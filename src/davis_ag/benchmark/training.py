@@ -1,4 +1,7 @@
-"""Train the paper's A2C agent (section IV-C) with Stable-Baselines3, checkpointed and resumable.
+"""Train an agent with Stable-Baselines3 on the train split, checkpointed and resumable: the paper's
+A2C (section IV-C), PPO or DQN (on the discrete moves), each with the paper's network as its
+features extractor, the same keep-best-train snapshot rule (:mod:`davis_ag.benchmark.selection`),
+checkpoints, training record and progress (a bar on a terminal, a line a minute in a log).
 
 A 300K-step run on a CPU takes hours, so training saves a checkpoint every few thousand steps
 (model, optimiser state and step count in SB3's zip, beside a small JSON of the run's settings)
@@ -26,7 +29,9 @@ from davis_ag.atomic_files import (
     write_or_rescue,
 )
 from davis_ag.benchmark import TVMEnv
+from davis_ag.benchmark.algorithms import ALGORITHMS, resolve_sb3_settings
 from davis_ag.benchmark.networks import ARCHITECTURES
+from davis_ag.benchmark.progress import TrainingProgress
 from davis_ag.benchmark.selection import KeepBestOnTrain, check_keep, snapshot_path
 from davis_ag.benchmark.tvm import as_dataset
 from davis_ag.errors import MachineError, UserError
@@ -50,7 +55,7 @@ SELECT_EVERY = 10_000
 #: from start to start with these settings, with SB3's defaults and with the bonus alone (which
 #: left the flattest policy and the lowest sampled score); these learnt a little faster early on.
 #: What made the evaluated A2C a fixed action was chiefly too little training played
-#: deterministically (see ``A2C_DETERMINISTIC`` in agents.py).
+#: deterministically (see ``DETERMINISTIC_PLAY`` in policies.py).
 A2C_SETTINGS: dict[str, Any] = {"ent_coef": 0.01, "normalize_advantage": True}
 #: Stable-Baselines3's own A2C defaults for the settings above (what ``--a2c-settings sb3`` trains).
 SB3_DEFAULT_SETTINGS: dict[str, Any] = {"ent_coef": 0.0, "normalize_advantage": False}
@@ -205,8 +210,9 @@ def _resumable(settings_file: Path, model_file: Path,
     sittings = saved.pop("sittings", [])
     curve = saved.pop("curve", [])
     scores = saved.pop("selection", [])
-    # Checkpoints from before settings were recorded trained with SB3's defaults.
-    saved.setdefault("a2c_settings", SB3_DEFAULT_SETTINGS)
+    # Checkpoints from before settings were recorded trained A2C with SB3's defaults.
+    if saved.get("algorithm", "A2C") == "A2C":
+        saved.setdefault("a2c_settings", SB3_DEFAULT_SETTINGS)
     saved.setdefault("start_rule", "scene")  # and drew starts scene first
     saved.setdefault("keep", "last")  # and kept the last snapshot
     if saved.get("dataset") == "/":
@@ -218,16 +224,26 @@ def _resumable(settings_file: Path, model_file: Path,
     return done, sittings, curve if isinstance(curve, list) else [], scores if isinstance(scores, list) else []
 
 
-def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed: int = 0,
-              out_path: str | os.PathLike[str] = "a2c.zip", n_envs: int = 8,
-              crop: str | None = None, cache_dir: str | os.PathLike[str] | None = None,
-              arch: str = "paper", device: str = "auto", verbose: int = 0,
-              callback: Any = None, checkpoint_every: int = CHECKPOINT_EVERY,
-              settings: str | dict[str, Any] = "ours", keep: str = "best-train",
-              select_every: int = SELECT_EVERY, force: bool = False) -> Path:
-    """Train the paper's A2C agent on the train split and save it; resume a killed run.
+def train_a2c(dataset: Any, scenario: str, **kwargs: Any) -> Path:
+    """:func:`train_agent` with ``algo="a2c"``: the paper's agent."""
+    return train_agent(dataset, scenario, algo="a2c", **kwargs)
 
-    Hyperparameters (the paper gives none) are Stable-Baselines3's A2C defaults, learning rate
+
+def train_agent(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed: int = 0,
+                out_path: str | os.PathLike[str] = "a2c.zip", n_envs: int = 8,
+                crop: str | None = None, cache_dir: str | os.PathLike[str] | None = None,
+                arch: str = "paper", device: str = "auto", verbose: int = 0,
+                callback: Any = None, checkpoint_every: int = CHECKPOINT_EVERY,
+                settings: str | dict[str, Any] = "ours", keep: str = "best-train",
+                select_every: int = SELECT_EVERY, algo: str = "a2c", progress: bool = True,
+                force: bool = False) -> Path:
+    """Train an agent on the train split and save it; resume a killed run.
+
+    PPO and DQN: Stable-Baselines3's defaults changed only by
+    :data:`davis_ag.benchmark.algorithms.SB3_SETTINGS` (and a ``settings`` dict), ``CnnPolicy``
+    with the same ``arch`` network as A2C; DQN acts on the environment's discrete moves (``done``
+    included). Everything else below holds for all three.
+    A2C's hyperparameters (the paper gives none) are Stable-Baselines3's A2C defaults, learning rate
     7e-4, ``n_steps=5`` per environment and update, ``gamma=0.99``, ``gae_lambda=1``,
     ``vf_coef=0.5``, ``max_grad_norm=0.5``, RMSprop (alpha 0.99, eps 1e-5), changed by
     ``settings``: by default :data:`A2C_SETTINGS` (``ent_coef=0.01``, normalised advantages);
@@ -260,6 +276,8 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
         keep: ``best-train`` (default): save the snapshot with the best train-split OER_tau,
             scored every ``select_every`` steps and at the end; ``last``: the last one.
         select_every: Environment steps between train-split scores (``best-train`` only).
+        algo: ``a2c`` (default), ``ppo`` or ``dqn`` (:data:`ALGORITHMS`).
+        progress: Show progress (:class:`TrainingProgress`).
         force: Discard a checkpoint beside ``out_path`` that cannot be resumed (another run's,
             or a damaged one) instead of refusing (:func:`check_checkpoint`).
 
@@ -267,12 +285,15 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
         The saved model's path.
 
     Raises:
-        UserError: for a bad dataset, scenario, split or architecture, or a checkpoint that cannot
-            be resumed without ``force``.
+        UserError: for a bad dataset, scenario, split, algorithm or architecture, or a checkpoint
+            that cannot be resumed without ``force``.
         MachineError: when the machine fails the run (a full disk), naming what survives where.
     """
-    from stable_baselines3 import A2C
+    import stable_baselines3
 
+    if algo not in ALGORITHMS:
+        raise UserError(f"unknown algorithm {algo!r}: choose one of {', '.join(ALGORITHMS)}")
+    algorithm = getattr(stable_baselines3, algo.upper())
     if arch not in ARCHITECTURES:
         raise UserError(f"unknown network {arch!r}: choose one of {', '.join(ARCHITECTURES)}")
     if total_timesteps < 1 or n_envs < 1 or checkpoint_every < 0 or select_every < 0:
@@ -280,26 +301,26 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
     check_keep(keep)
     check_seed(seed, "--seed")
     check_device(device)
-    a2c_settings = resolve_settings(settings)
+    chosen = resolve_settings(settings) if algo == "a2c" else resolve_sb3_settings(algo, settings)
     final = model_path(Path(out_path).expanduser().absolute())
     prove_writable_file(final)  # before hours of training, not after
     model_file, settings_file = checkpoint_paths(final)
     # A path names the dataset itself (a Path's own .root would be "/"); a reader's dataset, its root.
     root = dataset if isinstance(dataset, (str, os.PathLike)) else getattr(dataset, "root", dataset)
     settings = {"dataset": str(Path(root).expanduser().absolute()), "scenario": scenario, "crop": crop,
-                "seed": seed, "n_envs": n_envs, "arch": arch, "algorithm": "A2C",
-                "a2c_settings": a2c_settings, "start_rule": "pairs", "keep": keep}
+                "seed": seed, "n_envs": n_envs, "arch": arch, "algorithm": algo.upper(),
+                "a2c_settings" if algo == "a2c" else "sb3_settings": chosen, "start_rule": "pairs", "keep": keep}
     resumed = check_checkpoint(settings_file, model_file, settings, force)
     opened = as_dataset(dataset)
     env = make_vec_tvm(opened, scenario, n_envs, seed, "train", crop, cache_dir)
     scores: list[dict[str, Any]] = []
     if resumed is not None:
         done, earlier, points, scores = resumed
-        model = load_checkpoint(model_file, env, device)
+        model = load_checkpoint(algorithm, model_file, env, device)
         print(f"resuming {final.name} from its checkpoint at {done} of {total_timesteps} steps", flush=True)
     else:
-        model = A2C("CnnPolicy", env, seed=seed, device=device, verbose=verbose,
-                    policy_kwargs=dict(ARCHITECTURES[arch]), **a2c_settings)
+        model = algorithm("CnnPolicy", env, seed=seed, device=device, verbose=verbose,
+                          policy_kwargs=dict(ARCHITECTURES[arch]), **chosen)
         done, earlier, points = 0, [], []
     sittings = _Sittings(earlier, done)
     curve = LearningCurve(CURVE_EVERY, points)
@@ -308,7 +329,8 @@ def train_a2c(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed:
         scoring_env = TVMEnv(opened, scenario, split="train", crop=crop, cache_dir=cache_dir)
         selection = KeepBestOnTrain(scoring_env, final, select_every, save_model, scores,
                                     prune_at_once=not checkpoint_every)
-    callbacks = [c for c in (callback, curve, selection) if c is not None]
+    shown = TrainingProgress(total_timesteps, f"{algo.upper()} {scenario}", selection) if progress else None
+    callbacks = [c for c in (callback, curve, selection, shown) if c is not None]
     if checkpoint_every:
         callbacks.append(_Checkpoint(checkpoint_every, model_file, settings_file, settings, sittings, curve,
                                      selection))
@@ -409,16 +431,15 @@ def _checkpoint_problem(settings_file: Path, model_file: Path, settings: dict[st
     return f"it is the checkpoint of another run ({'; '.join(differ[:3]) or 'older settings'}), which this one cannot resume"
 
 
-def load_checkpoint(model_file: Path, env: Any, device: str) -> Any:
-    """Load a checkpoint's model, a damaged one as one line with both ways on.
+def load_checkpoint(algorithm: Any, model_file: Path, env: Any, device: str) -> Any:
+    """Load a checkpoint's model with its SB3 ``algorithm`` class, a damaged one as one line with
+    both ways on.
 
     Raises:
         UserError: when SB3 cannot read it.
     """
-    from stable_baselines3 import A2C
-
     try:
-        return A2C.load(model_file, env=env, device=device)
+        return algorithm.load(model_file, env=env, device=device)
     except Exception as error:  # zipfile, pickle, torch and SB3 each raise their own
         if isinstance(error, (MemoryError, OSError)):
             raise

@@ -266,6 +266,23 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
             reward = self.reward(self._oer_0, self.oer)
         return self._observation(), reward, terminated, False, self._info()
 
+    def action_for(self, name: str) -> int:
+        """The index of the action called ``name`` (a policy may answer with names).
+
+        Raises:
+            UserError: for a name that is not an action of this scenario.
+        """
+        if name not in self.action_names:
+            raise UserError(f"invalid action {name!r}: this {self.scenario} environment has {', '.join(self.action_names)}")
+        return self.action_names.index(name)
+
+    def describe(self) -> dict[str, Any]:
+        """What an evaluation's protocol records of this environment: its id, scenario, split,
+        tau, scenes, dataset root, action names, start rule and eligible start count."""
+        return {"environment": "davis_ag/TVM-v0", "scenario": self.scenario, "split": self.split,
+                "tau": self.tau, "scenes": [s.id for s in self.scenes], "dataset": str(self.dataset.root),
+                "actions": list(self.action_names), "start_rule": self.start_rule, "starts": int(len(self.starts))}
+
     def _action_index(self, action: Any) -> int:
         """Validate an action (Python or NumPy integer, or a one-element integer array)."""
         if isinstance(action, np.ndarray) and action.size == 1:

@@ -103,7 +103,7 @@ def write_report(root: Path, out_dir: Path, results: dict[str, Any] | None = Non
     Args:
         root: The dataset root (or group or scene folder).
         out_dir: The report folder (created).
-        results: What :func:`davis_ag.benchmark.evaluation.evaluate_agents` returned, for the table and chart.
+        results: What :func:`davis_ag.benchmark.evaluation.evaluate_policies` returned (as JSON), for the table and chart.
         validation: The validation summary line.
         timer: Stage timings.
         generated: Per-scene generation statistics (:func:`davis_ag.workflows.demo.generate_scenes`).

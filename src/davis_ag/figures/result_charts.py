@@ -19,7 +19,7 @@ def plot_results(results: dict[str, Any], path: str | os.PathLike[str]) -> Path:
     bars, saved as PNG.
 
     Args:
-        results: What :func:`evaluate_agents` returned.
+        results: What :func:`davis_ag.benchmark.evaluation.evaluate_policies` returned, as JSON.
         path: The PNG to write.
 
     Returns:
@@ -40,8 +40,10 @@ def plot_results(results: dict[str, Any], path: str | os.PathLike[str]) -> Path:
         ax.set_title(title)
         ax.tick_params(axis="x", labelrotation=30)
     protocol = results["protocol"]
-    fig.suptitle(f"{protocol['scenario'].upper()} {protocol['split']}: {protocol['sessions']} x "
-                 f"{protocol['episodes']} episodes")
+    # What the bars rest on: the split's scenes and eligible starts (the grid's; drawn live otherwise).
+    starts = f", {protocol['starts']} eligible starts" if protocol.get("starts") is not None else ""
+    fig.suptitle(f"{protocol['scenario'].upper()} {protocol['split']}: {len(protocol.get('scenes', []))} scene(s)"
+                 f"{starts}, {protocol['sessions']} x {protocol['episodes']} episodes")
     fig.tight_layout()
     try:
         return save_figure_atomic(fig, path, dpi=120)

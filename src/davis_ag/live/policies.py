@@ -1,25 +1,26 @@
-"""Policies for TVMContinuous-v0: the heuristics that carry over to continuous moves, a greedy
-look-ahead, and trained Stable-Baselines3 models.
+"""Baselines for TVMContinuous-v0: the heuristics that carry over to continuous moves and a greedy
+look-ahead. Trained models are :class:`davis_ag.benchmark.policies.ModelPolicy`, and every policy
+is scored by :func:`davis_ag.benchmark.evaluation.evaluate_policies`, as on the grid.
 
 Section IV-B's heuristics draw random grid moves from a set (LRD: left/right/done, UDD:
 up/down/done, Rand: all). In continuous space "left or right" becomes a random sideways move of
 random length, "up or down" a random climb, and Rand a uniform action; ``done`` has no
 counterpart (a zero action stands still). Greedy has no grid counterpart: at each step it tries
 ``candidates`` random actions on the scene without slip (the environment's own renders, like the
-grid's Oracle reads its tables) and takes the one that shows the target best. Every policy has
-the :class:`davis_ag.benchmark.agents.Agent` interface (``reset(seed)``, ``act(obs, env)``) with
-an action array in place of an index.
+grid's Oracle reads its tables) and takes the one that shows the target best. Every policy is a
+:class:`davis_ag.benchmark.policies.Policy` (``reset(seed)``, ``act(observation, info)``) with
+an action array in place of an index; ``prepare(env)`` reads the environment first.
 """
 
 from __future__ import annotations
 
-import os
-from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
 import numpy as np
 
+from davis_ag.benchmark.policies import SeededPolicy, baselines_by_name, unwrapped
+from davis_ag.environments import CONTINUOUS_ID
 from davis_ag.errors import UserError
 from davis_ag.live.tvm_continuous import TVMContinuousEnv
 
@@ -33,13 +34,10 @@ def continuous(env: gym.Env) -> TVMContinuousEnv:
     Raises:
         UserError: for another environment.
     """
-    inner = getattr(env, "unwrapped", env)
-    if not isinstance(inner, TVMContinuousEnv):
-        raise UserError(f"expected a davis_ag/TVMContinuous-v0 environment, got {type(inner).__name__}")
-    return inner
+    return unwrapped(env, TVMContinuousEnv, CONTINUOUS_ID)
 
 
-class RandomAxes:
+class RandomAxes(SeededPolicy):
     """Uniform random moves along some action components (LR, UD), or all of them (Rand)."""
 
     def __init__(self, name: str, axes: tuple[int, ...] | None, seed: int | None = None) -> None:
@@ -48,24 +46,24 @@ class RandomAxes:
             axes: Action components to draw (uniform in [-1, 1]); the rest stay 0. None: all.
             seed: Seed of the agent's generator until :meth:`reset` gets one.
         """
+        super().__init__(seed)
         self.name, self.axes = name, axes
-        self._rng = np.random.default_rng(seed)
+        self._size = 0
 
-    def reset(self, seed: int | None = None) -> None:
-        """Reseed (None keeps the stream)."""
-        if seed is not None:
-            self._rng = np.random.default_rng(seed)
+    def prepare(self, env: gym.Env) -> None:
+        """Read the action's size (3 with ``aim="plant"``, 5 with ``"free"``)."""
+        self._size = continuous(env).action_space.shape[0]
 
-    def act(self, obs: np.ndarray, env: gym.Env) -> np.ndarray:
+    def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         """One random action of the environment's shape."""
-        size = continuous(env).action_space.shape[0]
+        size = self._size
         action = np.zeros(size, dtype=np.float32)
         axes = list(range(size)) if self.axes is None else list(self.axes)
         action[axes] = self._rng.uniform(-1.0, 1.0, size=len(axes))
         return action
 
 
-class Greedy:
+class Greedy(SeededPolicy):
     """Tries ``candidates`` random actions (without slip) and plays the best for the target's OER;
     stands still when none beats staying."""
 
@@ -74,17 +72,19 @@ class Greedy:
             candidates: Actions tried per step (one render each).
             seed: Seed of the candidate draw.
         """
+        super().__init__(seed)
         self.name, self.candidates = "Greedy", int(candidates)
-        self._rng = np.random.default_rng(seed)
+        self._env: TVMContinuousEnv | None = None
 
-    def reset(self, seed: int | None = None) -> None:
-        """Reseed (None keeps the stream)."""
-        if seed is not None:
-            self._rng = np.random.default_rng(seed)
+    def prepare(self, env: gym.Env) -> None:
+        """Keep the environment: its renders score the candidates."""
+        self._env = continuous(env)
 
-    def act(self, obs: np.ndarray, env: gym.Env) -> np.ndarray:
+    def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         """The best candidate action by the OER it would give."""
-        inner = continuous(env)
+        inner = self._env
+        if inner is None:
+            raise UserError("Greedy plays only after prepare(env): evaluate it with davis_ag.benchmark.evaluate")
         size = inner.action_space.shape[0]
         best, best_oer = np.zeros(size, dtype=np.float32), inner.oer
         for action in self._rng.uniform(-1.0, 1.0, size=(self.candidates, size)).astype(np.float32):
@@ -94,80 +94,18 @@ class Greedy:
         return best
 
 
-class ModelAgent:
-    """A trained SB3 model (PPO or SAC) as a policy."""
-
-    def __init__(self, model: Any, deterministic: bool = True) -> None:
-        """Args:
-            model: A loaded SB3 model, or the path of a PPO or SAC ``.zip``.
-            deterministic: Take the mean action instead of sampling.
-
-        Raises:
-            UserError: when the file is missing or not a PPO/SAC model.
-        """
-        if isinstance(model, (str, os.PathLike)):
-            model = load_model(Path(model))
-        self.model, self.deterministic = model, deterministic
-        self.name = type(model).__name__
-
-    def reset(self, seed: int | None = None) -> None:
-        """Nothing to reset: the policy is deterministic or sampled by SB3."""
-
-    def check(self, env: gym.Env) -> None:
-        """Refuse an environment whose action space the model was not trained for."""
-        inner = continuous(env)
-        if getattr(self.model.action_space, "shape", None) != inner.action_space.shape:
-            raise UserError(f"the model takes actions of shape {self.model.action_space.shape}, the environment "
-                            f"{inner.action_space.shape}: use a model trained with the same aim")
-
-    def act(self, obs: np.ndarray, env: gym.Env) -> np.ndarray:
-        """The model's action."""
-        action, _ = self.model.predict(obs, deterministic=self.deterministic)
-        return np.asarray(action, dtype=np.float32)
+#: Baseline names :func:`build_policies` accepts (trained models come from
+#: :func:`davis_ag.benchmark.policies.policy_from_spec`), and what makes each.
+BASELINES: dict[str, Any] = {
+    **{name: (lambda name=name, axes=axes: RandomAxes(name, axes)) for name, axes in HEURISTIC_AXES.items()},
+    "Greedy": Greedy}
+POLICY_NAMES: tuple[str, ...] = tuple(BASELINES)
 
 
-def load_model(path: Path) -> Any:
-    """A saved PPO or SAC model.
+def build_policies(names: list[str]) -> list[Any]:
+    """Continuous baselines by name, in order (case-insensitive; see :data:`POLICY_NAMES`).
 
     Raises:
-        UserError: when the file is missing or holds neither.
+        UserError: for an unknown name (a trained model is a ``--policy MODEL.zip``).
     """
-    from stable_baselines3 import PPO, SAC
-
-    if not path.is_file():
-        raise UserError(f"{path}: no such model file; train one with davis_ag.live.training.train_continuous")
-    for algorithm in (PPO, SAC):
-        try:
-            return algorithm.load(path, device="cpu")
-        except Exception:  # noqa: BLE001 - try the next algorithm; any failure means "not this one"
-            continue
-    raise UserError(f"{path}: not a Stable-Baselines3 PPO or SAC model")
-
-
-#: Policy names :func:`build_policies` accepts (``Model`` also needs a model file).
-POLICY_NAMES: tuple[str, ...] = ("LR", "UD", "Rand", "Greedy", "Model")
-
-
-def build_policies(names: list[str], model: str | os.PathLike[str] | None = None,
-                   deterministic: bool = True) -> list[Any]:
-    """Policies by name, in order (case-insensitive; see :data:`POLICY_NAMES`); ``deterministic``
-    is the model's (False: it samples its actions).
-
-    Raises:
-        UserError: for an unknown name, or ``Model`` without a model file.
-    """
-    policies: list[Any] = []
-    for name in names:
-        key = name.strip().lower()
-        match = next((k for k in HEURISTIC_AXES if k.lower() == key), None)
-        if match:
-            policies.append(RandomAxes(match, HEURISTIC_AXES[match]))
-        elif key == "greedy":
-            policies.append(Greedy())
-        elif key in ("model", "a2c", "ppo", "sac"):
-            if model is None:
-                raise UserError(f"policy {name} needs a trained model: pass --model model.zip")
-            policies.append(ModelAgent(model, deterministic=deterministic))
-        else:
-            raise UserError(f"unknown continuous policy {name!r}: choose from {', '.join(POLICY_NAMES)}")
-    return policies
+    return baselines_by_name(names, BASELINES, "continuous ")

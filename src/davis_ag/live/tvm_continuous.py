@@ -56,6 +56,10 @@ from davis_ag.scene.view_grid import Viewpoint, excluded
 START_TRIES = 200
 #: Pitch limits of a free camera, degrees above the horizon.
 PITCH_RANGE = (-85.0, 45.0)
+#: The grid's move names as (action component, sign) (:meth:`TVMContinuousEnv.action_for`).
+NAMED_MOVES: dict[str, tuple[int, float]] = {
+    "left": (0, -1.0), "right": (0, 1.0), "backward": (1, -1.0), "forward": (1, 1.0),
+    "down": (2, -1.0), "up": (2, 1.0), "rotate_ccw": (3, 1.0), "rotate_cw": (3, -1.0)}
 
 
 def scene_folders(source: str | os.PathLike[str], scenario: str, split: str, crop: str | None) -> list[Path]:
@@ -115,6 +119,7 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         if self.tau < 1:
             raise UserError(f"tau must be at least 1, got {self.tau}")
         folders = scene_folders(dataset, spec.name, split, crop)
+        self.dataset_root = str(Path(os.fspath(dataset)).expanduser().absolute())
         if folders == [Path(os.fspath(dataset))]:
             self.split = "scene"  # one scene folder: no split
         if not folders:
@@ -249,6 +254,34 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
                 return
         raise UserError(f"{self.scene.settings.folder}: no start pose with a fruit of OER < {self.max_start_oer} "
                         f"in {START_TRIES} tries; use another scene or a higher max_start_oer")
+
+    def action_for(self, name: str) -> np.ndarray:
+        """A grid move's name as a full unit move along its axis (a policy may answer with names):
+        left/right -x/+x, backward/forward -y/+y, down/up -z/+z, rotate_ccw/rotate_cw +yaw/-yaw
+        (``aim="free"`` only); ``done`` stands still.
+
+        Raises:
+            UserError: for a name with no such move here.
+        """
+        size = self.action_space.shape[0]
+        action = np.zeros(size, dtype=np.float32)
+        if name == "done":
+            return action
+        axis, sign = NAMED_MOVES.get(name, (size, 0.0))
+        if axis >= size:
+            names = [n for n, (a, _) in NAMED_MOVES.items() if a < size] + ["done"]
+            raise UserError(f"invalid action {name!r}: this environment takes {', '.join(names)} or "
+                            f"{size} numbers in [-1, 1]")
+        action[axis] = sign
+        return action
+
+    def describe(self) -> dict[str, Any]:
+        """What an evaluation's protocol records of this environment (its starts are drawn poses,
+        so there is no start count)."""
+        return {"environment": "davis_ag/TVMContinuous-v0", "scenario": self.scenario, "split": self.split,
+                "tau": self.tau, "aim": self.aim, "scenes": [s.settings.metadata.scene for s in self.scenes],
+                "dataset": self.dataset_root,
+                "actions": ["dx", "dy", "dz", "dyaw", "dpitch"][: self.action_space.shape[0]]}
 
     def _action(self, action: Any) -> np.ndarray:
         a = np.asarray(action, dtype=np.float64).reshape(-1)

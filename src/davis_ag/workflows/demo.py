@@ -88,8 +88,8 @@ def run_baselines(root: Path, scenario: str, crop: str, split: str, episodes: in
     """Evaluate LRD, UDD, Rand, Oracle, the Best fixed action (and A2C when ``model`` is given)
     as in Table 4.
 
-    A2C plays as :data:`davis_ag.benchmark.agents.A2C_DETERMINISTIC` says (sampled); the same model taking
-    its most likely action is the extra row ``A2C (deterministic)``.
+    A2C plays as :data:`davis_ag.benchmark.policies.DETERMINISTIC_PLAY` says (sampled); the same model
+    taking its most likely action is the extra row ``A2C (deterministic)``.
 
     Args:
         root: The dataset root.
@@ -102,24 +102,18 @@ def run_baselines(root: Path, scenario: str, crop: str, split: str, episodes: in
         model: A trained A2C ``.zip``; adds the A2C column.
 
     Returns:
-        What :func:`davis_ag.benchmark.evaluation.evaluate_agents` returns.
+        What :func:`davis_ag.benchmark.evaluation.evaluate_policies` returns, as its JSON.
     """
-    from davis_ag.benchmark import TVMEnv
-    from davis_ag.benchmark.agents import A2C_DETERMINISTIC, A2CAgent, build_agents
-    from davis_ag.benchmark.evaluation import evaluate_agents
+    from davis_ag.benchmark.evaluation import evaluate
+    from davis_ag.benchmark.policies import ModelPolicy
 
-    agents = build_agents(list(BASELINES))
+    policies = []
     if model:
-        agents = build_agents(["A2C"], model=model, deterministic=A2C_DETERMINISTIC) + agents
-        deterministic = A2CAgent(agents[0].model, deterministic=True)
-        deterministic.name = "A2C (deterministic)"
-        agents.insert(1, deterministic)
-    env = TVMEnv(root, scenario=scenario, split=split, crop=crop)
-    results = evaluate_agents(env, agents, episodes=episodes, sessions=sessions, seed=seed,
-                              keep_episodes=True, best_fixed_action=True)
-    results["protocol"]["crop"] = crop
-    env.close()
-    return results
+        sampled = ModelPolicy(model)
+        policies = [sampled, ModelPolicy(sampled.model, deterministic=True, name="A2C (deterministic)")]
+    results = evaluate(policies, root, scenario=scenario, split=split, sessions=sessions, episodes=episodes,
+                       seed=seed, crop=crop, baselines=list(BASELINES))
+    return results.as_json()
 
 
 def run_demo(out: Path, scenes: int = 2, size: tuple[int, int] = DEMO_SIZE, seed: int = 0,

@@ -9,7 +9,6 @@ run cut short still leaves what it measured.
 from __future__ import annotations
 
 import json
-import sys
 import time
 from dataclasses import asdict, dataclass, replace
 from functools import partial
@@ -276,8 +275,7 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
             print(f"training A2C (the paper's network) on {key} train split for {timesteps} steps", flush=True)
             start = time.perf_counter()
             train_a2c(root, scenario_name, total_timesteps=timesteps, seed=config.seed,
-                      out_path=model, n_envs=config.n_envs, crop=crop_name, device="cpu",
-                      callback=_progress_callback(timesteps, key), keep=KEEP,
+                      out_path=model, n_envs=config.n_envs, crop=crop_name, device="cpu", keep=KEEP,
                       force=True)  # its own work folder: a checkpoint of other settings is redone, as said above
             seconds = time.perf_counter() - start
             write_json_atomic(stamp, {**wanted, "seconds": seconds})
@@ -357,29 +355,3 @@ def _summary(results: dict[str, Any]) -> dict[str, Any]:
         summary[PAIRED_KEY] = paired
     return summary
 
-
-def _progress_callback(total: int, label: str) -> Any:
-    """An SB3 callback drawing a tqdm bar over environment steps."""
-    from stable_baselines3.common.callbacks import BaseCallback
-    from tqdm import tqdm
-
-    class Progress(BaseCallback):
-        # A bar on a terminal; in a log (not a terminal), a line a minute instead of a redrawn bar.
-        def _on_training_start(self) -> None:
-            # A run resumed from a checkpoint starts at the checkpoint's step count, not at 0.
-            self.steps, self.last = int(self.model.num_timesteps), time.monotonic()
-            self.bar = tqdm(total=total, initial=self.steps, desc=f"A2C {label}", unit="step",
-                            mininterval=5, disable=None)
-
-        def _on_step(self) -> bool:
-            self.bar.update(self.training_env.num_envs)
-            self.steps += self.training_env.num_envs
-            if self.bar.disable and time.monotonic() - self.last >= 60:
-                self.last = time.monotonic()
-                print(f"A2C {label}: {self.steps} of {total} steps", file=sys.stderr, flush=True)
-            return True
-
-        def _on_training_end(self) -> None:
-            self.bar.close()
-
-    return Progress()

@@ -1,0 +1,154 @@
+"""A leaderboard from results files (``davis-ag compare``): one row per method, ranked by OER_tau.
+
+Results are ranked together only when they measure the same thing: the same protocol version,
+the same dataset (its identity, :class:`davis_ag.benchmark.results.DatasetIdentity`), environment,
+scenario, crop, split (hence scenes and eligible starts). Anything else is refused in one line.
+Files may differ in sessions, episodes or seed; then their means are still comparable (each an
+estimate of the same expectation), but their episodes are not the same, and a paired gap is
+given only between policies that played the same episodes: within one file, or across files of
+the same seed, sessions and episodes that kept their episodes.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import asdict, dataclass
+from typing import Any
+from pathlib import Path
+
+from davis_ag.benchmark.evaluation import PAIRED_BASELINES
+from davis_ag.benchmark.results import (
+    EvaluationResults,
+    PairedGap,
+    PolicyResult,
+    load_results,
+    signed_number,
+    split_text,
+    table_number,
+)
+from davis_ag.errors import UserError
+
+
+@dataclass
+class Row:
+    """One method of the leaderboard: its name, the file it comes from and its results."""
+
+    name: str
+    base: str
+    file: Path
+    results: EvaluationResults
+    policy: PolicyResult
+    gaps: dict[str, PairedGap | None]
+
+
+def _identity(results: EvaluationResults) -> dict[str, object]:
+    """What must agree for two results to be ranked together, by what a message calls it."""
+    p = results.protocol
+    return {"protocol version": p.version,
+            "dataset": results.dataset.fingerprint if results.dataset else None,
+            "environment": p.environment, "scenario": p.scenario, "crop": p.crop, "split": p.split,
+            "test scenes": tuple(p.scenes), "tau": p.tau, "start rule": p.start_rule, "eligible starts": p.starts}
+
+
+def check_comparable(files: list[tuple[Path, EvaluationResults]]) -> None:
+    """Refuse results that measure different things (see the module docstring).
+
+    Raises:
+        UserError: one line naming the two files and what differs.
+    """
+    (first, base), others = files[0], files[1:]
+    if base.protocol.version == 0:
+        raise UserError(f"{first} was written before results files had a protocol version: evaluate again "
+                        "with this davis-ag to rank it")
+    if base.dataset is None:
+        raise UserError(f"{first} does not record its dataset's identity: evaluate again with this davis-ag to rank it")
+    wanted = _identity(base)
+    for path, results in others:
+        found = _identity(results)
+        for key, value in wanted.items():
+            if found[key] != value:
+                raise UserError(f"{path} and {first} differ in {key} ({_shown(found[key])} against {_shown(value)}): "
+                                "results of different datasets, splits or protocol versions cannot be ranked together")
+
+
+def _shown(value: Any) -> Any:
+    """A scene list as its length, anything else as it is (for one line)."""
+    return f"{len(value)} scene(s)" if isinstance(value, tuple) else value
+
+
+def _same_episodes(a: EvaluationResults, b: EvaluationResults) -> bool:
+    pa, pb = a.protocol, b.protocol
+    return (pa.seed, pa.sessions, pa.episodes) == (pb.seed, pb.sessions, pb.episodes)
+
+
+def _gap(row_results: EvaluationResults, policy: PolicyResult, baseline: str,
+         files: list[tuple[Path, EvaluationResults]]) -> PairedGap | None:
+    """The row's gap to ``baseline``: its own file's, else across files that played the same episodes."""
+    if baseline in policy.paired:
+        return policy.paired[baseline]
+    if policy.episodes is None:
+        return None
+    from davis_ag.benchmark.paired import paired_gap
+
+    for _, other in files:
+        theirs = other.policies.get(baseline)
+        if theirs is not None and theirs.episodes and _same_episodes(row_results, other):
+            try:
+                gap = paired_gap([e.model_dump() for e in policy.episodes], [e.model_dump() for e in theirs.episodes],
+                                 seed=row_results.protocol.seed)
+            except ValueError:  # not the same starts after all
+                continue
+            return PairedGap.model_validate(asdict(gap))
+    return None
+
+
+def leaderboard(paths: list[str | os.PathLike[str]]) -> list[Row]:
+    """The rows of the leaderboard of some results files, best OER_tau first.
+
+    A method in several files with the same numbers (a baseline evaluated again on the same
+    episodes) is one row; a name with different numbers gets its file's name beside it.
+
+    Raises:
+        UserError: for an unreadable file or results that cannot be ranked together.
+    """
+    if not paths:
+        raise UserError("give at least one RESULTS.json")
+    files = [(Path(p), load_results(p)) for p in paths]
+    check_comparable(files)
+    rows: list[Row] = []
+    for path, results in files:
+        for name, policy in results.policies.items():
+            same = [r for r in rows if r.base == name]
+            if any(r.policy.oer_tau == policy.oer_tau and r.policy.reward == policy.reward for r in same):
+                continue
+            label = f"{name} ({path.name})" if same else name
+            gaps = {b: _gap(results, policy, b, files) for b in PAIRED_BASELINES if b != name}
+            rows.append(Row(label, name, path, results, policy, gaps))
+    return sorted(rows, key=lambda r: -r.policy.oer_tau.mean)
+
+
+def _gap_cell(gap: PairedGap | None) -> str:
+    return "-" if gap is None else f"{signed_number(gap.gap)} [{signed_number(gap.low)}, {signed_number(gap.high)}]"
+
+
+def format_leaderboard(rows: list[Row]) -> str:
+    """The leaderboard as a Markdown page: what the numbers rest on, then the ranked table."""
+    protocol = rows[0].results.protocol
+    dataset = rows[0].results.dataset
+    sampling = sorted({split_text(r.results.protocol) for r in rows})
+    baselines = [b for b in PAIRED_BASELINES if any(r.gaps.get(b) for r in rows)]
+    lines = [f"# Leaderboard: {protocol.scenario.upper()}{' ' + protocol.crop if protocol.crop else ''}, "
+             f"{protocol.environment}, {protocol.split} split", "",
+             "What the numbers rest on: " + "; ".join(sampling) + ". "
+             f"Dataset {dataset.fingerprint} ({len(dataset.scenes)} scenes), protocol version {protocol.version}.", "",
+             "| Rank | Method | OER_tau | Cum. reward | Ep. length | "
+             + " | ".join(f"Gap to {b} [95 %]" for b in baselines) + (" | " if baselines else "") + "File |",
+             "|---:|---|---:|---:|---:|" + "---:|" * len(baselines) + "---|"]
+    for rank, row in enumerate(rows, 1):
+        p = row.policy
+        cells = [str(rank), row.name] + [f"{table_number(m.mean)} ±{table_number(m.std)}" for m in (p.oer_tau, p.reward, p.length)]
+        cells += [_gap_cell(row.gaps.get(b)) for b in baselines] + [row.file.name]
+        lines.append("| " + " | ".join(cells) + " |")
+    lines += ["", "Mean ± std over sessions. Gap: mean OER_tau minus the baseline's on the same episodes, with the "
+              "95 % bootstrap interval over episodes; `-`: the baseline itself, or a method that did not play the same episodes."]
+    return "\n".join(lines) + "\n"

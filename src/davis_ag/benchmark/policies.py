@@ -1,0 +1,323 @@
+"""The policy protocol every davis-ag environment is benchmarked with, and policies named by a SPEC.
+
+A policy (:class:`Policy`) has a ``name`` (its row in results tables) and two methods:
+``reset(seed)`` at the start of each episode (``seed`` fixes the policy's own randomness) and
+``act(observation, info) -> action`` once per step, with the observation and the ``info`` dict the
+environment just returned. The same protocol serves TVM-v0 (an action index, or an action name
+such as ``"left"``) and TVMContinuous-v0 (an array in [-1, 1], or a move name, which
+:meth:`TVMContinuousEnv.action_for` turns into a unit move). A policy that needs to know the
+environment before it plays (its action names, its tables, whether a model's spaces fit) also
+defines ``prepare(env)``: the evaluation calls it once, before any episode, and a policy that
+does not fit raises :class:`davis_ag.errors.UserError` there.
+
+A SPEC (``davis-ag evaluate --policy``, :func:`policy_from_spec`) is one of:
+
+- ``MODEL.zip``: a saved Stable-Baselines3 model of any algorithm; the algorithm is read from
+  the file (:func:`model_algorithm`) and names the row (``PPO``, ``A2C``, ``DQN``...);
+- ``module:attr`` or ``path/to/file.py:attr``: a callable ``(observation, info) -> action``, a
+  class with ``reset``/``act`` (made with no arguments) or such an object.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import inspect
+import json
+import os
+import sys
+import zipfile
+from pathlib import Path
+from typing import Any, Callable, Protocol, runtime_checkable
+
+import numpy as np
+
+from davis_ag.errors import UserError
+
+#: How a trained model plays by default (one owner for every SB3 model: ``davis-ag evaluate``,
+#: ``reproduce``, the train-split score that picks a snapshot): False samples each action from
+#: the policy. Played deterministically, a policy repeats a refused move for the rest of the
+#: episode (the observation after a refused move is the same image), and a policy whose most
+#: likely action is the same at every start is exactly a fixed action: on the train split
+#: (tools/a2c_trials.py) a short-trained A2C played deterministically was "always forward" while
+#: sampling it scored higher; trained longer, deterministic play scored about one standard
+#: deviation higher than sampling. Sampling is kept as the safe default on unseen scenes, where
+#: the policy is least sure; ``davis-ag evaluate --deterministic`` plays the most likely action,
+#: and ``reproduce`` reports it as the row ``A2C (deterministic)``.
+DETERMINISTIC_PLAY = False
+
+#: Stable-Baselines3 algorithms a saved model may be, by the name :func:`model_algorithm` reads.
+ALGORITHMS: tuple[str, ...] = ("A2C", "PPO", "DQN", "SAC", "TD3", "DDPG")
+
+
+@runtime_checkable
+class Policy(Protocol):
+    """What the evaluation loop needs from a policy (see the module docstring)."""
+
+    name: str
+
+    def reset(self, seed: int | None = None) -> None:
+        """Start an episode; ``seed`` fixes the policy's own randomness (if any)."""
+
+    def act(self, observation: np.ndarray, info: dict[str, Any]) -> Any:
+        """The action for ``observation`` (``info``: what the environment said with it)."""
+
+
+def unwrapped(env: Any, kind: type, env_id: str) -> Any:
+    """The environment of class ``kind`` under any wrappers (what a policy's ``prepare`` reads).
+
+    Raises:
+        UserError: when ``env`` is another environment.
+    """
+    inner = getattr(env, "unwrapped", env)
+    if not isinstance(inner, kind):
+        raise UserError(f"expected a {env_id} environment, got {type(inner).__name__}")
+    return inner
+
+
+class SeededPolicy:
+    """Base of the policies with a random stream of their own: ``reset(seed)`` reseeds it."""
+
+    def __init__(self, seed: int | None = None) -> None:
+        """Args:
+            seed: Seed of the policy's generator until :meth:`reset` gets one.
+        """
+        self._rng = np.random.default_rng(seed)
+
+    def reset(self, seed: int | None = None) -> None:
+        """Reseed the policy's draws (``None`` keeps the current stream)."""
+        if seed is not None:
+            self._rng = np.random.default_rng(seed)
+
+
+def baselines_by_name(names: list[str], makers: dict[str, Callable[[], Any]], kind: str = "") -> list[Any]:
+    """An environment's baselines by name, in the order given (any case).
+
+    Args:
+        names: The names asked for.
+        makers: Each baseline's name and a function making it.
+        kind: How error messages call the environment's policies (``"continuous "``).
+
+    Raises:
+        UserError: for an unknown name (a trained model is a ``--policy MODEL.zip``).
+    """
+    canonical = {k.lower(): k for k in makers}
+    made = []
+    for name in names:
+        key = name.strip().lower()
+        if key in canonical:
+            made.append(makers[canonical[key]]())
+        elif key in ("model", *(a.lower() for a in ALGORITHMS)):
+            raise UserError(f"{name} is not a baseline: give the trained model with --policy MODEL.zip")
+        else:
+            raise UserError(f"unknown {kind}policy {name!r}: choose from {', '.join(makers)}")
+    return made
+
+
+def prepare(policy: Any, env: Any) -> None:
+    """Call the policy's optional ``prepare(env)`` (learn the environment, refuse a misfit)."""
+    method = getattr(policy, "prepare", None)
+    if callable(method):
+        method(env)
+
+
+class FunctionPolicy:
+    """A plain callable ``(observation, info) -> action`` as a :class:`Policy` (no randomness)."""
+
+    def __init__(self, function: Callable[[np.ndarray, dict[str, Any]], Any], name: str | None = None) -> None:
+        """Args:
+            function: The callable.
+            name: Row name (default: the callable's ``__name__``).
+        """
+        self.function = function
+        self.name = name or getattr(function, "__name__", type(function).__name__)
+
+    def reset(self, seed: int | None = None) -> None:
+        """Seed NumPy's global generator, which a plain function may draw from."""
+        if seed is not None:
+            np.random.seed(seed % 2**32)
+
+    def act(self, observation: np.ndarray, info: dict[str, Any]) -> Any:
+        """The function's action."""
+        return self.function(observation, info)
+
+
+def as_policy(thing: Any, name: str | None = None) -> Any:
+    """A :class:`Policy` from a policy object, a class with ``reset``/``act`` or a callable.
+
+    Raises:
+        UserError: when ``thing`` is none of them.
+    """
+    if inspect.isclass(thing):
+        if not callable(getattr(thing, "act", None)):
+            raise UserError(f"class {thing.__name__} has no act(observation, info) method: give a policy class "
+                            "with reset(seed) and act(observation, info), or a function")
+        try:
+            thing = thing()
+        except TypeError as error:
+            raise UserError(f"class {thing.__name__} cannot be made without arguments ({error}): give an "
+                            "object or a function instead") from None
+    if callable(getattr(thing, "act", None)):
+        if not callable(getattr(thing, "reset", None)):
+            raise UserError(f"{type(thing).__name__} has act but no reset(seed) method: add one")
+        if name or not isinstance(getattr(thing, "name", None), str):
+            thing.name = name or type(thing).__name__
+        return thing
+    if callable(thing):
+        return FunctionPolicy(thing, name)
+    raise UserError(f"{thing!r} is not a policy: give a function (observation, info) -> action, or an object "
+                    "with reset(seed) and act(observation, info)")
+
+
+def model_algorithm(path: Path) -> str:
+    """The Stable-Baselines3 algorithm a saved model was trained with, read from its file.
+
+    SB3 keeps the model's constructor settings in the zip's ``data`` entry: the policy class's
+    module names the off-policy algorithms (``stable_baselines3.dqn.policies``...); A2C and PPO
+    share their policy classes, and only PPO has a clip range.
+
+    Raises:
+        UserError: when the file is missing or not a Stable-Baselines3 model.
+    """
+    if not path.is_file():
+        raise UserError(f"{path}: no such model file; train one with `davis-ag train`")
+    try:
+        with zipfile.ZipFile(path) as archive:
+            data = json.loads(archive.read("data"))
+        module = str(data["policy_class"].get("__module__", ""))
+    except (zipfile.BadZipFile, KeyError, ValueError, AttributeError, OSError) as error:
+        raise UserError(f"{path}: not a Stable-Baselines3 model ({error}); give the .zip "
+                        "`davis-ag train` (or SB3's model.save) wrote") from None
+    for name in ("DQN", "SAC", "TD3", "DDPG"):
+        if f".{name.lower()}." in module:
+            return name
+    return "PPO" if "clip_range" in data else "A2C"
+
+
+def load_model(path: str | os.PathLike[str], device: str = "cpu") -> Any:
+    """A saved Stable-Baselines3 model of any algorithm (:func:`model_algorithm`).
+
+    Raises:
+        UserError: when the file is missing or cannot be loaded.
+    """
+    import stable_baselines3
+
+    path = Path(path)
+    algorithm = model_algorithm(path)
+    try:
+        return getattr(stable_baselines3, algorithm).load(path, device=device)
+    except Exception as error:  # noqa: BLE001 - any load failure is a bad file
+        raise UserError(f"{path}: a {algorithm} model that does not load ({error}); "
+                        "give the .zip `davis-ag train` wrote") from None
+
+
+def _space_text(space: Any) -> str:
+    return f"{space.n} actions" if hasattr(space, "n") else f"actions of shape {getattr(space, 'shape', None)}"
+
+
+class ModelPolicy:
+    """A trained Stable-Baselines3 model (any algorithm with ``predict``) as a :class:`Policy`."""
+
+    def __init__(self, model: Any, deterministic: bool = DETERMINISTIC_PLAY, name: str | None = None,
+                 device: str = "cpu") -> None:
+        """Args:
+            model: A loaded SB3 model, or the path of a saved ``.zip``.
+            deterministic: Take the most likely action instead of sampling (see
+                :data:`DETERMINISTIC_PLAY`, the default).
+            name: Row name (default: the algorithm, e.g. ``PPO``).
+            device: Torch device to load a saved model on.
+
+        Raises:
+            UserError: when the file is missing or not an SB3 model.
+        """
+        if isinstance(model, (str, os.PathLike)):
+            model = load_model(model, device)
+        # A Q-learner's policy is its greedy action: SB3's "sampled" DQN is epsilon-greedy with
+        # training's exploration rate, which is no distribution of the learnt policy.
+        greedy = hasattr(model, "q_net")
+        self.model, self.deterministic = model, bool(deterministic) or greedy
+        self.name = name or type(model).__name__
+
+    @property
+    def play(self) -> str:
+        """``deterministic`` or ``sampled``, as results record it."""
+        return "deterministic" if self.deterministic else "sampled"
+
+    def reset(self, seed: int | None = None) -> None:
+        """Seed torch's sampling when acting stochastically (a no-op when deterministic)."""
+        if seed is not None and not self.deterministic:
+            import torch
+
+            torch.manual_seed(seed)
+
+    def prepare(self, env: Any) -> None:
+        """Refuse an environment the model was not trained for, before any episode.
+
+        Raises:
+            UserError: when the action or observation space differs (e.g. an SP model on MP:
+                7 actions against 9; a grid model on the continuous environment).
+        """
+        ours, theirs = self.model.action_space, env.action_space
+        if type(ours) is not type(theirs) or getattr(ours, "n", None) != getattr(theirs, "n", None) \
+                or getattr(ours, "shape", None) != getattr(theirs, "shape", None):
+            raise UserError(f"{self.name}: the model has {_space_text(ours)}, this environment {_space_text(theirs)}: "
+                            "use a model trained on the same environment and scenario")
+        shape = getattr(self.model.observation_space, "shape", None)
+        # SB3 stores image spaces channels-first.
+        if shape is not None and sorted(shape) != sorted(env.observation_space.shape):
+            raise UserError(f"{self.name}: the model takes observations of shape {shape}, the environment gives "
+                            f"{env.observation_space.shape}: use a model trained by davis-ag train")
+
+    def act(self, observation: np.ndarray, info: dict[str, Any]) -> Any:
+        """The model's action for ``observation``."""
+        action, _ = self.model.predict(observation, deterministic=self.deterministic)
+        return action
+
+
+def _import_target(target: str, spec: str) -> Any:
+    """The module or file a SPEC's left part names, imported."""
+    if target.endswith(".py") or os.sep in target or "/" in target:
+        path = Path(target).expanduser()
+        if not path.is_file():
+            raise UserError(f"--policy {spec}: no such file {path}")
+        name = f"davis_ag_policy_{abs(hash(str(path.absolute())))}"
+        loader_spec = importlib.util.spec_from_file_location(name, path)
+        if loader_spec is None or loader_spec.loader is None:
+            raise UserError(f"--policy {spec}: {path} is not a Python file")
+        module = importlib.util.module_from_spec(loader_spec)
+        sys.modules[name] = module
+        loader_spec.loader.exec_module(module)
+        return module
+    try:
+        return importlib.import_module(target)
+    except ModuleNotFoundError as error:
+        raise UserError(f"--policy {spec}: no module {error.name!r} (is it on PYTHONPATH? a file needs "
+                        "its path, e.g. ./my_policy.py:act)") from None
+
+
+def policy_from_spec(spec: str, name: str | None = None, deterministic: bool = DETERMINISTIC_PLAY) -> Any:
+    """The :class:`Policy` a SPEC names (see the module docstring).
+
+    Args:
+        spec: ``MODEL.zip``, ``module:attr`` or ``path/to/file.py:attr``.
+        name: Row name (default: the algorithm for a model, the attribute's name otherwise).
+        deterministic: How a model plays (ignored by other policies).
+
+    Raises:
+        UserError: for a missing file, module or attribute, or something that is not a policy.
+    """
+    text = str(spec).strip()
+    target, colon, attr = text.rpartition(":")
+    if not colon or not target or not attr or attr.endswith((".zip", ".py")) or os.sep in attr:
+        if text.endswith(".py"):
+            raise UserError(f"--policy {spec}: name the function or class too, e.g. {text}:my_policy")
+        policy = ModelPolicy(text, deterministic=deterministic, name=name)
+    else:
+        module = _import_target(target, spec)
+        try:
+            thing = getattr(module, attr)
+        except AttributeError:
+            raise UserError(f"--policy {spec}: {target} has no {attr!r}") from None
+        policy = as_policy(thing, name)
+    policy.source = text
+    return policy

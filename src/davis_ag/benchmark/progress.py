@@ -1,0 +1,65 @@
+"""Training's progress: a bar on a terminal, a line a minute in a log (tqdm formats both)."""
+
+from __future__ import annotations
+
+import sys
+import time
+
+from stable_baselines3.common.callbacks import BaseCallback
+
+from davis_ag.benchmark.selection import KeepBestOnTrain
+
+#: Seconds between progress lines in a log (on a terminal a bar is redrawn instead).
+PROGRESS_EVERY_S = 60.0
+
+class TrainingProgress(BaseCallback):
+    """Training's progress over environment steps: a tqdm bar on a terminal (steps, rate, time
+    left, the last train-split score), and in a log (not a terminal) the same line once a minute.
+
+    A run resumed from a checkpoint starts at the checkpoint's step count, not at 0.
+    """
+
+    def __init__(self, total: int, label: str, selection: KeepBestOnTrain | None = None,
+                 every_s: float | None = None) -> None:
+        """Args:
+            total: The run's total environment steps.
+            label: What is trained (``PPO sp``), the bar's description.
+            selection: The snapshot scorer whose last score is shown.
+            every_s: Seconds between log lines when not on a terminal (default :data:`PROGRESS_EVERY_S`).
+        """
+        super().__init__()
+        self.total, self.label, self.selection = total, label, selection
+        self.every_s = PROGRESS_EVERY_S if every_s is None else every_s
+        self.steps, self._first, self._start, self._last, self.bar = 0, 0, 0.0, 0.0, None
+
+    def _on_training_start(self) -> None:
+        from tqdm import tqdm
+
+        self.steps = self._first = int(self.model.num_timesteps)
+        self._start = self._last = time.monotonic()
+        # disable=None: no bar where stderr is not a terminal (a log), the lines below instead.
+        self.bar = tqdm(total=self.total, initial=self.steps, desc=self.label, unit="step", mininterval=2,
+                        disable=None, dynamic_ncols=True)
+
+    def _score(self) -> str:
+        best = self.selection.scores[-1] if self.selection and self.selection.scores else None
+        return f"train OER_tau {best['oer_tau']:.3f} at {best['step']}" if best else "no train score yet"
+
+    def _on_step(self) -> bool:
+        from tqdm import tqdm
+
+        n = self.training_env.num_envs
+        self.steps += n
+        if not self.bar.disable:
+            self.bar.set_postfix_str(self._score(), refresh=False)
+            self.bar.update(n)
+        elif time.monotonic() - self._last >= self.every_s:
+            self._last = time.monotonic()
+            line = tqdm.format_meter(self.steps, self.total, self._last - self._start, prefix=self.label,
+                                     unit="step", initial=self._first, ncols=0)
+            print(f"{line} | {self._score()}", file=sys.stderr, flush=True)
+        return True
+
+    def _on_training_end(self) -> None:
+        if self.bar is not None:
+            self.bar.close()

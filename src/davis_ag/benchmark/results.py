@@ -1,0 +1,230 @@
+"""The results file of an evaluation: a documented, versioned schema (pydantic), and the dataset's
+identity that decides which results may be ranked together.
+
+One :class:`EvaluationResults` is what :func:`davis_ag.benchmark.evaluate` returns and exactly
+what ``davis-ag evaluate --out RESULTS.json`` writes (:meth:`EvaluationResults.as_json`, read back
+by :func:`load_results`). docs/benchmark-your-method.md documents every field.
+
+Versions: :data:`PROTOCOL_VERSION` changes whenever a change to the environments, the start
+rule, the reward or the evaluation loop would move a number; files of different versions are
+never ranked together. Files written before the version was recorded read as version 0.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
+
+from davis_ag.errors import UserError
+from davis_ag.formats.scene_file import SceneFile
+
+#: Section V-C's protocol as this code implements it (see the module docstring).
+PROTOCOL_VERSION = 1
+#: The ``format`` field of every results file.
+FORMAT = "davis-ag evaluation results"
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class Metric(_Model):
+    """One metric of one policy: mean and population std over sessions (Table 4's ``±``), the
+    standard error of the mean over all episodes, and each session's mean."""
+
+    mean: float
+    std: float
+    sem: float
+    sessions: list[float]
+
+
+class SceneGap(_Model):
+    """A paired gap on one test scene: mean difference, episodes, distinct starts among them."""
+
+    scene: str
+    gap: float
+    episodes: int
+    starts: int
+
+
+class PairedGap(_Model):
+    """Mean OER_tau of a policy minus a baseline's on the same episodes, with the bootstrap
+    interval over episodes (:mod:`davis_ag.benchmark.paired`) and the gap per test scene."""
+
+    gap: float
+    low: float
+    high: float
+    episodes: int
+    per_scene: list[SceneGap]
+
+
+class Episode(_Model):
+    """One episode of one policy. ``path`` holds view names on the grid and poses
+    ``[x, y, z, yaw, pitch]`` on the continuous environment; ``actions`` indices or arrays."""
+
+    session: int
+    oer_0: float
+    oer_tau: float
+    reward: float
+    length: int
+    scene: str
+    target_fruit: int
+    path: list[Any]
+    actions: list[Any]
+    refused: int | None = None
+
+
+class PolicyResult(_Model):
+    """One policy's row: Table 4's metrics and what else the evaluation knows of it."""
+
+    oer_tau: Metric
+    reward: Metric
+    length: Metric
+    oer_0: Metric
+    refused: Metric | None = None
+    source: str | None = Field(None, description="the SPEC or baseline name it was built from")
+    play: str | None = Field(None, description="a trained model's play: sampled or deterministic")
+    action: str | None = Field(None, description="the action of the Best fixed action row")
+    action_counts: dict[str, int] | None = None
+    mean_abs_action: dict[str, float] | None = None
+    exact: dict[str, float] | None = Field(None, description="exact expectations of an image-blind policy")
+    paired: dict[str, PairedGap] = Field(default_factory=dict, description="gap to each baseline by name")
+    episodes: list[Episode] | None = None
+
+
+class SceneIdentity(_Model):
+    """A scene of the dataset as generated: its id, seed and the code version that made it
+    (None for scenes without our scene.json, e.g. the original download)."""
+
+    id: str
+    seed: int | None = None
+    code: str | None = None
+
+
+class DatasetIdentity(_Model):
+    """Which dataset was evaluated: every scene with its seed and code version, and a short hash
+    of that list (two copies of one dataset hash alike wherever they lie)."""
+
+    fingerprint: str
+    scenes: list[SceneIdentity]
+
+
+class Protocol(_Model):
+    """Section V-C's protocol as run: environment, scenario, split, the split's scenes and
+    eligible starts, sessions x episodes, the base seed (episode ``e`` of session ``s`` resets
+    with ``SeedSequence([seed, s])``'s ``e``-th state, the policy with ``SeedSequence([seed, s, 1])``'s)."""
+
+    version: int = 0
+    environment: str = "davis_ag/TVM-v0"
+    scenario: str
+    crop: str | None = None
+    split: str
+    tau: int
+    episodes: int
+    sessions: int
+    seed: int
+    scenes: list[str]
+    dataset: str
+    actions: list[str]
+    start_rule: str | None = None
+    starts: int | None = None
+    aim: str | None = None
+
+
+class EvaluationResults(_Model):
+    """An evaluation: its protocol, the dataset's identity, the code, one row per policy."""
+
+    format: str = FORMAT
+    protocol: Protocol
+    dataset: DatasetIdentity | None = None
+    code: str | None = None
+    policies: dict[str, PolicyResult]
+    fixed_actions: dict[str, dict[str, float]] | None = None
+    train_split: dict[str, Any] | None = None
+
+    def as_json(self) -> dict[str, Any]:
+        """The results as the JSON file holds them (unset optional fields left out)."""
+        return self.model_dump(mode="json", exclude_none=True)
+
+    def write(self, path: str | os.PathLike[str]) -> Path:
+        """Write the results as indented JSON, atomically."""
+        from davis_ag.atomic_files import write_json_atomic
+
+        return write_json_atomic(path, self.as_json(), indent=2)
+
+
+def as_results(results: EvaluationResults | dict[str, Any]) -> EvaluationResults:
+    """Results as the typed object, from the object or from its JSON dict."""
+    return results if isinstance(results, EvaluationResults) else EvaluationResults.model_validate(results)
+
+
+def load_results(path: str | os.PathLike[str]) -> EvaluationResults:
+    """Read a results file.
+
+    Raises:
+        UserError: when the file is missing, not JSON, or not an evaluation's results.
+    """
+    path = Path(path)
+    try:
+        data = json.loads(path.read_text())
+    except OSError as error:
+        raise UserError(f"{path}: cannot read it ({error.strerror or error})") from None
+    except ValueError as error:
+        raise UserError(f"{path}: not JSON ({error}); give a RESULTS.json davis-ag evaluate wrote") from None
+    try:
+        return EvaluationResults.model_validate(data)
+    except ValidationError as error:
+        first = error.errors()[0]
+        where = ".".join(str(p) for p in first["loc"])
+        raise UserError(f"{path}: not davis-ag evaluation results ({where}: {first['msg']}); give a RESULTS.json "
+                        "davis-ag evaluate wrote") from None
+
+
+def scene_identity(scene_id: str, metadata: SceneFile | None) -> SceneIdentity:
+    """A scene's identity from its scene.json (None: a scene without one)."""
+    code = metadata.generator.version if metadata is not None and metadata.generator is not None else None
+    return SceneIdentity(id=str(scene_id), seed=metadata.seed if metadata is not None else None, code=code)
+
+
+def dataset_identity(scenes: list[SceneIdentity]) -> DatasetIdentity:
+    """The identity of a dataset's scenes (sorted by id) and its fingerprint."""
+    ordered = sorted(scenes, key=lambda s: s.id)
+    text = json.dumps([s.model_dump() for s in ordered], sort_keys=True)
+    return DatasetIdentity(fingerprint=hashlib.sha256(text.encode()).hexdigest()[:16], scenes=ordered)
+
+
+def identify_dataset(root: str | os.PathLike[str]) -> DatasetIdentity | None:
+    """The identity of the dataset at ``root`` (every scene), or None when it is not one
+    (e.g. a single scene folder given to the continuous environment)."""
+    from davis_ag.benchmark.tvm import as_dataset
+
+    try:
+        dataset = as_dataset(root)
+        return dataset_identity([scene_identity(s.id, s.metadata) for s in dataset.scenes])
+    except (UserError, OSError, ValueError):
+        return None
+
+
+def split_text(protocol: Protocol) -> str:
+    """What a number rests on, to print beside it: the split, its scenes and eligible starts."""
+    scenes = protocol.scenes
+    shown = ", ".join(scenes[:4]) + (f", ... ({len(scenes) - 4} more)" if len(scenes) > 4 else "")
+    starts = f"; {protocol.starts} eligible starts" if protocol.starts is not None else "; starts drawn live"
+    return (f"split {protocol.split}: {len(scenes)} {protocol.scenario.upper()} scene(s) ({shown}){starts}; "
+            f"{protocol.sessions} sessions x {protocol.episodes} episodes, seed {protocol.seed}, tau={protocol.tau}")
+
+
+def table_number(value: float) -> str:
+    """Table 4 style: three decimals, no leading zero below 1 (``.433``)."""
+    text = f"{value:.3f}"
+    return text[1:] if text.startswith("0.") else text.replace("-0.", "-.")
+
+
+def signed_number(value: float) -> str:
+    """:func:`table_number` with its sign (``+.013``, ``-.027``)."""
+    return ("+" if value >= 0 else "") + table_number(value)

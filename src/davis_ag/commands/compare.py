@@ -1,0 +1,36 @@
+"""``davis-ag compare RESULTS.json...``: a leaderboard of evaluations of the same dataset, split and
+protocol, with each method's paired gaps to the baselines."""
+
+from __future__ import annotations
+
+import argparse
+
+from davis_ag.commands import arguments
+
+HELP = "rank methods of several results files (a leaderboard with paired gaps)"
+DESCRIPTION = ("Rank every method of the given results files (written by davis-ag evaluate) by OER_tau, with reward, "
+               "episode length and the paired gaps to the Best fixed action and Rand (95 % bootstrap intervals "
+               "where the episodes are the same), and say what the numbers rest on (scenes, eligible starts, "
+               "sessions x episodes). Refuses results of different datasets, splits or protocol versions.")
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add ``compare``'s arguments to its ``parser`` (see :mod:`davis_ag.commands`)."""
+    parser.add_argument("results", type=arguments.path, nargs="+", metavar="RESULTS.json",
+                        help="results files of davis-ag evaluate")
+    parser.add_argument("--out", type=arguments.path, default=None, metavar="PAGE.md",
+                        help="also write the leaderboard as a Markdown page")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Rank, print and write the page."""
+    from davis_ag.atomic_files import write_text_atomic
+    from davis_ag.benchmark.leaderboard import format_leaderboard, leaderboard
+
+    if args.out:
+        arguments.prove_writable_file(args.out)
+    page = format_leaderboard(leaderboard(args.results))
+    print(page, end="")
+    if args.out:
+        print(f"wrote {write_text_atomic(args.out, page)}")
+    return 0

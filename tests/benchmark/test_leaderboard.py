@@ -1,0 +1,49 @@
+"""davis-ag compare: a leaderboard of results of one dataset, split and protocol, and nothing else."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from layout_factory import write_tiny_dataset
+
+from davis_ag import cli
+from davis_ag.benchmark import evaluate
+from davis_ag.benchmark.leaderboard import format_leaderboard, leaderboard
+
+
+def _always(move: str):
+    def policy(observation, info):
+        return move
+    policy.__name__ = f"always_{move}"
+    return policy
+
+
+def test_compare_ranks_methods_with_their_gaps(sp_root: Path, tmp_path: Path,
+                                               capsys: pytest.CaptureFixture[str]) -> None:
+    first = evaluate([_always("up")], sp_root, "sp", sessions=2, episodes=6).write(tmp_path / "up.json")
+    second = evaluate([_always("down")], sp_root, "sp", sessions=2, episodes=6).write(tmp_path / "down.json")
+    rows = leaderboard([first, second])
+    names = [r.name for r in rows]
+    # The baselines of both files played the same episodes: one row each.
+    assert sorted(names) == sorted(["always_up", "always_down", "LRD", "UDD", "Rand", "Oracle", "Best fixed action"])
+    assert [r.policy.oer_tau.mean for r in rows] == sorted((r.policy.oer_tau.mean for r in rows), reverse=True)
+    assert all(r.gaps["Rand"] is not None for r in rows if r.name != "Rand")
+    page = tmp_path / "board.md"
+    assert cli.main(["compare", str(first), str(second), "--out", str(page)]) == 0
+    text = page.read_text()
+    assert text == format_leaderboard(rows) and text in capsys.readouterr().out
+    assert "1 SP scene(s) (Single-Strawberry/001)" in text and "eligible starts" in text
+    assert "Gap to Best fixed action [95 %]" in text
+
+
+def test_compare_refuses_another_dataset_or_split(sp_root: Path, tmp_path: Path,
+                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    ours = evaluate([], sp_root, "sp", sessions=1, episodes=3).write(tmp_path / "ours.json")
+    other_root = write_tiny_dataset(tmp_path / "other", "sp", "strawberry", scenes=2, seed=7)
+    theirs = evaluate([], other_root, "sp", sessions=1, episodes=3).write(tmp_path / "theirs.json")
+    train = evaluate([], sp_root, "sp", split="train", sessions=1, episodes=3).write(tmp_path / "train.json")
+    for other, what in ((theirs, "differ in dataset"), (train, "differ in split")):
+        assert cli.main(["compare", str(ours), str(other)]) == 2
+        err = capsys.readouterr().err.strip()
+        assert what in err and "cannot be ranked together" in err and "\n" not in err
