@@ -31,14 +31,7 @@ import numpy as np
 
 from davis_ag.atomic_files import atomic_output
 from davis_ag.data.reader import Scene, open_dataset
-from davis_ag.detection.instances import (
-    CATEGORIES,
-    LabelledView,
-    count_views,
-    iter_split_views,
-    scenes_by_split,
-    tally,
-)
+from davis_ag.detection.instances import CATEGORIES, LabelledView, count_views, iter_split_views, scenes_by_split, tally
 from davis_ag.detection.organ_export import (
     ORGAN_CATEGORY_BASE,
     coco_organ_categories,

@@ -25,14 +25,7 @@ import numpy as np
 
 from davis_ag.atomic_files import atomic_output, temporary_sibling, write_text_atomic
 from davis_ag.data.reader import Scene, open_dataset
-from davis_ag.detection.instances import (
-    CATEGORIES,
-    LabelledView,
-    count_views,
-    iter_split_views,
-    scenes_by_split,
-    tally,
-)
+from davis_ag.detection.instances import CATEGORIES, LabelledView, count_views, iter_split_views, scenes_by_split, tally
 from davis_ag.detection.organ_export import organ_masks, yolo_organ_class, yolo_organ_names
 from davis_ag.errors import MachineError, UserError
 from davis_ag.formats.layout import IMAGE_SUFFIX, view_stem
