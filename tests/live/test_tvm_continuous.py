@@ -184,7 +184,7 @@ def test_evaluate_command_takes_the_continuous_environment(live_root: Path, tmp_
     assert "not a baseline of --env continuous" in capsys.readouterr().err
     # A policy file written with the grid's move names plays here too (named moves are unit moves).
     Path("mine.py").write_text("def climb(observation, info):\n    return 'up' if info['steps'] < 2 else 'done'\n")
-    assert cli.main(args[:-2] + ["--policies", "Rand", "--policy", "mine.py:climb"]) == 0
+    assert cli.main(args[:-2] + ["--policies", "Rand", "--policy", "mine.py:climb", "--force"]) == 0
     mine = json.loads(Path("r.json").read_text())["policies"]["climb"]
     assert mine["mean_abs_action"]["dz"] == pytest.approx(2 / 3, abs=1e-4) and mine["mean_abs_action"]["dx"] == 0
     assert "Rand" in mine["paired"]

@@ -217,8 +217,8 @@ def _build(scene: Any, folder: Path, fingerprint: str) -> None:
             target = view.pointers.get(action, "")
             if target:
                 if target not in position:
-                    raise UserError(f"scene {scene.id} view {view.name}: {action} points to "
-                                    f"missing view {target!r}; fix annotations.json")
+                    raise UserError(f"{scene.annotations_path}: view {view.name}'s {action} points to "
+                                    f"missing view {target!r}; fix annotations.json or regenerate the scene")
                 pointers[i, j] = position[target]
         # One bincount gives every fruit's visible pixel count in the view.
         counts = np.bincount(mask.ravel(), minlength=256)
