@@ -188,7 +188,7 @@ def _build(scene: Any, folder: Path, fingerprint: str) -> None:
 
     views = list(scene.views.values())
     if not views:
-        raise UserError(f"scene {scene.id} has no views; check its annotations.json")
+        raise UserError(f"{scene.annotations_path}: scene {scene.id} has no views; check its annotations.json")
     names = [view.name for view in views]
     position = {name: i for i, name in enumerate(names)}
     images = np.lib.format.open_memmap(folder / "images.npy", mode="w+", dtype=np.uint8,
@@ -204,12 +204,12 @@ def _build(scene: Any, folder: Path, fingerprint: str) -> None:
                 "mask and the exposure rate needs masks: use a download or generation that includes them")
         resized, (width, height) = _resized_image(view)
         if mask.shape != (height, width):
-            raise UserError(f"scene {scene.id} view {view.name}: mask is {mask.shape[1]}x"
+            raise UserError(f"{view.mask_path}: mask is {mask.shape[1]}x"
                             f"{mask.shape[0]}, image {width}x{height}; regenerate the mask")
         if image_size is None:
             image_size = (width, height)
         elif image_size != (width, height):
-            raise UserError(f"scene {scene.id} view {view.name} is {width}x{height}, the first "
+            raise UserError(f"{view.image_path}: {width}x{height}, the first "
                             f"view {image_size[0]}x{image_size[1]}; all views must share a size")
         images[i, :, :, :3] = resized
         images[i, :, :, 3] = 0
