@@ -5,7 +5,7 @@ views, every altitude kept), drawn at the paper's 1280x720.
 Section IV (Fig. 2) shows one strawberry plant with 24 fruit whose visible-fruit count ranges
 from fewer than 5 to 16 or more across positions, no view seeing all 24; Fig. 3 shows that
 changing altitude at a fixed position both loses and gains fruit. Section V-C: the OER of SP
-strawberry boxes is right-skewed, 4 % of them below 0.4 (tools/scene_stats.py measures this
+strawberry boxes is right-skewed, 4 % of them below 0.4 (davis-ag scene-stats measures this
 over several scenes; docs/scenes.md has the result).
 
 Fig. 2 counts a fruit as visible when Helios's Synthetic Annotation plug-in would box it (10
@@ -109,6 +109,6 @@ def test_oer_is_right_skewed(scene: dict) -> None:
                    "of this scene's published boxes below OER 0.4 (paper: 4 %); the share over 10 scenes is in "
                    "docs/scenes.md. Strict: when the plants meet the paper, this test says so.")
 def test_few_boxes_below_0_4_as_in_the_paper(scene: dict) -> None:
-    # Section V-C: 4 % below 0.4. One scene varies more than several (tools/scene_stats.py
+    # Section V-C: 4 % below 0.4. One scene varies more than several (davis-ag scene-stats
     # measures those, 2-8 % asked): 1-8 % here.
     assert 0.01 <= (scene["oer"] < 0.4).mean() <= 0.08

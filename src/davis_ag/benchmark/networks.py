@@ -37,7 +37,7 @@ class PaperCNN(BaseFeaturesExtractor):
             features_dim: Size of the feature vector (512 in the paper).
             channels_last: Run the convolutions on channels-last (NHWC) tensors. The same
                 network and numbers to float rounding; oneDNN's NHWC kernels made an A2C update
-                faster on this CPU (tools/a2c_speed.py, docs/performance.md). Off gives the
+                faster on this CPU (docs/performance.md). Off gives the
                 plain NCHW layout the measurement compares with.
         """
         super().__init__(observation_space, features_dim)

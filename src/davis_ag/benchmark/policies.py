@@ -39,7 +39,7 @@ from davis_ag.errors import UserError
 #: the policy. Played deterministically, a policy repeats a refused move for the rest of the
 #: episode (the observation after a refused move is the same image), and a policy whose most
 #: likely action is the same at every start is exactly a fixed action: on the train split
-#: (tools/a2c_trials.py) a short-trained A2C played deterministically was "always forward" while
+#: (docs/benchmark.md) a short-trained A2C played deterministically was "always forward" while
 #: sampling it scored higher; trained longer, deterministic play scored about one standard
 #: deviation higher than sampling. Sampling is kept as the safe default on unseen scenes, where
 #: the policy is least sure; ``davis-ag evaluate --deterministic`` plays the most likely action,

@@ -51,7 +51,7 @@ SELECT_EVERY = 10_000
 #: reward (``max(OER_tau - OER_0, 0)**2``, about .02 on average) stops setting the step size;
 #: ``ent_coef=0.01`` is then the usual entropy bonus, which keeps the policy from turning into a
 #: point mass on one move over a long run. Measured on the train split only
-#: (tools/a2c_trials.py): after enough steps A2C learns policies whose most likely move differs
+#: (docs/benchmark.md): after enough steps A2C learns policies whose most likely move differs
 #: from start to start with these settings, with SB3's defaults and with the bonus alone (which
 #: left the flattest policy and the lowest sampled score); these learnt a little faster early on.
 #: What made the evaluated A2C a fixed action was chiefly too little training played

@@ -10,7 +10,7 @@ days (mean 5.9 over 10 seeds), where the paper's showcase plant (section IV, Fig
 Strawberry: 50 nodes, as the original's 50 stems. Growth is determinate and stops at the first
 flower, so the nodes must come faster (``phyllochron_min`` 0.5 instead of 2 days); one floral
 bud per node and a fruit set of 0.5 (library: 0.3) give about 25 fruit (measured by
-tools/scene_stats.py: docs/scenes.md). The leaf length is measured per leaflet, as the Canopy
+davis-ag scene-stats: docs/scenes.md). The leaf length is measured per leaflet, as the Canopy
 Generator's ``leaf_length`` is (``architecture_plants.LEAF_UNIT``), which doubles the leaflets.
 Where the fruit hang decides how many a camera sees (Fig. 2). The library builder makes every
 internode 4 mm whatever ``internode_length_max`` says, so 50 nodes stacked into a 20 cm column
@@ -20,7 +20,7 @@ than 5 fruit, where Fig. 2 has several. We set each internode to 1 mm as it is c
 so the fruit lie around the crown on the soil, and let the petioles lean further out and arch
 over them (pitch 20-50 degrees from vertical instead of 10-45, curvature -200 to -100 instead of
 -150 to -50): the leaves roof the fruit as in the original's bush. docs/scenes.md has what this
-does to the fruit in view (tools/scene_stats.py). What did not work (shared notes, measured):
+does to the fruit in view (davis-ag scene-stats). What did not work (shared notes, measured):
 two floral buds per node fuse fruit pairs and lift the plant; more nodes without a shorter
 phyllochron change nothing; vegetative bud break grows dozens of crowns; petioles leaning out
 45-85 degrees dive under the soil once the crown is compact.

@@ -104,7 +104,7 @@ class CropSpec:
 # views). Strawberry does not: its single-plant grid is 2.5 x 2.5 m (11 x 11, 95 kept x 3), as
 # the original's Fig. 2 shows (-1.25..1.25 m); no 7 x 3 m lattice leaves 47 positions around five
 # plants with a 0.75 m exclusion radius, a 4 x 3 m one (9 x 7) around plants 0.3 m apart does.
-# These are inferences from the counts and the figure (tools/grid_conventions.py), not the paper's.
+# These are inferences from the counts and the figure (docs/dataset-format.md), not the paper's.
 CROPS: dict[str, CropSpec] = {
     "strawberry": CropSpec(
         name="strawberry", title="Strawberry", plant_height=0.40, fruit_radius=0.025,

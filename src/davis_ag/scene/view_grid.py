@@ -11,7 +11,7 @@ Conventions (also in the README, "Images per scene"):
   reach half a step further east. A position whose horizontal (2-D) distance to any plant's
   stem is at most the crop's exclusion radius is not placed, so the same positions exist at
   every altitude. With the crop's grid (``scenario_spec(name, crop)``) this gives Table 3's
-  images per scene: see ``tools/grid_conventions.py`` for the conventions tried.
+  images per scene (docs/dataset-format.md names the conventions tried).
 - Yaw: degrees counter-clockwise from +x; pitch: degrees above the horizon (negative looks down).
 - Moves keep the lattice indices simple: right/left go to the next position in the same row
   (+x / -x, exactly one step); forward/backward go to the next row (+y / -y) at the same column

@@ -147,7 +147,7 @@ def a2c_line(scenario: str, policies: dict[str, Any], out: Path | None) -> str |
             f"plays {how}.")
     if "A2C (deterministic)" in policies:
         text += " `A2C (deterministic)` is the same model taking its most likely action."
-    text += " The settings and the play were chosen on training scenes only (tools/a2c_trials.py)."
+    text += " The settings and the play were chosen on training scenes only (docs/benchmark.md)."
     return text
 
 
