@@ -27,9 +27,11 @@ demo: $(STAMP)
 test: $(STAMP)
 	$(BIN)/python -m pytest -q
 
-# ruff (pyflakes, pycodestyle, bugbear) over the code and tests, mypy over src/ (pyproject.toml).
+# ruff (pyflakes, pycodestyle, bugbear, and the formatter's check) over the code and tests, mypy
+# over src/ (settings in pyproject.toml). `ruff format src tests` makes the format check pass.
 lint: $(STAMP)
 	$(BIN)/ruff check src tests
+	$(BIN)/ruff format --check src tests
 	$(BIN)/mypy src
 
 bench: $(STAMP)

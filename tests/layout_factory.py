@@ -75,8 +75,13 @@ class _Camera:
     @property
     def as_json(self) -> dict[str, float]:
         return {
-            "width": self.width, "height": self.height, "fx": self.fx, "fy": self.fx,
-            "cx": self.width / 2, "cy": self.height / 2, "hfov_deg": TINY_HFOV_DEG,
+            "width": self.width,
+            "height": self.height,
+            "fx": self.fx,
+            "fy": self.fx,
+            "cx": self.width / 2,
+            "cy": self.height / 2,
+            "hfov_deg": TINY_HFOV_DEG,
             "vfov_deg": math.degrees(2 * math.atan(self.height / 2 / self.fx)),
         }
 
@@ -90,8 +95,11 @@ class _Camera:
         depth = float(d @ fwd)
         if depth <= 1e-6:
             return 0.0, 0.0, depth
-        return (self.width / 2 + self.fx * float(d @ right) / depth,
-                self.height / 2 - self.fx * float(d @ up) / depth, depth)
+        return (
+            self.width / 2 + self.fx * float(d @ right) / depth,
+            self.height / 2 - self.fx * float(d @ up) / depth,
+            depth,
+        )
 
 
 def _grow(sc: ScenarioSpec, cr: CropSpec, rng: np.random.Generator) -> tuple[list, list, list]:
@@ -102,24 +110,38 @@ def _grow(sc: ScenarioSpec, cr: CropSpec, rng: np.random.Generator) -> tuple[lis
         plants.append({"id": p, "position": [px, py, 0.0], "height": round(height, 4)})
         for _ in range(_FRUITS_PER_PLANT[sc.name]):
             angle, reach = rng.uniform(0, 2 * math.pi), rng.uniform(0.03, 0.12)
-            centre = [px + reach * math.cos(angle), py + reach * math.sin(angle),
-                      height * rng.uniform(0.25, 0.75)]
+            centre = [px + reach * math.cos(angle), py + reach * math.sin(angle), height * rng.uniform(0.25, 0.75)]
             radius = _FRUIT_RADIUS * rng.uniform(0.8, 1.2)
-            fruits.append({"id": len(fruits), "plant": p, "center": [round(c, 5) for c in centre],
-                           "size": [round(2 * radius, 5)] * 3})
+            fruits.append(
+                {
+                    "id": len(fruits),
+                    "plant": p,
+                    "center": [round(c, 5) for c in centre],
+                    "size": [round(2 * radius, 5)] * 3,
+                }
+            )
         for _ in range(_LEAVES_PER_PLANT):
             angle, reach = rng.uniform(0, 2 * math.pi), rng.uniform(0.08, 0.22)
-            centre = [px + reach * math.cos(angle), py + reach * math.sin(angle),
-                      height * rng.uniform(0.2, 0.9)]
-            leaves.append({"plant": p, "center": [round(c, 5) for c in centre],
-                           "half_size": round(rng.uniform(0.03, 0.06), 5),
-                           "aspect": round(rng.uniform(0.5, 2.0), 3),
-                           "shade": round(rng.uniform(0.7, 1.0), 3)})
+            centre = [px + reach * math.cos(angle), py + reach * math.sin(angle), height * rng.uniform(0.2, 0.9)]
+            leaves.append(
+                {
+                    "plant": p,
+                    "center": [round(c, 5) for c in centre],
+                    "half_size": round(rng.uniform(0.03, 0.06), 5),
+                    "aspect": round(rng.uniform(0.5, 2.0), 3),
+                    "shade": round(rng.uniform(0.7, 1.0), 3),
+                }
+            )
     return plants, fruits, leaves
 
 
-def _render(camera: _Camera, view: Viewpoint, crop: str, fruits: list, leaves: list,
-            ) -> tuple[np.ndarray, np.ndarray, dict[int, float]]:
+def _render(
+    camera: _Camera,
+    view: Viewpoint,
+    crop: str,
+    fruits: list,
+    leaves: list,
+) -> tuple[np.ndarray, np.ndarray, dict[int, float]]:
     """RGB image, raw owner map (fruit id or -1) and each fruit's visible fraction."""
     h, w = camera.height, camera.width
     vv, uu = np.mgrid[0:h, 0:w] + 0.5
@@ -170,8 +192,9 @@ def _boxes_and_mask(owner: np.ndarray) -> tuple[list[list[int]], np.ndarray]:
     return boxes, mask
 
 
-def write_tiny_scene(scene_dir: Path, scenario: str = "sp", crop: str = "strawberry", seed: int = 0,
-                     size: tuple[int, int] = (128, 72)) -> Path:
+def write_tiny_scene(
+    scene_dir: Path, scenario: str = "sp", crop: str = "strawberry", seed: int = 0, size: tuple[int, int] = (128, 72)
+) -> Path:
     """Write one scene folder (annotations.json, scene.json, images/) in our writer's layout.
 
     Args:
@@ -199,25 +222,45 @@ def write_tiny_scene(scene_dir: Path, scenario: str = "sp", crop: str = "strawbe
         name = view_name(view.number)
         Image.fromarray(rgb).save(images / name, "JPEG", quality=95)
         Image.fromarray(mask).save(images / view_file_name(name, "mask"))
-        annotations[name] = {"bounding_boxes": boxes, "pose": [round(p, 5) for p in view.pose],
-                             **published_pointers(grid, view.index)}
+        annotations[name] = {
+            "bounding_boxes": boxes,
+            "pose": [round(p, 5) for p in view.pose],
+            **published_pointers(grid, view.index),
+        }
         visible_fraction[name] = {str(k): v for k, v in sorted(visible.items())}
     (scene_dir / "annotations.json").write_text(json.dumps(annotations, indent=1))
     metadata = {
-        "seed": seed, "generator": {"name": "tests/layout_factory.py"}, "scenario": sc.name, "crop": cr.name,
+        "seed": seed,
+        "generator": {"name": "tests/layout_factory.py"},
+        "scenario": sc.name,
+        "crop": cr.name,
         "camera": camera.as_json,
-        "grid": {"extent": list(sc.extent), "step": sc.step, "headings": sc.headings,
-                 "altitudes": [cr.altitudes[i] for i in sc.altitude_levels],
-                 "exclusion_radius": cr.exclusion_radius},
+        "grid": {
+            "extent": list(sc.extent),
+            "step": sc.step,
+            "headings": sc.headings,
+            "altitudes": [cr.altitudes[i] for i in sc.altitude_levels],
+            "exclusion_radius": cr.exclusion_radius,
+        },
         "min_fruit_pixels": TINY_MIN_FRUIT_PIXELS,
-        "plants": plants, "fruits": fruits, "leaves": leaves, "visible_fraction": visible_fraction,
+        "plants": plants,
+        "fruits": fruits,
+        "leaves": leaves,
+        "visible_fraction": visible_fraction,
     }
     (scene_dir / "scene.json").write_text(json.dumps(metadata, indent=1))
     return scene_dir
 
 
-def write_tiny_dataset(root: Path, scenario: str = "sp", crop: str = "strawberry", scenes: int = 2,
-                       seed: int = 0, size: tuple[int, int] = (128, 72), splits: bool = True) -> Path:
+def write_tiny_dataset(
+    root: Path,
+    scenario: str = "sp",
+    crop: str = "strawberry",
+    scenes: int = 2,
+    seed: int = 0,
+    size: tuple[int, int] = (128, 72),
+    splits: bool = True,
+) -> Path:
     """Write a small, fully consistent dataset in the published layout (plus our extras).
 
     Args:
@@ -250,9 +293,15 @@ def write_tiny_dataset(root: Path, scenario: str = "sp", crop: str = "strawberry
     return root
 
 
-def write_original_style_dataset(root: Path, scenario: str = "sp", crop: str = "strawberry",
-                                 scenes: int = 1, seed: int = 0, size: tuple[int, int] = (128, 72),
-                                 missing_mask: bool = False) -> Path:
+def write_original_style_dataset(
+    root: Path,
+    scenario: str = "sp",
+    crop: str = "strawberry",
+    scenes: int = 1,
+    seed: int = 0,
+    size: tuple[int, int] = (128, 72),
+    missing_mask: bool = False,
+) -> Path:
     """Like :func:`write_tiny_dataset`, then rewritten into every shape the original README allows.
 
     Keys lose ".jpeg"; pointer values lose it on every other view; "" pointers are dropped
@@ -273,8 +322,10 @@ def write_original_style_dataset(root: Path, scenario: str = "sp", crop: str = "
         raw = json.loads((scene_dir / "annotations.json").read_text())
         out = {}
         for n, (key, entry) in enumerate(raw.items()):
-            new: dict = {"bounding_boxes": [[float(v) for v in box] for box in entry["bounding_boxes"]],
-                         "capture_time": n * 0.5}
+            new: dict = {
+                "bounding_boxes": [[float(v) for v in box] for box in entry["bounding_boxes"]],
+                "capture_time": n * 0.5,
+            }
             if n:
                 new["pose"] = entry["pose"]
             for action in config.ALL_ACTIONS:

@@ -15,8 +15,9 @@ def test_a_marked_section_is_replaced_and_the_rest_kept(tmp_path: Path) -> None:
     doc = tmp_path / "page.md"
     doc.write_text("top\n<!-- n:start -->\nold\n<!-- n:end -->\nbottom\n<!-- m:start -->\nkeep\n<!-- m:end -->\n")
     write_marked_section(doc, "n", "| a | 1 |")
-    assert doc.read_text() == ("top\n<!-- n:start -->\n| a | 1 |\n<!-- n:end -->\nbottom\n"
-                               "<!-- m:start -->\nkeep\n<!-- m:end -->\n")
+    assert doc.read_text() == (
+        "top\n<!-- n:start -->\n| a | 1 |\n<!-- n:end -->\nbottom\n<!-- m:start -->\nkeep\n<!-- m:end -->\n"
+    )
 
 
 def test_a_page_without_the_markers_is_left_whole(tmp_path: Path) -> None:

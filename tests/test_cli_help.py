@@ -23,5 +23,7 @@ def test_help_is_plain_text(command: str, capsys: pytest.CaptureFixture[str]) ->
 
 
 def test_plain_text_keeps_the_words() -> None:
-    assert cli.plain_text("``davis-ag view`` (:mod:`davis_ag.live`, :func:`~davis_ag.cli.main`)") == \
-        "davis-ag view (davis_ag.live, davis_ag.cli.main)"
+    assert (
+        cli.plain_text("``davis-ag view`` (:mod:`davis_ag.live`, :func:`~davis_ag.cli.main`)")
+        == "davis-ag view (davis_ag.live, davis_ag.cli.main)"
+    )

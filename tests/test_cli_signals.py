@@ -50,8 +50,10 @@ def test_sigterm_ends_generate_with_one_line_and_the_run_resumes(tmp_path: Path)
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     code, err = stop_when(process, lambda: (out / "dataset.json").exists(), signal.SIGTERM)
     assert code == 128 + signal.SIGTERM, err
-    assert err.splitlines() == ["davis-ag generate: stopped by SIGTERM; finished scenes are kept and a scene in "
-                                "progress resumes from its views: run the same command again to resume"], err
+    assert err.splitlines() == [
+        "davis-ag generate: stopped by SIGTERM; finished scenes are kept and a scene in "
+        "progress resumes from its views: run the same command again to resume"
+    ], err
     assert "leaked" not in err
     done = subprocess.run(command + ["--quiet"], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0 and "leaked" not in done.stderr, done.stderr
@@ -61,16 +63,39 @@ def test_sigterm_ends_generate_with_one_line_and_the_run_resumes(tmp_path: Path)
 def test_sigint_ends_train_with_one_line_keeping_its_checkpoint(tmp_path: Path) -> None:
     data = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2, size=(64, 48))
     model = tmp_path / "a2c.zip"
-    command = [*DAVIS_AG, "train", "--dataset", str(data), "--scenario", "sp", "--arch", "pooled", "--n-envs", "2",
-               "--device", "cpu", "--verbose", "0", "--keep", "last", "--checkpoint-every", "20", "--out", str(model)]
+    command = [
+        *DAVIS_AG,
+        "train",
+        "--dataset",
+        str(data),
+        "--scenario",
+        "sp",
+        "--arch",
+        "pooled",
+        "--n-envs",
+        "2",
+        "--device",
+        "cpu",
+        "--verbose",
+        "0",
+        "--keep",
+        "last",
+        "--checkpoint-every",
+        "20",
+        "--out",
+        str(model),
+    ]
     env = {**os.environ, "OMP_NUM_THREADS": "1"}
-    process = subprocess.Popen([*command, "--timesteps", "1000000"], stdout=subprocess.PIPE,
-                               stderr=subprocess.PIPE, text=True, env=env)
+    process = subprocess.Popen(
+        [*command, "--timesteps", "1000000"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env
+    )
     checkpoint = tmp_path / "a2c.checkpoint.json"
     code, err = stop_when(process, checkpoint.exists, signal.SIGINT)
     assert code == 128 + signal.SIGINT, err
-    assert err.splitlines() == ["davis-ag train: stopped by SIGINT; the last checkpoint and the best snapshot so far "
-                                "are kept beside --out: run the same command again to resume"], err
+    assert err.splitlines() == [
+        "davis-ag train: stopped by SIGINT; the last checkpoint and the best snapshot so far "
+        "are kept beside --out: run the same command again to resume"
+    ], err
     assert not model.exists() and not list(tmp_path.glob(".*"))  # no lock, no temporary left
     # What resumes (tests/benchmark/test_training.py resumes such checkpoints): whole and readable.
     assert json.loads(checkpoint.read_text())["timesteps_done"] >= 20
@@ -81,8 +106,12 @@ def test_sigint_ends_train_with_one_line_keeping_its_checkpoint(tmp_path: Path) 
 def test_sigterm_ends_evaluate_leaving_nothing_half_written(command: list[str], tmp_path: Path) -> None:
     data = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2, size=(64, 48))
     out = tmp_path / "results" / "r.json"
-    process = subprocess.Popen([*DAVIS_AG, *command, "--dataset", str(data), "--scenario", "sp", "--out", str(out)],
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    process = subprocess.Popen(
+        [*DAVIS_AG, *command, "--dataset", str(data), "--scenario", "sp", "--out", str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     code, err = stop_when(process, lambda: (out.parent / ".r.json.lock").exists(), signal.SIGTERM)
     assert code == 128 + signal.SIGTERM and err.endswith("run the same command again to resume"), err
     assert err.count("\n") == 0 and not list(out.parent.iterdir())  # no lock, no temporary, no half file

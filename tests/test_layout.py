@@ -71,8 +71,7 @@ def stage(module: str) -> str:
 
 def own_edges() -> dict[str, set[str]]:
     """Module -> the davis_ag modules it imports."""
-    return {name: {m for m, _, _ in imports(path) if m in MODULES and m != name}
-            for name, path in MODULES.items()}
+    return {name: {m for m, _, _ in imports(path) if m in MODULES and m != name} for name, path in MODULES.items()}
 
 
 def test_every_module_belongs_to_a_stage_and_says_what_it_is() -> None:
@@ -90,8 +89,7 @@ def test_imports_point_to_earlier_stages(name: str) -> None:
     rank = RANK[stage(name)] if name != "davis_ag" else 0
     for module, line, _ in imports(MODULES[name]):
         if module.startswith("davis_ag.") and stage(module) in RANK:
-            assert RANK[stage(module)] <= rank, (
-                f"{MODULES[name]}:{line}: {stage(name)} imports {module}, a later stage")
+            assert RANK[stage(module)] <= rank, f"{MODULES[name]}:{line}: {stage(name)} imports {module}, a later stage"
 
 
 def test_no_import_cycles() -> None:
@@ -102,7 +100,7 @@ def test_no_import_cycles() -> None:
         state[node] = 1
         for nxt in sorted(edges[node]):
             if state.get(nxt) == 1:
-                cycle = path[path.index(nxt):] + [nxt] if nxt in path else [node, nxt]
+                cycle = path[path.index(nxt) :] + [nxt] if nxt in path else [node, nxt]
                 pytest.fail("import cycle: " + " -> ".join(cycle))
             if nxt not in state:
                 visit(nxt, path + [nxt])
@@ -117,7 +115,8 @@ def test_no_import_cycles() -> None:
 def test_geometry_and_benchmark_never_load_helios_or_a_renderer_at_import(name: str) -> None:
     for module, line, _ in imports(MODULES[name], top_level_only=True):
         assert not module.startswith(("pyhelios", "davis_ag.render", "moderngl")), (
-            f"{MODULES[name]}:{line}: imports {module} at module level")
+            f"{MODULES[name]}:{line}: imports {module} at module level"
+        )
 
 
 def test_data_and_benchmark_know_nothing_of_helios() -> None:
@@ -126,7 +125,8 @@ def test_data_and_benchmark_know_nothing_of_helios() -> None:
         if stage(name) in ("data", "benchmark", "detection"):
             for module, line, _ in imports(path):
                 assert not module.startswith(("pyhelios", "davis_ag.render", "davis_ag.generate")), (
-                    f"{path}:{line}: imports {module}")
+                    f"{path}:{line}: imports {module}"
+                )
 
 
 def test_no_module_imports_another_modules_private_names() -> None:
@@ -139,8 +139,18 @@ def test_no_module_imports_another_modules_private_names() -> None:
 def test_the_layout_reads_as_the_pipeline() -> None:
     """`ls src/davis_ag` shows every stage as a folder."""
     folders = {p.name for p in PACKAGE.iterdir() if p.is_dir() and (p / "__init__.py").exists()}
-    assert {"scene", "render", "labels", "generate", "data", "benchmark", "figures", "workflows",
-            "commands", "detection"} <= folders
+    assert {
+        "scene",
+        "render",
+        "labels",
+        "generate",
+        "data",
+        "benchmark",
+        "figures",
+        "workflows",
+        "commands",
+        "detection",
+    } <= folders
 
 
 ARCHITECTURE = PACKAGE.parents[1] / "docs" / "architecture.md"
@@ -157,21 +167,37 @@ def test_stage_numbers_agree_in_the_package_docstrings_and_architecture_md() -> 
             package = PACKAGE / name / "__init__.py"
             if package.exists():
                 doc = ast.get_docstring(ast.parse(package.read_text())) or ""
-                assert doc.startswith(f"Stage {rank + 1}, "), f"{package}: its docstring should open 'Stage {rank + 1}, '"
+                assert doc.startswith(f"Stage {rank + 1}, "), (
+                    f"{package}: its docstring should open 'Stage {rank + 1}, '"
+                )
 
 
 def test_importing_the_specs_loads_neither_gymnasium_nor_torch() -> None:
     """``import davis_ag`` is light: the environments are registered by name, not by importing them."""
-    code = ("import sys, davis_ag.scene.specs, davis_ag.formats.layout; "
-            "print(sorted(m for m in ('gymnasium', 'torch', 'davis_ag.benchmark', 'pyhelios') if m in sys.modules))")
-    loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
-                            env={"PYTHONPATH": str(PACKAGE.parent), "PATH": "/usr/bin:/bin"}).stdout.strip()
+    code = (
+        "import sys, davis_ag.scene.specs, davis_ag.formats.layout; "
+        "print(sorted(m for m in ('gymnasium', 'torch', 'davis_ag.benchmark', 'pyhelios') if m in sys.modules))"
+    )
+    loaded = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        check=True,
+        env={"PYTHONPATH": str(PACKAGE.parent), "PATH": "/usr/bin:/bin"},
+    ).stdout.strip()
     assert loaded == "[]"
 
 
 def test_the_environments_are_made_by_name_after_importing_gymnasium_then_davis_ag() -> None:
-    code = ("import gymnasium, davis_ag, sys; from davis_ag.environments import ENTRY_POINTS; "
-            "print([gymnasium.spec(i).entry_point for i in ENTRY_POINTS], 'davis_ag.benchmark' in sys.modules)")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
-                         env={"PYTHONPATH": str(PACKAGE.parent), "PATH": "/usr/bin:/bin"}).stdout.strip()
+    code = (
+        "import gymnasium, davis_ag, sys; from davis_ag.environments import ENTRY_POINTS; "
+        "print([gymnasium.spec(i).entry_point for i in ENTRY_POINTS], 'davis_ag.benchmark' in sys.modules)"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        check=True,
+        env={"PYTHONPATH": str(PACKAGE.parent), "PATH": "/usr/bin:/bin"},
+    ).stdout.strip()
     assert out == "['davis_ag.benchmark.tvm:TVMEnv', 'davis_ag.live.tvm_continuous:TVMContinuousEnv'] False"

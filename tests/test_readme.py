@@ -22,9 +22,9 @@ README = (ROOT / "README.md").read_text()
 
 def block(start: str, end: str = "```") -> str:
     """The text of the README's fenced block that follows ``start``."""
-    after = README[README.index(start):]
-    body = after[after.index("```") + 3:]
-    return body[body.index("\n") + 1:body.index(end)]
+    after = README[README.index(start) :]
+    body = after[after.index("```") + 3 :]
+    return body[body.index("\n") + 1 : body.index(end)]
 
 
 def test_the_readme_reads_in_five_minutes() -> None:
@@ -76,8 +76,7 @@ def test_every_command_in_the_readmes_text_parses_as_written() -> None:
                 assert args.task == "segment", "README: export yolo --organs needs --task segment"
 
 
-def test_the_python_block_runs_on_a_dataset(sp_root: Path, monkeypatch: pytest.MonkeyPatch,
-                                             tmp_path: Path) -> None:
+def test_the_python_block_runs_on_a_dataset(sp_root: Path, monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
     (tmp_path / "data").symlink_to(sp_root, target_is_directory=True)
     monkeypatch.chdir(tmp_path)
     code = block("## In Python")
@@ -99,8 +98,11 @@ def test_the_preview_example_shows_fruit_boxed(tmp_path: Path, capsys: pytest.Ca
     """The README's preview command, as written but for the output folder, boxes fruit in every view."""
     from davis_ag import cli
 
-    (command,) = [line for line in block("## Generate, validate, train, evaluate").splitlines()
-                  if line.startswith("davis-ag preview")]
+    (command,) = [
+        line
+        for line in block("## Generate, validate, train, evaluate").splitlines()
+        if line.startswith("davis-ag preview")
+    ]
     words = shlex.split(command)[1:]
     words[words.index("--out") + 1] = str(tmp_path)
     assert cli.main(words) == 0

@@ -89,8 +89,9 @@ def save_figure_atomic(figure: Any, path: str | os.PathLike[str], dpi: float | N
             figure.savefig(handle, format=fmt, **({} if dpi is None else {"dpi": dpi}))
     except OSError as error:
         kind = MachineError if is_machine_failure(error) else UserError
-        raise kind(f"{out}: cannot write the figure ({error.strerror or error}); free the space or choose "
-                   "another output path") from None
+        raise kind(
+            f"{out}: cannot write the figure ({error.strerror or error}); free the space or choose another output path"
+        ) from None
     return out
 
 
@@ -208,8 +209,10 @@ def rescue_folder() -> Path:
     """Where results are kept when their own path cannot be written: a fresh folder in the
     user's cache (``$XDG_CACHE_HOME`` or ``~/.cache``), else the system's temporary folder."""
     stamp = time.strftime("%Y%m%d-%H%M%S")
-    for base in (Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "davis-ag" / "rescued",
-                 Path(tempfile.gettempdir())):
+    for base in (
+        Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "davis-ag" / "rescued",
+        Path(tempfile.gettempdir()),
+    ):
         try:
             base.mkdir(parents=True, exist_ok=True)
             return Path(tempfile.mkdtemp(prefix=f"davis-ag-{stamp}-", dir=base))
@@ -242,7 +245,8 @@ def write_or_rescue(path: str | os.PathLike[str], write: Callable[[Path], None],
     try:
         write(kept)
     except OSError as error:
-        raise MachineError(f"cannot write {what} to {target} ({reason}) nor to {kept} "
-                           f"({error.strerror or error}): {what} is lost; free space and run again") from None
-    raise MachineError(f"cannot write {what} to {target} ({reason}); it was kept in {kept}: move it "
-                       "where you want it")
+        raise MachineError(
+            f"cannot write {what} to {target} ({reason}) nor to {kept} "
+            f"({error.strerror or error}): {what} is lost; free space and run again"
+        ) from None
+    raise MachineError(f"cannot write {what} to {target} ({reason}); it was kept in {kept}: move it where you want it")

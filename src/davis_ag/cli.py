@@ -15,8 +15,23 @@ from davis_ag.provenance import code_version
 # Each name is a module of davis_ag.commands defining HELP, DESCRIPTION, add_arguments(parser),
 # run(args) and maybe FORMATTER_CLASS (the package's docstring says what each is); add_command alone
 # makes the sub-parsers from them, so that every command's is made the same way.
-COMMANDS = ["generate", "validate", "train", "evaluate", "compare", "preview", "demo", "reproduce", "stats",
-            "plot", "view", "export", "transfer", "bench", "scene-stats"]
+COMMANDS = [
+    "generate",
+    "validate",
+    "train",
+    "evaluate",
+    "compare",
+    "preview",
+    "demo",
+    "reproduce",
+    "stats",
+    "plot",
+    "view",
+    "export",
+    "transfer",
+    "bench",
+    "scene-stats",
+]
 
 
 #: What a stopped command keeps, for its last line (every command resumes by being run again).
@@ -74,8 +89,12 @@ def add_command(subparsers: argparse._SubParsersAction, name: str) -> argparse.A
         The sub-command's parser, its ``func`` default the module's ``run``.
     """
     module = importlib.import_module(f"davis_ag.commands.{name.replace('-', '_')}")
-    parser = subparsers.add_parser(name, help=plain_text(module.HELP), description=plain_text(module.DESCRIPTION),
-                                   formatter_class=getattr(module, "FORMATTER_CLASS", argparse.HelpFormatter))
+    parser = subparsers.add_parser(
+        name,
+        help=plain_text(module.HELP),
+        description=plain_text(module.DESCRIPTION),
+        formatter_class=getattr(module, "FORMATTER_CLASS", argparse.HelpFormatter),
+    )
     module.add_arguments(parser)
     parser.set_defaults(func=module.run)
     return parser
@@ -97,14 +116,20 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     except OSError as error:  # the machine, not the code: a full disk, a folder gone, a lost mount
         where = f"{error.filename}: " if error.filename else ""
-        print(f"davis-ag {args.command}: error: {where}{error.strerror or error}; nothing finished was "
-              "lost: free the space or fix the path and run the same command again", file=sys.stderr)
+        print(
+            f"davis-ag {args.command}: error: {where}{error.strerror or error}; nothing finished was "
+            "lost: free the space or fix the path and run the same command again",
+            file=sys.stderr,
+        )
         return 1
     except KeyboardInterrupt as error:
         number = error.signal_number if isinstance(error, Stopped) else signal.SIGINT
         kept = KEPT_WHEN_STOPPED.get(args.command, "nothing half-written was left")
-        print(f"davis-ag {args.command}: stopped by {signal.Signals(number).name}; {kept}: run the same "
-              "command again to resume", file=sys.stderr)
+        print(
+            f"davis-ag {args.command}: stopped by {signal.Signals(number).name}; {kept}: run the same "
+            "command again to resume",
+            file=sys.stderr,
+        )
         return 128 + int(number)
     finally:
         for number, handler in previous.items():

@@ -82,8 +82,11 @@ def test_oracle_dominates_on_the_same_episodes(sp_root: Path, mp_root: Path) -> 
         for name in ("LRD", "UDD", "Rand"):
             other = results["policies"][name]["episodes"]
             for o, x in zip(oracle, other):
-                assert (o["scene"], o["path"][0], o["target_fruit"]) == \
-                    (x["scene"], x["path"][0], x["target_fruit"])  # same episode
+                assert (o["scene"], o["path"][0], o["target_fruit"]) == (
+                    x["scene"],
+                    x["path"][0],
+                    x["target_fruit"],
+                )  # same episode
                 assert o["oer_tau"] >= x["oer_tau"] - 1e-7
                 assert o["reward"] >= x["reward"] - 1e-7
         assert results["policies"]["Oracle"]["reward"]["mean"] > 0
@@ -116,8 +119,9 @@ def test_short_a2c_run_beats_random(sp_root: Path, tmp_path: Path, one_thread: N
 
 
 def _short_a2c_run(sp_root: Path, tmp_path: Path) -> None:
-    path = train_a2c(sp_root, "sp", total_timesteps=3000, seed=0, out_path=tmp_path / "m",
-                     n_envs=4, arch="pooled", device="cpu")
+    path = train_a2c(
+        sp_root, "sp", total_timesteps=3000, seed=0, out_path=tmp_path / "m", n_envs=4, arch="pooled", device="cpu"
+    )
     assert path.suffix == ".zip" and path.is_file()
     env = TVMEnv(sp_root, "sp", "train")
     results = evaluate_policies(env, [ModelPolicy(path), heuristic("Rand")], episodes=200, sessions=2).as_json()

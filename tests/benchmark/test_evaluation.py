@@ -50,8 +50,7 @@ def test_protocol_and_summary(sp_root: Path) -> None:
         episodes = summary["episodes"]
         assert len(episodes) == 90
         for metric in ("oer_tau", "reward", "length"):
-            sessions = [np.mean([e[metric] for e in episodes if e["session"] == s])
-                        for s in range(3)]
+            sessions = [np.mean([e[metric] for e in episodes if e["session"] == s]) for s in range(3)]
             assert summary[metric]["sessions"] == pytest.approx(sessions)
             assert summary[metric]["mean"] == pytest.approx(np.mean(sessions))
             assert summary[metric]["std"] == pytest.approx(np.std(sessions))
@@ -65,12 +64,12 @@ def test_protocol_and_summary(sp_root: Path) -> None:
         for e in episodes:
             assert 1 <= e["length"] <= 3
             assert e["reward"] == pytest.approx(max(e["oer_tau"] - e["oer_0"], 0) ** 2)
-    starts = {name: [(e["scene"], e["path"][0], e["target_fruit"]) for e in s["episodes"]]
-              for name, s in policies.items()}
+    starts = {
+        name: [(e["scene"], e["path"][0], e["target_fruit"]) for e in s["episodes"]] for name, s in policies.items()
+    }
     assert all(v == starts["LRD"] for v in starts.values())  # same episodes for every policy
     again = evaluate_policies(env, build_agents(["Rand"]), episodes=30, sessions=3, seed=5).as_json()
-    assert again["policies"]["Rand"]["reward"] == {
-        k: v for k, v in policies["Rand"]["reward"].items()}  # reproducible
+    assert again["policies"]["Rand"]["reward"] == {k: v for k, v in policies["Rand"]["reward"].items()}  # reproducible
 
 
 def test_episode_length_counts_done(sp_root: Path) -> None:
@@ -90,8 +89,10 @@ def test_table_json_and_plot(sp_root: Path, tmp_path: Path) -> None:
     assert "±" in lines[2]
     # The footer explains the exact rows only where there are some.
     assert ("OER_tau exact" in table) == ("exact: expectation" in table)
-    blind = {**results, "policies": {n: {k: v for k, v in p.items() if k != "exact"}
-                                     for n, p in results["policies"].items()}}
+    blind = {
+        **results,
+        "policies": {n: {k: v for k, v in p.items() if k != "exact"} for n, p in results["policies"].items()},
+    }
     assert "1 SP scene(s) (Single-Strawberry/001)" in table and "eligible starts" in table
     assert "exact" not in format_table(blind)
     out = write_json(results, tmp_path / "r" / "results.json")
@@ -103,14 +104,45 @@ def test_table_json_and_plot(sp_root: Path, tmp_path: Path) -> None:
 def test_commands(sp_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], one_thread: None) -> None:
     model = tmp_path / "model.zip"
     args = _parser().parse_args(
-        ["train", "--dataset", str(sp_root), "--scenario", "sp", "--timesteps", "40",
-         "--n-envs", "2", "--arch", "pooled", "--device", "cpu", "--verbose", "0",
-         "--out", str(model)])
+        [
+            "train",
+            "--dataset",
+            str(sp_root),
+            "--scenario",
+            "sp",
+            "--timesteps",
+            "40",
+            "--n-envs",
+            "2",
+            "--arch",
+            "pooled",
+            "--device",
+            "cpu",
+            "--verbose",
+            "0",
+            "--out",
+            str(model),
+        ]
+    )
     assert args.func(args) == 0 and model.is_file()
     out = tmp_path / "results.json"
     args = _parser().parse_args(
-        ["evaluate", "--dataset", str(sp_root), "--scenario", "sp", "--model", str(model),
-         "--episodes", "5", "--sessions", "2", "--out", str(out)])
+        [
+            "evaluate",
+            "--dataset",
+            str(sp_root),
+            "--scenario",
+            "sp",
+            "--model",
+            str(model),
+            "--episodes",
+            "5",
+            "--sessions",
+            "2",
+            "--out",
+            str(out),
+        ]
+    )
     assert args.func(args) == 0
     printed = capsys.readouterr().out
     assert "A2C" in printed and "Oracle" in printed and "OER_tau" in printed
@@ -119,42 +151,88 @@ def test_commands(sp_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture[s
     assert saved["policies"]["A2C"]["play"] == "sampled"  # as reproduce plays it; --deterministic otherwise
     assert "Best fixed action: always" in printed and "OER_tau exact" in printed
     args = _parser().parse_args(
-        ["evaluate", "--dataset", str(sp_root), "--scenario", "sp", "--model", str(model), "--deterministic",
-         "--policies", "LRD", "--episodes", "3", "--sessions", "1", "--out", str(out), "--force"])
+        [
+            "evaluate",
+            "--dataset",
+            str(sp_root),
+            "--scenario",
+            "sp",
+            "--model",
+            str(model),
+            "--deterministic",
+            "--policies",
+            "LRD",
+            "--episodes",
+            "3",
+            "--sessions",
+            "1",
+            "--out",
+            str(out),
+            "--force",
+        ]
+    )
     assert args.func(args) == 0
     assert json.loads(out.read_text())["policies"]["A2C"]["play"] == "deterministic"
     assert out.with_suffix(".png").is_file()
 
 
-@pytest.mark.parametrize("argv, message", [
-    (["--policies", "LRD,Bogus"], "unknown name 'Bogus'"),  # refused as parsed
-    (["--episodes", "0"], "argument --episodes"),
-])
-def test_evaluate_bad_values_are_refused_as_parsed(sp_root: Path, tmp_path: Path, argv: list[str], message: str,
-                                                   capsys: pytest.CaptureFixture[str]) -> None:
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["--policies", "LRD,Bogus"], "unknown name 'Bogus'"),  # refused as parsed
+        (["--episodes", "0"], "argument --episodes"),
+    ],
+)
+def test_evaluate_bad_values_are_refused_as_parsed(
+    sp_root: Path, tmp_path: Path, argv: list[str], message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
     with pytest.raises(SystemExit) as exit_:
-        _parser().parse_args(["evaluate", "--dataset", str(sp_root), "--scenario", "sp",
-                              "--out", str(tmp_path / "r.json"), *argv])
+        _parser().parse_args(
+            ["evaluate", "--dataset", str(sp_root), "--scenario", "sp", "--out", str(tmp_path / "r.json"), *argv]
+        )
     assert exit_.value.code == 2 and message in capsys.readouterr().err
 
 
 def test_a_continuous_policy_on_the_grid_is_refused(sp_root: Path, tmp_path: Path) -> None:
-    args = _parser().parse_args(["evaluate", "--dataset", str(sp_root), "--scenario", "sp",
-                                 "--out", str(tmp_path / "r.json"), "--policies", "LRD,Greedy"])
+    args = _parser().parse_args(
+        [
+            "evaluate",
+            "--dataset",
+            str(sp_root),
+            "--scenario",
+            "sp",
+            "--out",
+            str(tmp_path / "r.json"),
+            "--policies",
+            "LRD,Greedy",
+        ]
+    )
     with pytest.raises(UserError, match="not a baseline of --env grid"):
         args.func(args)
     assert not (tmp_path / "r.json").exists()
 
 
 def test_evaluate_missing_model(sp_root: Path, tmp_path: Path) -> None:
-    args = _parser().parse_args(["evaluate", "--dataset", str(sp_root), "--scenario", "sp",
-                                 "--out", str(tmp_path / "r.json"), "--model", "/nonexistent.zip"])
+    args = _parser().parse_args(
+        [
+            "evaluate",
+            "--dataset",
+            str(sp_root),
+            "--scenario",
+            "sp",
+            "--out",
+            str(tmp_path / "r.json"),
+            "--model",
+            "/nonexistent.zip",
+        ]
+    )
     with pytest.raises(UserError, match="no such model"):
         args.func(args)
 
 
 def test_not_a_dataset(tmp_path: Path) -> None:
-    args = _parser().parse_args(["evaluate", "--dataset", str(tmp_path), "--scenario", "sp",
-                                 "--out", str(tmp_path / "r.json")])
+    args = _parser().parse_args(
+        ["evaluate", "--dataset", str(tmp_path), "--scenario", "sp", "--out", str(tmp_path / "r.json")]
+    )
     with pytest.raises(UserError, match="not a DAVIS-Ag dataset"):
         args.func(args)

@@ -52,8 +52,11 @@ def test_dynamic_programme_matches_every_action_sequence_played(sp_root: Path, p
     for row in range(0, len(env.starts), max(1, len(env.starts) // 6)):  # a spread of starts
         scene, box = env.starts[row]
         cache = env.caches[scene]
-        start = (env.scenes[scene].id, cache.view_names[cache.box_view[box]],
-                 int(cache.fruit_ids[cache.box_fruit[box]]))
+        start = (
+            env.scenes[scene].id,
+            cache.view_names[cache.box_view[box]],
+            int(cache.fruit_ids[cache.box_fruit[box]]),
+        )
         played = _enumerate(env, start, probs)
         for key, value in played.items():
             assert per_start[key][row] == pytest.approx(value, abs=1e-6), (policy, start, key)
@@ -61,8 +64,9 @@ def test_dynamic_programme_matches_every_action_sequence_played(sp_root: Path, p
 
 def test_sampled_means_fall_within_their_standard_errors_of_the_exact_values(sp_root: Path) -> None:
     env = TVMEnv(sp_root, "sp", split="train")
-    results = evaluate_policies(env, build_agents(["LRD", "UDD", "Rand"]), episodes=200, sessions=3,
-                              seed=3, best_fixed_action=True).as_json()
+    results = evaluate_policies(
+        env, build_agents(["LRD", "UDD", "Rand"]), episodes=200, sessions=3, seed=3, best_fixed_action=True
+    ).as_json()
     for name in ("LRD", "UDD", "Rand", BEST_FIXED):
         summary = results["policies"][name]
         for key in ("oer_tau", "reward", "length"):
@@ -108,8 +112,9 @@ def test_unknown_start_rule_is_refused(sp_root: Path) -> None:
 
 def test_best_fixed_action_row_and_histograms_in_the_json(sp_root: Path, tmp_path: Path) -> None:
     env = TVMEnv(sp_root, "sp", split="test")
-    results = evaluate_policies(env, build_agents(["LRD", "Rand"]), episodes=40, sessions=3,
-                              best_fixed_action=True).as_json()
+    results = evaluate_policies(
+        env, build_agents(["LRD", "Rand"]), episodes=40, sessions=3, best_fixed_action=True
+    ).as_json()
     fixed = fixed_action_expectations(env)
     assert list(results["fixed_actions"]) == list(env.action_names)
     for action, values in fixed.items():
@@ -132,7 +137,8 @@ def test_fixed_action_agent_matches_its_exact_value(sp_root: Path) -> None:
     agent = FixedActionAgent("left")
     assert agent.name == "always left"
     assert expected_metrics(env, agent.action_probabilities(env)) == pytest.approx(
-        fixed_action_expectations(env)["left"])
+        fixed_action_expectations(env)["left"]
+    )
 
 
 def test_the_train_split_yardstick_is_every_fixed_action_on_train(sp_root: Path) -> None:

@@ -15,12 +15,14 @@ from davis_ag.benchmark.leaderboard import format_leaderboard, leaderboard
 def _always(move: str):
     def policy(observation, info):
         return move
+
     policy.__name__ = f"always_{move}"
     return policy
 
 
-def test_compare_ranks_methods_with_their_gaps(sp_root: Path, tmp_path: Path,
-                                               capsys: pytest.CaptureFixture[str]) -> None:
+def test_compare_ranks_methods_with_their_gaps(
+    sp_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     first = evaluate([_always("up")], sp_root, "sp", sessions=2, episodes=6).write(tmp_path / "up.json")
     second = evaluate([_always("down")], sp_root, "sp", sessions=2, episodes=6).write(tmp_path / "down.json")
     rows = leaderboard([first, second])
@@ -37,8 +39,9 @@ def test_compare_ranks_methods_with_their_gaps(sp_root: Path, tmp_path: Path,
     assert "Gap to Best fixed action [95 %]" in text
 
 
-def test_compare_refuses_another_dataset_or_split(sp_root: Path, tmp_path: Path,
-                                                  capsys: pytest.CaptureFixture[str]) -> None:
+def test_compare_refuses_another_dataset_or_split(
+    sp_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     ours = evaluate([], sp_root, "sp", sessions=1, episodes=3).write(tmp_path / "ours.json")
     other_root = write_tiny_dataset(tmp_path / "other", "sp", "strawberry", scenes=2, seed=7)
     theirs = evaluate([], other_root, "sp", sessions=1, episodes=3).write(tmp_path / "theirs.json")

@@ -20,8 +20,7 @@ OBSERVATION = gym.spaces.Box(0, 255, (224, 224, 4), dtype=np.uint8)
 
 def policy(arch: str, actions: int = 7) -> ActorCriticCnnPolicy:
     channels_first = gym.spaces.Box(0, 255, (4, 224, 224), dtype=np.uint8)
-    return ActorCriticCnnPolicy(channels_first, gym.spaces.Discrete(actions), lambda _: 7e-4,
-                                **ARCHITECTURES[arch])
+    return ActorCriticCnnPolicy(channels_first, gym.spaces.Discrete(actions), lambda _: 7e-4, **ARCHITECTURES[arch])
 
 
 def test_convolutions_are_the_papers() -> None:

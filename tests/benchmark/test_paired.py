@@ -13,8 +13,10 @@ from davis_ag.benchmark.paired import paired_gap
 def episodes(oer: list[float], scenes: list[str] | None = None) -> list[dict]:
     """Episode records as an evaluation writes them, one start per episode."""
     scenes = scenes or ["SP/000"] * len(oer)
-    return [{"session": i % 3, "scene": s, "path": [f"{i:04d}.jpeg"], "target_fruit": i % 5, "oer_tau": v}
-            for i, (v, s) in enumerate(zip(oer, scenes))]
+    return [
+        {"session": i % 3, "scene": s, "path": [f"{i:04d}.jpeg"], "target_fruit": i % 5, "oer_tau": v}
+        for i, (v, s) in enumerate(zip(oer, scenes))
+    ]
 
 
 def test_a_policy_better_on_every_scene_has_an_interval_above_zero() -> None:
@@ -51,8 +53,10 @@ def test_episodes_that_are_not_the_same_are_refused() -> None:
 
 
 @settings(max_examples=30, deadline=None)
-@given(st.lists(st.tuples(st.floats(0, 1), st.floats(0, 1), st.integers(0, 3)), min_size=2, max_size=60),
-       st.integers(0, 2**16))
+@given(
+    st.lists(st.tuples(st.floats(0, 1), st.floats(0, 1), st.integers(0, 3)), min_size=2, max_size=60),
+    st.integers(0, 2**16),
+)
 def test_the_gap_is_the_difference_of_means_and_lies_in_its_interval(rows: list, seed: int) -> None:
     first, second, scene = zip(*rows)
     scenes = [f"MP/{s:03d}" for s in scene]

@@ -14,7 +14,7 @@ from davis_ag.benchmark.exact import start_expectations
 from davis_ag.benchmark.policies import ModelPolicy, Policy, model_algorithm, policy_from_spec
 from davis_ag.errors import UserError
 
-POLICY_FILE = '''
+POLICY_FILE = """
 import numpy as np
 
 def always_down(observation, info):
@@ -26,7 +26,7 @@ class Wiggle:
         self.rng = np.random.default_rng(seed)
     def act(self, observation, info):
         return int(self.rng.integers(2))
-'''
+"""
 
 
 @pytest.fixture()
@@ -39,8 +39,11 @@ def policy_file(tmp_path: Path) -> Path:
 def test_every_spec_form_plays(sp_root: Path, policy_file: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.syspath_prepend(str(policy_file.parent))
     monkeypatch.delitem(sys.modules, "my_policies", raising=False)
-    policies = [policy_from_spec(f"{policy_file}:always_down"), policy_from_spec("my_policies:Wiggle"),
-                policy_from_spec(f"{policy_file}:always_down", name="mine")]
+    policies = [
+        policy_from_spec(f"{policy_file}:always_down"),
+        policy_from_spec("my_policies:Wiggle"),
+        policy_from_spec(f"{policy_file}:always_down", name="mine"),
+    ]
     assert [p.name for p in policies] == ["always_down", "Wiggle", "mine"]
     assert all(isinstance(p, Policy) for p in policies)
     results = evaluate(policies, sp_root, scenario="sp", split="all", sessions=1, episodes=6, baselines=["Rand"])
@@ -49,16 +52,21 @@ def test_every_spec_form_plays(sp_root: Path, policy_file: Path, monkeypatch: py
     assert rows["always_down"].action_counts["down"] == sum(e.length for e in rows["always_down"].episodes)
     assert set(rows["Wiggle"].action_counts) >= {"forward", "backward"}
     assert rows["always_down"].source == f"{policy_file}:always_down"
-    assert set(rows["Wiggle"].paired) == {"Rand", "Best fixed action"} and set(rows["Rand"].paired) == {"Best fixed action"}
+    assert set(rows["Wiggle"].paired) == {"Rand", "Best fixed action"} and set(rows["Rand"].paired) == {
+        "Best fixed action"
+    }
 
 
-@pytest.mark.parametrize("spec, message", [
-    ("nowhere.py:act", "no such file"),
-    ("no_such_module_here:act", "no module"),
-    ("{file}:missing", "has no 'missing'"),
-    ("{file}", "name the function or class too"),
-    ("/nonexistent/model.zip", "no such model file"),
-])
+@pytest.mark.parametrize(
+    "spec, message",
+    [
+        ("nowhere.py:act", "no such file"),
+        ("no_such_module_here:act", "no module"),
+        ("{file}:missing", "has no 'missing'"),
+        ("{file}", "name the function or class too"),
+        ("/nonexistent/model.zip", "no such model file"),
+    ],
+)
 def test_bad_specs_get_one_line(spec: str, message: str, policy_file: Path) -> None:
     with pytest.raises(UserError, match=message) as error:
         policy_from_spec(spec.format(file=policy_file))
@@ -82,14 +90,14 @@ def test_a_policy_that_always_plays_one_move_scores_its_exact_oer(sp_root: Path)
     """Every episode of "always down" ends exactly where the exact computation says its start ends
     (:func:`davis_ag.benchmark.exact.start_expectations` with probability 1 on ``down``)."""
     env = TVMEnv(sp_root, "sp", "all")
-    results = evaluate_policies(env, [_named(lambda o, i: "down", "down")], episodes=40, sessions=2,
-                                keep_episodes=True)
+    results = evaluate_policies(env, [_named(lambda o, i: "down", "down")], episodes=40, sessions=2, keep_episodes=True)
     exact = start_expectations(env, np.eye(len(env.action_names))[env.action_names.index("down")])
     rows = {}
     for row, (scene, box) in enumerate(env.starts.tolist()):
         cache = env.caches[scene]
-        rows[(env.scenes[scene].id, cache.view_names[cache.box_view[box]],
-              int(cache.fruit_ids[cache.box_fruit[box]]))] = row
+        rows[
+            (env.scenes[scene].id, cache.view_names[cache.box_view[box]], int(cache.fruit_ids[cache.box_fruit[box]]))
+        ] = row
     episodes = results.policies["down"].episodes
     expected = [exact["oer_tau"][rows[(e.scene, e.path[0], e.target_fruit)]] for e in episodes]
     assert [e.oer_tau for e in episodes] == pytest.approx(expected, abs=1e-6)
@@ -122,5 +130,7 @@ def test_a_policy_that_fails_is_one_line_naming_where(sp_root: Path) -> None:
     def broken(observation, info):
         return {}["missing"]
 
-    with pytest.raises(UserError, match=r"policy broken: act failed with KeyError: 'missing' \(at .*test_policies.py:\d+\)"):
+    with pytest.raises(
+        UserError, match=r"policy broken: act failed with KeyError: 'missing' \(at .*test_policies.py:\d+\)"
+    ):
         evaluate_policies(TVMEnv(sp_root, "sp", "all"), [_named(broken, "broken")], episodes=1, sessions=1)

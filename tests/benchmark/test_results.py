@@ -16,12 +16,19 @@ def test_the_file_is_the_object(sp_root: Path, tmp_path: Path) -> None:
     results = evaluate([lambda observation, info: "left"], sp_root, scenario="sp", sessions=2, episodes=5, seed=3)
     assert isinstance(results, EvaluationResults)
     protocol = results.protocol
-    assert (protocol.version, protocol.split, protocol.sessions, protocol.episodes, protocol.seed) == \
-        (PROTOCOL_VERSION, "test", 2, 5, 3)
+    assert (protocol.version, protocol.split, protocol.sessions, protocol.episodes, protocol.seed) == (
+        PROTOCOL_VERSION,
+        "test",
+        2,
+        5,
+        3,
+    )
     assert protocol.scenes == ["Single-Strawberry/001"] and protocol.starts > 0
     # The dataset's identity: every scene (not only the split's) with its seed.
-    assert [(s.id, s.seed) for s in results.dataset.scenes] == [("Single-Strawberry/000", 0),
-                                                                ("Single-Strawberry/001", 1)]
+    assert [(s.id, s.seed) for s in results.dataset.scenes] == [
+        ("Single-Strawberry/000", 0),
+        ("Single-Strawberry/001", 1),
+    ]
     path = results.write(tmp_path / "r.json")
     assert load_results(path) == results
     assert json.loads(path.read_text()) == results.as_json()

@@ -21,12 +21,12 @@ from davis_ag.errors import MachineError, UserError
 from davis_ag.provenance import code_version
 
 
-def test_a_killed_run_resumes_from_its_checkpoint(tmp_path: Path, one_thread: None,
-                                                  capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_killed_run_resumes_from_its_checkpoint(
+    tmp_path: Path, one_thread: None, capsys: pytest.CaptureFixture[str]
+) -> None:
     root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2)
     out = tmp_path / "models" / "a2c"
-    kwargs = dict(total_timesteps=240, seed=1, out_path=out, n_envs=2, arch="pooled", device="cpu",
-                  checkpoint_every=40)
+    kwargs = dict(total_timesteps=240, seed=1, out_path=out, n_envs=2, arch="pooled", device="cpu", checkpoint_every=40)
     with pytest.raises(KeyboardInterrupt):
         train_a2c(root, "sp", callback=KillAfter(130), **kwargs)
     model_file, settings_file = checkpoint_paths(out)
@@ -42,70 +42,154 @@ def test_a_killed_run_resumes_from_its_checkpoint(tmp_path: Path, one_thread: No
     # The record says it was made in two sittings, which steps each made, and with what code.
     record = json.loads(training_record_path(out).read_text())
     sittings = record["sittings"]
-    assert [(s["from_step"], s["to_step"]) for s in sittings] == [(0, saved["timesteps_done"]),
-                                                                  (saved["timesteps_done"], 240)]
+    assert [(s["from_step"], s["to_step"]) for s in sittings] == [
+        (0, saved["timesteps_done"]),
+        (saved["timesteps_done"], 240),
+    ]
     assert all(s["code"] == code_version() and s["seconds"] > 0 for s in sittings)
-    assert record["timesteps"] == 240 and record["seconds"] == pytest.approx(sum(s["seconds"] for s in sittings), abs=0.2)
+    assert record["timesteps"] == 240 and record["seconds"] == pytest.approx(
+        sum(s["seconds"] for s in sittings), abs=0.2
+    )
 
 
-def test_a_checkpoint_of_another_dataset_is_not_resumed(tmp_path: Path, one_thread: None,
-                                                         capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_checkpoint_of_another_dataset_is_not_resumed(
+    tmp_path: Path, one_thread: None, capsys: pytest.CaptureFixture[str]
+) -> None:
     first = write_tiny_dataset(tmp_path / "first", "sp", "strawberry", scenes=2)
     second = write_tiny_dataset(tmp_path / "second", "sp", "strawberry", scenes=2)
     out = tmp_path / "a2c.zip"
     with pytest.raises(KeyboardInterrupt):
-        train_a2c(first, "sp", total_timesteps=200, seed=1, out_path=out, n_envs=2, arch="pooled",
-                  device="cpu", checkpoint_every=20, callback=KillAfter(60))
+        train_a2c(
+            first,
+            "sp",
+            total_timesteps=200,
+            seed=1,
+            out_path=out,
+            n_envs=2,
+            arch="pooled",
+            device="cpu",
+            checkpoint_every=20,
+            callback=KillAfter(60),
+        )
     saved = json.loads(checkpoint_paths(out)[1].read_text())
     assert saved["dataset"] == str(Path(first).absolute())
     with pytest.raises(UserError, match="checkpoint of another run .*another dataset.*--force"):
-        train_a2c(second, "sp", total_timesteps=100, seed=1, out_path=out, n_envs=2, arch="pooled",
-                  device="cpu", checkpoint_every=20)  # never discarded without a word
-    train_a2c(second, "sp", total_timesteps=100, seed=1, out_path=out, n_envs=2, arch="pooled",
-              device="cpu", checkpoint_every=20, force=True)
+        train_a2c(
+            second,
+            "sp",
+            total_timesteps=100,
+            seed=1,
+            out_path=out,
+            n_envs=2,
+            arch="pooled",
+            device="cpu",
+            checkpoint_every=20,
+        )  # never discarded without a word
+    train_a2c(
+        second,
+        "sp",
+        total_timesteps=100,
+        seed=1,
+        out_path=out,
+        n_envs=2,
+        arch="pooled",
+        device="cpu",
+        checkpoint_every=20,
+        force=True,
+    )
     assert "resuming" not in capsys.readouterr().out
 
 
 def test_a_checkpoint_from_before_datasets_were_recorded_still_resumes(
-        tmp_path: Path, one_thread: None, capsys: pytest.CaptureFixture[str]) -> None:
+    tmp_path: Path, one_thread: None, capsys: pytest.CaptureFixture[str]
+) -> None:
     root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2)
     out = tmp_path / "a2c.zip"
     with pytest.raises(KeyboardInterrupt):
-        train_a2c(root, "sp", total_timesteps=200, seed=1, out_path=out, n_envs=2, arch="pooled",
-                  device="cpu", checkpoint_every=20, callback=KillAfter(60))
+        train_a2c(
+            root,
+            "sp",
+            total_timesteps=200,
+            seed=1,
+            out_path=out,
+            n_envs=2,
+            arch="pooled",
+            device="cpu",
+            checkpoint_every=20,
+            callback=KillAfter(60),
+        )
     settings_file = checkpoint_paths(out)[1]
     saved = json.loads(settings_file.read_text())
     settings_file.write_text(json.dumps({**saved, "dataset": "/"}))  # as earlier versions wrote it
-    train_a2c(root, "sp", total_timesteps=200, seed=1, out_path=out, n_envs=2, arch="pooled",
-              device="cpu", checkpoint_every=20)
+    train_a2c(
+        root,
+        "sp",
+        total_timesteps=200,
+        seed=1,
+        out_path=out,
+        n_envs=2,
+        arch="pooled",
+        device="cpu",
+        checkpoint_every=20,
+    )
     assert "resuming" in capsys.readouterr().out
 
 
-def test_other_settings_never_resume_a_checkpoint(tmp_path: Path, one_thread: None,
-                                                  capsys: pytest.CaptureFixture[str]) -> None:
+def test_other_settings_never_resume_a_checkpoint(
+    tmp_path: Path, one_thread: None, capsys: pytest.CaptureFixture[str]
+) -> None:
     root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2)
     out = tmp_path / "a2c.zip"
     with pytest.raises(KeyboardInterrupt):
-        train_a2c(root, "sp", total_timesteps=200, seed=1, out_path=out, n_envs=2, arch="pooled",
-                  device="cpu", checkpoint_every=20, callback=KillAfter(60))
+        train_a2c(
+            root,
+            "sp",
+            total_timesteps=200,
+            seed=1,
+            out_path=out,
+            n_envs=2,
+            arch="pooled",
+            device="cpu",
+            checkpoint_every=20,
+            callback=KillAfter(60),
+        )
     with pytest.raises(UserError, match="seed 1, not 2"):
-        train_a2c(root, "sp", total_timesteps=100, seed=2, out_path=out, n_envs=2, arch="pooled",
-                  device="cpu", checkpoint_every=20)
-    path = train_a2c(root, "sp", total_timesteps=100, seed=2, out_path=out, n_envs=2, arch="pooled",
-                     device="cpu", checkpoint_every=20, force=True)
+        train_a2c(
+            root,
+            "sp",
+            total_timesteps=100,
+            seed=2,
+            out_path=out,
+            n_envs=2,
+            arch="pooled",
+            device="cpu",
+            checkpoint_every=20,
+        )
+    path = train_a2c(
+        root,
+        "sp",
+        total_timesteps=100,
+        seed=2,
+        out_path=out,
+        n_envs=2,
+        arch="pooled",
+        device="cpu",
+        checkpoint_every=20,
+        force=True,
+    )
     assert "resuming" not in capsys.readouterr().out
     assert A2C.load(path, device="cpu").num_timesteps == 100
 
 
 def test_the_record_keeps_the_settings_and_a_learning_curve_across_sittings(
-        tmp_path: Path, one_thread: None, monkeypatch: pytest.MonkeyPatch) -> None:
+    tmp_path: Path, one_thread: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
     import davis_ag.benchmark.training as training
 
     monkeypatch.setattr(training, "CURVE_EVERY", 20)
     root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2)
     out = tmp_path / "a2c.zip"
-    kwargs = dict(total_timesteps=240, seed=1, out_path=out, n_envs=2, arch="pooled", device="cpu",
-                  checkpoint_every=40)
+    kwargs = dict(total_timesteps=240, seed=1, out_path=out, n_envs=2, arch="pooled", device="cpu", checkpoint_every=40)
     with pytest.raises(KeyboardInterrupt):
         train_a2c(root, "sp", callback=KillAfter(130), **kwargs)
     first = json.loads(checkpoint_paths(out)[1].read_text())["curve"]
@@ -125,8 +209,9 @@ def test_the_record_keeps_the_settings_and_a_learning_curve_across_sittings(
     assert model.normalize_advantage == training.A2C_SETTINGS["normalize_advantage"]
 
 
-def test_settings_choose_the_sb3_defaults_or_refuse_unknown_ones(tmp_path: Path, one_thread: None,
-                                                                 capsys: pytest.CaptureFixture[str]) -> None:
+def test_settings_choose_the_sb3_defaults_or_refuse_unknown_ones(
+    tmp_path: Path, one_thread: None, capsys: pytest.CaptureFixture[str]
+) -> None:
     from davis_ag.benchmark.training import SB3_DEFAULT_SETTINGS
 
     root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2)
@@ -138,15 +223,37 @@ def test_settings_choose_the_sb3_defaults_or_refuse_unknown_ones(tmp_path: Path,
     # A checkpoint from before settings were recorded was trained with SB3's defaults on starts
     # drawn scene first: today's runs never resume it.
     with pytest.raises(KeyboardInterrupt):
-        train_a2c(root, "sp", total_timesteps=200, seed=1, out_path=out, n_envs=2, arch="pooled",
-                  device="cpu", checkpoint_every=20, callback=KillAfter(60), settings="sb3")
+        train_a2c(
+            root,
+            "sp",
+            total_timesteps=200,
+            seed=1,
+            out_path=out,
+            n_envs=2,
+            arch="pooled",
+            device="cpu",
+            checkpoint_every=20,
+            callback=KillAfter(60),
+            settings="sb3",
+        )
     settings_file = checkpoint_paths(out)[1]
     saved = json.loads(settings_file.read_text())
     assert saved["a2c_settings"] == SB3_DEFAULT_SETTINGS
     del saved["a2c_settings"], saved["start_rule"]
     settings_file.write_text(json.dumps(saved))
-    train_a2c(root, "sp", total_timesteps=200, seed=1, out_path=out, n_envs=2, arch="pooled",
-              device="cpu", checkpoint_every=0, settings="ours", force=True)
+    train_a2c(
+        root,
+        "sp",
+        total_timesteps=200,
+        seed=1,
+        out_path=out,
+        n_envs=2,
+        arch="pooled",
+        device="cpu",
+        checkpoint_every=0,
+        settings="ours",
+        force=True,
+    )
     assert "resuming" not in capsys.readouterr().out
 
 
@@ -154,8 +261,16 @@ def test_a_damaged_checkpoint_offers_both_ways_on(tmp_path: Path, one_thread: No
     """Issue 33 case 4: a checkpoint that is no zip ended in a chained traceback."""
     root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2)
     out = tmp_path / "a2c.zip"
-    kwargs = dict(total_timesteps=60, seed=1, out_path=out, n_envs=2, arch="pooled", device="cpu",
-                  checkpoint_every=20, keep="last")
+    kwargs = dict(
+        total_timesteps=60,
+        seed=1,
+        out_path=out,
+        n_envs=2,
+        arch="pooled",
+        device="cpu",
+        checkpoint_every=20,
+        keep="last",
+    )
     with pytest.raises(KeyboardInterrupt):
         train_a2c(root, "sp", callback=KillAfter(40), **kwargs)
     model_file = checkpoint_paths(out)[0]
@@ -169,8 +284,9 @@ def test_a_damaged_checkpoint_offers_both_ways_on(tmp_path: Path, one_thread: No
 
 
 @pytest.mark.parametrize("keep", ["best-train", "last"])
-def test_a_full_disk_at_the_end_never_loses_the_model(tmp_path: Path, one_thread: None, keep: str,
-                                                       monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_full_disk_at_the_end_never_loses_the_model(
+    tmp_path: Path, one_thread: None, keep: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """Issue 33 case 3: with --keep best-train a full disk at the final write kept no model anywhere,
     though the line said nothing finished was lost. Every write after the disk fills fails
     (``os.fsync``, as a write-back of a full disk does); the line names a file that holds a model."""
@@ -199,8 +315,20 @@ def test_a_full_disk_at_the_end_never_loses_the_model(tmp_path: Path, one_thread
 
     monkeypatch.setattr(atomic_files.os, "fsync", fsync)
     with pytest.raises(MachineError) as stopped:
-        train_a2c(root, "sp", total_timesteps=60, seed=1, out_path=out, n_envs=2, arch="pooled", device="cpu",
-                  checkpoint_every=20, keep=keep, select_every=20, callback=DiskFillsAt())
+        train_a2c(
+            root,
+            "sp",
+            total_timesteps=60,
+            seed=1,
+            out_path=out,
+            n_envs=2,
+            arch="pooled",
+            device="cpu",
+            checkpoint_every=20,
+            keep=keep,
+            select_every=20,
+            callback=DiskFillsAt(),
+        )
     line = str(stopped.value)
     assert "No space left on device" in line and "\n" not in line and "is kept in" in line
     kept = Path(line.split("is kept in ")[1].split(":")[0])
@@ -220,9 +348,14 @@ def test_a_cuda_device_the_machine_lacks_is_refused() -> None:
 
 
 @pytest.mark.parametrize("algo", ["ppo", "dqn"])
-def test_ppo_and_dqn_train_resume_and_keep_the_best(algo: str, sp_root: Path, tmp_path: Path,
-                                                     one_thread: None, capsys: pytest.CaptureFixture[str],
-                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+def test_ppo_and_dqn_train_resume_and_keep_the_best(
+    algo: str,
+    sp_root: Path,
+    tmp_path: Path,
+    one_thread: None,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
     """The same record, checkpoints, resume and keep-best-train rule as A2C, for each algorithm;
     progress goes to the log as lines (not a terminal here)."""
     import stable_baselines3
@@ -231,9 +364,21 @@ def test_ppo_and_dqn_train_resume_and_keep_the_best(algo: str, sp_root: Path, tm
     from davis_ag.benchmark.policies import model_algorithm
 
     out = tmp_path / algo
-    short = {"ppo": {"n_steps": 20, "batch_size": 20}, "dqn": {"learning_starts": 40}}[algo]  # SB3's: 4,096-step rollouts
-    kwargs = dict(total_timesteps=240, seed=1, out_path=out, n_envs=2, arch="pooled", device="cpu",
-                  checkpoint_every=80, select_every=120, algo=algo, settings=short)
+    short = {"ppo": {"n_steps": 20, "batch_size": 20}, "dqn": {"learning_starts": 40}}[
+        algo
+    ]  # SB3's: 4,096-step rollouts
+    kwargs = dict(
+        total_timesteps=240,
+        seed=1,
+        out_path=out,
+        n_envs=2,
+        arch="pooled",
+        device="cpu",
+        checkpoint_every=80,
+        select_every=120,
+        algo=algo,
+        settings=short,
+    )
     with pytest.raises(KeyboardInterrupt):
         training.train_agent(sp_root, "sp", callback=KillAfter(170), **kwargs)
     assert json.loads(checkpoint_paths(out)[1].read_text())["timesteps_done"] == 160

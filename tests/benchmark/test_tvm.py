@@ -20,8 +20,6 @@ from davis_ag.errors import UserError
 ENV_IDS = sorted(i for i in gymnasium.registry if i.startswith("davis_ag/") and i != CONTINUOUS_ID)
 
 
-
-
 def _episode(env: gymnasium.Env, seed: int, actions: list[int]) -> list:
     obs, info = env.reset(seed=seed)
     trace = [(obs, info)]
@@ -63,8 +61,14 @@ def test_seeded_determinism(env_id: str, sp_root: Path) -> None:
         for sa, sb in zip(ta, tb):
             np.testing.assert_array_equal(sa[0], sb[0])
             assert sa[1:] == sb[1:]
-    starts = {(_episode(a, s, [])[0][1]["scene"], _episode(a, s, [])[0][1]["path"][0],
-               _episode(a, s, [])[0][1]["target_fruit"]) for s in range(40)}
+    starts = {
+        (
+            _episode(a, s, [])[0][1]["scene"],
+            _episode(a, s, [])[0][1]["path"][0],
+            _episode(a, s, [])[0][1]["target_fruit"],
+        )
+        for s in range(40)
+    }
     assert len(starts) > 1  # the seed does matter
 
 
@@ -84,7 +88,7 @@ def _oer_from_files(root: Path, scene: str, view: str, fruit: int) -> float:
     boxes = json.loads((root / scene / "annotations.json").read_text())[view]["bounding_boxes"]
     x, y, w, h = next(b[:4] for b in boxes if b[4] == fruit)
     mask = np.asarray(Image.open(root / scene / "images" / view.replace(".jpeg", "_seg.png")))
-    return float(np.count_nonzero(mask[y:y + h, x:x + w] == fruit)) / (w * h)
+    return float(np.count_nonzero(mask[y : y + h, x : x + w] == fruit)) / (w * h)
 
 
 def test_reward_formula() -> None:

@@ -28,8 +28,13 @@ def test_good_seeds(text: str, value: int) -> None:
 
 def test_counts_and_bounds() -> None:
     assert arguments.count("3") == 3 and arguments.whole("0") == 0 and arguments.bounded(1, 5)("5") == 5
-    for parse, text in [(arguments.count, "0"), (arguments.count, "-2"), (arguments.whole, "-1"),
-                        (arguments.bounded(1, 5), "6"), (arguments.bounded(1, 5), "0")]:
+    for parse, text in [
+        (arguments.count, "0"),
+        (arguments.count, "-2"),
+        (arguments.whole, "-1"),
+        (arguments.bounded(1, 5), "6"),
+        (arguments.bounded(1, 5), "0"),
+    ]:
         with pytest.raises(argparse.ArgumentTypeError):
             parse(text)
 
@@ -61,8 +66,12 @@ def _unwritable(tmp_path: Path) -> list[tuple[Path, str]]:
     """Places no run can write, as root too: /proc, a path under a regular file."""
     a_file = tmp_path / "a-file"
     a_file.write_text("x")
-    return [(Path("/proc/x"), "cannot write in /proc"), (Path("/proc/x/y/z"), "cannot write in /proc"),
-            (a_file / "sub", "which is a file"), (a_file / "sub" / "deeper", "which is a file")]
+    return [
+        (Path("/proc/x"), "cannot write in /proc"),
+        (Path("/proc/x/y/z"), "cannot write in /proc"),
+        (a_file / "sub", "which is a file"),
+        (a_file / "sub" / "deeper", "which is a file"),
+    ]
 
 
 def test_folders_are_proven_writable_by_creating_a_file(tmp_path: Path) -> None:

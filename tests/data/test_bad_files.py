@@ -46,12 +46,30 @@ def _audit(event: str, args: tuple) -> None:
 
 sys.addaudithook(_audit)  # audit hooks cannot be removed; this one only looks while _WATCHED is set
 
-JSON_VALUES = st.recursive(st.none() | st.booleans() | st.integers(-2**40, 2**40) | st.floats(allow_nan=True)
-                           | st.sampled_from(["", "x", "..", "../0001.jpeg", "/etc/passwd", "0001", "9999.jpeg"]),
-                           lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=3), inner,
-                                                                                         max_size=2), max_leaves=6)
-BAD_NAMES = st.sampled_from(["../0001.jpeg", "/etc/passwd", "..", "../../outside/x.jpeg", "0001.png", "x.jpeg",
-                             "0001/..", "\\..\\x.jpeg", "", " ", "0"])
+JSON_VALUES = st.recursive(
+    st.none()
+    | st.booleans()
+    | st.integers(-(2**40), 2**40)
+    | st.floats(allow_nan=True)
+    | st.sampled_from(["", "x", "..", "../0001.jpeg", "/etc/passwd", "0001", "9999.jpeg"]),
+    lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=3), inner, max_size=2),
+    max_leaves=6,
+)
+BAD_NAMES = st.sampled_from(
+    [
+        "../0001.jpeg",
+        "/etc/passwd",
+        "..",
+        "../../outside/x.jpeg",
+        "0001.png",
+        "x.jpeg",
+        "0001/..",
+        "\\..\\x.jpeg",
+        "",
+        " ",
+        "0",
+    ]
+)
 
 
 @pytest.fixture(scope="module")
@@ -90,12 +108,14 @@ def annotations_damage(root: Path, outside: Path, data: st.DataObject) -> Path:
     elif kind == "box value":
         boxes = doc[name]["bounding_boxes"] or [[0, 0, 1, 1, 0, 0]]
         box = boxes[0]
-        box[data.draw(st.integers(0, 5))] = data.draw(st.sampled_from([-1, 10**12, "x", None, 1.5, 255, 1000, True,
-                                                                        -(10**9), float("inf")]))
+        box[data.draw(st.integers(0, 5))] = data.draw(
+            st.sampled_from([-1, 10**12, "x", None, 1.5, 255, 1000, True, -(10**9), float("inf")])
+        )
         doc[name]["bounding_boxes"] = boxes
     elif kind == "pointer":
-        doc[name][data.draw(st.sampled_from(["forward", "backward", "left", "right", "up", "down"]))] = \
-            data.draw(BAD_NAMES | JSON_VALUES)
+        doc[name][data.draw(st.sampled_from(["forward", "backward", "left", "right", "up", "down"]))] = data.draw(
+            BAD_NAMES | JSON_VALUES
+        )
     elif kind == "key":
         doc[data.draw(BAD_NAMES)] = doc.pop(name)
     else:
@@ -157,8 +177,15 @@ def cache_damage(root: Path, outside: Path, data: st.DataObject) -> Path:
     folder = root / ".davis_ag_cache" / SCENE
     name = data.draw(st.sampled_from(["meta.json", "tables.npz", "images.npy"]), label="cache file")
     path = folder / name
-    kind = data.draw(st.sampled_from(["truncate", "link", "table"] if name == "tables.npz" else
-                                     ["truncate", "link", "field"] if name == "meta.json" else ["truncate", "link"]))
+    kind = data.draw(
+        st.sampled_from(
+            ["truncate", "link", "table"]
+            if name == "tables.npz"
+            else ["truncate", "link", "field"]
+            if name == "meta.json"
+            else ["truncate", "link"]
+        )
+    )
     if kind == "truncate":
         _truncate(path, data)
     elif kind == "link":
@@ -173,16 +200,28 @@ def cache_damage(root: Path, outside: Path, data: st.DataObject) -> Path:
         with np.load(path) as npz:
             tables = {k: npz[k] for k in npz.files}
         key = data.draw(st.sampled_from(sorted(tables)))
-        tables[key] = data.draw(st.sampled_from([
-            tables[key][:1], tables[key] + 10**6, -tables[key] - 5, np.zeros((2, 2, 2), np.int32),
-            tables[key].astype(np.float64) + 0.5]))
+        tables[key] = data.draw(
+            st.sampled_from(
+                [
+                    tables[key][:1],
+                    tables[key] + 10**6,
+                    -tables[key] - 5,
+                    np.zeros((2, 2, 2), np.int32),
+                    tables[key].astype(np.float64) + 0.5,
+                ]
+            )
+        )
         np.savez(path, **tables)
     return path
 
 
 def link_damage(root: Path, outside: Path, data: st.DataObject) -> Path:
-    which = data.draw(st.sampled_from(["annotations.json", "scene.json", "images/0001.jpeg", "images/0002_seg.png",
-                                       "scene folder", "splits.json"]), label="linked")
+    which = data.draw(
+        st.sampled_from(
+            ["annotations.json", "scene.json", "images/0001.jpeg", "images/0002_seg.png", "scene folder", "splits.json"]
+        ),
+        label="linked",
+    )
     if which == "scene folder":
         path = root / SCENE
         shutil.copytree(path, outside / "000")
@@ -197,8 +236,13 @@ def link_damage(root: Path, outside: Path, data: st.DataObject) -> Path:
 
 
 DAMAGE: dict[str, Callable[[Path, Path, st.DataObject], Path]] = {
-    "annotations": annotations_damage, "scene.json": scene_json_damage, "splits": splits_damage,
-    "pixels": pixels_damage, "cache": cache_damage, "link": link_damage}
+    "annotations": annotations_damage,
+    "scene.json": scene_json_damage,
+    "splits": splits_damage,
+    "pixels": pixels_damage,
+    "cache": cache_damage,
+    "link": link_damage,
+}
 
 
 # ---------------------------------------------------------------------------------------------
@@ -238,8 +282,12 @@ def _only_user_errors(use: Callable[[Path], Any], root: Path) -> str | None:
     return None
 
 
-@settings(max_examples=50, deadline=None, derandomize=True,
-          suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+@settings(
+    max_examples=50,
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
 @given(data=st.data())
 def test_damaged_files_give_reports_and_user_errors_only(data: st.DataObject, pristine: Path, sandbox: Path) -> None:
     case = sandbox / f"case-{next(_counter)}"
@@ -260,8 +308,9 @@ def test_damaged_files_give_reports_and_user_errors_only(data: st.DataObject, pr
     assert not _OPENED, f"opened outside the dataset: {_OPENED}"
     assert {p: p.stat().st_mtime_ns for p in outside.rglob("*")} == before
     if kind == "link":  # named by validate, refused by the reader and the environment
-        assert any(str(p.path).startswith(str(damaged)) and "outside the dataset" in p.reason
-                   for p in report.problems), report.problems
+        assert any(
+            str(p.path).startswith(str(damaged)) and "outside the dataset" in p.reason for p in report.problems
+        ), report.problems
         assert read_error and "outside the dataset" in read_error
         # The environment reads the annotations (the cache's key) and, through a cache built from
         # the untouched pictures, no picture.

@@ -18,8 +18,13 @@ poses = st.tuples(st.floats(-5, 5), st.floats(-5, 5), st.floats(0.1, 3), st.floa
 
 
 @settings(max_examples=100, deadline=None)
-@given(pose=poses, width=st.integers(16, 400), height=st.integers(16, 300), vfov=st.floats(20, 90),
-       seed=st.integers(0, 2**31))
+@given(
+    pose=poses,
+    width=st.integers(16, 400),
+    height=st.integers(16, 300),
+    vfov=st.floats(20, 90),
+    seed=st.integers(0, 2**31),
+)
 def test_unprojected_pixels_project_back_to_their_centres(pose, width, height, vfov, seed) -> None:
     camera = Camera(width, height, vfov)
     intrinsics = camera.intrinsics()
@@ -68,5 +73,6 @@ def test_ply_round_trips_and_other_libraries_read_it(tmp_path: Path) -> None:
     assert not list(path.parent.glob(".*.tmp"))
     trimesh = pytest.importorskip("trimesh")
     cloud = trimesh.load(path)
-    assert isinstance(cloud, trimesh.PointCloud) and np.allclose(cloud.vertices, np.stack(
-        [points["x"], points["y"], points["z"]], 1), atol=1e-6)
+    assert isinstance(cloud, trimesh.PointCloud) and np.allclose(
+        cloud.vertices, np.stack([points["x"], points["y"], points["z"]], 1), atol=1e-6
+    )

@@ -69,8 +69,9 @@ def test_scene_properties(ours: Path) -> None:
         sp[len(sp)]
     assert sp.metadata is not None and sp.metadata.camera.width == 128
     assert set(sp.metadata.visible_fraction) == set(names)
-    assert ds.splits == SplitsFile(seed=0, train=["Single-Strawberry/000", "Multi-Vine/000"],
-                                   test=["Single-Strawberry/001"])
+    assert ds.splits == SplitsFile(
+        seed=0, train=["Single-Strawberry/000", "Multi-Vine/000"], test=["Single-Strawberry/001"]
+    )
     assert ds.splits.train == ["Single-Strawberry/000", "Multi-Vine/000"]
 
 
@@ -207,8 +208,9 @@ def test_bad_view_names(bad: object) -> None:
         normalise_view_name(bad)  # type: ignore[arg-type]
 
 
-boxes = st.builds(Box, st.integers(0, 2000), st.integers(0, 2000), st.integers(1, 500),
-                  st.integers(1, 500), st.integers(0, 254))
+boxes = st.builds(
+    Box, st.integers(0, 2000), st.integers(0, 2000), st.integers(1, 500), st.integers(1, 500), st.integers(0, 254)
+)
 
 
 @given(boxes, st.booleans())
@@ -218,8 +220,9 @@ def test_box_round_trip(box: Box, as_float: bool) -> None:
     assert box.xmax - box.xmin + 1 == box.width and box.area == box.width * box.height
 
 
-@pytest.mark.parametrize("bad", [[1, 2, 3, 4], "1,2,3,4,5", [1, 2, 3, 4, "a"], [1, 2, 3, 4, True],
-                                 [1, 2, float("nan"), 4, 5]])
+@pytest.mark.parametrize(
+    "bad", [[1, 2, 3, 4], "1,2,3,4,5", [1, 2, 3, 4, "a"], [1, 2, 3, 4, True], [1, 2, float("nan"), 4, 5]]
+)
 def test_bad_boxes(bad: object) -> None:
     with pytest.raises(ValueError):
         parse_box(bad)
@@ -231,8 +234,9 @@ def test_pose_round_trip(values: list[float]) -> None:
     assert parse_pose(None) is None
 
 
-small_boxes = st.builds(Box, st.integers(0, 40), st.integers(0, 30), st.integers(1, 24),
-                        st.integers(1, 18), st.integers(0, 254))
+small_boxes = st.builds(
+    Box, st.integers(0, 40), st.integers(0, 30), st.integers(1, 24), st.integers(1, 18), st.integers(0, 254)
+)
 
 
 @given(small_boxes, st.integers(0, 254))

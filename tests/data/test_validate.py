@@ -76,18 +76,22 @@ def test_original_style_passes(tmp_path: Path, capsys: pytest.CaptureFixture[str
 def test_dangling_pointer(dataset: Path, capsys: pytest.CaptureFixture[str]) -> None:
     def dangle(data: dict) -> None:
         data["0002.jpeg"]["forward"] = "9999.jpeg"
+
     edit_annotations(dataset / SCENE / "annotations.json", dangle)
     for quick in ([], ["--quick"]):
         code, lines, _ = run(capsys, str(dataset), *quick)
         assert code == 1
-        assert lines[:-1] == [f"{dataset / SCENE / 'annotations.json'}: 0002.jpeg: forward points to "
-                              "9999.jpeg, which is not a view of this scene"]
+        assert lines[:-1] == [
+            f"{dataset / SCENE / 'annotations.json'}: 0002.jpeg: forward points to "
+            "9999.jpeg, which is not a view of this scene"
+        ]
         assert lines[-1].endswith(": 1 problem")
 
 
 def test_box_disagreeing_with_mask(dataset: Path, capsys: pytest.CaptureFixture[str]) -> None:
     def widen(data: dict) -> None:
         data["0003.jpeg"]["bounding_boxes"][0][2] += 3
+
     edit_annotations(dataset / SCENE / "annotations.json", widen)
     code, lines, _ = run(capsys, str(dataset / "Single-Strawberry"))
     assert code == 1 and len(lines) == 2
@@ -116,8 +120,10 @@ def test_missing_image_and_mask(dataset: Path, capsys: pytest.CaptureFixture[str
     (images / "0006_seg.png").unlink()
     code, lines, _ = run(capsys, str(dataset))
     assert code == 1
-    assert lines[:-1] == [f"{images / '0005.jpeg'}: missing: annotations.json has an entry 0005.jpeg for it",
-                          f"{images / '0006_seg.png'}: missing: the instance mask of 0006.jpeg"]
+    assert lines[:-1] == [
+        f"{images / '0005.jpeg'}: missing: annotations.json has an entry 0005.jpeg for it",
+        f"{images / '0006_seg.png'}: missing: the instance mask of 0006.jpeg",
+    ]
 
 
 def test_malformed_json(dataset: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -135,6 +141,7 @@ def test_schema_problems_each_reported(dataset: Path, capsys: pytest.CaptureFixt
         data["0002.jpeg"]["pose"] = "up"
         data["0003.jpeg"] = []
         data["0004.jpeg"]["bounding_boxes"].append(data["0004.jpeg"]["bounding_boxes"][0])
+
     edit_annotations(dataset / SCENE / "annotations.json", break_schema)
     code, lines, _ = run(capsys, str(dataset), "--quick")
     reasons = [line.split("annotations.json: ", 1)[1] for line in lines[:-1]]
@@ -148,10 +155,12 @@ def test_schema_problems_each_reported(dataset: Path, capsys: pytest.CaptureFixt
 def test_orphan_image_splits_and_counts(dataset: Path, capsys: pytest.CaptureFixture[str]) -> None:
     scene = dataset / "Single-Strawberry" / "002"
     last = sorted((scene / "images").glob("*.jpeg"))[-1]
+
     def drop_last(data: dict) -> None:
         del data[last.name]
         for entry in data.values():
             entry.update({k: "" for k, v in entry.items() if v == last.name})
+
     edit_annotations(scene / "annotations.json", drop_last)
     splits = json.loads((dataset / "splits.json").read_text())
     splits["test"].append("Single-Strawberry/000")
@@ -187,8 +196,9 @@ def test_not_a_dataset(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> No
     assert err.count("\n") == 1 and "not a DAVIS-Ag dataset" in err and err.startswith("davis-ag validate: error:")
 
 
-def test_relative_paths_print_relative(dataset: Path, capsys: pytest.CaptureFixture[str],
-                                       monkeypatch: pytest.MonkeyPatch) -> None:
+def test_relative_paths_print_relative(
+    dataset: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
     (dataset / SCENE / "images" / "0007.jpeg").unlink()
     monkeypatch.chdir(dataset)
     code, lines, _ = run(capsys, ".")

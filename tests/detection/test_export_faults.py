@@ -38,8 +38,9 @@ def export(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, st
 
 
 @pytest.mark.parametrize("fmt", ["coco", "yolo"])
-def test_an_image_linked_out_of_the_dataset_is_never_read(fmt: str, data: Path, tmp_path: Path,
-                                                          capsys: pytest.CaptureFixture[str]) -> None:
+def test_an_image_linked_out_of_the_dataset_is_never_read(
+    fmt: str, data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """Case 6: YOLO copied a view image that is a symlink to a file outside the dataset."""
     outside = tmp_path / "secret.jpeg"
     shutil.copy(data / VIEW, outside)
@@ -50,8 +51,9 @@ def test_an_image_linked_out_of_the_dataset_is_never_read(fmt: str, data: Path, 
     assert not [p for p in (tmp_path / "out").rglob("*") if p.is_file() and p.read_bytes() == outside.read_bytes()]
 
 
-def test_boxes_outside_the_image_are_cut_to_it_and_counted(data: Path, tmp_path: Path,
-                                                          capsys: pytest.CaptureFixture[str]) -> None:
+def test_boxes_outside_the_image_are_cut_to_it_and_counted(
+    data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """Case 6: a negative box went into COCO (area 14) and YOLO (negative width)."""
     path = data / "Single-Strawberry" / "000" / "annotations.json"
     annotations = json.loads(path.read_text())
@@ -71,8 +73,9 @@ def test_boxes_outside_the_image_are_cut_to_it_and_counted(data: Path, tmp_path:
             assert all(0 <= float(v) <= 1 for v in line.split()[1:]), line
 
 
-def test_a_truncated_image_stops_the_export_before_it_is_copied(data: Path, tmp_path: Path,
-                                                                capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_truncated_image_stops_the_export_before_it_is_copied(
+    data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """Case 6: a truncated JPEG was copied into YOLO with exit 0."""
     image = data / VIEW
     image.write_bytes(image.read_bytes()[:-200])
@@ -81,8 +84,9 @@ def test_a_truncated_image_stops_the_export_before_it_is_copied(data: Path, tmp_
     assert not list((tmp_path / "yolo").rglob("*_000_0001.jpeg"))
 
 
-def test_a_renamed_scene_folder_is_refused_not_dropped(data: Path, tmp_path: Path,
-                                                       capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_renamed_scene_folder_is_refused_not_dropped(
+    data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """Case 6: a scene folder renamed to an odd name gave a COCO train split of 0 images, exit 0."""
     (data / "Single-Strawberry" / "000").rename(data / "Single-Strawberry" / "000 (copy)")
     code, _, err = export(capsys, "coco", str(data), str(tmp_path / "coco"))
@@ -90,8 +94,9 @@ def test_a_renamed_scene_folder_is_refused_not_dropped(data: Path, tmp_path: Pat
     assert "Single-Strawberry/000" in err and "Single-Strawberry/000 (copy)" in err and "rename" in err
 
 
-def test_a_killed_export_leaves_nothing_the_next_run_keeps(pristine: Path, tmp_path: Path,
-                                                           capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_killed_export_leaves_nothing_the_next_run_keeps(
+    pristine: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """Case 7: kill -9 during export coco left hidden working folders no later run removed; a
     stopped export is carried on by the same command, a finished one replaced only with --force."""
     out = tmp_path / "coco"
@@ -106,9 +111,9 @@ def test_a_killed_export_leaves_nothing_the_next_run_keeps(pristine: Path, tmp_p
     assert export(capsys, "coco", str(pristine), str(out), "--force")[0] == 0
 
 
-def test_a_full_disk_leaves_no_half_image_under_its_name(pristine: Path, tmp_path: Path,
-                                                         monkeypatch: pytest.MonkeyPatch,
-                                                         capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_full_disk_leaves_no_half_image_under_its_name(
+    pristine: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
     """Case 7: export yolo on a full disk left a truncated image under its final name and named the
     source image as where space ran out. Here links are impossible (another file system) and the
     disk fills after the first kilobyte of a copy."""

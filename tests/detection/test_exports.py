@@ -42,7 +42,10 @@ def test_coco_masks_and_boxes_round_trip(dataset: Path, tmp_path: Path) -> None:
         coco = COCO(str(tmp_path / "annotations" / f"instances_{split}.json"))
         assert counts[split]["images"] == len(coco.imgs) == sum(len(s) for s in scenes)
         assert {c["name"]: c["id"] for c in coco.loadCats(coco.getCatIds())} == {
-            "strawberry": 1, "tomato": 2, "vine": 3}
+            "strawberry": 1,
+            "tomato": 2,
+            "vine": 3,
+        }
         checked = 0
         for image in coco.imgs.values():
             view = data.scene(image["scene"]).view(image["view"])
@@ -59,8 +62,9 @@ def test_coco_masks_and_boxes_round_trip(dataset: Path, tmp_path: Path) -> None:
                 assert ann["category_id"] == (1 if view.scene.crop == "strawberry" else 2)
                 assert ann["attributes"]["visible_fraction"] == fractions[str(box.fruit_id)]
                 checked += 1
-            assert ("depth_file" in image) == (image["scene"] == "Single-Strawberry/000"
-                                               and image["view"] == "0002.jpeg")
+            assert ("depth_file" in image) == (
+                image["scene"] == "Single-Strawberry/000" and image["view"] == "0002.jpeg"
+            )
         assert checked > 10
 
 
@@ -140,8 +144,9 @@ def test_yolo_polygons_fill_back_to_the_masks(dataset: Path, tmp_path: Path) -> 
     assert compared > 5
 
 
-def test_export_command_refuses_a_foreign_folder_and_writes_both_formats(dataset: Path, tmp_path: Path,
-                                                                         capsys: pytest.CaptureFixture) -> None:
+def test_export_command_refuses_a_foreign_folder_and_writes_both_formats(
+    dataset: Path, tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
     (tmp_path / "busy").mkdir()
     (tmp_path / "busy" / "notes.txt").write_text("mine")
     assert main(["export", "coco", str(dataset), str(tmp_path / "busy")]) == 2
@@ -175,7 +180,7 @@ def _with_classes(dataset: Path, folder: Path) -> tuple[Path, dict[str, np.ndarr
     for view in open_dataset(copy).scene("Single-Strawberry/000"):
         mask = view.mask()
         classes = np.zeros(mask.shape, np.uint8)
-        classes[mask.shape[0] // 3:] = 1
+        classes[mask.shape[0] // 3 :] = 1
         classes[2:6, 2:10] = 3
         classes[6:8, 2:10] = 4
         classes[mask != 255] = 2
@@ -192,8 +197,13 @@ def test_coco_organs_are_semantic_rle_masks(dataset: Path, tmp_path: Path) -> No
     export_coco(copy, tmp_path / "out", progress=False, organs=True)
     coco = COCO(str(tmp_path / "out" / "annotations" / "instances_train.json"))
     names = {c["id"]: c["name"] for c in coco.loadCats(coco.getCatIds())}
-    assert {k: v for k, v in names.items() if k > 100} == {101: "soil", 102: "fruit", 103: "leaf", 104: "stem",
-                                                           105: "trunk"}
+    assert {k: v for k, v in names.items() if k > 100} == {
+        101: "soil",
+        102: "fruit",
+        103: "leaf",
+        104: "stem",
+        105: "trunk",
+    }
     checked = 0
     for image in coco.loadImgs(coco.getImgIds()):
         organs = [a for a in coco.loadAnns(coco.getAnnIds(imgIds=image["id"])) if a["category_id"] > 100]
@@ -219,10 +229,19 @@ def test_yolo_organs_are_polygons_after_the_crops(dataset: Path, tmp_path: Path)
         export_yolo(copy, tmp_path / "boxes", "detect", progress=False, organs=True)
     export_yolo(copy, tmp_path / "out", "segment", progress=False, organs=True)
     names = yaml.safe_load((tmp_path / "out" / "data.yaml").read_text())["names"]
-    assert names == {0: "strawberry", 1: "tomato", 2: "vine", 3: "organ_soil", 4: "organ_fruit", 5: "organ_leaf",
-                     6: "organ_stem", 7: "organ_trunk"}
+    assert names == {
+        0: "strawberry",
+        1: "tomato",
+        2: "vine",
+        3: "organ_soil",
+        4: "organ_fruit",
+        5: "organ_leaf",
+        6: "organ_stem",
+        7: "organ_trunk",
+    }
     for name, classes in written.items():
         label = tmp_path / "out" / "labels" / "train" / f"{flat_name('Single-Strawberry/000/' + name)}.txt"
-        organ_classes = sorted(int(line.split()[0]) for line in label.read_text().splitlines()
-                               if int(line.split()[0]) >= 3)
+        organ_classes = sorted(
+            int(line.split()[0]) for line in label.read_text().splitlines() if int(line.split()[0]) >= 3
+        )
         assert organ_classes == sorted(2 + v for v in set(np.unique(classes).tolist()) - {0})

@@ -28,9 +28,13 @@ print(compiled, torchvision.ops.nms(boxes, scores, 0.5).tolist())
 def test_torchvision_imports_and_its_nms_keeps_the_right_boxes() -> None:
     pytest.importorskip("ultralytics")
     # A fresh interpreter: the operators must be defined before torchvision's first import.
-    done = subprocess.run([sys.executable, "-c", CHECK], capture_output=True, text=True, timeout=300,
-                          env={"PYTHONPATH": str(SRC), "PATH": "/usr/bin:/bin", "HOME": str(Path.home()),
-                               "YOLO_OFFLINE": "1"})
+    done = subprocess.run(
+        [sys.executable, "-c", CHECK],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={"PYTHONPATH": str(SRC), "PATH": "/usr/bin:/bin", "HOME": str(Path.home()), "YOLO_OFFLINE": "1"},
+    )
     assert done.returncode == 0, done.stderr[-2000:]
     compiled, kept = done.stdout.split(maxsplit=1)
     assert compiled in ("True", "False")  # False: the CUDA wheel beside a CPU torch, patched

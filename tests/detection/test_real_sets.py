@@ -30,7 +30,9 @@ def test_coco_and_yolo_layouts_give_the_same_pool(exports: tuple[Path, Path]) ->
     from_coco = load_pool(coco / "annotations" / "instances_train.json")
     assert from_yaml.names == {0: "strawberry", 1: "tomato", 2: "vine"} == from_coco.names
     train = {p.name.removesuffix(".jpeg"): lines for p, lines in from_yaml.items if "/train/" in str(p)}
-    coco_lines = {f"{p.parent.parent.parent.name}_{p.parent.parent.name}_{p.stem}": lines for p, lines in from_coco.items}
+    coco_lines = {
+        f"{p.parent.parent.parent.name}_{p.parent.parent.name}_{p.stem}": lines for p, lines in from_coco.items
+    }
     assert coco_lines == train and len(from_folder.items) == len(from_yaml.items) > len(train)
 
 

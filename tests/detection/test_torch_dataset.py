@@ -19,7 +19,7 @@ from davis_ag.errors import UserError
 @pytest.fixture(scope="module")
 def dataset(tmp_path_factory: pytest.TempPathFactory) -> Path:
     root = write_tiny_dataset(tmp_path_factory.mktemp("tiny"), "sp", "strawberry", scenes=2, size=(64, 48))
-    depth = (np.arange(64 * 48, dtype=np.uint16).reshape(48, 64) + 500)
+    depth = np.arange(64 * 48, dtype=np.uint16).reshape(48, 64) + 500
     Image.fromarray(depth).save(root / "Single-Strawberry" / "000" / "images" / "0003_depth.png")
     return root
 
@@ -42,9 +42,12 @@ def test_items_follow_the_detection_convention(dataset: Path) -> None:
             assert torch.equal(mask.bool(), torch.from_numpy(seg == box.fruit_id))
         fractions = scene.metadata.visible_in(view.name)
         assert [round(v, 4) for v in target["visible_fraction"].tolist()] == [
-            fractions[str(b.fruit_id)] for b in view.boxes]
+            fractions[str(b.fruit_id)] for b in view.boxes
+        ]
         if view.name == "0003.jpeg":
-            assert target["depth"].shape == (1, 48, 64) and math.isclose(target["depth"][0, 0, 1].item(), 0.501, rel_tol=1e-6)
+            assert target["depth"].shape == (1, 48, 64) and math.isclose(
+                target["depth"][0, 0, 1].item(), 0.501, rel_tol=1e-6
+            )
         else:
             assert target["depth"] is None
 
@@ -66,13 +69,19 @@ def test_a_torchvision_detector_learns_from_it(dataset: Path) -> None:
     data = DavisAgDetection(dataset, "train", with_masks=False, skip_empty=True)
     loader = torch.utils.data.DataLoader(data, batch_size=4, shuffle=False, collate_fn=collate)
     # torchvision's FCOS on a small backbone (stride 4, 32 channels): seconds on a CPU.
-    backbone = torch.nn.Sequential(torch.nn.Conv2d(3, 16, 3, 2, 1), torch.nn.ReLU(),
-                                   torch.nn.Conv2d(16, 32, 3, 2, 1), torch.nn.ReLU(),
-                                   torch.nn.Conv2d(32, 32, 3, 1, 1), torch.nn.ReLU())
+    backbone = torch.nn.Sequential(
+        torch.nn.Conv2d(3, 16, 3, 2, 1),
+        torch.nn.ReLU(),
+        torch.nn.Conv2d(16, 32, 3, 2, 1),
+        torch.nn.ReLU(),
+        torch.nn.Conv2d(32, 32, 3, 1, 1),
+        torch.nn.ReLU(),
+    )
     backbone.out_channels = 32
     anchors = AnchorGenerator(sizes=((8,),), aspect_ratios=((1.0,),))
-    model = FCOS(backbone, num_classes=4, min_size=48, max_size=64, anchor_generator=anchors,
-                 center_sampling_radius=2.0)
+    model = FCOS(
+        backbone, num_classes=4, min_size=48, max_size=64, anchor_generator=anchors, center_sampling_radius=2.0
+    )
     optimiser = torch.optim.AdamW(model.parameters(), lr=3e-3)
     images, targets = next(iter(loader))
     model.train()

@@ -17,12 +17,27 @@ import time
 from pathlib import Path
 from typing import Any
 
-FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-         "--disable-background-networking", "--disable-component-update", "--disable-sync",
-         "--hide-scrollbars", "--remote-debugging-pipe"]
+FLAGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--hide-scrollbars",
+    "--remote-debugging-pipe",
+]
 #: Key name -> (code, Windows virtual key code) for the keys the viewer uses.
-_KEYS = {"ArrowUp": ("ArrowUp", 38), "ArrowDown": ("ArrowDown", 40), "ArrowLeft": ("ArrowLeft", 37),
-         "ArrowRight": ("ArrowRight", 39), "PageUp": ("PageUp", 33), "PageDown": ("PageDown", 34)}
+_KEYS = {
+    "ArrowUp": ("ArrowUp", 38),
+    "ArrowDown": ("ArrowDown", 40),
+    "ArrowLeft": ("ArrowLeft", 37),
+    "ArrowRight": ("ArrowRight", 39),
+    "PageUp": ("PageUp", 33),
+    "PageDown": ("PageDown", 34),
+}
 
 
 def find_chromium() -> str | None:
@@ -64,7 +79,11 @@ class Chromium:
 
         self.process = subprocess.Popen(
             [executable, *FLAGS, f"--user-data-dir={profile}", f"--window-size={width},{height}"],
-            preexec_fn=wire, pass_fds=(3, 4), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            preexec_fn=wire,
+            pass_fds=(3, 4),
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
         os.close(to_child)
         os.close(from_child)
         self._next_id = 0
@@ -75,8 +94,11 @@ class Chromium:
             target = self.send("Target.createTarget", {"url": "about:blank"})["targetId"]
             self.session = self.send("Target.attachToTarget", {"targetId": target, "flatten": True})["sessionId"]
             self.send("Page.enable", session=True)
-            self.send("Emulation.setDeviceMetricsOverride",
-                      {"width": width, "height": height, "deviceScaleFactor": 1, "mobile": False}, session=True)
+            self.send(
+                "Emulation.setDeviceMetricsOverride",
+                {"width": width, "height": height, "deviceScaleFactor": 1, "mobile": False},
+                session=True,
+            )
         except BaseException:
             self.close()  # never leave a browser behind
             raise
@@ -93,8 +115,9 @@ class Chromium:
                         self._replies[message["id"]] = message
                         self._done.notify_all()
 
-    def send(self, method: str, params: dict[str, Any] | None = None, session: bool = False,
-             timeout: float = 30.0) -> dict[str, Any]:
+    def send(
+        self, method: str, params: dict[str, Any] | None = None, session: bool = False, timeout: float = 30.0
+    ) -> dict[str, Any]:
         """Send one command and wait for its reply.
 
         Raises:
@@ -120,8 +143,9 @@ class Chromium:
 
     def evaluate(self, expression: str) -> Any:
         """The value of a JavaScript expression in the page (promises awaited)."""
-        result = self.send("Runtime.evaluate", {"expression": expression, "returnByValue": True,
-                                                "awaitPromise": True}, session=True)
+        result = self.send(
+            "Runtime.evaluate", {"expression": expression, "returnByValue": True, "awaitPromise": True}, session=True
+        )
         if "exceptionDetails" in result:
             raise RuntimeError(f"{expression}: {result['exceptionDetails']}")
         return result["result"].get("value")
@@ -146,16 +170,24 @@ class Chromium:
             code, vk = _KEYS[key]
             down = {"type": "rawKeyDown", "key": key, "code": code, "windowsVirtualKeyCode": vk}
         else:
-            down = {"type": "keyDown", "key": key, "code": f"Key{key.upper()}", "text": key,
-                    "windowsVirtualKeyCode": ord(key.upper())}
+            down = {
+                "type": "keyDown",
+                "key": key,
+                "code": f"Key{key.upper()}",
+                "text": key,
+                "windowsVirtualKeyCode": ord(key.upper()),
+            }
         self.send("Input.dispatchKeyEvent", down, session=True)
         self.send("Input.dispatchKeyEvent", {**down, "type": "keyUp", "text": ""}, session=True)
 
     def click(self, x: float, y: float) -> None:
         """Click the left mouse button at page coordinates."""
         for kind in ("mousePressed", "mouseReleased"):
-            self.send("Input.dispatchMouseEvent", {"type": kind, "x": x, "y": y, "button": "left",
-                                                   "clickCount": 1}, session=True)
+            self.send(
+                "Input.dispatchMouseEvent",
+                {"type": kind, "x": x, "y": y, "button": "left", "clickCount": 1},
+                session=True,
+            )
 
     def screenshot(self, path: Path) -> Path:
         """Save the page as PNG."""
@@ -224,5 +256,11 @@ if __name__ == "__main__":  # python tests/figures/chromium_pipe.py DATASET OUT.
     import sys
 
     args = sys.argv[1:]
-    print(screenshot_viewer(Path(args[0]), Path(args[1]), args[2] if len(args) > 2 else None,
-                            args[3].split(",") if len(args) > 3 else None))
+    print(
+        screenshot_viewer(
+            Path(args[0]),
+            Path(args[1]),
+            args[2] if len(args) > 2 else None,
+            args[3].split(",") if len(args) > 3 else None,
+        )
+    )

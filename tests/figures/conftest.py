@@ -49,8 +49,8 @@ def real_results(real_root: Path) -> Path:
     from davis_ag.benchmark.evaluation import evaluate_policies, write_json
 
     env = TVMEnv(real_root, scenario="sp", split="all", max_start_oer=1.01)
-    results = evaluate_policies(env, build_agents(["LRD", "UDD", "Rand", "Oracle"]), episodes=12,
-                              sessions=2, seed=0, keep_episodes=True).as_json()
+    results = evaluate_policies(
+        env, build_agents(["LRD", "UDD", "Rand", "Oracle"]), episodes=12, sessions=2, seed=0, keep_episodes=True
+    ).as_json()
     env.close()
     return write_json(results, real_root.parent / "results.json")
-

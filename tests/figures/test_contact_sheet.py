@@ -43,13 +43,15 @@ def test_contact_sheet_rejects_bad_sizes(scene: Scene, tmp_path: Path) -> None:
     assert not (tmp_path / "x.png").exists()
 
 
-def test_failed_write_leaves_old_file_and_no_temp(scene: Scene, tmp_path: Path,
-                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+def test_failed_write_leaves_old_file_and_no_temp(
+    scene: Scene, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     out = tmp_path / "sheet.png"
     out.write_bytes(b"old")
 
     def broken(*args: object, **kwargs: object) -> None:
         raise RuntimeError("disk full")
+
     monkeypatch.setattr(Figure, "savefig", broken)
     with pytest.raises(RuntimeError):
         draw_contact_sheet(scene, out, n_views=2)

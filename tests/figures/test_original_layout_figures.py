@@ -31,11 +31,14 @@ def test_stats_without_scene_json(original: Path) -> None:
     stats = dataset_statistics(open_dataset(original))
     groups = stats["table3"]["groups"]
     assert {g: (v["scenes"], v["scenario"], v["crop"]) for g, v in groups.items()} == {
-        "Single-Strawberry": (2, "sp", "strawberry"), "Multi-Vine": (1, "mp", "vine")}
+        "Single-Strawberry": (2, "sp", "strawberry"),
+        "Multi-Vine": (1, "mp", "vine"),
+    }
     sp = stats["fruit"]["Single-Strawberry"]
     assert sp["fruit_per_plant"] is None and sp["visible_fraction"] is None
-    firsts = [json.loads((original / f"Single-Strawberry/{i:03d}/annotations.json").read_text())["0001"]
-              for i in range(2)]
+    firsts = [
+        json.loads((original / f"Single-Strawberry/{i:03d}/annotations.json").read_text())["0001"] for i in range(2)
+    ]
     assert sp["masks_missing"] == sum(len(f["bounding_boxes"]) for f in firsts)  # views without a mask
     text = format_statistics(stats)
     assert "Multi-Vine" in text and "79,200" in text  # the paper's MP vine images beside ours

@@ -40,17 +40,20 @@ def _plot(capsys: pytest.CaptureFixture[str], *args: str) -> dict[str, Any]:
     return json.loads(next(p for p in written if p.suffix == ".json").read_text())
 
 
-def test_visibility_counts_match_the_boxes(real_root: Path, tmp_path: Path,
-                                           capsys: pytest.CaptureFixture[str]) -> None:
+def test_visibility_counts_match_the_boxes(real_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     data = _plot(capsys, "visibility", str(real_root), "--out", str(tmp_path / "vis"))
     raw = _raw(real_root)
     expected: dict[tuple[float, float, float], set[int]] = {}
     for entry in raw.values():
         x, y, z = entry["pose"][:3]
         expected.setdefault((round(x, 3), round(y, 3), round(z, 3)), set()).update(
-            b[4] for b in entry["bounding_boxes"])
-    drawn = {(round(x, 3), round(y, 3), round(panel["z"], 3)): count
-             for panel in data["altitudes"] for x, y, count in zip(panel["x"], panel["y"], panel["count"])}
+            b[4] for b in entry["bounding_boxes"]
+        )
+    drawn = {
+        (round(x, 3), round(y, 3), round(panel["z"], 3)): count
+        for panel in data["altitudes"]
+        for x, y, count in zip(panel["x"], panel["y"], panel["count"])
+    }
     assert drawn == {k: len(v) for k, v in expected.items()}
     assert len(data["altitudes"]) == 3  # one panel per altitude
     edges = data["edges"]
@@ -58,8 +61,9 @@ def test_visibility_counts_match_the_boxes(real_root: Path, tmp_path: Path,
         assert panel["class"] == [int(np.searchsorted(edges, c, side="right")) for c in panel["count"]]
 
 
-def test_altitude_histograms_follow_the_up_pointers(real_root: Path, tmp_path: Path,
-                                                    capsys: pytest.CaptureFixture[str]) -> None:
+def test_altitude_histograms_follow_the_up_pointers(
+    real_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     data = _plot(capsys, "altitude", str(real_root), "--out", str(tmp_path / "alt"))
     raw = _raw(real_root)
     heights = sorted({round(e["pose"][2], 2) for e in raw.values()})
@@ -84,14 +88,15 @@ def test_altitude_histograms_follow_the_up_pointers(real_root: Path, tmp_path: P
     assert sum(histogram["counts"]) == len(columns)
 
 
-def test_oer_histogram_matches_masks_and_environment(real_root: Path, tmp_path: Path,
-                                                     capsys: pytest.CaptureFixture[str]) -> None:
+def test_oer_histogram_matches_masks_and_environment(
+    real_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     data = _plot(capsys, "oer", str(real_root), "--out", str(tmp_path / "oer"))
     values = []
     for name, entry in _raw(real_root).items():
         mask = np.asarray(Image.open(_scene_dir(real_root) / "images" / name.replace(".jpeg", "_seg.png")))
         for x, y, w, h, fruit, _ in entry["bounding_boxes"]:
-            values.append(np.count_nonzero(mask[y:y + h, x:x + w] == fruit) / (w * h))
+            values.append(np.count_nonzero(mask[y : y + h, x : x + w] == fruit) / (w * h))
     assert data["boxes"] == len(values) > 0
     assert data["counts"] == np.histogram(values, bins=data["edges"])[0].tolist()
     # The environment's cache computes the same OERs on its own path.
@@ -101,10 +106,10 @@ def test_oer_histogram_matches_masks_and_environment(real_root: Path, tmp_path: 
     assert sorted(cache.box_oer.tolist()) == pytest.approx(sorted(values), abs=1e-6)
 
 
-def test_actions_count_the_recorded_episodes(real_results: Path, tmp_path: Path,
-                                             capsys: pytest.CaptureFixture[str]) -> None:
-    data = _plot(capsys, "actions", "--results", str(real_results), "--policy", "Rand",
-                 "--out", str(tmp_path / "act"))
+def test_actions_count_the_recorded_episodes(
+    real_results: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    data = _plot(capsys, "actions", "--results", str(real_results), "--policy", "Rand", "--out", str(tmp_path / "act"))
     results = json.loads(real_results.read_text())
     names = results["protocol"]["actions"]
     assert data["actions"] == names == ["forward", "backward", "left", "right", "up", "down", "done"]
@@ -117,14 +122,25 @@ def test_actions_count_the_recorded_episodes(real_results: Path, tmp_path: Path,
     assert data["choices"] == [e["actions"] for e in results["policies"]["Rand"]["episodes"]]
 
 
-def test_episode_strip_replays_a_recorded_episode(real_root: Path, real_results: Path, tmp_path: Path,
-                                                  capsys: pytest.CaptureFixture[str]) -> None:
+def test_episode_strip_replays_a_recorded_episode(
+    real_root: Path, real_results: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     results = json.loads(real_results.read_text())
     episodes = results["policies"]["Oracle"]["episodes"]
     index = max(range(len(episodes)), key=lambda i: episodes[i]["reward"])
     record = episodes[index]
-    data = _plot(capsys, "episode", "--results", str(real_results), "--policy", "Oracle",
-                 "--episode", str(index), "--out", str(tmp_path / "ep"))
+    data = _plot(
+        capsys,
+        "episode",
+        "--results",
+        str(real_results),
+        "--policy",
+        "Oracle",
+        "--episode",
+        str(index),
+        "--out",
+        str(tmp_path / "ep"),
+    )
     raw = _raw(real_root)
     assert data["views"] == record["path"]
     assert data["poses"] == [raw[name]["pose"] for name in record["path"]]
@@ -132,14 +148,23 @@ def test_episode_strip_replays_a_recorded_episode(real_root: Path, real_results:
     assert data["oer"][-1] == pytest.approx(record["oer_tau"], abs=1e-6)
     # The same episode walked from its start and actions gives the same views.
     names = results["protocol"]["actions"]
-    walked = _plot(capsys, "episode", str(real_root), "--start", record["path"][0], "--actions",
-                   ",".join(names[a] for a in record["actions"]), "--target", str(record["target_fruit"]),
-                   "--out", str(tmp_path / "walked"))
+    walked = _plot(
+        capsys,
+        "episode",
+        str(real_root),
+        "--start",
+        record["path"][0],
+        "--actions",
+        ",".join(names[a] for a in record["actions"]),
+        "--target",
+        str(record["target_fruit"]),
+        "--out",
+        str(tmp_path / "walked"),
+    )
     assert walked["views"] == record["path"]
 
 
-def test_phenotypes_and_contact_sheet(real_root: Path, tmp_path: Path,
-                                      capsys: pytest.CaptureFixture[str]) -> None:
+def test_phenotypes_and_contact_sheet(real_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     data = _plot(capsys, "phenotypes", str(real_root), "--out", str(tmp_path / "ph"))
     assert (tmp_path / "ph_contact_sheet.png").read_bytes()[:8] == PNG
     plant = json.loads((_scene_dir(real_root) / "scene.json").read_text())["plants"][0]
@@ -173,32 +198,45 @@ def test_stats_table3_and_fruit(real_root: Path, tmp_path: Path, capsys: pytest.
 
     cache = load_scene_cache(open_dataset(real_root).scene("Single-Strawberry/000"), real_root)
     for max_oer in (1.01, 0.4):
-        starts = [(cache.view_names[cache.box_view[r]], int(cache.fruit_ids[cache.box_fruit[r]]))
-                  for r in range(len(cache.box_oer))
-                  if cache.box_oer[r] < max_oer and cache.box_pixels[r] >= meta["min_fruit_pixels"]]
+        starts = [
+            (cache.view_names[cache.box_view[r]], int(cache.fruit_ids[cache.box_fruit[r]]))
+            for r in range(len(cache.box_oer))
+            if cache.box_oer[r] < max_oer and cache.box_pixels[r] >= meta["min_fruit_pixels"]
+        ]
         no_view = sum(raw[view][move] == "" for view, _ in starts for move in SP_ACTIONS)
-        lost = sum(raw[view][move] != "" and fruit_id not in {b[4] for b in raw[raw[view][move]]["bounding_boxes"]}
-                   for view, fruit_id in starts for move in SP_ACTIONS)
+        lost = sum(
+            raw[view][move] != "" and fruit_id not in {b[4] for b in raw[raw[view][move]]["bounding_boxes"]}
+            for view, fruit_id in starts
+            for move in SP_ACTIONS
+        )
         counts = refused_moves(cache, SP_ACTIONS, meta["min_fruit_pixels"], max_oer)
-        assert (counts.starts, counts.moves, counts.no_view, counts.target_lost) == \
-            (len(starts), 6 * len(starts), no_view, lost)
+        assert (counts.starts, counts.moves, counts.no_view, counts.target_lost) == (
+            len(starts),
+            6 * len(starts),
+            no_view,
+            lost,
+        )
         assert max_oer < 1 or (len(starts) > 20 and no_view > 0 and lost > 0)
     refused = stats["refused_moves"]["Single-Strawberry"]
     assert (refused["starts"], refused["no_view"], refused["target_lost"]) == (len(starts), no_view, lost)
     assert "moves refused from starts" in printed
 
 
-@pytest.mark.parametrize("args, words", [
-    (["plot", "actions", "--out", "X"], "--results"),
-    (["plot", "visibility", "--out", "X"], "dataset folder"),
-    (["plot", "visibility", "ROOT", "--scene", "Single-Tomato/009", "--out", "X"], "no scene"),
-    (["plot", "episode", "ROOT", "--start", "0001", "--actions", "fly", "--out", "X"], "unknown action"),
-    (["plot", "oer", "ROOT", "--formats", "gif", "--out", "X"], "--formats"),
-    (["plot", "actions", "--results", "OLD", "--out", "X"], "rerun"),
-    (["stats", "NOWHERE"], "no such folder"),
-])
-def test_bad_input_is_one_line(real_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str],
-                               args: list[str], words: str) -> None:
+@pytest.mark.parametrize(
+    "args, words",
+    [
+        (["plot", "actions", "--out", "X"], "--results"),
+        (["plot", "visibility", "--out", "X"], "dataset folder"),
+        (["plot", "visibility", "ROOT", "--scene", "Single-Tomato/009", "--out", "X"], "no scene"),
+        (["plot", "episode", "ROOT", "--start", "0001", "--actions", "fly", "--out", "X"], "unknown action"),
+        (["plot", "oer", "ROOT", "--formats", "gif", "--out", "X"], "--formats"),
+        (["plot", "actions", "--results", "OLD", "--out", "X"], "rerun"),
+        (["stats", "NOWHERE"], "no such folder"),
+    ],
+)
+def test_bad_input_is_one_line(
+    real_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], args: list[str], words: str
+) -> None:
     old = tmp_path / "old.json"  # results written before per-episode records existed
     old.write_text(json.dumps({"protocol": {"scenario": "sp"}, "policies": {"LRD": {"oer_tau": {}}}}))
     swap = {"ROOT": str(real_root), "X": str(tmp_path / "x"), "OLD": str(old), "NOWHERE": str(tmp_path / "no")}

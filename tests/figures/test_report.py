@@ -37,14 +37,28 @@ def test_report_writes_pngs_and_links_resolve(tiny_root: Path, tmp_path: Path) -
     with timer.stage("generate"):
         pass
     out = tmp_path / "report"
-    index = write_report(tiny_root, out, results=results, validation="checked 3 scenes: sound",
-                         timer=timer, generated=[{"scene": "Single-Strawberry/000", "skipped": True}])
+    index = write_report(
+        tiny_root,
+        out,
+        results=results,
+        validation="checked 3 scenes: sound",
+        timer=timer,
+        generated=[{"scene": "Single-Strawberry/000", "skipped": True}],
+    )
     assert index == out / "index.html"
     text = index.read_text()
     links = re.findall(r"(?:src|href)='([^']+)'", text)
     images = [link for link in links if link.endswith(".png")]
-    assert {"contact_sheet.png", "mask.png", "figures/oer.png", "baselines.png", "visibility_000.png",
-            "figures/actions.png", "figures/episode.png", "figures/altitude.png"} <= set(images)
+    assert {
+        "contact_sheet.png",
+        "mask.png",
+        "figures/oer.png",
+        "baselines.png",
+        "visibility_000.png",
+        "figures/actions.png",
+        "figures/episode.png",
+        "figures/altitude.png",
+    } <= set(images)
     for link in images:
         assert not link.startswith("/"), "links must be relative"
         assert _is_png(out / link), link
@@ -60,7 +74,8 @@ def test_visibility_one_panel_per_altitude(tiny_root: Path, tmp_path: Path) -> N
         assert [panel["z"] for panel in plotted.data["altitudes"]] == heights
         # Every view lies at exactly one position of its altitude's panel.
         assert sum(len(panel["x"]) for panel in plotted.data["altitudes"]) == len(
-            {tuple(round(c * 1000) for c in v.pose[:3]) for v in scene.views.values()})
+            {tuple(round(c * 1000) for c in v.pose[:3]) for v in scene.views.values()}
+        )
 
 
 def test_oer_without_masks_is_one_line(tiny_root: Path, tmp_path: Path) -> None:
@@ -105,11 +120,24 @@ def test_results_markdown_puts_ours_beside_the_paper(tmp_path: Path) -> None:
     from davis_ag.commands.reproduce import CONFIGS, write_results_md
 
     stat = {"mean": 0.5, "std": 0.01}
-    state = {"results": {"sp": {"protocol": {"split": "test", "tau": 3, "sessions": 3, "episodes": 200,
-                                             "scenes": ["Single-Strawberry/002"]},
-                                "policies": {name: {"oer_tau": stat, "reward": stat, "length": stat}
-                                             for name in ("LRD", "UDD", "Rand", "Oracle", "A2C")}}},
-             "stages": {"sp-strawberry: generate": {"seconds": 12.0, "note": "1 scene"}}}
+    state = {
+        "results": {
+            "sp": {
+                "protocol": {
+                    "split": "test",
+                    "tau": 3,
+                    "sessions": 3,
+                    "episodes": 200,
+                    "scenes": ["Single-Strawberry/002"],
+                },
+                "policies": {
+                    name: {"oer_tau": stat, "reward": stat, "length": stat}
+                    for name in ("LRD", "UDD", "Rand", "Oracle", "A2C")
+                },
+            }
+        },
+        "stages": {"sp-strawberry: generate": {"seconds": 12.0, "note": "1 scene"}},
+    }
     text = write_results_md(tmp_path / "results.md", CONFIGS["small"], state, tmp_path).read_text()
     assert "| A2C | .500 ± .010 | .520 ± .004 |" in text
     assert "## MP vine" in text and "Not run" in text

@@ -19,11 +19,14 @@ def test_rolling_mean_weights_points_by_their_episodes() -> None:
 
 def test_learning_curve_png_and_numbers(tmp_path: Path) -> None:
     curve = [{"step": 1000 * (k + 1), "episodes": 300, "reward": 0.01 + 0.001 * k, "length": 2.9} for k in range(30)]
-    plotted = plot_learning_curve({"sp-strawberry": {"curve": curve}, "mp-vine": {}}, tmp_path / "curve",
-                                  formats=("png",), window=5)
+    plotted = plot_learning_curve(
+        {"sp-strawberry": {"curve": curve}, "mp-vine": {}}, tmp_path / "curve", formats=("png",), window=5
+    )
     assert plotted.paths == [tmp_path / "curve.png"] and plotted.paths[0].read_bytes()[:4] == b"\x89PNG"
     data = plotted.data["sp-strawberry"]
-    assert data["steps"][-1] == 30_000 and data["smoothed"][-1] == pytest.approx(np.mean([0.01 + 0.001 * k for k in range(25, 30)]))
+    assert data["steps"][-1] == 30_000 and data["smoothed"][-1] == pytest.approx(
+        np.mean([0.01 + 0.001 * k for k in range(25, 30)])
+    )
     assert "mp-vine" not in plotted.data  # a record without a curve draws nothing
     with pytest.raises(UserError, match="no training record holds a learning curve"):
         plot_learning_curve({"sp-strawberry": {}}, tmp_path / "none", formats=("png",))
@@ -33,8 +36,9 @@ def test_a_record_that_kept_its_best_snapshot_draws_the_scores(tmp_path: Path) -
     curve = [{"step": 1000 * (k + 1), "episodes": 300, "reward": 0.02, "length": 3.0} for k in range(30)]
     scores = [{"step": 10_000, "oer_tau": 0.50}, {"step": 20_000, "oer_tau": 0.58}, {"step": 30_000, "oer_tau": 0.44}]
     selection = {"scores": scores, "kept_step": 20_000}
-    plotted = plot_learning_curve({"sp-strawberry": {"curve": curve, "selection": selection}},
-                                  tmp_path / "curve", formats=("png",))
+    plotted = plot_learning_curve(
+        {"sp-strawberry": {"curve": curve, "selection": selection}}, tmp_path / "curve", formats=("png",)
+    )
     data = plotted.data["sp-strawberry"]
     assert data["scored_steps"] == [10_000, 20_000, 30_000] and data["scored_oer_tau"] == [0.50, 0.58, 0.44]
     assert data["kept_step"] == 20_000

@@ -77,8 +77,8 @@ def test_organ_classes_are_a_layer_where_the_scene_has_them(served: tuple[Path, 
     images = root / "Single-Strawberry/000/images"
     width, height = Image.open(images / "0001.jpeg").size
     classes = np.zeros((height, width), np.uint8)
-    classes[height // 2:] = 1  # soil below the horizon, a fruit in the middle
-    classes[height // 2 - 2: height // 2 + 2, width // 2 - 2: width // 2 + 2] = 2
+    classes[height // 2 :] = 1  # soil below the horizon, a fruit in the middle
+    classes[height // 2 - 2 : height // 2 + 2, width // 2 - 2 : width // 2 + 2] = 2
     Image.fromarray(classes, mode="L").save(images / "0001_class.png")
     server = _serve(root)  # a new server: scene payloads are built once
     try:
@@ -135,8 +135,9 @@ def test_view_command_refuses_a_bad_port(served: tuple[Path, int], capsys: pytes
     assert "cannot listen" in err and "\n" not in err
 
 
-def test_view_command_refuses_an_unknown_scene_at_start(served: tuple[Path, int],
-                                                        capsys: pytest.CaptureFixture[str]) -> None:
+def test_view_command_refuses_an_unknown_scene_at_start(
+    served: tuple[Path, int], capsys: pytest.CaptureFixture[str]
+) -> None:
     """Issue 33 case 9: ``view --scene nope/123`` was accepted, and the page found nothing."""
     root, _ = served
     assert cli.main(["view", str(root), "--port", "0", "--scene", "nope/123"]) == 2
@@ -161,14 +162,17 @@ def _state(browser: Chromium) -> dict[str, Any]:
         "(() => { const p = document.getElementById('photo');"
         " return p.complete && p.naturalWidth > 0 && JSON.stringify({view: viewer.view,"
         " pose: document.getElementById('pose').textContent, src: p.src, width: p.naturalWidth,"
-        " message: document.getElementById('message').textContent}); })()")
+        " message: document.getElementById('message').textContent}); })()"
+    )
 
 
 def test_page_in_headless_chromium(real_root: Path, tmp_path: Path) -> None:
     executable = find_chromium()
     if executable is None:
-        pytest.skip("no chromium: install Debian's `chromium` package (the test installs it itself "
-                    "when run as root with apt-get)")
+        pytest.skip(
+            "no chromium: install Debian's `chromium` package (the test installs it itself "
+            "when run as root with apt-get)"
+        )
     raw = json.loads((real_root / "Single-Strawberry/000/annotations.json").read_text())
     start = next(n for n, e in raw.items() if e["right"] and e["up"] and raw[e["right"]]["up"])
     plain, deep = _serve(real_root), _serve(_with_depth(real_root, tmp_path))
@@ -205,13 +209,16 @@ def test_page_in_headless_chromium(real_root: Path, tmp_path: Path) -> None:
         assert browser.evaluate("viewer.view") == up
         # Masks on: the overlay shows and is a loaded image.
         browser.press("m")
-        browser.wait_for("!document.getElementById('mask').classList.contains('hidden') &&"
-                         " document.getElementById('mask').naturalWidth === 128")
+        browser.wait_for(
+            "!document.getElementById('mask').classList.contains('hidden') &&"
+            " document.getElementById('mask').naturalWidth === 128"
+        )
         # A click on the map jumps to that position (same altitude).
         target = browser.evaluate(
             "(() => { const c = [...document.querySelectorAll('#map .spot')]"
             ".find(e => e.getAttribute('data-view') !== viewer.view); const r = c.getBoundingClientRect();"
-            " return [c.getAttribute('data-view'), r.x + r.width / 2, r.y + r.height / 2]; })()")
+            " return [c.getAttribute('data-view'), r.x + r.width / 2, r.y + r.height / 2]; })()"
+        )
         browser.click(target[1], target[2])
         browser.wait_for(f"viewer.view === {json.dumps(target[0])}")
         assert raw[target[0]]["pose"][2] == pytest.approx(raw[up]["pose"][2])
@@ -224,8 +231,10 @@ def test_page_in_headless_chromium(real_root: Path, tmp_path: Path) -> None:
         browser.wait_for(f"location.port === '{deep.server_address[1]}' && window.viewer && viewer.ready")
         assert not browser.evaluate("document.getElementById('depth-toggle').classList.contains('hidden')")
         browser.press("z")
-        browser.wait_for("!document.getElementById('depth').classList.contains('hidden') &&"
-                         " document.getElementById('depth').naturalWidth === 128")
+        browser.wait_for(
+            "!document.getElementById('depth').classList.contains('hidden') &&"
+            " document.getElementById('depth').naturalWidth === 128"
+        )
     finally:
         browser.close()
         for server in (plain, deep):

@@ -34,9 +34,15 @@ def test_one_image_size_rule() -> None:
 
 
 def test_dataset_json_keeps_later_keys_and_defaults_old_ones() -> None:
-    old = {"seed": 3, "image_size": [640, 360], "vfov_deg": 45.0,
-           "groups": {"Single-Tomato": {"grid": {"extent": [3, 3], "step": 0.25, "altitude_levels": [0, 1, 2],
-                                                 "headings": 1}}}, "future": 1}
+    old = {
+        "seed": 3,
+        "image_size": [640, 360],
+        "vfov_deg": 45.0,
+        "groups": {
+            "Single-Tomato": {"grid": {"extent": [3, 3], "step": 0.25, "altitude_levels": [0, 1, 2], "headings": 1}}
+        },
+        "future": 1,
+    }
     read = DatasetFile.model_validate(old).to_json()
     assert (read["renderer"], read["look"], read["plants"], read["future"]) == ("helios", "helios", "architecture", 1)
     with pytest.raises(ValidationError) as caught:
@@ -53,12 +59,19 @@ def test_splits_json() -> None:
 
 
 def test_annotation_entries_as_we_write_them() -> None:
-    entry = {"bounding_boxes": [[1, 2, 3, 4, 5, 0]], "pose": [0, 0, 0.25, 90, -10],
-             "forward": "0002.jpeg", "backward": ""}
+    entry = {
+        "bounding_boxes": [[1, 2, 3, 4, 5, 0]],
+        "pose": [0, 0, 0.25, 90, -10],
+        "forward": "0002.jpeg",
+        "backward": "",
+    }
     assert AnnotationEntry.model_validate(entry).to_json() == {**entry, "pose": [0.0, 0.0, 0.25, 90.0, -10.0]}
-    for change, path in (({"bounding_boxes": [[1, 2, 0, 4, 5, 0]]}, "bounding_boxes.0.2"),
-                         ({"bounding_boxes": [[1, 2, 3, 4, 255, 0]]}, "bounding_boxes.0.4"),
-                         ({"left": "2.jpeg"}, "left"), ({"jump": ""}, "jump")):
+    for change, path in (
+        ({"bounding_boxes": [[1, 2, 0, 4, 5, 0]]}, "bounding_boxes.0.2"),
+        ({"bounding_boxes": [[1, 2, 3, 4, 255, 0]]}, "bounding_boxes.0.4"),
+        ({"left": "2.jpeg"}, "left"),
+        ({"jump": ""}, "jump"),
+    ):
         with pytest.raises(ValidationError) as caught:
             AnnotationEntry.model_validate({**entry, **change})
         assert one_line(caught.value).startswith(f"{path}: "), one_line(caught.value)
@@ -67,10 +80,13 @@ def test_annotation_entries_as_we_write_them() -> None:
 def test_a_bad_config_is_one_line_naming_the_key_and_what_is_allowed() -> None:
     from davis_ag.formats.models import DatasetConfigFile
 
-    for data, line in (({"groups": [{"scenario": "sp", "crop": "tomato", "scenes": 1, "sceens": 2}]},
-                        "groups.0.sceens: unknown key"),
-                       ({"plants": "bonsai", "groups": [{"scenario": "sp", "crop": "tomato", "scenes": 1}]},
-                        "plants: must be 'canopy' or 'architecture', not 'bonsai'")):
+    for data, line in (
+        ({"groups": [{"scenario": "sp", "crop": "tomato", "scenes": 1, "sceens": 2}]}, "groups.0.sceens: unknown key"),
+        (
+            {"plants": "bonsai", "groups": [{"scenario": "sp", "crop": "tomato", "scenes": 1}]},
+            "plants: must be 'canopy' or 'architecture', not 'bonsai'",
+        ),
+    ):
         with pytest.raises(ValidationError) as caught:
             DatasetConfigFile.model_validate(data)
         assert one_line(caught.value, "c.yaml") == f"c.yaml: {line}"

@@ -60,16 +60,36 @@ def test_the_dataset_and_its_scenes_are_recognised(data: Path, tmp_path: Path) -
     assert dataset_holding(tmp_path / "results" / "r.json") is None
 
 
-@pytest.mark.parametrize("where", [("Single-Strawberry/000/annotations.json", "--out"), ("splits.json", "--out"),
-                                   ("Single-Strawberry/000/images/0001_seg.png", "--plot")])
-def test_evaluate_never_writes_into_a_dataset(where: tuple[str, str], data: Path, tmp_path: Path,
-                                              capsys: pytest.CaptureFixture[str]) -> None:
+@pytest.mark.parametrize(
+    "where",
+    [
+        ("Single-Strawberry/000/annotations.json", "--out"),
+        ("splits.json", "--out"),
+        ("Single-Strawberry/000/images/0001_seg.png", "--plot"),
+    ],
+)
+def test_evaluate_never_writes_into_a_dataset(
+    where: tuple[str, str], data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """Case 1: evaluate --out DATA/.../annotations.json replaced a scene's labels with results."""
     before = digest(data)
     path, flag = where
     target = str(data / path)
-    argv = ["evaluate", "--dataset", str(data), "--scenario", "sp", "--episodes", "2", "--sessions", "1",
-            "--policies", "LRD", "--out", target if flag == "--out" else str(tmp_path / "r.json")]
+    argv = [
+        "evaluate",
+        "--dataset",
+        str(data),
+        "--scenario",
+        "sp",
+        "--episodes",
+        "2",
+        "--sessions",
+        "1",
+        "--policies",
+        "LRD",
+        "--out",
+        target if flag == "--out" else str(tmp_path / "r.json"),
+    ]
     if flag == "--plot":
         argv += ["--plot", target]
     line = one_line(capsys, *argv)
@@ -77,12 +97,26 @@ def test_evaluate_never_writes_into_a_dataset(where: tuple[str, str], data: Path
     assert digest(data) == before
 
 
-def test_an_existing_result_is_replaced_only_with_force(data: Path, tmp_path: Path,
-                                                        capsys: pytest.CaptureFixture[str]) -> None:
+def test_an_existing_result_is_replaced_only_with_force(
+    data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """Case 5: a second evaluate to an existing --out replaced the earlier results without a word."""
     out = tmp_path / "r.json"
-    argv = ["evaluate", "--dataset", str(data), "--scenario", "sp", "--episodes", "2", "--sessions", "1",
-            "--policies", "LRD", "--out", str(out)]
+    argv = [
+        "evaluate",
+        "--dataset",
+        str(data),
+        "--scenario",
+        "sp",
+        "--episodes",
+        "2",
+        "--sessions",
+        "1",
+        "--policies",
+        "LRD",
+        "--out",
+        str(out),
+    ]
     assert run(capsys, *argv)[0] == 0
     first = out.read_bytes()
     (tmp_path / ".r.png.tmp").write_bytes(b"")  # case 7: what a killed run leaves
@@ -93,21 +127,45 @@ def test_an_existing_result_is_replaced_only_with_force(data: Path, tmp_path: Pa
     assert not list(tmp_path.glob(".*"))  # no lock, no temporary left behind
 
 
-def test_a_second_run_on_one_output_is_refused(tmp_path: Path, data: Path,
-                                               capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_second_run_on_one_output_is_refused(tmp_path: Path, data: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """Case 5: two train or export runs on one output raced on one temporary file."""
     model, export = tmp_path / "m.zip", tmp_path / "coco"
     export.mkdir()
-    holder = subprocess.Popen([sys.executable, "-c", (
-        "import sys, time\n"
-        "from pathlib import Path\n"
-        "from davis_ag.formats.outputs import claim_output\n"
-        f"with claim_output(Path({str(model)!r})), claim_output(Path({str(export)!r}), folder=True):\n"
-        "    print('claimed', flush=True); time.sleep(60)\n")], stdout=subprocess.PIPE, text=True)
+    holder = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            (
+                "import sys, time\n"
+                "from pathlib import Path\n"
+                "from davis_ag.formats.outputs import claim_output\n"
+                f"with claim_output(Path({str(model)!r})), claim_output(Path({str(export)!r}), folder=True):\n"
+                "    print('claimed', flush=True); time.sleep(60)\n"
+            ),
+        ],
+        stdout=subprocess.PIPE,
+        text=True,
+    )
     try:
         assert holder.stdout.readline().strip() == "claimed"
-        line = one_line(capsys, "train", "--dataset", str(data), "--scenario", "sp", "--timesteps", "8",
-                        "--n-envs", "2", "--arch", "pooled", "--device", "cpu", "--out", str(model))
+        line = one_line(
+            capsys,
+            "train",
+            "--dataset",
+            str(data),
+            "--scenario",
+            "sp",
+            "--timesteps",
+            "8",
+            "--n-envs",
+            "2",
+            "--arch",
+            "pooled",
+            "--device",
+            "cpu",
+            "--out",
+            str(model),
+        )
         assert f"{model} is being written by another davis-ag run (PID {holder.pid})" in line
         line = one_line(capsys, "export", "coco", str(data), str(export))
         assert f"{export} is being written by another davis-ag run (PID {holder.pid})" in line

@@ -16,14 +16,43 @@ from davis_ag.formats.scene_file import SCENE_FORMAT, SceneFile, read_scene_file
 OLDER = {
     "format": SCENE_FORMAT,
     "generator": {"name": "davis-ag", "version": "0.1.0+abc", "pyhelios3d": "1.3.40", "python": "3.11.9"},
-    "seed": 1234, "dataset_seed": 0, "scenario": "sp", "crop": "strawberry", "scene": "Single-Strawberry/007",
-    "camera": {"model": "pinhole", "width": 1280, "height": 720, "fx": 869.1, "fy": 869.1, "cx": 640.0,
-               "cy": 360.0, "vfov_deg": 45, "hfov_deg": 72.6, "distortion": [0.0, 0.0, 0.0, 0.0, 0.0]},
+    "seed": 1234,
+    "dataset_seed": 0,
+    "scenario": "sp",
+    "crop": "strawberry",
+    "scene": "Single-Strawberry/007",
+    "camera": {
+        "model": "pinhole",
+        "width": 1280,
+        "height": 720,
+        "fx": 869.1,
+        "fy": 869.1,
+        "cx": 640.0,
+        "cy": 360.0,
+        "vfov_deg": 45,
+        "hfov_deg": 72.6,
+        "distortion": [0.0, 0.0, 0.0, 0.0, 0.0],
+    },
     "renderer": {"name": "helios", "look": "helios", "antialiasing": "4x multisampled colour"},
-    "grid": {"extent_m": [1, 1.5], "step_m": 0.1, "altitudes_m": [0.25, 0.4], "headings": 1,
-             "exclusion_radius_m": 0.2, "aim_height_m": 0.12, "views": 300},
-    "plants": [{"index": 0, "seed": 9, "position": [0.0, 0.0, 0.0], "phenotype_measured": {"plant_height": 0.2},
-                "fruit_count": 2, "builds": 1}],
+    "grid": {
+        "extent_m": [1, 1.5],
+        "step_m": 0.1,
+        "altitudes_m": [0.25, 0.4],
+        "headings": 1,
+        "exclusion_radius_m": 0.2,
+        "aim_height_m": 0.12,
+        "views": 300,
+    },
+    "plants": [
+        {
+            "index": 0,
+            "seed": 9,
+            "position": [0.0, 0.0, 0.0],
+            "phenotype_measured": {"plant_height": 0.2},
+            "fruit_count": 2,
+            "builds": 1,
+        }
+    ],
     "fruits": [{"id": 0, "plant": 0, "center": [0.01, 0.02, 0.1], "size": [0.03, 0.03, 0.04]}],
     "views": {"0001.jpeg": {"grid": [0, 0, 0, 0], "nominal": [0.0, -0.5, 0.25, 90, -20]}},
     "visible_fraction": {"0001.jpeg": {"0": 0.75, "1": 1}},
@@ -49,12 +78,15 @@ def test_the_original_download_and_test_layouts_record_less_and_still_read() -> 
     assert scene.index is None and scene.image_size() == (64, 48)
 
 
-@pytest.mark.parametrize(("change", "named"), [
-    ({"seed": "twelve"}, "seed"),
-    ({"camera": {"width": 1280.5}}, "camera.width"),
-    ({"fruits": [{"id": 0, "center": "middle"}]}, "fruits.0.center"),
-    ({"visible_fraction": {"0001.jpeg": [0.5]}}, "visible_fraction.0001.jpeg"),
-])
+@pytest.mark.parametrize(
+    ("change", "named"),
+    [
+        ({"seed": "twelve"}, "seed"),
+        ({"camera": {"width": 1280.5}}, "camera.width"),
+        ({"fruits": [{"id": 0, "center": "middle"}]}, "fruits.0.center"),
+        ({"visible_fraction": {"0001.jpeg": [0.5]}}, "visible_fraction.0001.jpeg"),
+    ],
+)
 def test_a_damaged_field_is_one_line_naming_it(tmp_path: Path, change: dict, named: str) -> None:
     path = tmp_path / "scene.json"
     path.write_text(json.dumps({**OLDER, **change}))

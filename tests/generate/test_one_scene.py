@@ -51,7 +51,8 @@ def test_generated_scene_is_a_sound_dataset(generated: tuple[Path, Path, dict]) 
     assert sorted(p.name for p in scene_dir.iterdir()) == ["annotations.json", "images", "scene.json"]
     names = [f"{i:04d}.jpeg" for i in range(1, VIEWS + 1)]
     assert sorted(p.name for p in (scene_dir / "images").iterdir()) == sorted(
-        names + [n.replace(".jpeg", suffix) for n in names for suffix in ("_seg.png", "_depth.png", "_class.png")])
+        names + [n.replace(".jpeg", suffix) for n in names for suffix in ("_seg.png", "_depth.png", "_class.png")]
+    )
 
     report = validate_dataset(root)
     assert report.ok, [str(p) for p in report.problems]
@@ -146,8 +147,7 @@ def same_scene(first: Path, second: Path) -> None:
         assert image.read_bytes() == (second / "images" / image.name).read_bytes(), image.name
 
 
-def test_a_scene_stopped_mid_way_resumes_to_the_same_scene(generated: tuple[Path, Path, dict],
-                                                           tmp_path: Path) -> None:
+def test_a_scene_stopped_mid_way_resumes_to_the_same_scene(generated: tuple[Path, Path, dict], tmp_path: Path) -> None:
     def stop_after_9(done: int, total: int) -> None:
         if done == 9:
             raise KeyboardInterrupt  # Ctrl-C; a kill -9 leaves the same folder without a word
@@ -164,8 +164,9 @@ def test_a_scene_stopped_mid_way_resumes_to_the_same_scene(generated: tuple[Path
     same_scene(generated[1], scene_dir)
 
 
-def test_a_view_cut_short_and_those_after_it_are_drawn_again(generated: tuple[Path, Path, dict],
-                                                           tmp_path: Path) -> None:
+def test_a_view_cut_short_and_those_after_it_are_drawn_again(
+    generated: tuple[Path, Path, dict], tmp_path: Path
+) -> None:
     def stop_after_9(done: int, total: int) -> None:
         if done == 9:
             raise KeyboardInterrupt
@@ -183,8 +184,9 @@ def test_a_partial_scene_of_another_request_is_cleared(generated: tuple[Path, Pa
     partial = tmp_path / "Single-Strawberry" / ".000.partial"
     (partial / "images").mkdir(parents=True)
     (partial / "resume.json").write_text(json.dumps({"request": "another one"}))
-    (partial / "views.jsonl").write_text(json.dumps({"name": "0001.jpeg", "entry": {}, "extras": {},
-                                                     "files": ["0001.jpeg"]}) + "\n")
+    (partial / "views.jsonl").write_text(
+        json.dumps({"name": "0001.jpeg", "entry": {}, "extras": {}, "files": ["0001.jpeg"]}) + "\n"
+    )
     (partial / "images" / "0001.jpeg").write_bytes(b"not this scene's view")
     scene_dir, _ = generate_scene(REQUEST, tmp_path)
     assert json.loads((scene_dir / "scene.json").read_text())["timing_s"]["views_from_an_earlier_run"] == 0
@@ -226,11 +228,19 @@ def test_unknown_crop_and_scenario_are_refused(capsys: pytest.CaptureFixture[str
     assert not (tmp_path / "ds").exists()
 
 
-@pytest.mark.parametrize("args", [
-    ["--scenes", "0"], ["--scenes", "-3"], ["--scenes", "two"],
-    ["--size", "garbage"], ["--size", "1280x"], ["--size", "8x8"],
-    ["--seed", "-1"], ["--first", "999", "--scenes", "2"],
-])
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["--scenes", "0"],
+        ["--scenes", "-3"],
+        ["--scenes", "two"],
+        ["--size", "garbage"],
+        ["--size", "1280x"],
+        ["--size", "8x8"],
+        ["--seed", "-1"],
+        ["--first", "999", "--scenes", "2"],
+    ],
+)
 def test_bad_numbers_are_refused(args: list[str], capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
     line = refused(capsys, *args, "--out", str(tmp_path / "ds"))
     assert line.startswith("davis-ag generate: ")
@@ -255,7 +265,9 @@ def test_an_out_holding_other_things_is_left_alone(capsys: pytest.CaptureFixture
 
 
 def test_a_scene_made_with_another_seed_is_not_overwritten(
-    generated: tuple[Path, Path, dict], capsys: pytest.CaptureFixture[str], tmp_path: Path,
+    generated: tuple[Path, Path, dict],
+    capsys: pytest.CaptureFixture[str],
+    tmp_path: Path,
 ) -> None:
     _, scene_dir, _ = generated
     root = tmp_path / "ds"
@@ -286,8 +298,7 @@ def test_generate_command_refuses_mock_helios_before_any_scene(
 ) -> None:
     import pyhelios.plugins
 
-    monkeypatch.setattr(pyhelios.plugins, "get_library_info",
-                        lambda: {"is_mock": True, "library_path": None})
+    monkeypatch.setattr(pyhelios.plugins, "get_library_info", lambda: {"is_mock": True, "library_path": None})
     out = tmp_path / "data"
     code = cli.main(["generate", "--scenes", "1", "--out", str(out), "--workers", "1"])
     err = capsys.readouterr().err.strip().splitlines()
@@ -309,8 +320,13 @@ def test_depth_images_are_written_read_and_checked(generated: tuple[Path, Path, 
         assert raw.dtype == np.uint16 and depth.dtype == np.float32 and depth.shape == (CAMERA.height, CAMERA.width)
         assert (depth[0] == 0).all() and depth.max() > 0  # sky on the top row, ground below
         x, y, z, yaw, pitch = view.pose
-        forward = np.array([np.cos(np.radians(pitch)) * np.cos(np.radians(yaw)),
-                            np.cos(np.radians(pitch)) * np.sin(np.radians(yaw)), np.sin(np.radians(pitch))])
+        forward = np.array(
+            [
+                np.cos(np.radians(pitch)) * np.cos(np.radians(yaw)),
+                np.cos(np.radians(pitch)) * np.sin(np.radians(yaw)),
+                np.sin(np.radians(pitch)),
+            ]
+        )
         for box in view.boxes:
             seen = np.median(depth[mask == box.fruit_id])
             assert abs(seen - (fruits[box.fruit_id] - (x, y, z)) @ forward) < 0.05
@@ -345,8 +361,10 @@ def test_depth_and_renderer_settings_flow_from_flags_and_configs() -> None:
     config = single_group_config("sp", "strawberry", 1, 0, 0, (96, 54), "helios", None, depth=False)
     (request,) = config.requests()
     assert (request.renderer, request.look, request.depth) == ("helios", "helios", False)
-    text = ("renderer: opengl\nlook: helios\ndepth: false\nantialiasing: 1\n"
-            "groups: [{scenario: sp, crop: tomato, scenes: 1}]\n")
+    text = (
+        "renderer: opengl\nlook: helios\ndepth: false\nantialiasing: 1\n"
+        "groups: [{scenario: sp, crop: tomato, scenes: 1}]\n"
+    )
     (request,) = parse_dataset_config(text, "test").requests()
     assert (request.renderer, request.look, request.depth, request.antialiasing) == ("opengl", "helios", False, "none")
     with pytest.raises(UserError, match="antialiasing"):
@@ -357,8 +375,7 @@ def test_depth_and_renderer_settings_flow_from_flags_and_configs() -> None:
         single_group_config("sp", "strawberry", 1, 0, 0, (96, 54), "helios", "default")
 
 
-def test_organ_classes_come_from_the_same_pass_as_the_masks(generated: tuple[Path, Path, dict],
-                                                            tmp_path: Path) -> None:
+def test_organ_classes_come_from_the_same_pass_as_the_masks(generated: tuple[Path, Path, dict], tmp_path: Path) -> None:
     from davis_ag.scene.organs import FRUIT, LEAF, ORGAN_NAMES, SKY, SOIL, STEM
 
     root, scene_dir, _ = generated
@@ -417,14 +434,16 @@ def test_each_fruits_points_lie_around_its_centre(generated: tuple[Path, Path, d
     assert len(list((out / "Single-Strawberry" / "000").glob("*.ply"))) == VIEWS
 
 
-def test_random_appearance_changes_the_pictures_not_the_labels(generated: tuple[Path, Path, dict],
-                                                              tmp_path: Path) -> None:
+def test_random_appearance_changes_the_pictures_not_the_labels(
+    generated: tuple[Path, Path, dict], tmp_path: Path
+) -> None:
     _, paper_dir, _ = generated
     random_dir, _ = generate_scene(replace(REQUEST, appearance="random"), tmp_path)
     meta = json.loads((random_dir / "scene.json").read_text())
     assert meta["appearance"]["mode"] == "random" and meta["lighting"]["sky_texture"] == meta["appearance"]["sky"]
-    assert (json.loads((random_dir / "annotations.json").read_text())
-            == json.loads((paper_dir / "annotations.json").read_text()))
+    assert json.loads((random_dir / "annotations.json").read_text()) == json.loads(
+        (paper_dir / "annotations.json").read_text()
+    )
     differ = 0
     for path in sorted((paper_dir / "images").iterdir()):
         ours = np.asarray(Image.open(random_dir / "images" / path.name)).astype(int)

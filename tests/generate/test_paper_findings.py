@@ -63,8 +63,12 @@ def scene(tmp_path_factory: pytest.TempPathFactory) -> dict:
     seen = {tuple(meta["views"][v.name]["grid"][:3]): {b.fruit_id for b in v.boxes} for v in opened}
     cache = load_scene_cache(opened, Path(root))
     published = cache.box_pixels >= STRAWBERRY.min_fruit_pixels
-    return {"seen": seen, "fruit": len(meta["fruits"]), "plants": meta["plants"],
-            "oer": np.asarray(cache.box_oer[published], dtype=float)}
+    return {
+        "seen": seen,
+        "fruit": len(meta["fruits"]),
+        "plants": meta["plants"],
+        "oer": np.asarray(cache.box_oer[published], dtype=float),
+    }
 
 
 def test_the_plant_carries_as_many_fruit_as_the_papers(scene: dict) -> None:
@@ -105,9 +109,12 @@ def test_oer_is_right_skewed(scene: dict) -> None:
     assert np.mean(centred**3) / np.mean(centred**2) ** 1.5 < -0.1
 
 
-@pytest.mark.xfail(strict=True, reason="a known gap: the Canopy Generator strawberry as we rebuild it puts 0.4 % "
-                   "of this scene's published boxes below OER 0.4 (paper: 4 %); the share over 10 scenes is in "
-                   "docs/scenes.md. Strict: when the plants meet the paper, this test says so.")
+@pytest.mark.xfail(
+    strict=True,
+    reason="a known gap: the Canopy Generator strawberry as we rebuild it puts 0.4 % "
+    "of this scene's published boxes below OER 0.4 (paper: 4 %); the share over 10 scenes is in "
+    "docs/scenes.md. Strict: when the plants meet the paper, this test says so.",
+)
 def test_few_boxes_below_0_4_as_in_the_paper(scene: dict) -> None:
     # Section V-C: 4 % below 0.4. One scene varies more than several (davis-ag scene-stats
     # measures those, 2-8 % asked): 1-8 % here.

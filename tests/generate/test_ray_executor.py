@@ -72,8 +72,9 @@ def test_a_worker_killed_mid_scene_on_a_two_node_cluster(tmp_path: Path) -> None
 
     root = tmp_path / "data"
     env = {**os.environ, "RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER": "0", "RAY_USAGE_STATS_ENABLED": "0"}
-    done = subprocess.run([sys.executable, "-c", DRIVER, str(root)], capture_output=True, text=True, env=env,
-                          timeout=300, check=False)
+    done = subprocess.run(
+        [sys.executable, "-c", DRIVER, str(root)], capture_output=True, text=True, env=env, timeout=300, check=False
+    )
     assert done.returncode == 0, done.stdout + done.stderr[-3000:]
     assert "killed" in done.stdout, done.stdout
     assert "made ['Single-Strawberry/000', 'Single-Strawberry/001']" in done.stdout

@@ -20,8 +20,14 @@ from davis_ag.generate.run_config import (
 from davis_ag.scene.specs import CROPS, SCENARIOS
 
 #: Table 3 of the paper: scenes per group.
-TABLE_3 = {"Single-Strawberry": 86, "Single-Tomato": 130, "Single-Vine": 182,
-           "Multi-Strawberry": 77, "Multi-Tomato": 113, "Multi-Vine": 44}
+TABLE_3 = {
+    "Single-Strawberry": 86,
+    "Single-Tomato": 130,
+    "Single-Vine": 182,
+    "Multi-Strawberry": 77,
+    "Multi-Tomato": 113,
+    "Multi-Vine": 44,
+}
 
 
 def test_presets_ship_with_the_package() -> None:
@@ -47,9 +53,11 @@ def test_mini_preset_is_small() -> None:
 
 def test_config_file_with_grid_override(tmp_path: Path) -> None:
     path = tmp_path / "small.yaml"
-    path.write_text("seed: 7\nimage_size: [320, 180]\ngrid: {step: 0.5}\ngroups:\n"
-                    "  - {scenario: single, crop: tomato, scenes: 2, first: 3}\n"
-                    "  - {scenario: mp, crop: grape, scenes: 1, grid: {altitude_levels: [0], headings: 4}}\n")
+    path.write_text(
+        "seed: 7\nimage_size: [320, 180]\ngrid: {step: 0.5}\ngroups:\n"
+        "  - {scenario: single, crop: tomato, scenes: 2, first: 3}\n"
+        "  - {scenario: mp, crop: grape, scenes: 1, grid: {altitude_levels: [0], headings: 4}}\n"
+    )
     config = load_dataset_config(path)
     assert config.name == "small" and config.seed == 7
     assert [r.folder for r in config.requests()] == ["Single-Tomato/003", "Single-Tomato/004", "Multi-Vine/000"]
@@ -71,47 +79,82 @@ def test_only_picks_scenes_and_groups() -> None:
         config.requests(["Single-Strawberry/086"])
 
 
-@pytest.mark.parametrize(("text", "message"), [
-    ("groups: [", "not valid YAML at line"),
-    ("- 1\n- 2\n", "must be a mapping"),
-    ("seed: 1\n", "groups: missing"),
-    ("groups: []\n", "groups: must be a non-empty list"),
-    ("sed: 1\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "sed: unknown key"),
-    ("seed: -1\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "seed: must be a whole number from 0 to 4294967295, not -1"),
-    ("seed: 1.5\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "seed: must be a whole number"),
-    ("image_size: 1280\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "image_size: must be WIDTHxHEIGHT"),
-    ("image_size: 8x8\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "image_size: 8x8: each side must be from 16 to 8192 pixels"),
-    ("groups: [{scenario: sp, crop: banana, scenes: 1}]\n", "groups.0.crop: unknown crop 'banana': choose one of strawberry, tomato, vine"),
-    ("groups: [{scenario: xp, crop: tomato, scenes: 1}]\n", "groups.0.scenario: unknown scenario"),
-    ("groups: [{scenario: sp, crop: tomato}]\n", "groups.0.scenes: missing"),
-    ("groups: [{scenario: sp, crop: tomato, scenes: 0}]\n", "groups.0.scenes: must be a whole number from 1 to 1000"),
-    ("groups: [{scenario: sp, crop: tomato, scenes: 'many'}]\n", "groups.0.scenes: must be a whole number"),
-    ("groups: [{scenario: sp, crop: tomato, scenes: 5, first: 998}]\n", "do not fit 000..999"),
-    ("groups: [{scenario: sp, crop: tomato, scenes: 1, sceens: 2}]\n", "groups.0.sceens: unknown key"),
-    ("groups:\n - {scenario: sp, crop: tomato, scenes: 1}\n - {scenario: single, crop: tomato, scenes: 2}\n",
-     "groups.1: Single-Tomato is already groups.0"),
-    ("grid: {step: 0}\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "grid.step: must be greater than 0"),
-    ("grid: {stepp: 1}\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "grid.stepp: unknown key"),
-    ("groups: [{scenario: sp, crop: tomato, scenes: 1, grid: {altitude_levels: [2, 0]}}]\n",
-     "groups.0.grid.altitude_levels: must list distinct levels"),
-    ("groups: [{scenario: sp, crop: tomato, scenes: 1, grid: {headings: 4}}]\n", "only 1"),
-    ("groups: [{scenario: mp, crop: tomato, scenes: 1, grid: {headings: 8}}]\n", "does not work for multi plant"),
-    ("groups: [{scenario: sp, crop: tomato, scenes: 1, grid: {extent: [1, 1], step: 2}}]\n", "no position fits"),
-    ("strawberry_altitudes: fig2\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n",
-     "strawberry_altitudes: must be 'table1' or 'readme', not 'fig2'"),
-    ("image_size: 99999x99999\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n",
-     "image_size: 99999x99999: each side must be from 16 to 8192 pixels (the renderer's limit)"),
-    ("seed: 4294967296\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "seed: must be a whole number from 0 to"),
-    ("renderer: vulkan\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "renderer: must be 'opengl' or 'helios'"),
-    # Issue 33 case 2: a step of 1e-9 m grew until the kernel killed the run at 24 GB.
-    ("grid: {step: 1e-9}\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n",
-     "grid: step 1e-09 m over [3.0, 3.0] m gives up to 27,000,000,018,000,000,003 views a scene, more than 10,000"),
-    ("grid: {step: 0.01}\ngroups: [{scenario: mp, crop: vine, scenes: 1}]\n", "views a scene, more than 10,000"),
-    ("groups: [{scenario: sp, crop: tomato, scenes: 1, grid: {step: 0.001}}]\n",
-     "groups.0.grid: step 0.001 m over"),
-    ("grid: {extent: [1000, 3]}\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n",
-     "grid.extent.0: must be less than or equal to 100"),
-])
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("groups: [", "not valid YAML at line"),
+        ("- 1\n- 2\n", "must be a mapping"),
+        ("seed: 1\n", "groups: missing"),
+        ("groups: []\n", "groups: must be a non-empty list"),
+        ("sed: 1\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "sed: unknown key"),
+        (
+            "seed: -1\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n",
+            "seed: must be a whole number from 0 to 4294967295, not -1",
+        ),
+        ("seed: 1.5\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "seed: must be a whole number"),
+        ("image_size: 1280\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "image_size: must be WIDTHxHEIGHT"),
+        (
+            "image_size: 8x8\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n",
+            "image_size: 8x8: each side must be from 16 to 8192 pixels",
+        ),
+        (
+            "groups: [{scenario: sp, crop: banana, scenes: 1}]\n",
+            "groups.0.crop: unknown crop 'banana': choose one of strawberry, tomato, vine",
+        ),
+        ("groups: [{scenario: xp, crop: tomato, scenes: 1}]\n", "groups.0.scenario: unknown scenario"),
+        ("groups: [{scenario: sp, crop: tomato}]\n", "groups.0.scenes: missing"),
+        (
+            "groups: [{scenario: sp, crop: tomato, scenes: 0}]\n",
+            "groups.0.scenes: must be a whole number from 1 to 1000",
+        ),
+        ("groups: [{scenario: sp, crop: tomato, scenes: 'many'}]\n", "groups.0.scenes: must be a whole number"),
+        ("groups: [{scenario: sp, crop: tomato, scenes: 5, first: 998}]\n", "do not fit 000..999"),
+        ("groups: [{scenario: sp, crop: tomato, scenes: 1, sceens: 2}]\n", "groups.0.sceens: unknown key"),
+        (
+            "groups:\n - {scenario: sp, crop: tomato, scenes: 1}\n - {scenario: single, crop: tomato, scenes: 2}\n",
+            "groups.1: Single-Tomato is already groups.0",
+        ),
+        ("grid: {step: 0}\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "grid.step: must be greater than 0"),
+        ("grid: {stepp: 1}\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n", "grid.stepp: unknown key"),
+        (
+            "groups: [{scenario: sp, crop: tomato, scenes: 1, grid: {altitude_levels: [2, 0]}}]\n",
+            "groups.0.grid.altitude_levels: must list distinct levels",
+        ),
+        ("groups: [{scenario: sp, crop: tomato, scenes: 1, grid: {headings: 4}}]\n", "only 1"),
+        ("groups: [{scenario: mp, crop: tomato, scenes: 1, grid: {headings: 8}}]\n", "does not work for multi plant"),
+        ("groups: [{scenario: sp, crop: tomato, scenes: 1, grid: {extent: [1, 1], step: 2}}]\n", "no position fits"),
+        (
+            "strawberry_altitudes: fig2\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n",
+            "strawberry_altitudes: must be 'table1' or 'readme', not 'fig2'",
+        ),
+        (
+            "image_size: 99999x99999\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n",
+            "image_size: 99999x99999: each side must be from 16 to 8192 pixels (the renderer's limit)",
+        ),
+        (
+            "seed: 4294967296\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n",
+            "seed: must be a whole number from 0 to",
+        ),
+        (
+            "renderer: vulkan\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n",
+            "renderer: must be 'opengl' or 'helios'",
+        ),
+        # Issue 33 case 2: a step of 1e-9 m grew until the kernel killed the run at 24 GB.
+        (
+            "grid: {step: 1e-9}\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n",
+            "grid: step 1e-09 m over [3.0, 3.0] m gives up to 27,000,000,018,000,000,003 views a scene, more than 10,000",
+        ),
+        ("grid: {step: 0.01}\ngroups: [{scenario: mp, crop: vine, scenes: 1}]\n", "views a scene, more than 10,000"),
+        (
+            "groups: [{scenario: sp, crop: tomato, scenes: 1, grid: {step: 0.001}}]\n",
+            "groups.0.grid: step 0.001 m over",
+        ),
+        (
+            "grid: {extent: [1000, 3]}\ngroups: [{scenario: sp, crop: tomato, scenes: 1}]\n",
+            "grid.extent.0: must be less than or equal to 100",
+        ),
+    ],
+)
 def test_bad_configs_name_file_key_and_problem(text: str, message: str) -> None:
     with pytest.raises(UserError) as caught:
         parse_dataset_config(text, "bad.yaml")
@@ -131,11 +174,35 @@ def test_missing_config_lists_presets(tmp_path: Path) -> None:
 
 
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(st.recursive(st.none() | st.booleans() | st.integers() | st.floats() | st.text(max_size=12),
-                    lambda inner: st.lists(inner, max_size=4) | st.dictionaries(
-                        st.sampled_from(["groups", "grid", "step", "extent", "scenes", "crop", "scenario",
-                                         "seed", "image_size", "headings", "first", "x"]), inner, max_size=5),
-                    max_leaves=20))
+@given(
+    st.recursive(
+        st.none() | st.booleans() | st.integers() | st.floats() | st.text(max_size=12),
+        lambda inner: (
+            st.lists(inner, max_size=4)
+            | st.dictionaries(
+                st.sampled_from(
+                    [
+                        "groups",
+                        "grid",
+                        "step",
+                        "extent",
+                        "scenes",
+                        "crop",
+                        "scenario",
+                        "seed",
+                        "image_size",
+                        "headings",
+                        "first",
+                        "x",
+                    ]
+                ),
+                inner,
+                max_size=5,
+            )
+        ),
+        max_leaves=20,
+    )
+)
 def test_any_yaml_value_is_a_config_or_one_line(value: object) -> None:
     """Whatever the file holds, the parser gives a config whose grids respect the bounds, or one line."""
     import yaml
@@ -182,8 +249,9 @@ def test_strawberry_altitudes_are_table_1s_unless_the_readmes_are_asked_for() ->
     assert grids[0]["altitudes_m"] == [0.25, 0.40, 0.55] and grids[1]["altitudes_m"] == [0.50, 0.75, 1.00]
 
 
-def test_generate_flag_takes_the_readme_altitudes(capsys: pytest.CaptureFixture, monkeypatch: pytest.MonkeyPatch,
-                                                  tmp_path: Path) -> None:
+def test_generate_flag_takes_the_readme_altitudes(
+    capsys: pytest.CaptureFixture, monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
     from davis_ag import cli
     from davis_ag.commands import generate
 
@@ -204,8 +272,9 @@ def test_generate_flag_takes_the_readme_altitudes(capsys: pytest.CaptureFixture,
     assert stopped.value.code == 2 and "invalid choice: 'fig2'" in capsys.readouterr().err
 
 
-def test_a_config_bomb_is_refused_before_anything_is_written(tmp_path: Path,
-                                                             capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_config_bomb_is_refused_before_anything_is_written(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """Issue 33 case 2: ``grid: {step: 1e-9}`` wrote dataset.json, then ate the machine."""
     from davis_ag.cli import main
 
@@ -217,8 +286,9 @@ def test_a_config_bomb_is_refused_before_anything_is_written(tmp_path: Path,
     assert not (tmp_path / "data").exists()
 
 
-def test_ray_missing_is_refused_before_anything_is_written(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
-                                                           capsys: pytest.CaptureFixture[str]) -> None:
+def test_ray_missing_is_refused_before_anything_is_written(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
     """Issue 33 case 9: --executor ray without Ray wrote the out folder and dataset.json first."""
     import sys
 

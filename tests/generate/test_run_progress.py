@@ -10,8 +10,9 @@ from davis_ag.generate.one_scene import SceneRequest
 from davis_ag.scene.specs import CROPS, SCENARIOS
 
 
-def test_no_bars_in_a_log_but_a_line_per_scene_and_per_interval(capsys: pytest.CaptureFixture[str],
-                                                                monkeypatch: pytest.MonkeyPatch) -> None:
+def test_no_bars_in_a_log_but_a_line_per_scene_and_per_interval(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
     requests = [SceneRequest(SCENARIOS["sp"], CROPS["strawberry"], i, 0) for i in range(2)]
     views = run_progress.count_views(SCENARIOS["sp"], CROPS["strawberry"])
     monkeypatch.setattr(run_progress, "LOG_INTERVAL_S", 0.0)  # a line at every event, to see one
@@ -26,7 +27,8 @@ def test_no_bars_in_a_log_but_a_line_per_scene_and_per_interval(capsys: pytest.C
     assert "\r" not in err and "\x1b[" not in err  # no bar, no cursor movement
     lines = err.splitlines()
     assert [line for line in lines if line.startswith("Single-Strawberry/")] == [
-        f"Single-Strawberry/00{i}: {views} views, grown in 1.0 s, {2 / views:.3f} s per view" for i in range(2)]
+        f"Single-Strawberry/00{i}: {views} views, grown in 1.0 s, {2 / views:.3f} s per view" for i in range(2)
+    ]
     assert f"{2 * views} of {2 * views} views (100 %), 0 min left" in lines
 
 

@@ -85,27 +85,44 @@ def test_split_is_seeded_70_30_per_group() -> None:
 
 
 def test_write_splits_reads_the_scenes_on_disk(tmp_path: Path) -> None:
-    for scene in ("Single-Strawberry/000", "Single-Strawberry/001", "Single-Strawberry/.002.partial",
-                  "Multi-Tomato/000"):
+    for scene in (
+        "Single-Strawberry/000",
+        "Single-Strawberry/001",
+        "Single-Strawberry/.002.partial",
+        "Multi-Tomato/000",
+    ):
         (tmp_path / scene).mkdir(parents=True)
         (tmp_path / scene / "annotations.json").write_text("{}")
     (tmp_path / "dataset.json").write_text(json.dumps({"seed": 5, "groups": {}}))
     data = json.loads(write_splits(tmp_path).read_text())
     assert data["seed"] == 5
-    assert sorted(data["train"] + data["test"]) == ["Multi-Tomato/000", "Single-Strawberry/000",
-                                                   "Single-Strawberry/001"]
+    assert sorted(data["train"] + data["test"]) == [
+        "Multi-Tomato/000",
+        "Single-Strawberry/000",
+        "Single-Strawberry/001",
+    ]
     assert not list(tmp_path.glob(".*.tmp"))
 
 
-def test_a_second_run_on_the_same_folder_is_refused(tiny_config: Path, tmp_path: Path,
-                                                    capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_second_run_on_the_same_folder_is_refused(
+    tiny_config: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     root = tmp_path / "data"
     root.mkdir()
-    holder = subprocess.Popen([sys.executable, "-c", (
-        "import fcntl, os, sys, time\n"
-        f"fd = os.open({str(root / LOCK_FILE)!r}, os.O_RDWR | os.O_CREAT)\n"
-        "fcntl.flock(fd, fcntl.LOCK_EX); os.write(fd, str(os.getpid()).encode())\n"
-        "print('locked', flush=True); time.sleep(60)\n")], stdout=subprocess.PIPE, text=True)
+    holder = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            (
+                "import fcntl, os, sys, time\n"
+                f"fd = os.open({str(root / LOCK_FILE)!r}, os.O_RDWR | os.O_CREAT)\n"
+                "fcntl.flock(fd, fcntl.LOCK_EX); os.write(fd, str(os.getpid()).encode())\n"
+                "print('locked', flush=True); time.sleep(60)\n"
+            ),
+        ],
+        stdout=subprocess.PIPE,
+        text=True,
+    )
     try:
         assert holder.stdout.readline().strip() == "locked"
         requests = load_dataset_config(tiny_config).requests()
@@ -145,8 +162,10 @@ def test_other_settings_never_touch_existing_scenes(reference: Path, tiny_config
     shutil.copytree(reference, root)
     before = digest(root)
     config = load_dataset_config(tiny_config)
-    for changed, message in [({"seed": 4}, "made with seed 3, not 4"),
-                             ({"camera": type(config.camera)(96, 48)}, "made with image_size")]:
+    for changed, message in [
+        ({"seed": 4}, "made with seed 3, not 4"),
+        ({"camera": type(config.camera)(96, 48)}, "made with image_size"),
+    ]:
         with pytest.raises(UserError, match=message):
             run_dataset(dataclasses.replace(config, **changed).requests(), root, RunOptions(progress=False))
     assert digest(root) == before
@@ -206,8 +225,10 @@ def test_killed_pool_run_resumes_to_the_same_dataset(reference: Path, tiny_confi
 
 
 def test_local_runs_never_import_ray() -> None:
-    code = ("import sys, davis_ag.cli, davis_ag.generate.runner, davis_ag.commands.generate\n"
-            "assert 'ray' not in sys.modules, 'ray imported'\n")
+    code = (
+        "import sys, davis_ag.cli, davis_ag.generate.runner, davis_ag.commands.generate\n"
+        "assert 'ray' not in sys.modules, 'ray imported'\n"
+    )
     subprocess.run([sys.executable, "-c", code], check=True, timeout=60)
 
 
@@ -224,8 +245,9 @@ def test_ray_executor_makes_the_same_dataset(reference: Path, tiny_config: Path,
     assert digest(root) == digest(reference)
 
 
-def test_generate_with_a_relative_out_from_another_folder(reference: Path, tiny_config: Path, tmp_path: Path,
-                                                          monkeypatch: pytest.MonkeyPatch) -> None:
+def test_generate_with_a_relative_out_from_another_folder(
+    reference: Path, tiny_config: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """As a newcomer runs it: a relative --out, from a folder that is neither the repo nor /tmp's root.
 
     pyhelios moves the process's working directory while it builds and closes a Visualizer; a
@@ -239,7 +261,8 @@ def test_generate_with_a_relative_out_from_another_folder(reference: Path, tiny_
 
 
 def test_a_full_disk_midway_leaves_no_half_scene_and_the_next_run_redoes_it(
-        reference: Path, tiny_config: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    reference: Path, tiny_config: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     import errno
     import itertools
 
@@ -255,14 +278,31 @@ def test_a_full_disk_midway_leaves_no_half_scene_and_the_next_run_redoes_it(
     monkeypatch.setattr(Image.Image, "save", filling)
     root = tmp_path / "data"
     requests = load_dataset_config(tiny_config).requests(["Single-Strawberry/000"])
-    with pytest.raises(MachineError, match="1 of 1 scenes failed .*No space left on device.*run the same command again"):
+    with pytest.raises(
+        MachineError, match="1 of 1 scenes failed .*No space left on device.*run the same command again"
+    ):
         run_dataset(requests, root, RunOptions(workers=1, progress=False))
     assert not list((root / "Single-Strawberry").iterdir())  # no half scene, visible or hidden
     assert not (root / "splits.json").exists()
     # Issue 33 case 9: the command exited 2 (bad input) where docs/errors.md says the machine's 1.
     calls = itertools.count(1000)
-    assert main(["generate", "--config", str(tiny_config), "--only", "Single-Strawberry/000", "--out", str(root),
-                 "--workers", "1", "--quiet"]) == 1
+    assert (
+        main(
+            [
+                "generate",
+                "--config",
+                str(tiny_config),
+                "--only",
+                "Single-Strawberry/000",
+                "--out",
+                str(root),
+                "--workers",
+                "1",
+                "--quiet",
+            ]
+        )
+        == 1
+    )
     assert not list((root / "Single-Strawberry").iterdir())
 
     monkeypatch.undo()  # space again

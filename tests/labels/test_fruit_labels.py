@@ -47,14 +47,18 @@ def test_lookup_maps_pixel_values_to_fruit_ids() -> None:
 
 def test_box_convention_is_xmin_ymin_inclusive_width_height() -> None:
     # Fruit 0 covers rows 2..4 and columns 5..9 with its two primitives; fruit 3 a single pixel.
-    ids = paint((20, 30), (10, slice(2, 5), slice(5, 8)), (11, slice(2, 5), slice(8, 10)), (21, slice(15, 16), slice(29, 30)))
+    ids = paint(
+        (20, 30), (10, slice(2, 5), slice(5, 8)), (11, slice(2, 5), slice(8, 10)), (21, slice(15, 16), slice(29, 30))
+    )
     labels = label_view(ids, LOOKUP, min_pixels=1)
     assert labels.boxes == [[5, 2, 5, 3, 0, 0], [29, 15, 1, 1, 3, 0]]
     assert labels.visible_pixels == {0: 15, 3: 1}
 
 
 def test_threshold_drops_small_fruit_from_boxes_and_segmentation() -> None:
-    ids = paint((20, 30), (10, slice(0, 4), slice(0, 4)), (12, slice(10, 13), slice(10, 13)), (3, slice(15, 20), slice(0, 30)))
+    ids = paint(
+        (20, 30), (10, slice(0, 4), slice(0, 4)), (12, slice(10, 13), slice(10, 13)), (3, slice(15, 20), slice(0, 30))
+    )
     labels = label_view(ids, LOOKUP, min_pixels=10)  # fruit 0: 16 pixels, fruit 1: 9 pixels
     assert [box[4] for box in labels.boxes] == [0]
     assert set(np.unique(labels.segmentation)) == {0, NO_FRUIT}
@@ -64,7 +68,9 @@ def test_threshold_drops_small_fruit_from_boxes_and_segmentation() -> None:
 
 
 def test_occluded_fruit_split_in_two_gets_one_box_spanning_both_parts() -> None:
-    ids = paint((20, 30), (20, slice(5, 10), slice(2, 6)), (22, slice(5, 10), slice(12, 16)), (4, slice(0, 20), slice(6, 12)))
+    ids = paint(
+        (20, 30), (20, slice(5, 10), slice(2, 6)), (22, slice(5, 10), slice(12, 16)), (4, slice(0, 20), slice(6, 12))
+    )
     labels = label_view(ids, LOOKUP, min_pixels=1)
     assert labels.boxes == [[2, 5, 14, 5, 3, 0]]
     assert labels.visible_pixels == {3: 40}
@@ -107,7 +113,9 @@ def test_boxes_and_masks_agree(fruit_map: np.ndarray, min_pixels: int, seed: int
 
 def unproject(u: float, v: float, depth: float) -> np.ndarray:
     """The world point VIEW sees at pixel coordinates (u, v) and the given depth."""
-    return np.array([depth, -(u - CAMERA.width / 2) * depth / CAMERA.fy, 1.0 + (CAMERA.height / 2 - v) * depth / CAMERA.fy])
+    return np.array(
+        [depth, -(u - CAMERA.width / 2) * depth / CAMERA.fy, 1.0 + (CAMERA.height / 2 - v) * depth / CAMERA.fy]
+    )
 
 
 def polygon(corners: list[tuple[float, float]], depth: float = 2.0) -> np.ndarray:
@@ -134,13 +142,20 @@ def test_pixel_aligned_square_covers_exactly_its_pixels() -> None:
 
 @settings(max_examples=60, deadline=None)
 @given(
-    st.floats(10, 120), st.floats(10, 60),  # first corner
-    st.floats(4, 30), st.floats(4, 25),  # square/rectangle size
+    st.floats(10, 120),
+    st.floats(10, 60),  # first corner
+    st.floats(4, 30),
+    st.floats(4, 25),  # square/rectangle size
     st.floats(0.5, 6.0),  # depth: the silhouette depends only on the projection
     st.booleans(),
 )
 def test_projected_shapes_match_their_analytic_area_within_a_pixel_border(
-    u: float, v: float, w: float, h: float, depth: float, triangle: bool,
+    u: float,
+    v: float,
+    w: float,
+    h: float,
+    depth: float,
+    triangle: bool,
 ) -> None:
     corners = [(u, v), (u + w, v), (u + w, v + h)] if triangle else [(u, v), (u + w, v), (u + w, v + h), (u, v + h)]
     area, perimeter = shoelace(corners)

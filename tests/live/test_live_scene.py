@@ -25,8 +25,9 @@ def test_a_grid_pose_drawn_live_is_the_stored_view(live_root: Path, live_scene: 
     checked = 0
     for view in scene:
         live = live_scene.render(live_scene.grid_view(view.name))
-        assert live.boxes == [list(b) for b in json.loads((scene.path / "annotations.json").read_text())
-                              [view.name]["bounding_boxes"]]
+        assert live.boxes == [
+            list(b) for b in json.loads((scene.path / "annotations.json").read_text())[view.name]["bounding_boxes"]
+        ]
         assert np.array_equal(live.segmentation, view.mask())
         assert live.visible_fraction == {int(k): v for k, v in stored["visible_fraction"][view.name].items()}
         jpeg = np.asarray(Image.open(scene.path / "images" / view.name)).astype(np.int64)
@@ -52,8 +53,9 @@ def test_reopening_uses_the_cache_and_a_tampered_cache_is_rebuilt(live_scene_dir
     assert (copy / CACHE_FILE).read_bytes() == (live_scene_dir / CACHE_FILE).read_bytes()  # left alone
 
 
-def test_a_scene_that_regrows_differently_is_refused(live_scene_dir: Path, tmp_path: Path, grown: tuple,
-                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_scene_that_regrows_differently_is_refused(
+    live_scene_dir: Path, tmp_path: Path, grown: tuple, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """The regrown fruit registry is checked against scene.json's. The growth is the generator's
     own (the fixture's plants, reused to save half a minute); the record is what changes."""
     import davis_ag.generate.one_scene as one_scene
@@ -99,20 +101,26 @@ def test_a_view_without_depth_is_the_same_view(live_scene: LiveScene) -> None:
     labels and OER as with the depth, for poses aimed at the plant and poses that put fruit at the
     frame's edge or out of it."""
     aimed = live_scene.aimed_pose(0.9, -0.6, 0.33)
-    poses = [aimed, live_scene.aimed_pose(-0.5, 0.4, 0.5), live_scene.aimed_pose(0.3, 0.35, 0.2),
-             *(live_scene.pose(0.9, -0.6, 0.33, yaw=aimed.yaw + turn, pitch=aimed.pitch + tilt)
-               for turn, tilt in ((14, 0), (-16, 4), (0, 15), (25, -10), (180, 0)))]
+    poses = [
+        aimed,
+        live_scene.aimed_pose(-0.5, 0.4, 0.5),
+        live_scene.aimed_pose(0.3, 0.35, 0.2),
+        *(
+            live_scene.pose(0.9, -0.6, 0.33, yaw=aimed.yaw + turn, pitch=aimed.pitch + tilt)
+            for turn, tilt in ((14, 0), (-16, 4), (0, 15), (25, -10), (180, 0))
+        ),
+    ]
     boxes_at_the_edge = 0
     for pose in poses:
         with_depth = live_scene.render(pose, 224, 224, antialiasing="none", fractions=False, fast_ground=True)
-        without = live_scene.render(pose, 224, 224, antialiasing="none", fractions=False, fast_ground=True,
-                                    depth=False)
+        without = live_scene.render(pose, 224, 224, antialiasing="none", fractions=False, fast_ground=True, depth=False)
         assert without.depth is None and with_depth.depth.shape == (224, 224)
         assert np.array_equal(without.colour, with_depth.colour)
         assert np.array_equal(without.segmentation, with_depth.segmentation)
         assert without.boxes == with_depth.boxes and without.oer == with_depth.oer
-        boxes_at_the_edge += sum(x0 == 0 or y0 == 0 or x0 + w == 224 or y0 + h == 224
-                                 for x0, y0, w, h, _, _ in without.boxes)
+        boxes_at_the_edge += sum(
+            x0 == 0 or y0 == 0 or x0 + w == 224 or y0 + h == 224 for x0, y0, w, h, _, _ in without.boxes
+        )
     assert boxes_at_the_edge > 0
 
 
@@ -132,8 +140,12 @@ def test_the_cache_is_no_stranger_to_the_dataset(live_root: Path) -> None:
 
 
 def test_a_scene_whose_cache_cannot_be_written_reopens_uncached(
-        live_scene_dir: Path, tmp_path: Path, grown: tuple, capsys: pytest.CaptureFixture[str],
-        monkeypatch: pytest.MonkeyPatch) -> None:
+    live_scene_dir: Path,
+    tmp_path: Path,
+    grown: tuple,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
     """A folder in the cache file's place: the scene still opens (regrown), says so in one line
     and leaves the folder alone."""
     import davis_ag.generate.one_scene as one_scene

@@ -63,7 +63,7 @@ def test_the_observation_is_the_view_and_the_targets_box(env: TVMContinuousEnv) 
     obs, info = env.reset(seed=0)
     x0, y0, w, h = env._labels.box(env.target)[:4]
     box = np.zeros((224, 224), bool)
-    box[y0:y0 + h, x0:x0 + w] = True
+    box[y0 : y0 + h, x0 : x0 + w] = True
     assert np.array_equal(obs[..., 3] == 255, box) and set(np.unique(obs[..., 3])) == {0, 255}
     assert np.array_equal(obs[..., :3], env._labels.colour)
     assert info["oer_0"] < 0.4  # section V-C's start condition
@@ -92,8 +92,9 @@ def _start(env: TVMContinuousEnv, x: float, y: float, z: float, yaw: float = 0.0
     view = env.scenes[0].aimed_pose(x, y, z)
     labels = env.scenes[0].render(view, 224, 224, antialiasing="none", fractions=False, fast_ground=True)
     target = max(labels.oer, key=lambda f: labels.visible_pixels[f])
-    _, info = env.reset(seed=0, options={"pose": [x, y, z, view.yaw if yaw == 0 else yaw, view.pitch],
-                                         "target": target})
+    _, info = env.reset(
+        seed=0, options={"pose": [x, y, z, view.yaw if yaw == 0 else yaw, view.pitch], "target": target}
+    )
     return info
 
 
@@ -157,10 +158,20 @@ def test_policies_play_the_same_starts(env: TVMContinuousEnv, tmp_path: Path) ->
         build_policies(["Oracle"])
 
 
-def test_ppo_trains_briefly_and_plays(live_scene_dir: Path, env: TVMContinuousEnv, tmp_path: Path,
-                                      capsys: pytest.CaptureFixture[str]) -> None:
-    path, records = train_continuous(live_scene_dir, "sp", total_timesteps=48, seed=0, out_path=tmp_path / "ppo",
-                                     arch="pooled", n_steps=24, batch_size=12, progress_every=24)
+def test_ppo_trains_briefly_and_plays(
+    live_scene_dir: Path, env: TVMContinuousEnv, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path, records = train_continuous(
+        live_scene_dir,
+        "sp",
+        total_timesteps=48,
+        seed=0,
+        out_path=tmp_path / "ppo",
+        arch="pooled",
+        n_steps=24,
+        batch_size=12,
+        progress_every=24,
+    )
     assert path.suffix == ".zip" and path.is_file()
     assert "PPO: 48/48 steps" in capsys.readouterr().out
     assert len(records) >= 48 // env.tau - 1 and all(r["reward"] >= 0 for r in records)
@@ -170,12 +181,29 @@ def test_ppo_trains_briefly_and_plays(live_scene_dir: Path, env: TVMContinuousEn
     assert results["policies"]["PPO"]["length"]["mean"] == env.tau
 
 
-def test_evaluate_command_takes_the_continuous_environment(live_root: Path, tmp_path: Path,
-                                                           monkeypatch: pytest.MonkeyPatch,
-                                                           capsys: pytest.CaptureFixture[str]) -> None:
+def test_evaluate_command_takes_the_continuous_environment(
+    live_root: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
     monkeypatch.chdir(tmp_path)
-    args = ["evaluate", "--env", "continuous", "--dataset", str(live_root), "--scenario", "sp", "--split", "all",
-            "--episodes", "2", "--sessions", "1", "--out", "r.json", "--policies", "LR,Rand"]
+    args = [
+        "evaluate",
+        "--env",
+        "continuous",
+        "--dataset",
+        str(live_root),
+        "--scenario",
+        "sp",
+        "--split",
+        "all",
+        "--episodes",
+        "2",
+        "--sessions",
+        "1",
+        "--out",
+        "r.json",
+        "--policies",
+        "LR,Rand",
+    ]
     assert cli.main(args) == 0
     results = json.loads(Path("r.json").read_text())
     assert results["protocol"]["environment"] == CONTINUOUS_ID and set(results["policies"]) == {"LR", "Rand"}
@@ -190,15 +218,39 @@ def test_evaluate_command_takes_the_continuous_environment(live_root: Path, tmp_
     assert "Rand" in mine["paired"]
 
 
-def test_the_docs_policy_file_runs_on_the_continuous_environment(live_root: Path, tmp_path: Path,
-                                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+def test_the_docs_policy_file_runs_on_the_continuous_environment(
+    live_root: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """docs/benchmark-your-method.md says its policy file scores here too."""
     from test_benchmark_your_method import PAGE, blocks  # tests/ is on the path, as for layout_factory
 
     monkeypatch.chdir(tmp_path)
     name, body = next((n, b) for _, n, b in blocks(PAGE.read_text()) if n)
     Path(name).write_text(body)
-    assert cli.main(["evaluate", "--env", "continuous", "--dataset", str(live_root), "--scenario", "sp", "--split",
-                     "all", "--episodes", "2", "--sessions", "1", "--policies", "Rand", "--out", "r.json",
-                     "--policy", f"{name}:toward_target"]) == 0
+    assert (
+        cli.main(
+            [
+                "evaluate",
+                "--env",
+                "continuous",
+                "--dataset",
+                str(live_root),
+                "--scenario",
+                "sp",
+                "--split",
+                "all",
+                "--episodes",
+                "2",
+                "--sessions",
+                "1",
+                "--policies",
+                "Rand",
+                "--out",
+                "r.json",
+                "--policy",
+                f"{name}:toward_target",
+            ]
+        )
+        == 0
+    )
     assert json.loads(Path("r.json").read_text())["policies"]["toward_target"]["length"]["mean"] == 3

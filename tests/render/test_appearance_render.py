@@ -72,10 +72,13 @@ def test_exposure_white_balance_and_sun_strength_change_colour_only(soil_context
     soil = ids > 0  # and the ball
     mean = clean[soil].reshape(-1, 3).mean(axis=0)
     for change, check in (
-            ({"exposure": 1.5}, lambda m: (m > mean + 5).all()),
-            ({"sun_strength": 0.5}, lambda m: (m < mean - 5).all()),
-            ({"white_balance": (1.15, 1.0, 0.85)}, lambda m: m[0] > mean[0] + 3 and m[2] < mean[2] - 3
-             and abs(m[1] - mean[1]) < 1)):
+        ({"exposure": 1.5}, lambda m: (m > mean + 5).all()),
+        ({"sun_strength": 0.5}, lambda m: (m < mean - 5).all()),
+        (
+            {"white_balance": (1.15, 1.0, 0.85)},
+            lambda m: m[0] > mean[0] + 3 and m[2] < mean[2] - 3 and abs(m[1] - mean[1]) < 1,
+        ),
+    ):
         colour, ids2, depth2 = draw(soil_context, replace(PAPER, **change))
         assert np.array_equal(ids, ids2) and np.array_equal(depth, depth2)
         assert check(colour[soil].reshape(-1, 3).mean(axis=0)), change

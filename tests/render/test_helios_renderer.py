@@ -66,11 +66,19 @@ def test_intrinsics_are_consistent() -> None:
 @settings(max_examples=100, deadline=None)
 @given(
     st.tuples(st.floats(-3, 3), st.floats(-3, 3), st.floats(0.1, 2)),
-    st.floats(-180, 180), st.floats(-80, 80),
-    st.floats(-0.4, 0.4), st.floats(-0.2, 0.2), st.floats(0.3, 5.0),
+    st.floats(-180, 180),
+    st.floats(-80, 80),
+    st.floats(-0.4, 0.4),
+    st.floats(-0.2, 0.2),
+    st.floats(0.3, 5.0),
 )
 def test_projection_inverts_the_pinhole_model(
-    position: tuple[float, float, float], yaw: float, pitch: float, right: float, up: float, depth: float,
+    position: tuple[float, float, float],
+    yaw: float,
+    pitch: float,
+    right: float,
+    up: float,
+    depth: float,
 ) -> None:
     view = pose(position, yaw, pitch)
     centre, distance = CAMERA.project(view, np.array(view.look_at(depth)))

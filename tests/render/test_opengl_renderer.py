@@ -139,7 +139,8 @@ def test_fxaa_touches_only_silhouettes(frames: dict) -> None:
     for axis in (0, 1):
         # The shader's test at the nearer pixel of a pair, a hair looser for float rounding.
         jump = np.abs(np.diff(depth, axis=axis)) > 0.019 * np.minimum(
-            depth.take(range(depth.shape[axis] - 1), axis=axis), depth.take(range(1, depth.shape[axis]), axis=axis))
+            depth.take(range(depth.shape[axis] - 1), axis=axis), depth.take(range(1, depth.shape[axis]), axis=axis)
+        )
         pad = [(0, 0), (0, 0)]
         pad[axis] = (0, 1)
         edge |= np.pad(jump, pad)

@@ -54,8 +54,9 @@ def test_section_v_c_tau() -> None:
 
 
 @pytest.mark.parametrize("crop", sorted(MIN_PIXELS_1280x720))
-@pytest.mark.parametrize("size, area_ratio", [((1280, 720), 1), ((640, 360), 1 / 4), ((2560, 1440), 4),
-                                              ((96, 54), 96 * 54 / (1280 * 720))])
+@pytest.mark.parametrize(
+    "size, area_ratio", [((1280, 720), 1), ((640, 360), 1 / 4), ((2560, 1440), 4), ((96, 54), 96 * 54 / (1280 * 720))]
+)
 def test_box_thresholds_scale_with_image_area(crop: str, size: tuple[int, int], area_ratio: float) -> None:
     assert CROPS[crop].min_fruit_pixels == MIN_PIXELS_1280x720[crop]
     request = SceneRequest(SCENARIOS["sp"], CROPS[crop], 0, 0, Camera(*size))
@@ -75,5 +76,7 @@ def test_environment_threshold_without_scene_json_scales_the_same_way() -> None:
     class Cache:
         image_size = (640, 360)
 
-    assert TVMEnv._min_pixels(Scene(), Cache()) == pytest.approx(240 / 4) == CROPS["tomato"].min_fruit_pixels_at(640, 360)
+    assert (
+        TVMEnv._min_pixels(Scene(), Cache()) == pytest.approx(240 / 4) == CROPS["tomato"].min_fruit_pixels_at(640, 360)
+    )
     assert np.isclose(TVMEnv._min_pixels(Scene(), type("C", (), {"image_size": (1280, 720)})()), 240)

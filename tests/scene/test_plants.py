@@ -172,18 +172,28 @@ def test_grown_plant_matches_its_target_within_table_1(crop: str, seed: int) -> 
         # original's bush (the library's 4 mm internodes made a 20 cm column hung with fruit).
         (plant_id,) = plant_architecture.getAllPlantIDs()
         assert plant_architecture.getPlantStemHeight(plant_id) < 0.08
-        fruit = np.array([np.concatenate(primitive_vertices(context, context.getObjectPrimitiveUUIDs(f))).mean(axis=0)
-                          for f in plant.fruit_objects])
-        leaves = np.concatenate([primitive_vertices(context, context.getObjectPrimitiveUUIDs(b))[0]
-                                 for b in plant_architecture.getPlantLeafObjectIDs(plant_id)])
+        fruit = np.array(
+            [
+                np.concatenate(primitive_vertices(context, context.getObjectPrimitiveUUIDs(f))).mean(axis=0)
+                for f in plant.fruit_objects
+            ]
+        )
+        leaves = np.concatenate(
+            [
+                primitive_vertices(context, context.getObjectPrimitiveUUIDs(b))[0]
+                for b in plant_architecture.getPlantLeafObjectIDs(plant_id)
+            ]
+        )
         assert fruit[:, 2].max() < plant.measured.plant_height / 2
         fruit_reach = np.hypot(*(fruit[:, :2] - position).T).max()
         assert np.percentile(np.hypot(*(leaves[:, :2] - position).T), 90) > fruit_reach + 0.05
         # Table 1's 2.5 cm "fruit radius" is the Canopy Generator's parameter, whose strawberry is
         # a tube half that radius at its widest: fruit about as wide as the radius (+- 20 %), half
         # the width a sphere of that radius would have.
-        widths = [np.median(principal_extents(np.concatenate(primitive_vertices(context, fruit_body_uuids(context, f))))[1:])
-                  for f in plant.fruit_objects]
+        widths = [
+            np.median(principal_extents(np.concatenate(primitive_vertices(context, fruit_body_uuids(context, f))))[1:])
+            for f in plant.fruit_objects
+        ]
         assert 0.75 * spec.fruit_radius < np.median(widths) < 1.3 * spec.fruit_radius
 
     summary = plant.summary()

@@ -13,11 +13,15 @@ def library_like() -> dict:
     """The shape of a strawberry mainstem's parameters (the keys the recipes touch)."""
     constant = {"distribution": "constant", "parameters": [1.0]}
     return {
-        "max_nodes": dict(constant), "phyllochron_min": dict(constant), "fruit_set_probability": dict(constant),
+        "max_nodes": dict(constant),
+        "phyllochron_min": dict(constant),
+        "fruit_set_probability": dict(constant),
         "flower_bud_break_probability": dict(constant),
-        "phytomer_parameters": {"petiole": {"pitch": dict(constant), "curvature": dict(constant)},
-                                "peduncle": {"length": dict(constant), "curvature": dict(constant)},
-                                "inflorescence": {"flowers_per_peduncle": dict(constant)}},
+        "phytomer_parameters": {
+            "petiole": {"pitch": dict(constant), "curvature": dict(constant)},
+            "peduncle": {"length": dict(constant), "curvature": dict(constant)},
+            "inflorescence": {"flowers_per_peduncle": dict(constant)},
+        },
     }
 
 

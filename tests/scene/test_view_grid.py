@@ -43,8 +43,9 @@ SP_MOVES = {"forward": (0, 1), "backward": (0, -1), "right": (1, 0), "left": (-1
 
 
 def make_grid(scenario: ScenarioSpec, crop: CropSpec, seed: int = 0) -> ViewGrid:
-    return build_view_grid(scenario, crop, plant_centres(scenario, crop), crop.centre_height,
-                           np.random.default_rng(seed))
+    return build_view_grid(
+        scenario, crop, plant_centres(scenario, crop), crop.centre_height, np.random.default_rng(seed)
+    )
 
 
 @st.composite
@@ -231,9 +232,15 @@ def test_multi_plant_headings_are_30_degrees_apart_and_rotation_only_turns(crop:
             target = grid.pointer(view.index, action)
             assert target is not None  # turning in place is always possible
             to = views[target]
-            assert (to.yaw - view.yaw - turn) % 360.0 == pytest.approx(0.0, abs=1e-6) or \
-                (to.yaw - view.yaw - turn) % 360.0 == pytest.approx(360.0, abs=1e-6)
-            assert (to.position, to.nominal, to.pitch, to.level) == (view.position, view.nominal, view.pitch, view.level)
+            assert (to.yaw - view.yaw - turn) % 360.0 == pytest.approx(0.0, abs=1e-6) or (
+                to.yaw - view.yaw - turn
+            ) % 360.0 == pytest.approx(360.0, abs=1e-6)
+            assert (to.position, to.nominal, to.pitch, to.level) == (
+                view.position,
+                view.nominal,
+                view.pitch,
+                view.level,
+            )
     # Twelve rotations in one direction come back to the start.
     index = 0
     for _ in range(12):

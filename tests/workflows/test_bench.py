@@ -18,8 +18,9 @@ def test_the_projection_counts_the_papers_images_and_farms() -> None:
 
 
 def test_the_grow_and_draw_bound_is_below_the_whole_cost() -> None:
-    ours = projection({c: 0.5 for c in CROPS}, {c: 30.0 for c in CROPS}, {c: 0.2 for c in CROPS},
-                      {c: 20.0 for c in CROPS})
+    ours = projection(
+        {c: 0.5 for c in CROPS}, {c: 30.0 for c in CROPS}, {c: 0.2 for c in CROPS}, {c: 20.0 for c in CROPS}
+    )
     assert 0 < ours["hours_one_machine_grow_and_draw_only"] < ours["hours_one_machine"]
     assert "hours_one_machine_grow_and_draw_only" not in projection({c: 0.5 for c in CROPS}, {c: 30.0 for c in CROPS})
 

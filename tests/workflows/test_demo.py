@@ -22,8 +22,9 @@ def _tiny_specs() -> tuple:
     return scenario, crop
 
 
-def test_demo_renders_validates_benchmarks_and_reports(tmp_path: Path, capsys: pytest.CaptureFixture[str],
-                                                       monkeypatch: pytest.MonkeyPatch) -> None:
+def test_demo_renders_validates_benchmarks_and_reports(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
     from davis_ag.scene.plants import require_native_helios
 
     try:
@@ -50,8 +51,7 @@ def test_demo_renders_validates_benchmarks_and_reports(tmp_path: Path, capsys: p
     assert (out / "report" / "results.json").is_file()
     assert (out / "dataset" / "splits.json").is_file()
     # Re-running reuses the finished scene instead of rendering it again.
-    assert run_demo(out, scenes=1, size=(96, 54), episodes=2, sessions=1, scenario=scenario,
-                    crop=crop) == 0
+    assert run_demo(out, scenes=1, size=(96, 54), episodes=2, sessions=1, scenario=scenario, crop=crop) == 0
     again = capsys.readouterr()
     assert "already complete" in again.out + again.err
     # ... but never one drawn at another size.

@@ -16,11 +16,19 @@ from davis_ag.benchmark.training import train_a2c
 
 def test_progress_of_a_resumed_run_starts_at_its_checkpoint(tmp_path: Path, one_thread: None) -> None:
     root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2)
-    kwargs = dict(total_timesteps=160, seed=1, out_path=tmp_path / "a2c", n_envs=2, arch="pooled",
-                  device="cpu", checkpoint_every=40)
+    kwargs = dict(
+        total_timesteps=160,
+        seed=1,
+        out_path=tmp_path / "a2c",
+        n_envs=2,
+        arch="pooled",
+        device="cpu",
+        checkpoint_every=40,
+    )
     with pytest.raises(KeyboardInterrupt):
-        train_a2c(root, "sp", callback=CallbackList([TrainingProgress(160, "t"), KillAfter(90)]), progress=False,
-                  **kwargs)
+        train_a2c(
+            root, "sp", callback=CallbackList([TrainingProgress(160, "t"), KillAfter(90)]), progress=False, **kwargs
+        )
     resumed = TrainingProgress(160, "t")
     train_a2c(root, "sp", callback=resumed, progress=False, **kwargs)
     # 80 steps came from the checkpoint and 80 from this sitting: the count ends at the total,
@@ -35,9 +43,10 @@ def test_the_configurations_table_in_the_docs_is_the_codes() -> None:
     page = (Path(__file__).resolve().parents[2] / "docs" / "benchmark.md").read_text()
     section = page.split(f"<!-- {CONFIGS_MARKER}:start -->\n", 1)[1].split(f"\n<!-- {CONFIGS_MARKER}:end -->", 1)[0]
     assert section == configurations_table(), (
-        "docs/benchmark.md is behind CONFIGS; rewrite it: python -c \"from davis_ag.atomic_files import "
+        'docs/benchmark.md is behind CONFIGS; rewrite it: python -c "from davis_ag.atomic_files import '
         "write_marked_section as w; from davis_ag.workflows import reproduce as r; "
-        "w('docs/benchmark.md', r.CONFIGS_MARKER, r.configurations_table())\"")
+        "w('docs/benchmark.md', r.CONFIGS_MARKER, r.configurations_table())\""
+    )
     # Issue 22: medium's MP split keeps at least 3 test scenes (70/30 of 10 or more).
     assert CONFIGS["medium"].mp_scenes >= 10 and "| `medium` | 10 scenes | 10 scenes," in section
 
@@ -70,4 +79,3 @@ def test_a_run_the_disk_cannot_hold_is_refused_before_anything_is_written(tmp_pa
     with pytest.raises(UserError, match=r"needs about .* GB more under .* GB free: free space, or pass --out"):
         reproduce(huge, out, tmp_path / "results.md")
     assert not out.exists() and not (tmp_path / "results.md").exists()
-

@@ -20,8 +20,10 @@ from davis_ag.workflows.results_page import (
 
 
 def paper_stats(scenario: str) -> dict:
-    return {name: {"oer_tau": {"mean": mean, "std": PAPER_TABLE4_STD[scenario]["oer_tau"][name]}}
-            for name, mean in PAPER_TABLE4[scenario]["oer_tau"].items()}
+    return {
+        name: {"oer_tau": {"mean": mean, "std": PAPER_TABLE4_STD[scenario]["oer_tau"][name]}}
+        for name, mean in PAPER_TABLE4[scenario]["oer_tau"].items()
+    }
 
 
 @pytest.mark.parametrize("scenario", ["sp", "mp"])
@@ -45,8 +47,11 @@ def test_an_ordering_fails_where_a_step_is_reversed_or_apart() -> None:
 def write_scene(root: Path, folder: str, version: str, plants: str | None = None) -> None:
     scene = root / "dataset" / folder
     scene.mkdir(parents=True)
-    meta = {"generator": {"version": version}, "camera": {"width": 640, "height": 360},
-            "renderer": {"name": "opengl", "look": "default", "antialiasing": "4x multisampled colour"}}
+    meta = {
+        "generator": {"version": version},
+        "camera": {"width": 640, "height": 360},
+        "renderer": {"name": "opengl", "look": "default", "antialiasing": "4x multisampled colour"},
+    }
     if plants is not None:
         meta["plant_generator"] = plants
     (scene / "scene.json").write_text(json.dumps(meta))
@@ -57,22 +62,37 @@ def test_a_run_resumed_across_code_changes_says_so(tmp_path: Path) -> None:
     write_scene(tmp_path, folders[0], "0.1.0+aaaa")
     write_scene(tmp_path, folders[1], "0.1.0+bbbb")
     (tmp_path / "models").mkdir()
-    record = {"timesteps": 300_000, "seconds": 7200.0, "steps_per_second": 41.7, "arch": "paper", "n_envs": 8,
-              "sittings": [{"code": "0.1.0+aaaa", "from_step": 0, "to_step": 120_000, "seconds": 3000.0},
-                           {"code": "0.1.0+bbbb", "from_step": 120_000, "to_step": 300_000, "seconds": 4200.0}]}
+    record = {
+        "timesteps": 300_000,
+        "seconds": 7200.0,
+        "steps_per_second": 41.7,
+        "arch": "paper",
+        "n_envs": 8,
+        "sittings": [
+            {"code": "0.1.0+aaaa", "from_step": 0, "to_step": 120_000, "seconds": 3000.0},
+            {"code": "0.1.0+bbbb", "from_step": 120_000, "to_step": 300_000, "seconds": 4200.0},
+        ],
+    }
     (tmp_path / "models" / "a2c_sp-strawberry.training.json").write_text(json.dumps(record))
     stat = {"mean": 0.5, "std": 0.01}
-    state = {"scene_folders": {"sp-strawberry": folders},
-             "results": {"sp": {"protocol": {"split": "test", "tau": 3, "sessions": 3, "episodes": 200,
-                                             "scenes": folders[1:]},
-                                "policies": {name: {"oer_tau": dict(stat, mean=m), "reward": stat, "length": stat}
-                                             for name, m in (("A2C", .6), ("Rand", .45), ("LRD", .44),
-                                                             ("UDD", .3))}}},
-             # What a resuming sitting (code bbbb) leaves in state.json: it re-records the generate
-             # stage it only skipped, and times only its own part of the training.
-             "stages": {"sp-strawberry: generate": {"seconds": 12.0, "note": "2 scenes", "code": "0.1.0+bbbb"},
-                        "sp-strawberry: train A2C": {"seconds": 4200.0, "note": "300000 steps, 71.4 steps/s",
-                                                     "code": "0.1.0+bbbb"}}}
+    state = {
+        "scene_folders": {"sp-strawberry": folders},
+        "results": {
+            "sp": {
+                "protocol": {"split": "test", "tau": 3, "sessions": 3, "episodes": 200, "scenes": folders[1:]},
+                "policies": {
+                    name: {"oer_tau": dict(stat, mean=m), "reward": stat, "length": stat}
+                    for name, m in (("A2C", 0.6), ("Rand", 0.45), ("LRD", 0.44), ("UDD", 0.3))
+                },
+            }
+        },
+        # What a resuming sitting (code bbbb) leaves in state.json: it re-records the generate
+        # stage it only skipped, and times only its own part of the training.
+        "stages": {
+            "sp-strawberry: generate": {"seconds": 12.0, "note": "2 scenes", "code": "0.1.0+bbbb"},
+            "sp-strawberry: train A2C": {"seconds": 4200.0, "note": "300000 steps, 71.4 steps/s", "code": "0.1.0+bbbb"},
+        },
+    }
     text = write_results_md(tmp_path / "results.md", CONFIGS["medium"], state, tmp_path).read_text()
     assert "0.1.0+aaaa (1 scene); 0.1.0+bbbb (1 scene) — made by more than one version of the code" in text
     assert "300,000 steps in 2 sitting(s)" in text and "the code changed between sittings" in text
@@ -82,8 +102,10 @@ def test_a_run_resumed_across_code_changes_says_so(tmp_path: Path) -> None:
     assert "do not edit by hand" in text and "How this run was made" in text
     # The stage table takes each stage's code from what did the work: the scenes, the sittings.
     assert "| sp-strawberry: generate | 12 | 0.1.0+aaaa (1 scene); 0.1.0+bbbb (1 scene) | 2 scenes |" in text
-    assert ("| sp-strawberry: train A2C | 7200 | 0.1.0+aaaa, 0.1.0+bbbb | 300,000 steps in 2 sitting(s), "
-            "41.7 steps/s over the sittings' wall time |") in text
+    assert (
+        "| sp-strawberry: train A2C | 7200 | 0.1.0+aaaa, 0.1.0+bbbb | 300,000 steps in 2 sitting(s), "
+        "41.7 steps/s over the sittings' wall time |"
+    ) in text
     assert "71.4" not in text and "| total | 7212 | | |" in text
 
 
@@ -94,9 +116,15 @@ def test_how_the_run_was_made_names_the_plants_and_the_a2c_settings(tmp_path: Pa
     write_scene(tmp_path, folders[1], "0.1.0+aaaa", plants="canopy")
     write_scene(tmp_path, folders[2], "0.1.0+aaaa")  # from before scene.json recorded its plants
     (tmp_path / "models").mkdir()
-    record = {"timesteps": 300_000, "seconds": 6000.0, "steps_per_second": 50.0, "arch": "paper", "n_envs": 8,
-              "a2c_settings": {"ent_coef": 0.01, "normalize_advantage": True},
-              "sittings": [{"code": "0.1.0+aaaa", "from_step": 0, "to_step": 300_000, "seconds": 6000.0}]}
+    record = {
+        "timesteps": 300_000,
+        "seconds": 6000.0,
+        "steps_per_second": 50.0,
+        "arch": "paper",
+        "n_envs": 8,
+        "a2c_settings": {"ent_coef": 0.01, "normalize_advantage": True},
+        "sittings": [{"code": "0.1.0+aaaa", "from_step": 0, "to_step": 300_000, "seconds": 6000.0}],
+    }
     (tmp_path / "models" / "a2c_sp-strawberry.training.json").write_text(json.dumps(record))
     state = {"scene_folders": {"sp-strawberry": folders}, "results": {}, "stages": {}}
     text = write_results_md(tmp_path / "results.md", CONFIGS["medium"], state, tmp_path).read_text()
@@ -104,13 +132,20 @@ def test_how_the_run_was_made_names_the_plants_and_the_a2c_settings(tmp_path: Pa
     assert "plants grown by `--plants canopy` (2 scenes); `--plants architecture` (1 scene)" in how
     assert "settings ent_coef=0.01, normalize_advantage=True over SB3's A2C defaults" in how
     assert "kept the last snapshot" in how  # a record from before snapshots were scored
-    record["selection"] = {"rule": "best-train", "every": 10_000, "episodes": 200, "play": "sampled",
-                           "kept_step": 120_000, "scores": [{"step": 120_000, "oer_tau": 0.561},
-                                                            {"step": 300_000, "oer_tau": 0.437}]}
+    record["selection"] = {
+        "rule": "best-train",
+        "every": 10_000,
+        "episodes": 200,
+        "play": "sampled",
+        "kept_step": 120_000,
+        "scores": [{"step": 120_000, "oer_tau": 0.561}, {"step": 300_000, "oer_tau": 0.437}],
+    }
     (tmp_path / "models" / "a2c_sp-strawberry.training.json").write_text(json.dumps(record))
     how = write_results_md(tmp_path / "results.md", CONFIGS["medium"], state, tmp_path).read_text()
-    assert ("kept the snapshot at 120,000 steps, the best of 2 scored on the train split (200 sampled "
-            "episodes each, every 10,000 steps): train OER_tau 0.561, the last snapshot's 0.437") in how
+    assert (
+        "kept the snapshot at 120,000 steps, the best of 2 scored on the train split (200 sampled "
+        "episodes each, every 10,000 steps): train OER_tau 0.561, the last snapshot's 0.437"
+    ) in how
     head = text.split("## How this run was made", 1)[0]
     assert "SB3 defaults" not in head and "A2C not evaluated yet" in head  # no play before an evaluation
 
@@ -121,16 +156,24 @@ def test_the_kept_snapshot_is_set_beside_the_best_fixed_action_on_train(tmp_path
     from davis_ag.workflows.results_policies import train_split_line
 
     (tmp_path / "models").mkdir()
-    record = {"selection": {"rule": "best-train", "every": 10_000, "episodes": 200, "play": "sampled",
-                            "kept_step": 240_000, "scores": [{"step": 240_000, "oer_tau": 0.565},
-                                                             {"step": 300_000, "oer_tau": 0.444}]}}
+    record = {
+        "selection": {
+            "rule": "best-train",
+            "every": 10_000,
+            "episodes": 200,
+            "play": "sampled",
+            "kept_step": 240_000,
+            "scores": [{"step": 240_000, "oer_tau": 0.565}, {"step": 300_000, "oer_tau": 0.444}],
+        }
+    }
     (tmp_path / "models" / "a2c_sp-strawberry.training.json").write_text(json.dumps(record))
     fixed = {a: {"oer_tau": v, "reward": 0.0, "length": 3.0} for a, v in (("up", 0.41), ("backward", 0.434))}
     result = {"train_split": {"split": "train", "starts": 176, "fixed_actions": fixed}}
     assert train_split_line("sp", result, tmp_path).startswith(
         "On the train split (176 eligible starts), where the snapshot was chosen: A2C's kept snapshot "
         "(240,000 steps) scores OER_tau .565 (200 sampled episodes), the best fixed action there (always "
-        "`backward`) .434 exactly, .131 above it; the last snapshot (300,000 steps) .444.")
+        "`backward`) .434 exactly, .131 above it; the last snapshot (300,000 steps) .444."
+    )
     fixed["backward"]["oer_tau"] = 0.6
     assert ".035 below it" in train_split_line("sp", result, tmp_path)
     # Without the yardstick (an evaluation from before it) or a scored run, no line.
@@ -144,26 +187,47 @@ def test_the_readme_block_beside_docs_is_rewritten_from_the_run(tmp_path: Path) 
     readme = tmp_path / "README.md"
     readme.write_text("# p\n\nbefore\n<!-- results-table4:start -->\nstale .999\n<!-- results-table4:end -->\nafter\n")
     stat = {"mean": 0.5, "std": 0.01}
-    policies = {name: {"oer_tau": dict(stat, mean=m), "reward": stat, "length": stat}
-                for name, m in (("A2C", .6), ("Rand", .45), ("LRD", .44), ("UDD", .3))}
-    state = {"results": {"sp": {"protocol": {"split": "test", "tau": 3, "sessions": 3, "episodes": 200,
-                                             "scenes": ["Single-Strawberry/003", "Single-Strawberry/007"]},
-                                "policies": policies,
-                                "a2c_vs_best_fixed": {"gap": 0.027, "low": 0.01, "high": 0.04, "episodes": 600,
-                                                      "per_scene": [{"scene": "Single-Strawberry/003", "gap": -0.2,
-                                                                     "episodes": 22, "starts": 1}]}}}}
+    policies = {
+        name: {"oer_tau": dict(stat, mean=m), "reward": stat, "length": stat}
+        for name, m in (("A2C", 0.6), ("Rand", 0.45), ("LRD", 0.44), ("UDD", 0.3))
+    }
+    state = {
+        "results": {
+            "sp": {
+                "protocol": {
+                    "split": "test",
+                    "tau": 3,
+                    "sessions": 3,
+                    "episodes": 200,
+                    "scenes": ["Single-Strawberry/003", "Single-Strawberry/007"],
+                },
+                "policies": policies,
+                "a2c_vs_best_fixed": {
+                    "gap": 0.027,
+                    "low": 0.01,
+                    "high": 0.04,
+                    "episodes": 600,
+                    "per_scene": [{"scene": "Single-Strawberry/003", "gap": -0.2, "episodes": 22, "starts": 1}],
+                },
+            }
+        }
+    }
     page = write_results_md(tmp_path / "docs" / "results.md", CONFIGS["medium"], state, tmp_path).read_text()
-    assert ("A2C minus `Best fixed action`: +.027, 95% bootstrap interval over episodes +.010 to +.040 (10,000 "
-            "resamples), above zero. Per test scene: Single-Strawberry/003 -.200 (22 episodes, 1 start); A2C is "
-            "ahead on 0 of 1.") in page
+    assert (
+        "A2C minus `Best fixed action`: +.027, 95% bootstrap interval over episodes +.010 to +.040 (10,000 "
+        "resamples), above zero. Per test scene: Single-Strawberry/003 -.200 (22 episodes, 1 start); A2C is "
+        "ahead on 0 of 1."
+    ) in page
     text = readme.read_text()
     assert "stale" not in text and text.startswith("# p\n\nbefore\n") and text.endswith("after\n")
     assert "| SP strawberry, ours (2 test scenes) | .600 ± .010 | .440 ± .010 | .300 ± .010 | .450 ± .010 | – |" in text
     assert "| SP strawberry, paper (Table 4) | .520 ± .004 | .433 ± .007 | .371 ± .008 | .438 ± .101 | - |" in text
     assert "| MP vine, ours | not run |" in text and "| MP vine, paper (Table 4) | .369 ± .009 |" in text
     assert "SP strawberry: A2C > Rand ~ LRD > UDD **holds**." in text
-    assert ("A2C minus `Best fixed action` on the same episodes (95% bootstrap interval over the test episodes): "
-            "SP strawberry +.027 (+.010 to +.040).") in text
+    assert (
+        "A2C minus `Best fixed action` on the same episodes (95% bootstrap interval over the test episodes): "
+        "SP strawberry +.027 (+.010 to +.040)."
+    ) in text
     # A page written elsewhere (a work folder beside the README) leaves the README alone.
     other = tmp_path / "work"
     other.mkdir()
@@ -174,11 +238,14 @@ def test_the_readme_block_beside_docs_is_rewritten_from_the_run(tmp_path: Path) 
 def test_a_broken_ordering_names_the_steps_that_break() -> None:
     # Our medium run's SP numbers: A2C .405 > Rand .388, but Rand and LRD are .030 apart with
     # stds .003 and .002, and UDD .360 is above LRD .358.
-    stats = {name: {"oer_tau": {"mean": m, "std": sd}} for name, m, sd in
-             (("A2C", .405, .002), ("Rand", .388, .003), ("LRD", .358, .002), ("UDD", .360, .005))}
+    stats = {
+        name: {"oer_tau": {"mean": m, "std": sd}}
+        for name, m, sd in (("A2C", 0.405, 0.002), ("Rand", 0.388, 0.003), ("LRD", 0.358, 0.002), ("UDD", 0.360, 0.005))
+    }
     assert ordering_failures(PAPER_ORDERINGS["sp"], stats) == [
         "Rand ~ LRD fails: .388 and .358 are .030 apart, more than their stds added (.005)",
-        "LRD > UDD fails: .358 is not above .360"]
+        "LRD > UDD fails: .358 is not above .360",
+    ]
     assert ordering_failures(PAPER_ORDERINGS["mp"], stats) == []  # A2C > Rand > LRD ~ UDD
 
 
@@ -189,8 +256,17 @@ def test_the_page_shows_what_each_policy_does(tmp_path: Path, sp_root: Path, one
     from davis_ag.workflows.reproduce import _summary
 
     (tmp_path / "docs").mkdir()
-    model = train_a2c(sp_root, "sp", total_timesteps=60, seed=0, out_path=tmp_path / "models" / "a2c_sp-strawberry",
-                      n_envs=2, arch="pooled", device="cpu", checkpoint_every=0)
+    model = train_a2c(
+        sp_root,
+        "sp",
+        total_timesteps=60,
+        seed=0,
+        out_path=tmp_path / "models" / "a2c_sp-strawberry",
+        n_envs=2,
+        arch="pooled",
+        device="cpu",
+        checkpoint_every=0,
+    )
     results = run_baselines(sp_root, "sp", "strawberry", "test", 20, 3, model=model)
     (tmp_path / "results").mkdir()
     (tmp_path / "results" / "sp-strawberry.json").write_text(json.dumps(results))
@@ -207,12 +283,15 @@ def test_the_page_shows_what_each_policy_does(tmp_path: Path, sp_root: Path, one
     assert "uniform over every eligible (view, target) pair" in text
     # Exact beside sampled, and each policy's action shares.
     lrd = policies["LRD"]
-    assert (f"| LRD | {_c(lrd['oer_tau']['mean'])} ± {_c(lrd['oer_tau']['sem'])} | {_c(lrd['exact']['oer_tau'])} |"
-            in text)
+    assert (
+        f"| LRD | {_c(lrd['oer_tau']['mean'])} ± {_c(lrd['oer_tau']['sem'])} | {_c(lrd['exact']['oer_tau'])} |" in text
+    )
     assert "| Policy | forward | backward | left | right | up | down | done |" in text
     # The episodes' drawn starts beside every start's mean OER_0 (always `done` ends where it starts).
-    assert (f"Mean start OER (OER_0) of these episodes: {_c(policies['LRD']['oer_0']['mean'])}, against "
-            f"{_c(results['fixed_actions']['done']['oer_tau'])} over every eligible start of the split (exact)") in text
+    assert (
+        f"Mean start OER (OER_0) of these episodes: {_c(policies['LRD']['oer_0']['mean'])}, against "
+        f"{_c(results['fixed_actions']['done']['oer_tau'])} over every eligible start of the split (exact)"
+    ) in text
     # Played as the benchmark plays it (sampled), the trained A2C is not one move repeated.
     shares = np.array(list(policies["A2C"]["action_counts"].values())) / sum(policies["A2C"]["action_counts"].values())
     assert (shares >= 0.05).sum() >= 2, policies["A2C"]["action_counts"]

@@ -14,8 +14,9 @@ from davis_ag.cli import main
 from davis_ag.workflows.transfer import PAPER_TABLE5
 
 
-def test_transfer_runs_end_to_end_offline(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
-                                          capsys: pytest.CaptureFixture) -> None:
+def test_transfer_runs_end_to_end_offline(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture
+) -> None:
     pretrain = write_tiny_dataset(tmp_path / "pretrain", "sp", "strawberry", scenes=2, size=(64, 48))
     held_out = write_tiny_dataset(tmp_path / "held-out", "sp", "strawberry", scenes=2, seed=5, size=(64, 48))
     assert main(["export", "yolo", str(held_out), str(tmp_path / "standin"), "--appearance-shift", "0"]) == 0
@@ -29,10 +30,33 @@ def test_transfer_runs_end_to_end_offline(tmp_path: Path, monkeypatch: pytest.Mo
     monkeypatch.setattr(socket, "getaddrinfo", refuse)
     monkeypatch.setattr(socket.socket, "connect", refuse)
     out = tmp_path / "out"
-    argv = ["transfer", "--pretrain", str(pretrain), "--real", str(tmp_path / "standin" / "data.yaml"),
-            "--real-label", "stand-in: shifted synthetic scenes", "--out", str(out), "--splits", "2",
-            "--train-size", "24", "--test-size", "8", "--epochs", "1", "--pretrain-epochs", "1",
-            "--imgsz", "64", "--batch", "8", "--results", str(tmp_path / "results.md")]
+    argv = [
+        "transfer",
+        "--pretrain",
+        str(pretrain),
+        "--real",
+        str(tmp_path / "standin" / "data.yaml"),
+        "--real-label",
+        "stand-in: shifted synthetic scenes",
+        "--out",
+        str(out),
+        "--splits",
+        "2",
+        "--train-size",
+        "24",
+        "--test-size",
+        "8",
+        "--epochs",
+        "1",
+        "--pretrain-epochs",
+        "1",
+        "--imgsz",
+        "64",
+        "--batch",
+        "8",
+        "--results",
+        str(tmp_path / "results.md"),
+    ]
     assert main(argv) == 0
     assert attempts == []
 
@@ -58,7 +82,19 @@ def test_transfer_runs_end_to_end_offline(tmp_path: Path, monkeypatch: pytest.Mo
 
 def test_transfer_with_a_missing_real_set_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
     pretrain = write_tiny_dataset(tmp_path / "pretrain", "sp", "strawberry", scenes=2, size=(64, 48))
-    assert main(["transfer", "--pretrain", str(pretrain), "--real", str(tmp_path / "nothing"),
-                 "--out", str(tmp_path / "out")]) == 2
+    assert (
+        main(
+            [
+                "transfer",
+                "--pretrain",
+                str(pretrain),
+                "--real",
+                str(tmp_path / "nothing"),
+                "--out",
+                str(tmp_path / "out"),
+            ]
+        )
+        == 2
+    )
     err = capsys.readouterr().err
     assert "not a labelled set" in err and len(err.strip().splitlines()) == 1

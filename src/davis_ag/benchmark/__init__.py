@@ -66,5 +66,15 @@ def __getattr__(name: str) -> Any:
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-__all__ = ["CONTINUOUS_ID", "ENV_IDS", "MAX_START_OER", "OBS_SIZE", "TVM_ID", "SceneCache", "TVMEnv",
-           "benchmark_steps", "evaluate", "load_scene_cache"]
+__all__ = [
+    "CONTINUOUS_ID",
+    "ENV_IDS",
+    "MAX_START_OER",
+    "OBS_SIZE",
+    "TVM_ID",
+    "SceneCache",
+    "TVMEnv",
+    "benchmark_steps",
+    "evaluate",
+    "load_scene_cache",
+]

@@ -44,9 +44,9 @@ class HeuristicAgent(SeededPolicy):
 
     def __init__(self, name: str, actions: tuple[str, ...] | None, seed: int | None = None) -> None:
         """Args:
-            name: Label in results tables.
-            actions: Action names to draw from; ``None`` means every action of the environment.
-            seed: Seed of the agent's generator until the next :meth:`reset` with a seed.
+        name: Label in results tables.
+        actions: Action names to draw from; ``None`` means every action of the environment.
+        seed: Seed of the agent's generator until the next :meth:`reset` with a seed.
         """
         super().__init__(seed)
         self.name = name
@@ -80,8 +80,8 @@ class FixedActionAgent:
 
     def __init__(self, action: str, name: str | None = None) -> None:
         """Args:
-            action: The action's name (``down``, ``done``, ...).
-            name: Label in results tables (default ``always <action>``).
+        action: The action's name (``down``, ``done``, ...).
+        name: Label in results tables (default ``always <action>``).
         """
         self.action = action
         self.name = name or f"always {action}"
@@ -190,8 +190,10 @@ class OracleAgent:
 
 #: Baseline names :func:`build_agents` accepts (trained models come from
 #: :func:`davis_ag.benchmark.policies.policy_from_spec`), and what makes each.
-BASELINES: dict[str, Any] = {**{name: (lambda name=name: heuristic(name)) for name in HEURISTIC_ACTIONS},
-                             "Oracle": OracleAgent}
+BASELINES: dict[str, Any] = {
+    **{name: (lambda name=name: heuristic(name)) for name in HEURISTIC_ACTIONS},
+    "Oracle": OracleAgent,
+}
 AGENT_NAMES: tuple[str, ...] = tuple(BASELINES)
 
 

@@ -16,8 +16,11 @@ ALGORITHMS: tuple[str, ...] = ("a2c", "ppo", "dqn")
 #: Not tuned: the paper trains A2C only, and no change was measured on the train split.
 SB3_SETTINGS: dict[str, dict[str, Any]] = {
     "ppo": {},
-    "dqn": {"buffer_size": 10_000, "optimize_memory_usage": True,
-            "replay_buffer_kwargs": {"handle_timeout_termination": False}},
+    "dqn": {
+        "buffer_size": 10_000,
+        "optimize_memory_usage": True,
+        "replay_buffer_kwargs": {"handle_timeout_termination": False},
+    },
 }
 
 

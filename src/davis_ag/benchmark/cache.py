@@ -93,8 +93,17 @@ class SceneCache:
 # vectorised learner share tables and memory maps instead of re-reading them.
 _OPEN: dict[tuple[str, str], SceneCache] = {}
 
-_TABLES = ("pointers", "fruit_ids", "box_index", "box_view", "box_fruit", "box_xywh",
-           "box_scaled", "box_oer", "box_pixels")
+_TABLES = (
+    "pointers",
+    "fruit_ids",
+    "box_index",
+    "box_view",
+    "box_fruit",
+    "box_xywh",
+    "box_scaled",
+    "box_oer",
+    "box_pixels",
+)
 
 
 def scene_fingerprint(scene: Any, root: Path) -> str:
@@ -132,8 +141,7 @@ def annotations_path(scene: Any, root: Path) -> Path:
     return Path(path) if path is not None else Path(root) / scene.id / ANNOTATIONS
 
 
-def scaled_box(xmin: int, ymin: int, width: int, height: int,
-               image_size: tuple[int, int]) -> tuple[int, int, int, int]:
+def scaled_box(xmin: int, ymin: int, width: int, height: int, image_size: tuple[int, int]) -> tuple[int, int, int, int]:
     """Map a box in original pixels to inclusive (x0, y0, x1, y1) in the 224x224 image.
 
     Rounded outwards (floor of the start, ceiling of the end) so that a fruit never falls out
@@ -177,7 +185,8 @@ def _resized_image(view: Any) -> tuple[np.ndarray, tuple[int, int]]:
         image = view.image()
         size = (image.shape[1], image.shape[0])
         small = Image.fromarray(np.ascontiguousarray(image[..., :3])).resize(
-            (OBS_SIZE, OBS_SIZE), Image.Resampling.BILINEAR)
+            (OBS_SIZE, OBS_SIZE), Image.Resampling.BILINEAR
+        )
     return np.asarray(small, dtype=np.uint8), size
 
 
@@ -191,8 +200,9 @@ def _build(scene: Any, folder: Path, fingerprint: str) -> None:
         raise UserError(f"{scene.annotations_path}: scene {scene.id} has no views; check its annotations.json")
     names = [view.name for view in views]
     position = {name: i for i, name in enumerate(names)}
-    images = np.lib.format.open_memmap(folder / "images.npy", mode="w+", dtype=np.uint8,
-                                       shape=(len(views), OBS_SIZE, OBS_SIZE, 4))
+    images = np.lib.format.open_memmap(
+        folder / "images.npy", mode="w+", dtype=np.uint8, shape=(len(views), OBS_SIZE, OBS_SIZE, 4)
+    )
     pointers = np.full((len(views), len(ALL_ACTIONS)), -1, dtype=np.int32)
     rows: list[tuple[int, int, tuple[int, int, int, int], float, int]] = []
     image_size: tuple[int, int] | None = None
@@ -201,31 +211,44 @@ def _build(scene: Any, folder: Path, fingerprint: str) -> None:
         if mask is None:
             raise UserError(
                 f"{view.mask_path}: missing; scene {scene.id} view {view.name} has no segmentation "
-                "mask and the exposure rate needs masks: use a download or generation that includes them")
+                "mask and the exposure rate needs masks: use a download or generation that includes them"
+            )
         resized, (width, height) = _resized_image(view)
         if mask.shape != (height, width):
-            raise UserError(f"{view.mask_path}: mask is {mask.shape[1]}x"
-                            f"{mask.shape[0]}, image {width}x{height}; regenerate the mask")
+            raise UserError(
+                f"{view.mask_path}: mask is {mask.shape[1]}x"
+                f"{mask.shape[0]}, image {width}x{height}; regenerate the mask"
+            )
         if image_size is None:
             image_size = (width, height)
         elif image_size != (width, height):
-            raise UserError(f"{view.image_path}: {width}x{height}, the first "
-                            f"view {image_size[0]}x{image_size[1]}; all views must share a size")
+            raise UserError(
+                f"{view.image_path}: {width}x{height}, the first "
+                f"view {image_size[0]}x{image_size[1]}; all views must share a size"
+            )
         images[i, :, :, :3] = resized
         images[i, :, :, 3] = 0
         for j, action in enumerate(ALL_ACTIONS):
             target = view.pointers.get(action, "")
             if target:
                 if target not in position:
-                    raise UserError(f"{scene.annotations_path}: view {view.name}'s {action} points to "
-                                    f"missing view {target!r}; fix annotations.json or regenerate the scene")
+                    raise UserError(
+                        f"{scene.annotations_path}: view {view.name}'s {action} points to "
+                        f"missing view {target!r}; fix annotations.json or regenerate the scene"
+                    )
                 pointers[i, j] = position[target]
         # One bincount gives every fruit's visible pixel count in the view.
         counts = np.bincount(mask.ravel(), minlength=256)
         for box in view.boxes:
-            rows.append((i, int(box.fruit_id), (int(box.xmin), int(box.ymin), int(box.width),
-                         int(box.height)), float(exposure_rate(mask, box)),
-                         int(counts[int(box.fruit_id)]) if 0 <= box.fruit_id < 256 else 0))
+            rows.append(
+                (
+                    i,
+                    int(box.fruit_id),
+                    (int(box.xmin), int(box.ymin), int(box.width), int(box.height)),
+                    float(exposure_rate(mask, box)),
+                    int(counts[int(box.fruit_id)]) if 0 <= box.fruit_id < 256 else 0,
+                )
+            )
     images.flush()
     del images
     assert image_size is not None
@@ -243,14 +266,19 @@ def _build(scene: Any, folder: Path, fingerprint: str) -> None:
         "box_view": np.array([r[0] for r in rows], dtype=np.int32),
         "box_fruit": np.array([column[r[1]] for r in rows], dtype=np.int32),
         "box_xywh": np.array([r[2] for r in rows], dtype=np.int32).reshape(-1, 4),
-        "box_scaled": np.array([scaled_box(*r[2], image_size) for r in rows],
-                               dtype=np.int32).reshape(-1, 4),
+        "box_scaled": np.array([scaled_box(*r[2], image_size) for r in rows], dtype=np.int32).reshape(-1, 4),
         "box_oer": np.array([r[3] for r in rows], dtype=np.float32),
         "box_pixels": np.array([r[4] for r in rows], dtype=np.int32),
     }
     np.savez(folder / "tables.npz", **tables)
-    meta = {"version": CACHE_VERSION, "fingerprint": fingerprint, "scene": scene.id,
-            "views": names, "image_size": list(image_size), "actions": list(ALL_ACTIONS)}
+    meta = {
+        "version": CACHE_VERSION,
+        "fingerprint": fingerprint,
+        "scene": scene.id,
+        "views": names,
+        "image_size": list(image_size),
+        "actions": list(ALL_ACTIONS),
+    }
     (folder / "meta.json").write_text(json.dumps(meta))
 
 
@@ -267,9 +295,13 @@ def _load(folder: Path, fingerprint: str) -> SceneCache | None:
         with np.load(files[1], allow_pickle=False) as npz:
             tables = {name: np.asarray(npz[name]) for name in _TABLES}
         images = np.load(files[2], mmap_mode="r", allow_pickle=False)
-        cache = SceneCache(scene_id=str(meta["scene"]), view_names=tuple(str(v) for v in meta["views"]),
-                           image_size=(int(meta["image_size"][0]), int(meta["image_size"][1])),
-                           images=images, **tables)
+        cache = SceneCache(
+            scene_id=str(meta["scene"]),
+            view_names=tuple(str(v) for v in meta["views"]),
+            image_size=(int(meta["image_size"][0]), int(meta["image_size"][1])),
+            images=images,
+            **tables,
+        )
     except Exception:  # noqa: BLE001 - whatever is wrong with it, the cache is rebuilt
         return None
     return cache if _consistent(cache) else None
@@ -280,21 +312,29 @@ def _consistent(cache: SceneCache) -> bool:
     n, n_boxes, n_fruits = cache.n_views, len(cache.box_view), len(cache.fruit_ids)
 
     def ints(array: np.ndarray, shape: tuple[int, ...], low: int, high: int) -> bool:
-        return (array.shape == shape and array.dtype.kind in "iu"
-                and (array.size == 0 or (int(array.min()) >= low and int(array.max()) < high)))
+        return (
+            array.shape == shape
+            and array.dtype.kind in "iu"
+            and (array.size == 0 or (int(array.min()) >= low and int(array.max()) < high))
+        )
 
-    return (n > 0 and min(cache.image_size) > 0
-            and cache.images.shape == (n, OBS_SIZE, OBS_SIZE, 4) and cache.images.dtype == np.uint8
-            and ints(cache.pointers, (n, len(ALL_ACTIONS)), -1, n)
-            and ints(cache.fruit_ids, (n_fruits,), -2**31, 2**31)
-            and ints(cache.box_index, (n, n_fruits), -1, n_boxes)
-            and ints(cache.box_view, (n_boxes,), 0, n)
-            and ints(cache.box_fruit, (n_boxes,), 0, max(n_fruits, 1))
-            and ints(cache.box_xywh, (n_boxes, 4), -2**31, 2**31)
-            and ints(cache.box_scaled, (n_boxes, 4), 0, OBS_SIZE)
-            and cache.box_oer.shape == (n_boxes,) and cache.box_oer.dtype.kind == "f"
-            and bool(np.all(np.isfinite(cache.box_oer)))
-            and ints(cache.box_pixels, (n_boxes,), 0, 2**31))
+    return (
+        n > 0
+        and min(cache.image_size) > 0
+        and cache.images.shape == (n, OBS_SIZE, OBS_SIZE, 4)
+        and cache.images.dtype == np.uint8
+        and ints(cache.pointers, (n, len(ALL_ACTIONS)), -1, n)
+        and ints(cache.fruit_ids, (n_fruits,), -(2**31), 2**31)
+        and ints(cache.box_index, (n, n_fruits), -1, n_boxes)
+        and ints(cache.box_view, (n_boxes,), 0, n)
+        and ints(cache.box_fruit, (n_boxes,), 0, max(n_fruits, 1))
+        and ints(cache.box_xywh, (n_boxes, 4), -(2**31), 2**31)
+        and ints(cache.box_scaled, (n_boxes, 4), 0, OBS_SIZE)
+        and cache.box_oer.shape == (n_boxes,)
+        and cache.box_oer.dtype.kind == "f"
+        and bool(np.all(np.isfinite(cache.box_oer)))
+        and ints(cache.box_pixels, (n_boxes,), 0, 2**31)
+    )
 
 
 def cache_folder(scene: Any, root: Path, cache_dir: str | os.PathLike[str] | None) -> Path:
@@ -303,8 +343,7 @@ def cache_folder(scene: Any, root: Path, cache_dir: str | os.PathLike[str] | Non
     return base / scene.id
 
 
-def load_scene_cache(scene: Any, root: Path,
-                     cache_dir: str | os.PathLike[str] | None = None) -> SceneCache:
+def load_scene_cache(scene: Any, root: Path, cache_dir: str | os.PathLike[str] | None = None) -> SceneCache:
     """Open a scene's cache, building (or rebuilding a stale one) first.
 
     Args:
@@ -330,8 +369,10 @@ def load_scene_cache(scene: Any, root: Path,
         folder.parent.mkdir(parents=True, exist_ok=True)
         tmp = Path(tempfile.mkdtemp(prefix=f".{folder.name}.tmp-", dir=folder.parent))
     except OSError as error:
-        raise UserError(f"cannot write the observation cache under {folder.parent}: "
-                        f"{error.strerror}; pass a writable cache_dir (--cache-dir)") from error
+        raise UserError(
+            f"cannot write the observation cache under {folder.parent}: "
+            f"{error.strerror}; pass a writable cache_dir (--cache-dir)"
+        ) from error
     try:
         _build(scene, tmp, fingerprint)
         if folder.exists():
@@ -351,7 +392,8 @@ def load_scene_cache(scene: Any, root: Path,
         shutil.rmtree(tmp, ignore_errors=True)
     cache = _load(folder, fingerprint)
     if cache is None:
-        raise UserError(f"the observation cache at {folder} could not be read back after "
-                        "building; delete that folder and retry")
+        raise UserError(
+            f"the observation cache at {folder} could not be read back after building; delete that folder and retry"
+        )
     _OPEN[key] = cache
     return cache

@@ -88,8 +88,10 @@ def _act(policy: Any, observation: Any, info: dict[str, Any]) -> Any:
         raise
     except Exception as error:  # noqa: BLE001 - any failure of someone else's code
         frame = traceback.extract_tb(error.__traceback__)[-1]
-        raise UserError(f"act failed with {type(error).__name__}: {error} (at {frame.filename}:{frame.lineno}); "
-                        "fix the policy and evaluate again") from None
+        raise UserError(
+            f"act failed with {type(error).__name__}: {error} (at {frame.filename}:{frame.lineno}); "
+            "fix the policy and evaluate again"
+        ) from None
 
 
 def run_episode(env: Any, policy: Any, reset_seed: int, policy_seed: int | None = None) -> dict[str, Any]:
@@ -119,22 +121,33 @@ def run_episode(env: Any, policy: Any, reset_seed: int, policy_seed: int | None 
         except UserError as error:
             raise UserError(f"policy {policy.name}: {error}") from None
         discrete = hasattr(env.action_space, "n")
-        actions.append(int(np.asarray(action).reshape(())) if discrete
-                       else [round(float(a), 4) for a in np.asarray(action, dtype=float).reshape(-1)])
+        actions.append(
+            int(np.asarray(action).reshape(()))
+            if discrete
+            else [round(float(a), 4) for a in np.asarray(action, dtype=float).reshape(-1)]
+        )
         total += float(reward)
         refused += bool(info.get("refused"))
         if terminated or truncated:
             break
-    record = {"oer_0": float(info["oer_0"]), "oer_tau": float(info["oer_t"]), "reward": total,
-              "length": len(actions), "scene": info["scene"], "target_fruit": int(info["target_fruit"]),
-              "path": list(info["path"]), "actions": actions}
+    record = {
+        "oer_0": float(info["oer_0"]),
+        "oer_tau": float(info["oer_t"]),
+        "reward": total,
+        "length": len(actions),
+        "scene": info["scene"],
+        "target_fruit": int(info["target_fruit"]),
+        "path": list(info["path"]),
+        "actions": actions,
+    }
     if "refused" in info:
         record["refused"] = refused
     return record
 
 
-def play_sessions(env: Any, policy: Any, keys: tuple[str, ...], seed: int, sessions: int,
-                  episodes: int) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+def play_sessions(
+    env: Any, policy: Any, keys: tuple[str, ...], seed: int, sessions: int, episodes: int
+) -> tuple[dict[str, Any], list[dict[str, Any]]]:
     """Play ``sessions`` x ``episodes`` seeded episodes (the same for every policy) and summarise.
 
     Returns:
@@ -149,14 +162,27 @@ def play_sessions(env: Any, policy: Any, keys: tuple[str, ...], seed: int, sessi
         for key in per_session:
             per_session[key].append(float(np.mean([run[key] for run in runs])))
         records.extend({"session": session, **run} for run in runs)
-    summary = {key: {"mean": float(np.mean(v)), "std": float(np.std(v)),
-                     "sem": float(np.std([r[key] for r in records]) / np.sqrt(len(records))), "sessions": v}
-               for key, v in per_session.items()}
+    summary = {
+        key: {
+            "mean": float(np.mean(v)),
+            "std": float(np.std(v)),
+            "sem": float(np.std([r[key] for r in records]) / np.sqrt(len(records))),
+            "sessions": v,
+        }
+        for key, v in per_session.items()
+    }
     return summary, records
 
 
-def evaluate_policies(env: Any, policies: list[Any], episodes: int = 200, sessions: int = 3, seed: int = 0,
-                      keep_episodes: bool = False, best_fixed_action: bool = False) -> EvaluationResults:
+def evaluate_policies(
+    env: Any,
+    policies: list[Any],
+    episodes: int = 200,
+    sessions: int = 3,
+    seed: int = 0,
+    keep_episodes: bool = False,
+    best_fixed_action: bool = False,
+) -> EvaluationResults:
     """Run every policy on the same episodes and summarise as Table 4 (see the module docstring).
 
     Args:
@@ -220,17 +246,24 @@ def evaluate_policies(env: Any, policies: list[Any], episodes: int = 200, sessio
         rows[policy.name] = summary
     for name, row in rows.items():
         row["paired"] = paired_gaps(name, records, seed)
-    return EvaluationResults(protocol=protocol, dataset=identify_dataset(protocol.dataset), code=code_version(),
-                             policies={n: PolicyResult.model_validate(r) for n, r in rows.items()},
-                             fixed_actions=fixed)
+    return EvaluationResults(
+        protocol=protocol,
+        dataset=identify_dataset(protocol.dataset),
+        code=code_version(),
+        policies={n: PolicyResult.model_validate(r) for n, r in rows.items()},
+        fixed_actions=fixed,
+    )
 
 
 def paired_gaps(name: str, records: dict[str, list[dict[str, Any]]], seed: int) -> dict[str, PairedGap]:
     """The paired gap of policy ``name`` to each of :data:`PAIRED_BASELINES` that played too."""
     from davis_ag.benchmark.paired import paired_gap
 
-    return {baseline: PairedGap.model_validate(asdict(paired_gap(records[name], records[baseline], seed=seed)))
-            for baseline in PAIRED_BASELINES if baseline in records and baseline != name}
+    return {
+        baseline: PairedGap.model_validate(asdict(paired_gap(records[name], records[baseline], seed=seed)))
+        for baseline in PAIRED_BASELINES
+        if baseline in records and baseline != name
+    }
 
 
 def format_table(results: EvaluationResults | dict[str, Any]) -> str:
@@ -257,26 +290,37 @@ def format_table(results: EvaluationResults | dict[str, Any]) -> str:
     has_exact = any(policies[name].exact for name in names)
     if has_exact:
         for key, title in METRICS.items():
-            cells.append(["", f"{title} exact", *(table_number(policies[n].exact[key]) if policies[n].exact else "-"
-                                                  for n in names)])
+            cells.append(
+                [
+                    "",
+                    f"{title} exact",
+                    *(table_number(policies[n].exact[key]) if policies[n].exact else "-" for n in names),
+                ]
+            )
     baselines = [b for b in PAIRED_BASELINES if b in policies]
     for baseline in baselines:
         row = ["", f"gap to {baseline}"]
         for name in names:
             gap = policies[name].paired.get(baseline)
-            row.append(f"{signed_number(gap.gap)} [{signed_number(gap.low)}, {signed_number(gap.high)}]" if gap else "-")
+            row.append(
+                f"{signed_number(gap.gap)} [{signed_number(gap.low)}, {signed_number(gap.high)}]" if gap else "-"
+            )
         cells.append(row)
     widths = [max(len(row[i]) for row in cells) for i in range(len(cells[0]))]
     lines = ["  ".join(c.ljust(w) for c, w in zip(row, widths)).rstrip() for row in cells]
     lines.insert(1, "-" * len(lines[0]))
-    lines.append(f"mean ±std over sessions; {split_text(protocol)}"
-                 + ("; exact: expectation over the split's starts" if has_exact else ""))
+    lines.append(
+        f"mean ±std over sessions; {split_text(protocol)}"
+        + ("; exact: expectation over the split's starts" if has_exact else "")
+    )
     if baselines:
-        lines.append("gap: mean OER_tau minus the baseline's on the same episodes, [95 % bootstrap interval "
-                     "over episodes]")
+        lines.append(
+            "gap: mean OER_tau minus the baseline's on the same episodes, [95 % bootstrap interval over episodes]"
+        )
     if BEST_FIXED in policies:
-        lines.append(f"{BEST_FIXED}: always {policies[BEST_FIXED].action}, the best single action "
-                     "by exact OER_tau on this split")
+        lines.append(
+            f"{BEST_FIXED}: always {policies[BEST_FIXED].action}, the best single action by exact OER_tau on this split"
+        )
     return "\n".join(lines)
 
 
@@ -285,10 +329,22 @@ def write_json(results: EvaluationResults | dict[str, Any], path: str | os.PathL
     return as_results(results).write(path)
 
 
-def evaluate(policies: list[Any], dataset: Any, scenario: str = "sp", split: str = "test", sessions: int = 3,
-             episodes: int = 200, seed: int = 0, *, env: str = "grid", crop: str | None = None,
-             baselines: bool | list[str] = True, deterministic: bool | None = None,
-             cache_dir: str | os.PathLike[str] | None = None, keep_episodes: bool = True) -> EvaluationResults:
+def evaluate(
+    policies: list[Any],
+    dataset: Any,
+    scenario: str = "sp",
+    split: str = "test",
+    sessions: int = 3,
+    episodes: int = 200,
+    seed: int = 0,
+    *,
+    env: str = "grid",
+    crop: str | None = None,
+    baselines: bool | list[str] = True,
+    deterministic: bool | None = None,
+    cache_dir: str | os.PathLike[str] | None = None,
+    keep_episodes: bool = True,
+) -> EvaluationResults:
     """Score policies beside the baselines with section V-C's protocol (``davis_ag.benchmark.evaluate``).
 
     Args:
@@ -322,8 +378,9 @@ def evaluate(policies: list[Any], dataset: Any, scenario: str = "sp", split: str
     if env not in ENVIRONMENTS:
         raise UserError(f"unknown env {env!r}: choose one of {', '.join(ENVIRONMENTS)}")
     play = DETERMINISTIC_PLAY if deterministic is None else deterministic
-    chosen = [policy_from_spec(p, deterministic=play) if isinstance(p, (str, os.PathLike)) else as_policy(p)
-              for p in policies]
+    chosen = [
+        policy_from_spec(p, deterministic=play) if isinstance(p, (str, os.PathLike)) else as_policy(p) for p in policies
+    ]
     names, builder = ENVIRONMENTS[env]
     if baselines:
         build = gym.envs.registration.load_env_creator(builder)
@@ -333,8 +390,15 @@ def evaluate(policies: list[Any], dataset: Any, scenario: str = "sp", split: str
         kwargs["cache_dir"] = cache_dir
     made = gym.make(TVM_ID if env == "grid" else CONTINUOUS_ID, disable_env_checker=True, **kwargs)
     try:
-        results = evaluate_policies(made, chosen, episodes=episodes, sessions=sessions, seed=seed,
-                                    keep_episodes=keep_episodes, best_fixed_action=env == "grid" and bool(baselines))
+        results = evaluate_policies(
+            made,
+            chosen,
+            episodes=episodes,
+            sessions=sessions,
+            seed=seed,
+            keep_episodes=keep_episodes,
+            best_fixed_action=env == "grid" and bool(baselines),
+        )
     finally:
         made.close()
     results.protocol.crop = crop

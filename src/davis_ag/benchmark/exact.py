@@ -55,8 +55,7 @@ def start_expectations(env: TVMEnv, probs: np.ndarray) -> dict[str, np.ndarray]:
     inner: TVMEnv = getattr(env, "unwrapped", env)
     probs = np.asarray(probs, dtype=float)
     if probs.shape != (len(inner.action_names),) or not np.isclose(probs.sum(), 1.0) or (probs < 0).any():
-        raise UserError(f"action probabilities must be {len(inner.action_names)} non-negative numbers "
-                        "summing to 1")
+        raise UserError(f"action probabilities must be {len(inner.action_names)} non-negative numbers summing to 1")
     p_done = float(probs[inner.done_action])
     moves = [(a, float(p)) for a, p in enumerate(probs[: inner.done_action]) if p > 0]
     starts = inner.starts
@@ -112,8 +111,9 @@ def expected_metrics(env: TVMEnv, probs: np.ndarray) -> dict[str, float]:
 def fixed_action_expectations(env: TVMEnv) -> dict[str, dict[str, float]]:
     """:func:`expected_metrics` of every policy that always plays one action, by action name."""
     inner: TVMEnv = getattr(env, "unwrapped", env)
-    return {name: expected_metrics(inner, np.eye(len(inner.action_names))[a])
-            for a, name in enumerate(inner.action_names)}
+    return {
+        name: expected_metrics(inner, np.eye(len(inner.action_names))[a]) for a, name in enumerate(inner.action_names)
+    }
 
 
 def split_fixed_actions(dataset: Any, scenario: str, split: str, crop: str | None) -> dict[str, Any]:

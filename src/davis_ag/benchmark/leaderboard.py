@@ -44,10 +44,18 @@ class Row:
 def _identity(results: EvaluationResults) -> dict[str, object]:
     """What must agree for two results to be ranked together, by what a message calls it."""
     p = results.protocol
-    return {"protocol version": p.version,
-            "dataset": results.dataset.fingerprint if results.dataset else None,
-            "environment": p.environment, "scenario": p.scenario, "crop": p.crop, "split": p.split,
-            "test scenes": tuple(p.scenes), "tau": p.tau, "start rule": p.start_rule, "eligible starts": p.starts}
+    return {
+        "protocol version": p.version,
+        "dataset": results.dataset.fingerprint if results.dataset else None,
+        "environment": p.environment,
+        "scenario": p.scenario,
+        "crop": p.crop,
+        "split": p.split,
+        "test scenes": tuple(p.scenes),
+        "tau": p.tau,
+        "start rule": p.start_rule,
+        "eligible starts": p.starts,
+    }
 
 
 def check_comparable(files: list[tuple[Path, EvaluationResults]]) -> None:
@@ -58,8 +66,10 @@ def check_comparable(files: list[tuple[Path, EvaluationResults]]) -> None:
     """
     (first, base), others = files[0], files[1:]
     if base.protocol.version == 0:
-        raise UserError(f"{first} was written before results files had a protocol version: evaluate again "
-                        "with this davis-ag to rank it")
+        raise UserError(
+            f"{first} was written before results files had a protocol version: evaluate again "
+            "with this davis-ag to rank it"
+        )
     if base.dataset is None:
         raise UserError(f"{first} does not record its dataset's identity: evaluate again with this davis-ag to rank it")
     wanted = _identity(base)
@@ -67,8 +77,10 @@ def check_comparable(files: list[tuple[Path, EvaluationResults]]) -> None:
         found = _identity(results)
         for key, value in wanted.items():
             if found[key] != value:
-                raise UserError(f"{path} and {first} differ in {key} ({_shown(found[key])} against {_shown(value)}): "
-                                "results of different datasets, splits or protocol versions cannot be ranked together")
+                raise UserError(
+                    f"{path} and {first} differ in {key} ({_shown(found[key])} against {_shown(value)}): "
+                    "results of different datasets, splits or protocol versions cannot be ranked together"
+                )
 
 
 def _shown(value: Any) -> Any:
@@ -81,8 +93,9 @@ def _same_episodes(a: EvaluationResults, b: EvaluationResults) -> bool:
     return (pa.seed, pa.sessions, pa.episodes) == (pb.seed, pb.sessions, pb.episodes)
 
 
-def _gap(row_results: EvaluationResults, policy: PolicyResult, baseline: str,
-         files: list[tuple[Path, EvaluationResults]]) -> PairedGap | None:
+def _gap(
+    row_results: EvaluationResults, policy: PolicyResult, baseline: str, files: list[tuple[Path, EvaluationResults]]
+) -> PairedGap | None:
     """The row's gap to ``baseline``: its own file's, else across files that played the same episodes."""
     if baseline in policy.paired:
         return policy.paired[baseline]
@@ -94,8 +107,11 @@ def _gap(row_results: EvaluationResults, policy: PolicyResult, baseline: str,
         theirs = other.policies.get(baseline)
         if theirs is not None and theirs.episodes and _same_episodes(row_results, other):
             try:
-                gap = paired_gap([e.model_dump() for e in policy.episodes], [e.model_dump() for e in theirs.episodes],
-                                 seed=row_results.protocol.seed)
+                gap = paired_gap(
+                    [e.model_dump() for e in policy.episodes],
+                    [e.model_dump() for e in theirs.episodes],
+                    seed=row_results.protocol.seed,
+                )
             except ValueError:  # not the same starts after all
                 continue
             return PairedGap.model_validate(asdict(gap))
@@ -137,18 +153,29 @@ def format_leaderboard(rows: list[Row]) -> str:
     dataset = rows[0].results.dataset
     sampling = sorted({split_text(r.results.protocol) for r in rows})
     baselines = [b for b in PAIRED_BASELINES if any(r.gaps.get(b) for r in rows)]
-    lines = [f"# Leaderboard: {protocol.scenario.upper()}{' ' + protocol.crop if protocol.crop else ''}, "
-             f"{protocol.environment}, {protocol.split} split", "",
-             "What the numbers rest on: " + "; ".join(sampling) + ". "
-             f"Dataset {dataset.fingerprint} ({len(dataset.scenes)} scenes), protocol version {protocol.version}.", "",
-             "| Rank | Method | OER_tau | Cum. reward | Ep. length | "
-             + " | ".join(f"Gap to {b} [95 %]" for b in baselines) + (" | " if baselines else "") + "File |",
-             "|---:|---|---:|---:|---:|" + "---:|" * len(baselines) + "---|"]
+    lines = [
+        f"# Leaderboard: {protocol.scenario.upper()}{' ' + protocol.crop if protocol.crop else ''}, "
+        f"{protocol.environment}, {protocol.split} split",
+        "",
+        "What the numbers rest on: " + "; ".join(sampling) + ". "
+        f"Dataset {dataset.fingerprint} ({len(dataset.scenes)} scenes), protocol version {protocol.version}.",
+        "",
+        "| Rank | Method | OER_tau | Cum. reward | Ep. length | "
+        + " | ".join(f"Gap to {b} [95 %]" for b in baselines)
+        + (" | " if baselines else "")
+        + "File |",
+        "|---:|---|---:|---:|---:|" + "---:|" * len(baselines) + "---|",
+    ]
     for rank, row in enumerate(rows, 1):
         p = row.policy
-        cells = [str(rank), row.name] + [f"{table_number(m.mean)} ±{table_number(m.std)}" for m in (p.oer_tau, p.reward, p.length)]
+        cells = [str(rank), row.name] + [
+            f"{table_number(m.mean)} ±{table_number(m.std)}" for m in (p.oer_tau, p.reward, p.length)
+        ]
         cells += [_gap_cell(row.gaps.get(b)) for b in baselines] + [row.file.name]
         lines.append("| " + " | ".join(cells) + " |")
-    lines += ["", "Mean ± std over sessions. Gap: mean OER_tau minus the baseline's on the same episodes, with the "
-              "95 % bootstrap interval over episodes; `-`: the baseline itself, or a method that did not play the same episodes."]
+    lines += [
+        "",
+        "Mean ± std over sessions. Gap: mean OER_tau minus the baseline's on the same episodes, with the "
+        "95 % bootstrap interval over episodes; `-`: the baseline itself, or a method that did not play the same episodes.",
+    ]
     return "\n".join(lines) + "\n"

@@ -40,8 +40,9 @@ class RefusedMoves:
         return (self.no_view + self.target_lost) / self.moves if self.moves else float("nan")
 
 
-def refused_moves(cache: SceneCache, actions: tuple[str, ...], min_pixels: float,
-                  max_start_oer: float = MAX_START_OER) -> RefusedMoves:
+def refused_moves(
+    cache: SceneCache, actions: tuple[str, ...], min_pixels: float, max_start_oer: float = MAX_START_OER
+) -> RefusedMoves:
     """Count the refused moves from one scene's eligible starts.
 
     Args:
@@ -67,4 +68,6 @@ def refused_moves_of_scenes(scenes: list[Any], caches: list[SceneCache], scenari
     """:func:`refused_moves` summed over scenes of one scenario (the environment's own threshold)."""
     actions = tuple(scenario_spec(scenario).actions)
     parts = [refused_moves(cache, actions, TVMEnv._min_pixels(scene, cache)) for scene, cache in zip(scenes, caches)]
-    return RefusedMoves(*(sum(getattr(p, name) for p in parts) for name in ("starts", "moves", "no_view", "target_lost")))
+    return RefusedMoves(
+        *(sum(getattr(p, name) for p in parts) for name in ("starts", "moves", "no_view", "target_lost"))
+    )

@@ -30,15 +30,16 @@ class PaperCNN(BaseFeaturesExtractor):
     On the 224x224x4 observation the maps are 73x73, 35x35 and 33x33.
     """
 
-    def __init__(self, observation_space: gym.spaces.Box, features_dim: int = PAPER_FEATURES,
-                 channels_last: bool = True) -> None:
+    def __init__(
+        self, observation_space: gym.spaces.Box, features_dim: int = PAPER_FEATURES, channels_last: bool = True
+    ) -> None:
         """Args:
-            observation_space: Channels-first image space (SB3 transposes ours to it).
-            features_dim: Size of the feature vector (512 in the paper).
-            channels_last: Run the convolutions on channels-last (NHWC) tensors. The same
-                network and numbers to float rounding; oneDNN's NHWC kernels made an A2C update
-                faster on this CPU (docs/performance.md). Off gives the
-                plain NCHW layout the measurement compares with.
+        observation_space: Channels-first image space (SB3 transposes ours to it).
+        features_dim: Size of the feature vector (512 in the paper).
+        channels_last: Run the convolutions on channels-last (NHWC) tensors. The same
+            network and numbers to float rounding; oneDNN's NHWC kernels made an A2C update
+            faster on this CPU (docs/performance.md). Off gives the
+            plain NCHW layout the measurement compares with.
         """
         super().__init__(observation_space, features_dim)
         layers: list[nn.Module] = []
@@ -68,13 +69,13 @@ class PooledFeatures(BaseFeaturesExtractor):
 
     def __init__(self, observation_space: gym.spaces.Box, features_dim: int = 64) -> None:
         """Args:
-            observation_space: Channels-first image space (SB3 transposes ours).
-            features_dim: Size of the feature vector.
+        observation_space: Channels-first image space (SB3 transposes ours).
+        features_dim: Size of the feature vector.
         """
         super().__init__(observation_space, features_dim)
         self.cnn = nn.Sequential(
-            nn.AvgPool2d(8), nn.Conv2d(observation_space.shape[0], 16, 3, stride=2), nn.ReLU(),
-            nn.Flatten())
+            nn.AvgPool2d(8), nn.Conv2d(observation_space.shape[0], 16, 3, stride=2), nn.ReLU(), nn.Flatten()
+        )
         with torch.no_grad():
             n = self.cnn(torch.zeros(1, *observation_space.shape)).shape[1]
         self.head = nn.Sequential(nn.Linear(n, features_dim), nn.ReLU())

@@ -64,8 +64,12 @@ class PairedGap:
 def _start(episode: dict[str, Any]) -> tuple:
     """What makes two episodes the same: session, scene, start (a view, or a pose) and target fruit."""
     start = episode["path"][0]
-    return episode["session"], episode["scene"], tuple(start) if isinstance(start, list) else start, \
-        episode["target_fruit"]
+    return (
+        episode["session"],
+        episode["scene"],
+        tuple(start) if isinstance(start, list) else start,
+        episode["target_fruit"],
+    )
 
 
 def paired_gap(first: list[dict[str, Any]], second: list[dict[str, Any]], seed: int = 0) -> PairedGap:
@@ -89,8 +93,14 @@ def paired_gap(first: list[dict[str, Any]], second: list[dict[str, Any]], seed: 
     if np.ptp(differences) == 0:  # no spread to resample: the interval is the point
         low = high = float(differences[0])
     else:  # percentile, not BCa: BCa is undefined when most differences are equal (policies that agree)
-        interval = stats.bootstrap((differences,), np.mean, n_resamples=RESAMPLES, confidence_level=CONFIDENCE,
-                                   method="percentile", random_state=np.random.default_rng(seed)).confidence_interval
+        interval = stats.bootstrap(
+            (differences,),
+            np.mean,
+            n_resamples=RESAMPLES,
+            confidence_level=CONFIDENCE,
+            method="percentile",
+            random_state=np.random.default_rng(seed),
+        ).confidence_interval
         low, high = float(interval.low), float(interval.high)
     scenes = [a["scene"] for a in first]
     per_scene = []

@@ -80,7 +80,7 @@ class SeededPolicy:
 
     def __init__(self, seed: int | None = None) -> None:
         """Args:
-            seed: Seed of the policy's generator until :meth:`reset` gets one.
+        seed: Seed of the policy's generator until :meth:`reset` gets one.
         """
         self._rng = np.random.default_rng(seed)
 
@@ -126,8 +126,8 @@ class FunctionPolicy:
 
     def __init__(self, function: Callable[[np.ndarray, dict[str, Any]], Any], name: str | None = None) -> None:
         """Args:
-            function: The callable.
-            name: Row name (default: the callable's ``__name__``).
+        function: The callable.
+        name: Row name (default: the callable's ``__name__``).
         """
         self.function = function
         self.name = name or getattr(function, "__name__", type(function).__name__)
@@ -150,13 +150,17 @@ def as_policy(thing: Any, name: str | None = None) -> Any:
     """
     if inspect.isclass(thing):
         if not callable(getattr(thing, "act", None)):
-            raise UserError(f"class {thing.__name__} has no act(observation, info) method: give a policy class "
-                            "with reset(seed) and act(observation, info), or a function")
+            raise UserError(
+                f"class {thing.__name__} has no act(observation, info) method: give a policy class "
+                "with reset(seed) and act(observation, info), or a function"
+            )
         try:
             thing = thing()
         except TypeError as error:
-            raise UserError(f"class {thing.__name__} cannot be made without arguments ({error}): give an "
-                            "object or a function instead") from None
+            raise UserError(
+                f"class {thing.__name__} cannot be made without arguments ({error}): give an "
+                "object or a function instead"
+            ) from None
     if callable(getattr(thing, "act", None)):
         if not callable(getattr(thing, "reset", None)):
             raise UserError(f"{type(thing).__name__} has act but no reset(seed) method: add one")
@@ -165,8 +169,10 @@ def as_policy(thing: Any, name: str | None = None) -> Any:
         return thing
     if callable(thing):
         return FunctionPolicy(thing, name)
-    raise UserError(f"{thing!r} is not a policy: give a function (observation, info) -> action, or an object "
-                    "with reset(seed) and act(observation, info)")
+    raise UserError(
+        f"{thing!r} is not a policy: give a function (observation, info) -> action, or an object "
+        "with reset(seed) and act(observation, info)"
+    )
 
 
 def model_algorithm(path: Path) -> str:
@@ -186,8 +192,10 @@ def model_algorithm(path: Path) -> str:
             data = json.loads(archive.read("data"))
         module = str(data["policy_class"].get("__module__", ""))
     except (zipfile.BadZipFile, KeyError, ValueError, AttributeError, OSError) as error:
-        raise UserError(f"{path}: not a Stable-Baselines3 model ({error}); give the .zip "
-                        "`davis-ag train` (or SB3's model.save) wrote") from None
+        raise UserError(
+            f"{path}: not a Stable-Baselines3 model ({error}); give the .zip "
+            "`davis-ag train` (or SB3's model.save) wrote"
+        ) from None
     for name in ("DQN", "SAC", "TD3", "DDPG"):
         if f".{name.lower()}." in module:
             return name
@@ -207,8 +215,9 @@ def load_model(path: str | os.PathLike[str], device: str = "cpu") -> Any:
     try:
         return getattr(stable_baselines3, algorithm).load(path, device=device)
     except Exception as error:  # noqa: BLE001 - any load failure is a bad file
-        raise UserError(f"{path}: a {algorithm} model that does not load ({error}); "
-                        "give the .zip `davis-ag train` wrote") from None
+        raise UserError(
+            f"{path}: a {algorithm} model that does not load ({error}); give the .zip `davis-ag train` wrote"
+        ) from None
 
 
 def _space_text(space: Any) -> str:
@@ -218,8 +227,9 @@ def _space_text(space: Any) -> str:
 class ModelPolicy:
     """A trained Stable-Baselines3 model (any algorithm with ``predict``) as a :class:`Policy`."""
 
-    def __init__(self, model: Any, deterministic: bool = DETERMINISTIC_PLAY, name: str | None = None,
-                 device: str = "cpu") -> None:
+    def __init__(
+        self, model: Any, deterministic: bool = DETERMINISTIC_PLAY, name: str | None = None, device: str = "cpu"
+    ) -> None:
         """Args:
             model: A loaded SB3 model, or the path of a saved ``.zip``.
             deterministic: Take the most likely action instead of sampling (see
@@ -258,15 +268,22 @@ class ModelPolicy:
                 7 actions against 9; a grid model on the continuous environment).
         """
         ours, theirs = self.model.action_space, env.action_space
-        if type(ours) is not type(theirs) or getattr(ours, "n", None) != getattr(theirs, "n", None) \
-                or getattr(ours, "shape", None) != getattr(theirs, "shape", None):
-            raise UserError(f"{self.name}: the model has {_space_text(ours)}, this environment {_space_text(theirs)}: "
-                            "use a model trained on the same environment and scenario")
+        if (
+            type(ours) is not type(theirs)
+            or getattr(ours, "n", None) != getattr(theirs, "n", None)
+            or getattr(ours, "shape", None) != getattr(theirs, "shape", None)
+        ):
+            raise UserError(
+                f"{self.name}: the model has {_space_text(ours)}, this environment {_space_text(theirs)}: "
+                "use a model trained on the same environment and scenario"
+            )
         shape = getattr(self.model.observation_space, "shape", None)
         # SB3 stores image spaces channels-first.
         if shape is not None and sorted(shape) != sorted(env.observation_space.shape):
-            raise UserError(f"{self.name}: the model takes observations of shape {shape}, the environment gives "
-                            f"{env.observation_space.shape}: use a model trained by davis-ag train")
+            raise UserError(
+                f"{self.name}: the model takes observations of shape {shape}, the environment gives "
+                f"{env.observation_space.shape}: use a model trained by davis-ag train"
+            )
 
     def act(self, observation: np.ndarray, info: dict[str, Any]) -> Any:
         """The model's action for ``observation``."""
@@ -291,8 +308,10 @@ def _import_target(target: str, spec: str) -> Any:
     try:
         return importlib.import_module(target)
     except ModuleNotFoundError as error:
-        raise UserError(f"--policy {spec}: no module {error.name!r} (is it on PYTHONPATH? a file needs "
-                        "its path, e.g. ./my_policy.py:act)") from None
+        raise UserError(
+            f"--policy {spec}: no module {error.name!r} (is it on PYTHONPATH? a file needs "
+            "its path, e.g. ./my_policy.py:act)"
+        ) from None
 
 
 def policy_from_spec(spec: str, name: str | None = None, deterministic: bool = DETERMINISTIC_PLAY) -> Any:

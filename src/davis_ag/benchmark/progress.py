@@ -12,6 +12,7 @@ from davis_ag.benchmark.selection import KeepBestOnTrain
 #: Seconds between progress lines in a log (on a terminal a bar is redrawn instead).
 PROGRESS_EVERY_S = 60.0
 
+
 class TrainingProgress(BaseCallback):
     """Training's progress over environment steps: a tqdm bar on a terminal (steps, rate, time
     left, the last train-split score), and in a log (not a terminal) the same line once a minute.
@@ -19,13 +20,14 @@ class TrainingProgress(BaseCallback):
     A run resumed from a checkpoint starts at the checkpoint's step count, not at 0.
     """
 
-    def __init__(self, total: int, label: str, selection: KeepBestOnTrain | None = None,
-                 every_s: float | None = None) -> None:
+    def __init__(
+        self, total: int, label: str, selection: KeepBestOnTrain | None = None, every_s: float | None = None
+    ) -> None:
         """Args:
-            total: The run's total environment steps.
-            label: What is trained (``PPO sp``), the bar's description.
-            selection: The snapshot scorer whose last score is shown.
-            every_s: Seconds between log lines when not on a terminal (default :data:`PROGRESS_EVERY_S`).
+        total: The run's total environment steps.
+        label: What is trained (``PPO sp``), the bar's description.
+        selection: The snapshot scorer whose last score is shown.
+        every_s: Seconds between log lines when not on a terminal (default :data:`PROGRESS_EVERY_S`).
         """
         super().__init__()
         self.total, self.label, self.selection = total, label, selection
@@ -38,8 +40,15 @@ class TrainingProgress(BaseCallback):
         self.steps = self._first = int(self.model.num_timesteps)
         self._start = self._last = time.monotonic()
         # disable=None: no bar where stderr is not a terminal (a log), the lines below instead.
-        self.bar = tqdm(total=self.total, initial=self.steps, desc=self.label, unit="step", mininterval=2,
-                        disable=None, dynamic_ncols=True)
+        self.bar = tqdm(
+            total=self.total,
+            initial=self.steps,
+            desc=self.label,
+            unit="step",
+            mininterval=2,
+            disable=None,
+            dynamic_ncols=True,
+        )
 
     def _score(self) -> str:
         best = self.selection.scores[-1] if self.selection and self.selection.scores else None
@@ -55,8 +64,15 @@ class TrainingProgress(BaseCallback):
             self.bar.update(n)
         elif time.monotonic() - self._last >= self.every_s:
             self._last = time.monotonic()
-            line = tqdm.format_meter(self.steps, self.total, self._last - self._start, prefix=self.label,
-                                     unit="step", initial=self._first, ncols=0)
+            line = tqdm.format_meter(
+                self.steps,
+                self.total,
+                self._last - self._start,
+                prefix=self.label,
+                unit="step",
+                initial=self._first,
+                ncols=0,
+            )
             print(f"{line} | {self._score()}", file=sys.stderr, flush=True)
         return True
 

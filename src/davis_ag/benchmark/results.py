@@ -181,8 +181,10 @@ def load_results(path: str | os.PathLike[str]) -> EvaluationResults:
     except ValidationError as error:
         first = error.errors()[0]
         where = ".".join(str(p) for p in first["loc"])
-        raise UserError(f"{path}: not davis-ag evaluation results ({where}: {first['msg']}); give a RESULTS.json "
-                        "davis-ag evaluate wrote") from None
+        raise UserError(
+            f"{path}: not davis-ag evaluation results ({where}: {first['msg']}); give a RESULTS.json "
+            "davis-ag evaluate wrote"
+        ) from None
 
 
 def scene_identity(scene_id: str, metadata: SceneFile | None) -> SceneIdentity:
@@ -215,8 +217,10 @@ def split_text(protocol: Protocol) -> str:
     scenes = protocol.scenes
     shown = ", ".join(scenes[:4]) + (f", ... ({len(scenes) - 4} more)" if len(scenes) > 4 else "")
     starts = f"; {protocol.starts} eligible starts" if protocol.starts is not None else "; starts drawn live"
-    return (f"split {protocol.split}: {len(scenes)} {protocol.scenario.upper()} scene(s) ({shown}){starts}; "
-            f"{protocol.sessions} sessions x {protocol.episodes} episodes, seed {protocol.seed}, tau={protocol.tau}")
+    return (
+        f"split {protocol.split}: {len(scenes)} {protocol.scenario.upper()} scene(s) ({shown}){starts}; "
+        f"{protocol.sessions} sessions x {protocol.episodes} episodes, seed {protocol.seed}, tau={protocol.tau}"
+    )
 
 
 def table_number(value: float) -> str:

@@ -50,8 +50,9 @@ def snapshot_path(final: Path, step: int) -> Path:
     return stem.with_name(f"{stem.name}.best-{step:07d}.zip")
 
 
-def train_split_score(model: Any, env: Any, episodes: int = SELECT_EPISODES,
-                      seed: int = SELECT_SEED) -> dict[str, float]:
+def train_split_score(
+    model: Any, env: Any, episodes: int = SELECT_EPISODES, seed: int = SELECT_SEED
+) -> dict[str, float]:
     """Mean OER_tau and reward of ``model`` over ``episodes`` episodes of ``env`` (the train split).
 
     Play is sampled or deterministic as in the benchmark (``DETERMINISTIC_PLAY``). Torch's random
@@ -67,8 +68,7 @@ def train_split_score(model: Any, env: Any, episodes: int = SELECT_EPISODES,
     resets, draws = episode_seeds(seed, 0, episodes)
     with torch.random.fork_rng(devices=[]):
         records = [run_episode(env, agent, r, d) for r, d in zip(resets, draws)]
-    return {key: round(float(np.mean([r[key] for r in records])), 6)
-            for key in ("oer_tau", "reward", "length")}
+    return {key: round(float(np.mean([r[key] for r in records])), 6) for key in ("oer_tau", "reward", "length")}
 
 
 class KeepBestOnTrain(BaseCallback):
@@ -79,16 +79,25 @@ class KeepBestOnTrain(BaseCallback):
     kept snapshot. Earlier scores of a resumed run are passed in.
     """
 
-    def __init__(self, env: Any, final: Path, every: int, save: Any,
-                 scores: list[dict[str, Any]] | None = None, episodes: int = SELECT_EPISODES,
-                 prune_at_once: bool = False) -> None:
+    def __init__(
+        self,
+        env: Any,
+        final: Path,
+        every: int,
+        save: Any,
+        scores: list[dict[str, Any]] | None = None,
+        episodes: int = SELECT_EPISODES,
+        prune_at_once: bool = False,
+    ) -> None:
         super().__init__()
         self.env, self.final, self.every, self.save = env, final, every, save
         self.episodes, self.prune_at_once = episodes, prune_at_once
         self.scores: list[dict[str, Any]] = list(scores or [])
         if self.best is not None and not snapshot_path(final, self.best["step"]).is_file():
-            print(f"note: the best snapshot so far ({self.best['step']} steps) is gone; "
-                  "earlier scores are dropped", flush=True)
+            print(
+                f"note: the best snapshot so far ({self.best['step']} steps) is gone; earlier scores are dropped",
+                flush=True,
+            )
             self.scores = []
         self._last = 0
 
@@ -122,9 +131,11 @@ class KeepBestOnTrain(BaseCallback):
                 raise
         if self.prune_at_once:
             self.prune()
-        print(f"train-split score at {step} steps: OER_tau {entry['oer_tau']:.3f}"
-              + (" (best so far)" if self.best is entry else f" (best {before['oer_tau']:.3f} at {before['step']})"),
-              flush=True)
+        print(
+            f"train-split score at {step} steps: OER_tau {entry['oer_tau']:.3f}"
+            + (" (best so far)" if self.best is entry else f" (best {before['oer_tau']:.3f} at {before['step']})"),
+            flush=True,
+        )
 
     def prune(self, keep_none: bool = False) -> None:
         """Remove every snapshot file but the best's (all of them with ``keep_none``)."""
@@ -136,8 +147,14 @@ class KeepBestOnTrain(BaseCallback):
     def record(self) -> dict[str, Any]:
         """What the training record says of the choice."""
         best = self.best
-        return {"rule": "best-train", "every": self.every, "episodes": self.episodes,
-                "play": _play(), "scores": self.scores, "kept_step": best["step"] if best else None}
+        return {
+            "rule": "best-train",
+            "every": self.every,
+            "episodes": self.episodes,
+            "play": _play(),
+            "scores": self.scores,
+            "kept_step": best["step"] if best else None,
+        }
 
 
 def _play() -> str:

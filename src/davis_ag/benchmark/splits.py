@@ -74,8 +74,7 @@ def select_scenes(dataset: Any, scenario: str, split: str, crop: str | None = No
     crop = crop_spec(crop).name if crop else None
     if split not in SPLITS:
         raise UserError(f"unknown split {split!r}: choose one of {', '.join(SPLITS)}")
-    scenes = [s for s in dataset.scenes
-              if scene_scenario(s) == scenario and (crop is None or scene_crop(s) == crop)]
+    scenes = [s for s in dataset.scenes if scene_scenario(s) == scenario and (crop is None or scene_crop(s) == crop)]
     where = f"{scenario}{'/' + crop if crop else ''} scenes of {dataset.root}"
     if not scenes:
         raise UserError(f"no {where}: pick a scenario/crop the dataset has")
@@ -84,6 +83,8 @@ def select_scenes(dataset: Any, scenario: str, split: str, crop: str | None = No
     keep = set(dataset_splits(dataset)[split])
     chosen = sorted((s for s in scenes if s.id in keep), key=lambda s: s.id)
     if not chosen:
-        raise UserError(f"the {split} split has none of the {len(scenes)} {where}: use "
-                        "--split all (split='all') or a dataset with more scenes")
+        raise UserError(
+            f"the {split} split has none of the {len(scenes)} {where}: use "
+            "--split all (split='all') or a dataset with more scenes"
+        )
     return chosen

@@ -62,12 +62,27 @@ SB3_DEFAULT_SETTINGS: dict[str, Any] = {"ent_coef": 0.0, "normalize_advantage": 
 #: Named setting sets of :func:`train_a2c`.
 SETTINGS_PRESETS: dict[str, dict[str, Any]] = {"ours": A2C_SETTINGS, "sb3": SB3_DEFAULT_SETTINGS}
 #: SB3 A2C keyword arguments a setting set may change.
-TUNABLE = ("ent_coef", "normalize_advantage", "learning_rate", "n_steps", "gamma", "vf_coef",
-           "max_grad_norm", "gae_lambda")
+TUNABLE = (
+    "ent_coef",
+    "normalize_advantage",
+    "learning_rate",
+    "n_steps",
+    "gamma",
+    "vf_coef",
+    "max_grad_norm",
+    "gae_lambda",
+)
 
 
-def make_vec_tvm(dataset: Any, scenario: str, n_envs: int, seed: int, split: str = "train",
-                 crop: str | None = None, cache_dir: str | os.PathLike[str] | None = None) -> Any:
+def make_vec_tvm(
+    dataset: Any,
+    scenario: str,
+    n_envs: int,
+    seed: int,
+    split: str = "train",
+    crop: str | None = None,
+    cache_dir: str | os.PathLike[str] | None = None,
+) -> Any:
     """``n_envs`` TVM environments in one SB3 ``DummyVecEnv`` (each wrapped in ``Monitor``).
 
     The environment is fast (tens of thousands of steps/s), so subprocesses would only add
@@ -86,8 +101,7 @@ def make_vec_tvm(dataset: Any, scenario: str, n_envs: int, seed: int, split: str
     from stable_baselines3.common.env_util import make_vec_env
 
     opened = as_dataset(dataset)
-    kwargs = {"dataset": opened, "scenario": scenario, "split": split, "crop": crop,
-              "cache_dir": cache_dir}
+    kwargs = {"dataset": opened, "scenario": scenario, "split": split, "crop": crop, "cache_dir": cache_dir}
     return make_vec_env(TVMEnv, n_envs=n_envs, seed=seed, env_kwargs=kwargs)
 
 
@@ -126,8 +140,12 @@ class _Sittings:
 
     def upto(self, step: int) -> list[dict[str, Any]]:
         """Every sitting, this one up to ``step``."""
-        now = {"code": code_version(), "from_step": self.first_step, "to_step": step,
-               "seconds": round(time.perf_counter() - self.start, 1)}
+        now = {
+            "code": code_version(),
+            "from_step": self.first_step,
+            "to_step": step,
+            "seconds": round(time.perf_counter() - self.start, 1),
+        }
         return [*self.earlier, now]
 
 
@@ -164,17 +182,30 @@ class LearningCurve(BaseCallback):
     def flush(self, step: int) -> None:
         """Close the current bin at ``step`` (a bin without episodes adds no point)."""
         if self._rewards:
-            self.points.append({"step": int(step), "episodes": len(self._rewards),
-                                "reward": round(float(sum(self._rewards) / len(self._rewards)), 6),
-                                "length": round(sum(self._lengths) / len(self._lengths), 4)})
+            self.points.append(
+                {
+                    "step": int(step),
+                    "episodes": len(self._rewards),
+                    "reward": round(float(sum(self._rewards) / len(self._rewards)), 6),
+                    "length": round(sum(self._lengths) / len(self._lengths), 4),
+                }
+            )
         self._rewards, self._lengths = [], []
 
 
 class _Checkpoint(BaseCallback):
     """Saves the model, the run's settings and its sittings every ``every`` environment steps."""
 
-    def __init__(self, every: int, model_file: Path, settings_file: Path, settings: dict[str, Any],
-                 sittings: _Sittings, curve: LearningCurve, selection: KeepBestOnTrain | None) -> None:
+    def __init__(
+        self,
+        every: int,
+        model_file: Path,
+        settings_file: Path,
+        settings: dict[str, Any],
+        sittings: _Sittings,
+        curve: LearningCurve,
+        selection: KeepBestOnTrain | None,
+    ) -> None:
         super().__init__()
         self.every, self.model_file, self.settings_file, self.settings = every, model_file, settings_file, settings
         self.sittings, self.curve, self.selection = sittings, curve, selection
@@ -188,16 +219,22 @@ class _Checkpoint(BaseCallback):
             self._last = self.model.num_timesteps
             save_model(self.model, self.model_file)
             scores = self.selection.scores if self.selection else []
-            write_json_atomic(self.settings_file, {**self.settings, "timesteps_done": self._last,
-                                                   "sittings": self.sittings.upto(self._last),
-                                                   "curve": self.curve.points, "selection": scores})
+            write_json_atomic(
+                self.settings_file,
+                {
+                    **self.settings,
+                    "timesteps_done": self._last,
+                    "sittings": self.sittings.upto(self._last),
+                    "curve": self.curve.points,
+                    "selection": scores,
+                },
+            )
             if self.selection:  # the checkpoint now names the best snapshot: older ones can go
                 self.selection.prune()
         return True
 
 
-def _resumable(settings_file: Path, model_file: Path,
-               settings: dict[str, Any]) -> tuple[int, list, list, list] | None:
+def _resumable(settings_file: Path, model_file: Path, settings: dict[str, Any]) -> tuple[int, list, list, list] | None:
     """Steps done, sittings, learning curve and snapshot scores so far of a checkpoint of a run
     with the same settings, else None."""
     try:
@@ -229,14 +266,27 @@ def train_a2c(dataset: Any, scenario: str, **kwargs: Any) -> Path:
     return train_agent(dataset, scenario, algo="a2c", **kwargs)
 
 
-def train_agent(dataset: Any, scenario: str, total_timesteps: int = 300_000, seed: int = 0,
-                out_path: str | os.PathLike[str] = "a2c.zip", n_envs: int = 8,
-                crop: str | None = None, cache_dir: str | os.PathLike[str] | None = None,
-                arch: str = "paper", device: str = "auto", verbose: int = 0,
-                callback: Any = None, checkpoint_every: int = CHECKPOINT_EVERY,
-                settings: str | dict[str, Any] = "ours", keep: str = "best-train",
-                select_every: int = SELECT_EVERY, algo: str = "a2c", progress: bool = True,
-                force: bool = False) -> Path:
+def train_agent(
+    dataset: Any,
+    scenario: str,
+    total_timesteps: int = 300_000,
+    seed: int = 0,
+    out_path: str | os.PathLike[str] = "a2c.zip",
+    n_envs: int = 8,
+    crop: str | None = None,
+    cache_dir: str | os.PathLike[str] | None = None,
+    arch: str = "paper",
+    device: str = "auto",
+    verbose: int = 0,
+    callback: Any = None,
+    checkpoint_every: int = CHECKPOINT_EVERY,
+    settings: str | dict[str, Any] = "ours",
+    keep: str = "best-train",
+    select_every: int = SELECT_EVERY,
+    algo: str = "a2c",
+    progress: bool = True,
+    force: bool = False,
+) -> Path:
     """Train an agent on the train split and save it; resume a killed run.
 
     PPO and DQN: Stable-Baselines3's defaults changed only by
@@ -307,9 +357,18 @@ def train_agent(dataset: Any, scenario: str, total_timesteps: int = 300_000, see
     model_file, settings_file = checkpoint_paths(final)
     # A path names the dataset itself (a Path's own .root would be "/"); a reader's dataset, its root.
     root = dataset if isinstance(dataset, (str, os.PathLike)) else getattr(dataset, "root", dataset)
-    settings = {"dataset": str(Path(root).expanduser().absolute()), "scenario": scenario, "crop": crop,
-                "seed": seed, "n_envs": n_envs, "arch": arch, "algorithm": algo.upper(),
-                "a2c_settings" if algo == "a2c" else "sb3_settings": chosen, "start_rule": "pairs", "keep": keep}
+    settings = {
+        "dataset": str(Path(root).expanduser().absolute()),
+        "scenario": scenario,
+        "crop": crop,
+        "seed": seed,
+        "n_envs": n_envs,
+        "arch": arch,
+        "algorithm": algo.upper(),
+        "a2c_settings" if algo == "a2c" else "sb3_settings": chosen,
+        "start_rule": "pairs",
+        "keep": keep,
+    }
     resumed = check_checkpoint(settings_file, model_file, settings, force)
     opened = as_dataset(dataset)
     env = make_vec_tvm(opened, scenario, n_envs, seed, "train", crop, cache_dir)
@@ -319,25 +378,33 @@ def train_agent(dataset: Any, scenario: str, total_timesteps: int = 300_000, see
         model = load_checkpoint(algorithm, model_file, env, device)
         print(f"resuming {final.name} from its checkpoint at {done} of {total_timesteps} steps", flush=True)
     else:
-        model = algorithm("CnnPolicy", env, seed=seed, device=device, verbose=verbose,
-                          policy_kwargs=dict(ARCHITECTURES[arch]), **chosen)
+        model = algorithm(
+            "CnnPolicy",
+            env,
+            seed=seed,
+            device=device,
+            verbose=verbose,
+            policy_kwargs=dict(ARCHITECTURES[arch]),
+            **chosen,
+        )
         done, earlier, points = 0, [], []
     sittings = _Sittings(earlier, done)
     curve = LearningCurve(CURVE_EVERY, points)
     selection = None
     if keep == "best-train":
         scoring_env = TVMEnv(opened, scenario, split="train", crop=crop, cache_dir=cache_dir)
-        selection = KeepBestOnTrain(scoring_env, final, select_every, save_model, scores,
-                                    prune_at_once=not checkpoint_every)
+        selection = KeepBestOnTrain(
+            scoring_env, final, select_every, save_model, scores, prune_at_once=not checkpoint_every
+        )
     shown = TrainingProgress(total_timesteps, f"{algo.upper()} {scenario}", selection) if progress else None
     callbacks = [c for c in (callback, curve, selection, shown) if c is not None]
     if checkpoint_every:
-        callbacks.append(_Checkpoint(checkpoint_every, model_file, settings_file, settings, sittings, curve,
-                                     selection))
+        callbacks.append(_Checkpoint(checkpoint_every, model_file, settings_file, settings, sittings, curve, selection))
     try:
         if total_timesteps > done:
-            model.learn(total_timesteps=total_timesteps - done, callback=callbacks or None,
-                        reset_num_timesteps=done == 0)
+            model.learn(
+                total_timesteps=total_timesteps - done, callback=callbacks or None, reset_num_timesteps=done == 0
+            )
         env.close()
         curve.flush(int(model.num_timesteps))
         extra: dict[str, Any] = {}
@@ -349,14 +416,25 @@ def train_agent(dataset: Any, scenario: str, total_timesteps: int = 300_000, see
             saved = final
             os.replace(snapshot_path(final, selection.best["step"]), final)
             extra["selection"] = selection.record()
-            print(f"kept the snapshot at {selection.best['step']} steps (train-split OER_tau "
-                  f"{selection.best['oer_tau']:.3f}, the best of {len(selection.scores)})", flush=True)
+            print(
+                f"kept the snapshot at {selection.best['step']} steps (train-split OER_tau "
+                f"{selection.best['oer_tau']:.3f}, the best of {len(selection.scores)})",
+                flush=True,
+            )
         record = sittings.upto(int(model.num_timesteps))
         seconds = sum(s["seconds"] for s in record)
-        write_json_atomic(training_record_path(final), {
-            **settings, "timesteps": int(model.num_timesteps), "sittings": record, "seconds": round(seconds, 1),
-            "steps_per_second": round((int(model.num_timesteps) - record[0]["from_step"]) / max(seconds, 1e-9), 1),
-            "curve": curve.points, **extra})
+        write_json_atomic(
+            training_record_path(final),
+            {
+                **settings,
+                "timesteps": int(model.num_timesteps),
+                "sittings": record,
+                "seconds": round(seconds, 1),
+                "steps_per_second": round((int(model.num_timesteps) - record[0]["from_step"]) / max(seconds, 1e-9), 1),
+                "curve": curve.points,
+                **extra,
+            },
+        )
     except OSError as error:  # a full disk at any point: say which finished snapshot survives, and where
         raise MachineError(what_survives(error, final, selection, model_file)) from None
     model_file.unlink(missing_ok=True)
@@ -376,8 +454,10 @@ def what_survives(error: OSError, final: Path, selection: KeepBestOnTrain | None
     if final.is_file() and (best is None or not snapshot_path(final, best["step"]).is_file()):
         kept = f"the trained model is saved in {final} (its training record is not)"
     elif best is not None and snapshot_path(final, best["step"]).is_file():
-        kept = (f"the best snapshot so far ({best['step']} steps, train-split OER_tau {best['oer_tau']:.3f}) "
-                f"is kept in {snapshot_path(final, best['step'])}")
+        kept = (
+            f"the best snapshot so far ({best['step']} steps, train-split OER_tau {best['oer_tau']:.3f}) "
+            f"is kept in {snapshot_path(final, best['step'])}"
+        )
     elif model_file.is_file():
         kept = f"the last checkpoint is kept in {model_file}"
     else:
@@ -385,8 +465,9 @@ def what_survives(error: OSError, final: Path, selection: KeepBestOnTrain | None
     return f"training stopped: {reason}; {kept}: free the space and run the same command again to finish"
 
 
-def check_checkpoint(settings_file: Path, model_file: Path, settings: dict[str, Any],
-                     force: bool) -> tuple[int, list, list, list] | None:
+def check_checkpoint(
+    settings_file: Path, model_file: Path, settings: dict[str, Any], force: bool
+) -> tuple[int, list, list, list] | None:
     """What to resume from a checkpoint beside the output, by the output rule: the same run's is
     resumed; one of another run, or a damaged one, is discarded only with ``force``.
 
@@ -403,8 +484,9 @@ def check_checkpoint(settings_file: Path, model_file: Path, settings: dict[str, 
     if problem is None:
         return _resumable(settings_file, model_file, settings)
     if not force:
-        raise UserError(f"{model_file}: {problem}: run again with --force to discard it and start over, "
-                        "or stop here to keep it")
+        raise UserError(
+            f"{model_file}: {problem}: run again with --force to discard it and start over, or stop here to keep it"
+        )
     print(f"note: {model_file.name}: {problem}; --force: starting over", flush=True)
     model_file.unlink(missing_ok=True)
     settings_file.unlink(missing_ok=True)
@@ -425,8 +507,11 @@ def _checkpoint_problem(settings_file: Path, model_file: Path, settings: dict[st
         return f"the checkpoint is damaged ({settings_file.name} is unreadable), so it cannot be resumed"
     if not isinstance(saved, dict):
         return f"the checkpoint is damaged ({settings_file.name} is not a record), so it cannot be resumed"
-    differ = [f"{key} {saved.get(key)!r}, not {settings[key]!r}" for key in settings
-              if key in saved and saved[key] != settings[key] and key != "dataset"]
+    differ = [
+        f"{key} {saved.get(key)!r}, not {settings[key]!r}"
+        for key in settings
+        if key in saved and saved[key] != settings[key] and key != "dataset"
+    ]
     differ += ["another dataset"] if saved.get("dataset") not in (settings["dataset"], "/", None) else []
     return f"it is the checkpoint of another run ({'; '.join(differ[:3]) or 'older settings'}), which this one cannot resume"
 
@@ -443,9 +528,11 @@ def load_checkpoint(algorithm: Any, model_file: Path, env: Any, device: str) -> 
     except Exception as error:  # zipfile, pickle, torch and SB3 each raise their own
         if isinstance(error, (MemoryError, OSError)):
             raise
-        raise UserError(f"{model_file}: the checkpoint is damaged ({type(error).__name__}: {error}), so it "
-                        "cannot be resumed: run again with --force to discard it and start over, or stop "
-                        "here to keep it") from None
+        raise UserError(
+            f"{model_file}: the checkpoint is damaged ({type(error).__name__}: {error}), so it "
+            "cannot be resumed: run again with --force to discard it and start over, or stop "
+            "here to keep it"
+        ) from None
 
 
 def resolve_settings(settings: str | dict[str, Any]) -> dict[str, Any]:
@@ -480,5 +567,6 @@ def check_device(device: str) -> None:
         count = torch.cuda.device_count() if torch.cuda.is_available() else 0
         if count == 0 or (chosen.index or 0) >= count:
             have = f"cuda:0 to cuda:{count - 1}" if count else "no CUDA device"
-            raise UserError(f"--device {device}: this machine has {have}: use auto, cpu"
-                            + (" or one of those" if count else ""))
+            raise UserError(
+                f"--device {device}: this machine has {have}: use auto, cpu" + (" or one of those" if count else "")
+            )

@@ -61,6 +61,8 @@ def can_start(oer: Any, max_start_oer: float = MAX_START_OER) -> Any:
 def episode_reward(oer_0: float, oer_end: float) -> float:
     """Section IV-C's reward at an episode's end: ``max(OER_end - OER_0, 0) ** 2``."""
     return float(max(oer_end - oer_0, 0.0) ** 2)
+
+
 #: How ``reset`` draws a start: ``pairs`` uniform over every eligible (scene, view, target),
 #: ``scene`` uniform over scenes, then views, then targets (see the module docstring).
 START_RULES = ("pairs", "scene")
@@ -89,10 +91,18 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 2}
 
-    def __init__(self, dataset: Any, scenario: str = "sp", split: str = "train",
-                 crop: str | None = None, cache_dir: str | os.PathLike[str] | None = None,
-                 max_start_oer: float = MAX_START_OER, tau: int | None = None,
-                 render_mode: str | None = None, start_rule: str = "pairs") -> None:
+    def __init__(
+        self,
+        dataset: Any,
+        scenario: str = "sp",
+        split: str = "train",
+        crop: str | None = None,
+        cache_dir: str | os.PathLike[str] | None = None,
+        max_start_oer: float = MAX_START_OER,
+        tau: int | None = None,
+        render_mode: str | None = None,
+        start_rule: str = "pairs",
+    ) -> None:
         """Open the scenes of one scenario and split, building their caches if needed.
 
         Args:
@@ -134,8 +144,7 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
         self.observation_space = spaces.Box(0, 255, (OBS_SIZE, OBS_SIZE, 4), dtype=np.uint8)
 
         self.scenes = select_scenes(self.dataset, spec.name, split, crop)
-        self.caches: list[SceneCache] = [
-            load_scene_cache(s, self.dataset.root, cache_dir) for s in self.scenes]
+        self.caches: list[SceneCache] = [load_scene_cache(s, self.dataset.root, cache_dir) for s in self.scenes]
         self._starts: list[tuple[int, _Starts]] = []
         for index, (scene, cache) in enumerate(zip(self.scenes, self.caches)):
             starts = self._eligible(cache, self._min_pixels(scene, cache), max_start_oer)
@@ -145,11 +154,12 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
             raise UserError(
                 f"no eligible start in the {split} split of {self.dataset.root} "
                 f"({len(self.scenes)} {spec.name} scenes): no boxed fruit has OER < "
-                f"{max_start_oer} and enough visible pixels; use another split or dataset")
+                f"{max_start_oer} and enough visible pixels; use another split or dataset"
+            )
         # Every eligible start as (scene index, box row), in scene, view, annotation order.
         self.starts: np.ndarray = np.array(
-            [(scene, int(box)) for scene, starts in self._starts for box in starts.boxes],
-            dtype=np.int64).reshape(-1, 2)
+            [(scene, int(box)) for scene, starts in self._starts for box in starts.boxes], dtype=np.int64
+        ).reshape(-1, 2)
         self._scene = self._view = self._box = self._fruit = self._t = -1
         self._oer_0 = 0.0
         self._path: list[str] = []
@@ -181,8 +191,9 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
 
     # ----------------------------------------------------------------------------- episode
 
-    def reset(self, *, seed: int | None = None,
-              options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
         """Start an episode.
 
         Args:
@@ -273,15 +284,25 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
             UserError: for a name that is not an action of this scenario.
         """
         if name not in self.action_names:
-            raise UserError(f"invalid action {name!r}: this {self.scenario} environment has {', '.join(self.action_names)}")
+            raise UserError(
+                f"invalid action {name!r}: this {self.scenario} environment has {', '.join(self.action_names)}"
+            )
         return self.action_names.index(name)
 
     def describe(self) -> dict[str, Any]:
         """What an evaluation's protocol records of this environment: its id, scenario, split,
         tau, scenes, dataset root, action names, start rule and eligible start count."""
-        return {"environment": "davis_ag/TVM-v0", "scenario": self.scenario, "split": self.split,
-                "tau": self.tau, "scenes": [s.id for s in self.scenes], "dataset": str(self.dataset.root),
-                "actions": list(self.action_names), "start_rule": self.start_rule, "starts": int(len(self.starts))}
+        return {
+            "environment": "davis_ag/TVM-v0",
+            "scenario": self.scenario,
+            "split": self.split,
+            "tau": self.tau,
+            "scenes": [s.id for s in self.scenes],
+            "dataset": str(self.dataset.root),
+            "actions": list(self.action_names),
+            "start_rule": self.start_rule,
+            "starts": int(len(self.starts)),
+        }
 
     def _action_index(self, action: Any) -> int:
         """Validate an action (Python or NumPy integer, or a one-element integer array)."""
@@ -290,8 +311,10 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
         if isinstance(action, (int, np.integer)) and not isinstance(action, bool):
             if 0 <= int(action) < len(self.action_names):
                 return int(action)
-        raise UserError(f"invalid action {action!r}: expected an integer in "
-                        f"0..{len(self.action_names) - 1} ({', '.join(self.action_names)})")
+        raise UserError(
+            f"invalid action {action!r}: expected an integer in "
+            f"0..{len(self.action_names) - 1} ({', '.join(self.action_names)})"
+        )
 
     def _move(self, view: int, action: int) -> tuple[int, int]:
         """Where a move leads for the current target: ``(view, box row)``; refused: stays."""
@@ -365,14 +388,19 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
         # The cache's fourth channel is all zeros: one contiguous copy, then the box.
         obs = np.array(cache.images[self._view])
         x0, y0, x1, y1 = cache.box_scaled[self._box].tolist()
-        obs[y0:y1 + 1, x0:x1 + 1, 3] = 255
+        obs[y0 : y1 + 1, x0 : x1 + 1, 3] = 255
         return obs
 
     def _info(self) -> dict[str, Any]:
         """Episode facts: start and current OER, views visited, target, scene, steps."""
-        return {"oer_0": self._oer_0, "oer_t": self.oer, "path": list(self._path),
-                "target_fruit": int(self.caches[self._scene].fruit_ids[self._fruit]),
-                "scene": self.scenes[self._scene].id, "steps": self._t}
+        return {
+            "oer_0": self._oer_0,
+            "oer_t": self.oer,
+            "path": list(self._path),
+            "target_fruit": int(self.caches[self._scene].fruit_ids[self._fruit]),
+            "scene": self.scenes[self._scene].id,
+            "steps": self._t,
+        }
 
     def render(self) -> np.ndarray | None:
         """``rgb_array``: the 224x224 view with the target's box outlined in red."""
@@ -382,6 +410,6 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
         frame = np.array(cache.images[self._view, :, :, :3])
         x0, y0, x1, y1 = cache.box_scaled[self._box].tolist()
         red = np.array([255, 0, 0], dtype=np.uint8)
-        frame[y0, x0:x1 + 1] = frame[y1, x0:x1 + 1] = red
-        frame[y0:y1 + 1, x0] = frame[y0:y1 + 1, x1] = red
+        frame[y0, x0 : x1 + 1] = frame[y1, x0 : x1 + 1] = red
+        frame[y0 : y1 + 1, x0] = frame[y0 : y1 + 1, x1] = red
         return frame

@@ -102,8 +102,9 @@ def name_list(choices: tuple[str, ...]) -> Callable[[str], list[str]]:
     def parse(text: str) -> list[str]:
         names = [n.strip() for n in text.split(",") if n.strip()]
         if not names:
-            raise argparse.ArgumentTypeError(f"{text!r} names nothing: give a comma-separated list of "
-                                             f"{', '.join(choices)}")
+            raise argparse.ArgumentTypeError(
+                f"{text!r} names nothing: give a comma-separated list of {', '.join(choices)}"
+            )
         unknown = [n for n in names if n.lower() not in canonical]
         if unknown:
             raise argparse.ArgumentTypeError(f"unknown name {unknown[0]!r}: choose from {', '.join(choices)}")
@@ -154,17 +155,30 @@ def add_renderer_flags(parser: argparse.ArgumentParser) -> None:
     from davis_ag.render.backends import LOOKS, RENDERERS
     from davis_ag.scene.specs import PLANT_GENERATORS
 
-    parser.add_argument("--renderer", choices=RENDERERS,
-                        help="opengl: ours (default); helios: pyhelios's Visualizer, the slower reference")
-    parser.add_argument("--look", choices=LOOKS,
-                        help="default: full-resolution, filtered textures (default); helios: Helios's frames, "
-                             "reduced unfiltered textures included (the helios renderer draws only this)")
-    parser.add_argument("--antialiasing", type=antialiasing_mode, metavar="{fxaa,msaa,none}",
-                        help="our renderer's: fxaa along silhouettes (default), msaa (4x samples: closest to "
-                             "Helios's frames, several times slower without a GPU) or none; ids exact in every mode")
-    parser.add_argument("--plants", choices=PLANT_GENERATORS,
-                        help="canopy: Helios's Canopy Generator plants, as the paper's (default); architecture: "
-                             "pyhelios3d's PlantArchitecture plants bent towards them")
+    parser.add_argument(
+        "--renderer",
+        choices=RENDERERS,
+        help="opengl: ours (default); helios: pyhelios's Visualizer, the slower reference",
+    )
+    parser.add_argument(
+        "--look",
+        choices=LOOKS,
+        help="default: full-resolution, filtered textures (default); helios: Helios's frames, "
+        "reduced unfiltered textures included (the helios renderer draws only this)",
+    )
+    parser.add_argument(
+        "--antialiasing",
+        type=antialiasing_mode,
+        metavar="{fxaa,msaa,none}",
+        help="our renderer's: fxaa along silhouettes (default), msaa (4x samples: closest to "
+        "Helios's frames, several times slower without a GPU) or none; ids exact in every mode",
+    )
+    parser.add_argument(
+        "--plants",
+        choices=PLANT_GENERATORS,
+        help="canopy: Helios's Canopy Generator plants, as the paper's (default); architecture: "
+        "pyhelios3d's PlantArchitecture plants bent towards them",
+    )
 
 
 def add_dataset_flags(parser: argparse.ArgumentParser, verb: str) -> None:
@@ -175,6 +189,7 @@ def add_dataset_flags(parser: argparse.ArgumentParser, verb: str) -> None:
         verb: what the command does, as ``--crop``'s help says it: "train" gives "train on one crop only".
     """
     parser.add_argument("--dataset", type=path, required=True, metavar="DIR", help="dataset root")
-    parser.add_argument("--scenario", required=True, choices=["sp", "mp"],
-                        help="single plant (tau=3) or multi plant (tau=5)")
+    parser.add_argument(
+        "--scenario", required=True, choices=["sp", "mp"], help="single plant (tau=3) or multi plant (tau=5)"
+    )
     parser.add_argument("--crop", default=None, help=f"{verb} on one crop only (default: all)")

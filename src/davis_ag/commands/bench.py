@@ -17,17 +17,35 @@ CROP_NAMES = ("strawberry", "tomato", "vine")
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add ``bench``'s arguments to its ``parser`` (see :mod:`davis_ag.commands`)."""
-    parser.add_argument("--out", type=arguments.path, default="out/bench.json", metavar="BENCH.json",
-                        help="the JSON report (default out/bench.json)")
-    parser.add_argument("--crops", type=arguments.name_list(CROP_NAMES), default=",".join(CROP_NAMES),
-                        help="crops to time, comma-separated (the documented path only where a target is set)")
+    parser.add_argument(
+        "--out",
+        type=arguments.path,
+        default="out/bench.json",
+        metavar="BENCH.json",
+        help="the JSON report (default out/bench.json)",
+    )
+    parser.add_argument(
+        "--crops",
+        type=arguments.name_list(CROP_NAMES),
+        default=",".join(CROP_NAMES),
+        help="crops to time, comma-separated (the documented path only where a target is set)",
+    )
     parser.add_argument("--repeats", type=arguments.count, default=3, help="interleaved repetitions (default 3)")
-    parser.add_argument("--antialiasing", choices=("fxaa", "msaa", "none"), default="fxaa",
-                        help="our renderer's antialiasing (default fxaa)")
-    parser.add_argument("--doc", type=arguments.path, metavar="PAGE.md",
-                        help="write the tables into this Markdown file's bench section")
-    parser.add_argument("--only", choices=("all", "continuous"), default="all",
-                        help="continuous: only TVMContinuous-v0's steps/s (about a minute)")
+    parser.add_argument(
+        "--antialiasing",
+        choices=("fxaa", "msaa", "none"),
+        default="fxaa",
+        help="our renderer's antialiasing (default fxaa)",
+    )
+    parser.add_argument(
+        "--doc", type=arguments.path, metavar="PAGE.md", help="write the tables into this Markdown file's bench section"
+    )
+    parser.add_argument(
+        "--only",
+        choices=("all", "continuous"),
+        default="all",
+        help="continuous: only TVMContinuous-v0's steps/s (about a minute)",
+    )
 
 
 def _is_report(path: Path) -> bool:
@@ -53,11 +71,12 @@ def run(args: argparse.Namespace) -> int:
     # replace a file that is not an earlier report.
     prove_writable_folder(args.out.parent)
     if args.out.exists() and not _is_report(args.out):
-        raise UserError(f"--out {args.out}: holds something other than an earlier bench report; "
-                        "give a new .json path")
+        raise UserError(f"--out {args.out}: holds something other than an earlier bench report; give a new .json path")
     if args.doc is not None and not (args.doc.is_file() and "<!-- bench:start -->" in args.doc.read_text()):
-        raise UserError(f"--doc {args.doc}: not a Markdown page with <!-- bench:start --> and <!-- bench:end --> "
-                        "markers; give docs/performance.md or leave --doc out")
+        raise UserError(
+            f"--doc {args.doc}: not a Markdown page with <!-- bench:start --> and <!-- bench:end --> "
+            "markers; give docs/performance.md or leave --doc out"
+        )
     if args.only == "continuous":
         run_continuous(args.out, args.doc)
         print(f"written {args.out}" + (f" and {args.doc}" if args.doc else ""))

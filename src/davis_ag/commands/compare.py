@@ -8,18 +8,26 @@ import argparse
 from davis_ag.commands import arguments
 
 HELP = "rank methods of several results files (a leaderboard with paired gaps)"
-DESCRIPTION = ("Rank every method of the given results files (written by davis-ag evaluate) by OER_tau, with reward, "
-               "episode length and the paired gaps to the Best fixed action and Rand (95 % bootstrap intervals "
-               "where the episodes are the same), and say what the numbers rest on (scenes, eligible starts, "
-               "sessions x episodes). Refuses results of different datasets, splits or protocol versions.")
+DESCRIPTION = (
+    "Rank every method of the given results files (written by davis-ag evaluate) by OER_tau, with reward, "
+    "episode length and the paired gaps to the Best fixed action and Rand (95 % bootstrap intervals "
+    "where the episodes are the same), and say what the numbers rest on (scenes, eligible starts, "
+    "sessions x episodes). Refuses results of different datasets, splits or protocol versions."
+)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add ``compare``'s arguments to its ``parser`` (see :mod:`davis_ag.commands`)."""
-    parser.add_argument("results", type=arguments.path, nargs="+", metavar="RESULTS.json",
-                        help="results files of davis-ag evaluate")
-    parser.add_argument("--out", type=arguments.path, default=None, metavar="PAGE.md",
-                        help="also write the leaderboard as a Markdown page")
+    parser.add_argument(
+        "results", type=arguments.path, nargs="+", metavar="RESULTS.json", help="results files of davis-ag evaluate"
+    )
+    parser.add_argument(
+        "--out",
+        type=arguments.path,
+        default=None,
+        metavar="PAGE.md",
+        help="also write the leaderboard as a Markdown page",
+    )
 
 
 def run(args: argparse.Namespace) -> int:

@@ -12,14 +12,16 @@ from davis_ag.errors import MachineError, UserError
 from davis_ag.formats.outputs import claim_output
 
 HELP = "score policies (yours, trained models, the baselines) as in Table 4"
-DESCRIPTION = ("Run every policy on the same episodes of the test split (sessions x episodes, fixed seeds), "
-               "print a Table 4 style summary with each policy's paired gap to the Best fixed action (grid) and "
-               "to Rand, write it as JSON (docs/benchmark-your-method.md documents the file) and a PNG bar chart. "
-               "--policy adds a method beside the baselines: a saved Stable-Baselines3 model of any algorithm, "
-               "or module:attr / path/to/file.py:attr naming a function (observation, info) -> action or a "
-               "class with reset(seed) and act(observation, info). On the grid the row 'Best fixed action' "
-               "(the best policy that always plays one action) is added, and the image-blind policies get their "
-               "exact expectations beside the sampled means.")
+DESCRIPTION = (
+    "Run every policy on the same episodes of the test split (sessions x episodes, fixed seeds), "
+    "print a Table 4 style summary with each policy's paired gap to the Best fixed action (grid) and "
+    "to Rand, write it as JSON (docs/benchmark-your-method.md documents the file) and a PNG bar chart. "
+    "--policy adds a method beside the baselines: a saved Stable-Baselines3 model of any algorithm, "
+    "or module:attr / path/to/file.py:attr naming a function (observation, info) -> action or a "
+    "class with reset(seed) and act(observation, info). On the grid the row 'Best fixed action' "
+    "(the best policy that always plays one action) is added, and the image-blind policies get their "
+    "exact expectations beside the sampled means."
+)
 
 #: Baselines --policies accepts on the grid.
 POLICIES = ("LRD", "UDD", "Rand", "Oracle")
@@ -30,34 +32,65 @@ CONTINUOUS_POLICIES = ("LR", "UD", "Rand", "Greedy")
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add ``evaluate``'s arguments to its ``parser`` (see :mod:`davis_ag.commands`)."""
     arguments.add_dataset_flags(parser, "evaluate")
-    parser.add_argument("--split", default="test", choices=["train", "test", "all"],
-                        help="scenes to evaluate on (default: test)")
-    parser.add_argument("--policy", action="append", default=[], metavar="SPEC",
-                        help="a method to score beside the baselines (repeatable): MODEL.zip (any Stable-Baselines3 "
-                             "algorithm, the row named after it), module:attr or path/to/file.py:attr (a function "
-                             "(observation, info) -> action, or a class with reset and act)")
-    parser.add_argument("--model", action="append", dest="policy", metavar="MODEL.zip",
-                        help="the same as --policy (kept for earlier scripts)")
-    parser.add_argument("--name", action="append", default=[], metavar="NAME",
-                        help="row name of the --policy given in the same position (repeatable)")
-    parser.add_argument("--env", default="grid", choices=["grid", "continuous"],
-                        help="grid: the dataset's views (TVM-v0, default); continuous: any pose, drawn live "
-                             "from regrown scenes (TVMContinuous-v0; scenes made by davis-ag generate)")
-    parser.add_argument("--policies", type=arguments.name_list(tuple(dict.fromkeys(POLICIES + CONTINUOUS_POLICIES))),
-                        default=None, help="comma-separated baselines (grid default: LRD,UDD,Rand,Oracle; "
-                                           "continuous: LR,UD,Rand,Greedy)")
-    parser.add_argument("--deterministic", action="store_true",
-                        help="trained models take their most likely action instead of sampling it (the default, "
-                             "as davis-ag reproduce plays A2C)")
-    parser.add_argument("--episodes", type=arguments.bounded(1, 10**6), default=200,
-                        help="episodes per session (200)")
+    parser.add_argument(
+        "--split", default="test", choices=["train", "test", "all"], help="scenes to evaluate on (default: test)"
+    )
+    parser.add_argument(
+        "--policy",
+        action="append",
+        default=[],
+        metavar="SPEC",
+        help="a method to score beside the baselines (repeatable): MODEL.zip (any Stable-Baselines3 "
+        "algorithm, the row named after it), module:attr or path/to/file.py:attr (a function "
+        "(observation, info) -> action, or a class with reset and act)",
+    )
+    parser.add_argument(
+        "--model",
+        action="append",
+        dest="policy",
+        metavar="MODEL.zip",
+        help="the same as --policy (kept for earlier scripts)",
+    )
+    parser.add_argument(
+        "--name",
+        action="append",
+        default=[],
+        metavar="NAME",
+        help="row name of the --policy given in the same position (repeatable)",
+    )
+    parser.add_argument(
+        "--env",
+        default="grid",
+        choices=["grid", "continuous"],
+        help="grid: the dataset's views (TVM-v0, default); continuous: any pose, drawn live "
+        "from regrown scenes (TVMContinuous-v0; scenes made by davis-ag generate)",
+    )
+    parser.add_argument(
+        "--policies",
+        type=arguments.name_list(tuple(dict.fromkeys(POLICIES + CONTINUOUS_POLICIES))),
+        default=None,
+        help="comma-separated baselines (grid default: LRD,UDD,Rand,Oracle; continuous: LR,UD,Rand,Greedy)",
+    )
+    parser.add_argument(
+        "--deterministic",
+        action="store_true",
+        help="trained models take their most likely action instead of sampling it (the default, "
+        "as davis-ag reproduce plays A2C)",
+    )
+    parser.add_argument("--episodes", type=arguments.bounded(1, 10**6), default=200, help="episodes per session (200)")
     parser.add_argument("--sessions", type=arguments.bounded(1, 1000), default=3, help="sessions (3)")
     parser.add_argument("--seed", type=arguments.seed, default=0, help="base seed of the episodes (0)")
-    parser.add_argument("--cache-dir", type=arguments.path, default=None, metavar="DIR",
-                        help="observation cache folder (default: DIR/.davis_ag_cache)")
+    parser.add_argument(
+        "--cache-dir",
+        type=arguments.path,
+        default=None,
+        metavar="DIR",
+        help="observation cache folder (default: DIR/.davis_ag_cache)",
+    )
     parser.add_argument("--out", type=arguments.path, required=True, metavar="RESULTS.json", help="results file")
-    parser.add_argument("--plot", type=arguments.path, default=None, metavar="PNG",
-                        help="bar chart (default: the --out path with .png)")
+    parser.add_argument(
+        "--plot", type=arguments.path, default=None, metavar="PNG", help="bar chart (default: the --out path with .png)"
+    )
     parser.add_argument("--force", action="store_true", help="replace an existing --out and --plot")
 
 
@@ -67,10 +100,14 @@ def run(args: argparse.Namespace) -> int:
     names = list(args.policies or allowed)
     wrong = [n for n in names if n not in allowed]
     if wrong:
-        raise UserError(f"--policies {wrong[0]} is not a baseline of --env {args.env}: choose from {', '.join(allowed)}")
+        raise UserError(
+            f"--policies {wrong[0]} is not a baseline of --env {args.env}: choose from {', '.join(allowed)}"
+        )
     specs = args.policy or []
     if len(args.name) > len(specs):
-        raise UserError(f"{len(args.name)} --name for {len(specs)} --policy: give one --name after each --policy it names")
+        raise UserError(
+            f"{len(args.name)} --name for {len(specs)} --policy: give one --name after each --policy it names"
+        )
     out = arguments.prove_writable_file(args.out)
     plot = arguments.prove_writable_file(args.plot or out.with_suffix(".png"), "--plot")
     if plot == out:
@@ -87,18 +124,32 @@ def _evaluate(args: argparse.Namespace, names: list[str], specs: list[str], out:
     from davis_ag.benchmark.policies import policy_from_spec
     from davis_ag.figures.result_charts import plot_results
 
-    policies = [policy_from_spec(spec, name, deterministic=args.deterministic)
-                for spec, name in zip(specs, args.name + [None] * len(specs))]
-    results = evaluate(policies, args.dataset, scenario=args.scenario, split=args.split, sessions=args.sessions,
-                       episodes=args.episodes, seed=args.seed, env=args.env, crop=args.crop, baselines=names,
-                       cache_dir=args.cache_dir)
+    policies = [
+        policy_from_spec(spec, name, deterministic=args.deterministic)
+        for spec, name in zip(specs, args.name + [None] * len(specs))
+    ]
+    results = evaluate(
+        policies,
+        args.dataset,
+        scenario=args.scenario,
+        split=args.split,
+        sessions=args.sessions,
+        episodes=args.episodes,
+        seed=args.seed,
+        env=args.env,
+        crop=args.crop,
+        baselines=names,
+        cache_dir=args.cache_dir,
+    )
     print(format_table(results))
     # The JSON is the result: keep it somewhere even when --out fails at the end.
     write_or_rescue(out, lambda path: write_json(results, path), "the results")
     try:
         plot_results(results.as_json(), plot)
     except OSError as error:
-        raise MachineError(f"the results are in {out}, but the chart could not be written to {plot} "
-                        f"({error.strerror or error}): run again with another --plot") from None
+        raise MachineError(
+            f"the results are in {out}, but the chart could not be written to {plot} "
+            f"({error.strerror or error}): run again with another --plot"
+        ) from None
     print(f"wrote {out} and {plot}")
     return 0

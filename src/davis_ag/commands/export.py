@@ -12,11 +12,13 @@ from davis_ag.errors import UserError
 from davis_ag.formats.outputs import LOCK_FILE, claim_output
 
 HELP = "write a dataset as COCO (RLE masks) or YOLO (ultralytics) detection data, or point clouds"
-DESCRIPTION = ("Export a DAVIS-Ag dataset for detectors, one set per split (splits.json, else the benchmark's "
-               "seeded 70/30 split by scene). coco: OUT/annotations/instances_<split>.json with RLE masks, "
-               "boxes, fruit ids and visible fractions, images referenced in place. yolo: the ultralytics "
-               "layout (images/, labels/, data.yaml). pointcloud: PLY point clouds in the world frame from "
-               "the depth images, with colour, organ class and fruit id.")
+DESCRIPTION = (
+    "Export a DAVIS-Ag dataset for detectors, one set per split (splits.json, else the benchmark's "
+    "seeded 70/30 split by scene). coco: OUT/annotations/instances_<split>.json with RLE masks, "
+    "boxes, fruit ids and visible fractions, images referenced in place. yolo: the ultralytics "
+    "layout (images/, labels/, data.yaml). pointcloud: PLY point clouds in the world frame from "
+    "the depth images, with colour, organ class and fruit id."
+)
 
 #: What an export folder may already hold (a previous export, which is refreshed in place).
 _OURS = {"coco": {"annotations"}, "yolo": {"images", "labels", "data.yaml"}, "pointcloud": set()}
@@ -29,40 +31,65 @@ LEFT_BY_A_KILL = ("annotations/.coco-*", "**/.*.tmp")
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add ``export``'s formats, each a sub-parser with its own arguments (see :mod:`davis_ag.commands`)."""
     formats = parser.add_subparsers(dest="format", required=True, metavar="{coco,yolo,pointcloud}")
-    for name, help_text in (("coco", "COCO instances JSON, masks as pycocotools RLE"),
-                            ("yolo", "ultralytics layout: images/, labels/, data.yaml")):
+    for name, help_text in (
+        ("coco", "COCO instances JSON, masks as pycocotools RLE"),
+        ("yolo", "ultralytics layout: images/, labels/, data.yaml"),
+    ):
         sub = formats.add_parser(name, help=help_text, description=help_text)
-        sub.add_argument("dir", type=arguments.path, metavar="DIR",
-                         help="dataset root, group folder or scene folder")
+        sub.add_argument("dir", type=arguments.path, metavar="DIR", help="dataset root, group folder or scene folder")
         sub.add_argument("out", type=arguments.path, metavar="OUT", help="export folder (new, or a previous export)")
-        sub.add_argument("--split", choices=("train", "test", "both"), default="both",
-                         help="which split to write (default both)")
+        sub.add_argument(
+            "--split", choices=("train", "test", "both"), default="both", help="which split to write (default both)"
+        )
         sub.add_argument("--force", action="store_true", help="replace a finished export in OUT")
-        sub.add_argument("--organs", action="store_true",
-                         help="also the organ classes (soil, fruit, leaf, stem, trunk) as semantic masks, from "
-                              "the views' NNNN_class.png" + (" (with --task segment)" if name == "yolo" else
-                                                            " (RLE, category ids 101-105)"))
+        sub.add_argument(
+            "--organs",
+            action="store_true",
+            help="also the organ classes (soil, fruit, leaf, stem, trunk) as semantic masks, from "
+            "the views' NNNN_class.png"
+            + (" (with --task segment)" if name == "yolo" else " (RLE, category ids 101-105)"),
+        )
         if name == "yolo":
-            sub.add_argument("--task", choices=("detect", "segment"), default="detect",
-                             help="label lines: boxes (detect, default) or polygons (segment)")
-            sub.add_argument("--appearance-shift", type=arguments.whole, default=None, metavar="SEED",
-                             help="re-colour, light from one side, blur, add noise and re-compress every "
-                                  "exported image (copies; the dataset is untouched): a stand-in for real "
-                                  "photographs when none are at hand")
+            sub.add_argument(
+                "--task",
+                choices=("detect", "segment"),
+                default="detect",
+                help="label lines: boxes (detect, default) or polygons (segment)",
+            )
+            sub.add_argument(
+                "--appearance-shift",
+                type=arguments.whole,
+                default=None,
+                metavar="SEED",
+                help="re-colour, light from one side, blur, add noise and re-compress every "
+                "exported image (copies; the dataset is untouched): a stand-in for real "
+                "photographs when none are at hand",
+            )
     cloud = formats.add_parser(
-        "pointcloud", help="PLY point clouds from the depth images (world frame, colour, organ, fruit id)",
+        "pointcloud",
+        help="PLY point clouds from the depth images (world frame, colour, organ, fruit id)",
         description="One PLY per view (OUT/<group>/<scene>/NNNN.ply), or per scene with --fuse "
-                    "(OUT/<group>/<scene>.ply): points in the world frame from each depth image, the "
-                    "recorded intrinsics and the pose, with colour, organ class and fruit id.")
+        "(OUT/<group>/<scene>.ply): points in the world frame from each depth image, the "
+        "recorded intrinsics and the pose, with colour, organ class and fruit id.",
+    )
     cloud.add_argument("dir", type=arguments.path, metavar="DIR", help="dataset root, group folder or scene folder")
     cloud.add_argument("out", type=arguments.path, metavar="OUT", help="export folder (new, or a previous export)")
     cloud.add_argument("--force", action="store_true", help="replace a finished export in OUT")
     cloud.add_argument("--fuse", action="store_true", help="one cloud per scene, all its views joined")
-    cloud.add_argument("--max-depth", type=arguments.positive_float, default=5.0, metavar="M",
-                       help="drop points farther than this from the camera, m (default 5; the far soil "
-                            "reaches 30 m)")
-    cloud.add_argument("--voxel", type=arguments.non_negative_float, default=None, metavar="M",
-                       help="keep one point per cube of this side, m (default 0.005 with --fuse, else 0: all)")
+    cloud.add_argument(
+        "--max-depth",
+        type=arguments.positive_float,
+        default=5.0,
+        metavar="M",
+        help="drop points farther than this from the camera, m (default 5; the far soil reaches 30 m)",
+    )
+    cloud.add_argument(
+        "--voxel",
+        type=arguments.non_negative_float,
+        default=None,
+        metavar="M",
+        help="keep one point per cube of this side, m (default 0.005 with --fuse, else 0: all)",
+    )
 
 
 def check_out(out: Path, fmt: str) -> None:
@@ -72,11 +99,17 @@ def check_out(out: Path, fmt: str) -> None:
     if out.is_dir():
         from davis_ag.scene.specs import parse_group_name
 
-        foreign = sorted(p.name for p in out.iterdir() if p.name not in _OURS[fmt] | {UNFINISHED, LOCK_FILE}
-                         and not (fmt == "pointcloud" and p.is_dir() and parse_group_name(p.name)))
+        foreign = sorted(
+            p.name
+            for p in out.iterdir()
+            if p.name not in _OURS[fmt] | {UNFINISHED, LOCK_FILE}
+            and not (fmt == "pointcloud" and p.is_dir() and parse_group_name(p.name))
+        )
         if foreign:
-            raise UserError(f"{out}: holds {', '.join(foreign[:3])}{' ...' if len(foreign) > 3 else ''}, "
-                            f"which is not a {fmt} export; give a new or empty folder")
+            raise UserError(
+                f"{out}: holds {', '.join(foreign[:3])}{' ...' if len(foreign) > 3 else ''}, "
+                f"which is not a {fmt} export; give a new or empty folder"
+            )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -114,8 +147,11 @@ def _export(args: argparse.Namespace) -> int:
         print(f"{split}: {c['images']} images, {c[unit]} {unit}")
     clipped, dropped = (sum(c.get(key, 0) for c in counts.values()) for key in ("clipped", "dropped"))
     if clipped or dropped:
-        print(f"note: {clipped} box(es) reaching outside their image were cut to it and {dropped} with no pixel "
-              "inside were left out; `davis-ag validate` lists them", file=sys.stderr)
+        print(
+            f"note: {clipped} box(es) reaching outside their image were cut to it and {dropped} with no pixel "
+            "inside were left out; `davis-ag validate` lists them",
+            file=sys.stderr,
+        )
     where = args.out / "annotations" if args.format == "coco" else args.out / "data.yaml"
     print(f"wrote {where}")
     return 0

@@ -18,23 +18,46 @@ FORMATTER_CLASS = argparse.RawDescriptionHelpFormatter
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add ``plot``'s arguments to its ``parser`` (see :mod:`davis_ag.commands`)."""
     parser.add_argument("kind", choices=list(KINDS), help="which figure")
-    parser.add_argument("dataset", type=arguments.path, nargs="?", default=None, metavar="DIR",
-                        help="dataset root, group or scene folder (all kinds but actions)")
-    parser.add_argument("--scene", default=None, metavar="ID",
-                        help="scene id, e.g. Single-Strawberry/000 (default: the first scene)")
-    parser.add_argument("--results", type=arguments.path, default=None, metavar="RESULTS.json",
-                        help="`davis-ag evaluate` results (actions, episode)")
+    parser.add_argument(
+        "dataset",
+        type=arguments.path,
+        nargs="?",
+        default=None,
+        metavar="DIR",
+        help="dataset root, group or scene folder (all kinds but actions)",
+    )
+    parser.add_argument(
+        "--scene", default=None, metavar="ID", help="scene id, e.g. Single-Strawberry/000 (default: the first scene)"
+    )
+    parser.add_argument(
+        "--results",
+        type=arguments.path,
+        default=None,
+        metavar="RESULTS.json",
+        help="`davis-ag evaluate` results (actions, episode)",
+    )
     parser.add_argument("--policy", default=None, help="policy of the per-episode panel or episode")
-    parser.add_argument("--episode", type=arguments.whole, default=0, metavar="N",
-                        help="recorded episode to draw (default 0)")
-    parser.add_argument("--start", default=None, metavar="VIEW",
-                        help="episode: start view to walk from instead of a recorded episode")
-    parser.add_argument("--actions", default="", metavar="A,B,...",
-                        help="episode: action names to walk from --start")
-    parser.add_argument("--target", type=arguments.whole, default=None, metavar="FRUIT",
-                        help="episode: target fruit id (a move losing its box is refused)")
-    parser.add_argument("--out", type=arguments.path, required=True, metavar="PATH",
-                        help="output path without suffix: PATH.png, PATH.svg, PATH.json")
+    parser.add_argument(
+        "--episode", type=arguments.whole, default=0, metavar="N", help="recorded episode to draw (default 0)"
+    )
+    parser.add_argument(
+        "--start", default=None, metavar="VIEW", help="episode: start view to walk from instead of a recorded episode"
+    )
+    parser.add_argument("--actions", default="", metavar="A,B,...", help="episode: action names to walk from --start")
+    parser.add_argument(
+        "--target",
+        type=arguments.whole,
+        default=None,
+        metavar="FRUIT",
+        help="episode: target fruit id (a move losing its box is refused)",
+    )
+    parser.add_argument(
+        "--out",
+        type=arguments.path,
+        required=True,
+        metavar="PATH",
+        help="output path without suffix: PATH.png, PATH.svg, PATH.json",
+    )
     parser.add_argument("--formats", default="png,svg", help="figure formats (default png,svg)")
 
 
@@ -47,10 +70,21 @@ def run(args: argparse.Namespace) -> int:
     if bad or not formats:
         raise UserError(f"--formats {args.formats!r}: choose from png, svg, pdf (comma-separated)")
     actions = [a.strip() for a in args.actions.split(",") if a.strip()]
-    plotted = make_plot(PlotRequest(args.kind, args.out, dataset=args.dataset, scene=args.scene,
-                                    results=args.results, policy=args.policy, episode=args.episode,
-                                    start=args.start, actions=actions, target=args.target,
-                                    formats=formats))
+    plotted = make_plot(
+        PlotRequest(
+            args.kind,
+            args.out,
+            dataset=args.dataset,
+            scene=args.scene,
+            results=args.results,
+            policy=args.policy,
+            episode=args.episode,
+            start=args.start,
+            actions=actions,
+            target=args.target,
+            formats=formats,
+        )
+    )
     for path in plotted.paths:
         print(f"wrote {path}")
     return 0

@@ -34,8 +34,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scenario", default="sp", help="sp or mp")
     parser.add_argument("--seed", type=arguments.seed, default=0, help="dataset seed (default 0)")
     parser.add_argument("--index", type=arguments.whole, default=0, help="scene index (default 0)")
-    parser.add_argument("--views", type=arguments.number_list, default=[1],
-                        help="comma-separated view numbers (default 1)")
+    parser.add_argument(
+        "--views", type=arguments.number_list, default=[1], help="comma-separated view numbers (default 1)"
+    )
     parser.add_argument("--size", type=arguments.image_size, default=(1280, 720), help="image size (default 1280x720)")
     arguments.add_renderer_flags(parser)
     parser.add_argument("--out", type=arguments.path, required=True, help="folder for the pictures")
@@ -51,8 +52,16 @@ def run(args: argparse.Namespace) -> int:
     # nominal grid, which slip does not change.
     _check_views(numbers, count_views(scenario, crop))
     arguments.prove_writable_folder(args.out)
-    request = SceneRequest(scenario, crop, args.index, args.seed, Camera(*args.size), renderer=renderer_name,
-                           look=look, plants=args.plants or DEFAULT_PLANTS)
+    request = SceneRequest(
+        scenario,
+        crop,
+        args.index,
+        args.seed,
+        Camera(*args.size),
+        renderer=renderer_name,
+        look=look,
+        plants=args.plants or DEFAULT_PLANTS,
+    )
     rng = np.random.default_rng(request.seed)
     model = build_scene(scenario, crop, rng, request.plants)
     grid = build_view_grid(scenario, crop, plant_centres(scenario, crop), model.aim_height, rng)
@@ -60,8 +69,9 @@ def run(args: argparse.Namespace) -> int:
     lookup = fruit_lookup({f.id: f.uuids for f in model.fruits}, model.uuid_count)
     polygons = {f.id: f.polygons for f in model.fruits}
     args.out.mkdir(parents=True, exist_ok=True)
-    with open_renderer(renderer_name, model.context, request.camera, model.lighting, look,
-                       args.antialiasing) as renderer:
+    with open_renderer(
+        renderer_name, model.context, request.camera, model.lighting, look, args.antialiasing
+    ) as renderer:
         for number in numbers:
             view = grid.viewpoints[number - 1]
             colour, primitive_ids, _ = renderer.render(view, depth=False)

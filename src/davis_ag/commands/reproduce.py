@@ -30,29 +30,42 @@ FORMATTER_CLASS = argparse.RawDescriptionHelpFormatter
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add ``reproduce``'s arguments to its ``parser`` (see :mod:`davis_ag.commands`)."""
     parser.add_argument("--out", type=arguments.path, required=True, metavar="DIR", help="work folder")
-    parser.add_argument("--results", type=arguments.path, default="docs/results.md", metavar="MD",
-                        help="Markdown results file (default: docs/results.md)")
-    parser.add_argument("--config", choices=list(CONFIGS), default="small",
-                        help="small (43 min measured on 2 CPU cores, default; not comparable with Table 4), "
-                             "medium (the paper's grids and 300K A2C steps, hours) or paper-scale (days)")
-    parser.add_argument("--sp-scenes", type=arguments.bounded(1, 1000), default=None,
-                        help="override the SP scene count")
-    parser.add_argument("--mp-scenes", type=arguments.bounded(1, 1000), default=None,
-                        help="override the MP scene count")
-    parser.add_argument("--sp-timesteps", type=arguments.bounded(1, 10**9), default=None,
-                        help="override SP A2C steps")
-    parser.add_argument("--mp-timesteps", type=arguments.bounded(1, 10**9), default=None,
-                        help="override MP A2C steps")
+    parser.add_argument(
+        "--results",
+        type=arguments.path,
+        default="docs/results.md",
+        metavar="MD",
+        help="Markdown results file (default: docs/results.md)",
+    )
+    parser.add_argument(
+        "--config",
+        choices=list(CONFIGS),
+        default="small",
+        help="small (43 min measured on 2 CPU cores, default; not comparable with Table 4), "
+        "medium (the paper's grids and 300K A2C steps, hours) or paper-scale (days)",
+    )
+    parser.add_argument(
+        "--sp-scenes", type=arguments.bounded(1, 1000), default=None, help="override the SP scene count"
+    )
+    parser.add_argument(
+        "--mp-scenes", type=arguments.bounded(1, 1000), default=None, help="override the MP scene count"
+    )
+    parser.add_argument("--sp-timesteps", type=arguments.bounded(1, 10**9), default=None, help="override SP A2C steps")
+    parser.add_argument("--mp-timesteps", type=arguments.bounded(1, 10**9), default=None, help="override MP A2C steps")
     parser.add_argument("--only", choices=["sp", "mp"], default=None, help="run one scenario only")
-    parser.add_argument("--rewrite-results", action="store_true",
-                        help="only rewrite --results from DIR/state.json; run nothing")
+    parser.add_argument(
+        "--rewrite-results", action="store_true", help="only rewrite --results from DIR/state.json; run nothing"
+    )
 
 
 def run(args: argparse.Namespace) -> int:
     """Run every stage of the chosen configuration and write the results file."""
     config = CONFIGS[args.config]
-    overrides = {k: getattr(args, k) for k in ("sp_scenes", "mp_scenes", "sp_timesteps", "mp_timesteps")
-                 if getattr(args, k) is not None}
+    overrides = {
+        k: getattr(args, k)
+        for k in ("sp_scenes", "mp_scenes", "sp_timesteps", "mp_timesteps")
+        if getattr(args, k) is not None
+    }
     config = replace(config, **overrides)
     arguments.prove_writable_file(args.results, "--results")
     if args.rewrite_results:
@@ -60,13 +73,10 @@ def run(args: argparse.Namespace) -> int:
         if not state.get("config"):
             raise UserError(f"{args.out / 'state.json'}: no finished run to write results from")
         saved = state["config"]
-        saved.update(size=tuple(saved["size"]),
-                     mp_extent=tuple(saved["mp_extent"]) if saved.get("mp_extent") else None)
+        saved.update(size=tuple(saved["size"]), mp_extent=tuple(saved["mp_extent"]) if saved.get("mp_extent") else None)
         write_results_md(args.results, ReproduceConfig(**saved), state, args.out)
         print(f"wrote {args.results}")
         return 0
     arguments.prove_writable_folder(args.out)
     pairs = [p for p in SCENARIO_CROPS if args.only in (None, p[0])]
     return reproduce(config, args.out, args.results, pairs)
-
-

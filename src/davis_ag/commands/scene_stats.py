@@ -17,20 +17,42 @@ MEASUREMENTS = ("views", "plants", "findings", "refused")
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add ``scene-stats``'s arguments to its ``parser`` (see :mod:`davis_ag.commands`)."""
-    parser.add_argument("measurement", nargs="?", choices=MEASUREMENTS,
-                        help="views (instant), plants (grows --count plants per crop), findings or refused "
-                             "(generate --count scenes at --size); none: only rewrite the pages")
-    parser.add_argument("--docs", type=arguments.path, default="docs", metavar="DOCS",
-                        help="the docs folder (default docs)")
+    parser.add_argument(
+        "measurement",
+        nargs="?",
+        choices=MEASUREMENTS,
+        help="views (instant), plants (grows --count plants per crop), findings or refused "
+        "(generate --count scenes at --size); none: only rewrite the pages",
+    )
+    parser.add_argument(
+        "--docs", type=arguments.path, default="docs", metavar="DOCS", help="the docs folder (default docs)"
+    )
     parser.add_argument("--count", type=arguments.count, default=10, help="plants per crop, or scenes (default 10)")
-    parser.add_argument("--size", type=arguments.image_size, default="1280x720", metavar="WxH",
-                        help="image size of the generated scenes (default 1280x720)")
-    parser.add_argument("--crops", type=arguments.name_list(("strawberry", "tomato", "vine")), default=None,
-                        help="plants: the crops to grow (default all; the others keep their saved rows)")
-    parser.add_argument("--generators", type=arguments.name_list(("canopy", "architecture")), default=None,
-                        help="refused: the plant generators compared (default both)")
-    parser.add_argument("--step", type=arguments.positive_float, default=0.25,
-                        help="findings: the grid step in metres (default 0.25, the paper's)")
+    parser.add_argument(
+        "--size",
+        type=arguments.image_size,
+        default="1280x720",
+        metavar="WxH",
+        help="image size of the generated scenes (default 1280x720)",
+    )
+    parser.add_argument(
+        "--crops",
+        type=arguments.name_list(("strawberry", "tomato", "vine")),
+        default=None,
+        help="plants: the crops to grow (default all; the others keep their saved rows)",
+    )
+    parser.add_argument(
+        "--generators",
+        type=arguments.name_list(("canopy", "architecture")),
+        default=None,
+        help="refused: the plant generators compared (default both)",
+    )
+    parser.add_argument(
+        "--step",
+        type=arguments.positive_float,
+        default=0.25,
+        help="findings: the grid step in metres (default 0.25, the paper's)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -39,9 +61,10 @@ def run(args: argparse.Namespace) -> int:
     from davis_ag.workflows.scene_stats_page import write_measurement
 
     if not (args.docs / "architecture.md").is_file():
-        raise UserError(f"{args.docs}: not the docs folder of a davis-ag clone (no architecture.md); "
-                        "run from the clone's root or give --docs")
-    write_measurement(args.docs, args.measurement, args.count, tuple(args.size), args.crops, args.generators,
-                      args.step)
+        raise UserError(
+            f"{args.docs}: not the docs folder of a davis-ag clone (no architecture.md); "
+            "run from the clone's root or give --docs"
+        )
+    write_measurement(args.docs, args.measurement, args.count, tuple(args.size), args.crops, args.generators, args.step)
     print(f"written {args.docs / 'scenes.md'}")
     return 0

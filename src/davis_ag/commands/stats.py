@@ -14,10 +14,12 @@ DESCRIPTION = __doc__
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add ``stats``'s arguments to its ``parser`` (see :mod:`davis_ag.commands`)."""
     parser.add_argument("dataset", type=arguments.path, metavar="DIR", help="dataset root, group or scene folder")
-    parser.add_argument("--out", type=arguments.path, default=None, metavar="STATS.json",
-                        help="also write the statistics as JSON here")
-    parser.add_argument("--no-oer", action="store_true",
-                        help="skip the OER distribution (it reads every mask: slow on a large dataset)")
+    parser.add_argument(
+        "--out", type=arguments.path, default=None, metavar="STATS.json", help="also write the statistics as JSON here"
+    )
+    parser.add_argument(
+        "--no-oer", action="store_true", help="skip the OER distribution (it reads every mask: slow on a large dataset)"
+    )
 
 
 def run(args: argparse.Namespace) -> int:

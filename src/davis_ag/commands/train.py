@@ -8,12 +8,14 @@ from davis_ag.commands import arguments
 from davis_ag.errors import UserError
 
 HELP = "train an A2C (or PPO, DQN) agent for target visibility maximisation"
-DESCRIPTION = ("Train a Stable-Baselines3 agent (--algo a2c, the paper's, by default; ppo; dqn) with the paper's network "
-               "(CnnPolicy; A2C: SB3's default hyperparameters with an entropy bonus and normalised advantages; PPO "
-               "and DQN: SB3's defaults, DQN with a smaller replay buffer) on the train split of the TVM environment "
-               "and save a .zip (the snapshot that scored best on the train split), with a training record "
-               "(settings, sittings, learning curve) beside it. Shows steps, rate, time left and the last "
-               "train-split score: a bar on a terminal, a line a minute in a log.")
+DESCRIPTION = (
+    "Train a Stable-Baselines3 agent (--algo a2c, the paper's, by default; ppo; dqn) with the paper's network "
+    "(CnnPolicy; A2C: SB3's default hyperparameters with an entropy bonus and normalised advantages; PPO "
+    "and DQN: SB3's defaults, DQN with a smaller replay buffer) on the train split of the TVM environment "
+    "and save a .zip (the snapshot that scored best on the train split), with a training record "
+    "(settings, sittings, learning curve) beside it. Shows steps, rate, time left and the last "
+    "train-split score: a bar on a terminal, a line a minute in a log."
+)
 
 
 def setting(text: str) -> tuple[str, object]:
@@ -32,36 +34,79 @@ def setting(text: str) -> tuple[str, object]:
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add ``train``'s arguments to its ``parser`` (see :mod:`davis_ag.commands`)."""
     arguments.add_dataset_flags(parser, "train")
-    parser.add_argument("--algo", choices=["a2c", "ppo", "dqn"], default="a2c",
-                        help="a2c (the paper's, default), ppo or dqn (on the discrete moves)")
-    parser.add_argument("--timesteps", type=arguments.bounded(1, 10**9), default=300_000, metavar="N",
-                        help="environment steps (default: 300000, as in the paper)")
+    parser.add_argument(
+        "--algo",
+        choices=["a2c", "ppo", "dqn"],
+        default="a2c",
+        help="a2c (the paper's, default), ppo or dqn (on the discrete moves)",
+    )
+    parser.add_argument(
+        "--timesteps",
+        type=arguments.bounded(1, 10**9),
+        default=300_000,
+        metavar="N",
+        help="environment steps (default: 300000, as in the paper)",
+    )
     parser.add_argument("--seed", type=arguments.seed, default=0, help="seed of SB3 and the environments")
-    parser.add_argument("--n-envs", type=arguments.bounded(1, 256), default=8,
-                        help="parallel environments (default: 8)")
-    parser.add_argument("--arch", choices=["paper", "nature", "pooled"], default="paper",
-                        help="network: paper (section V-B, default), nature (SB3's NatureCNN) or pooled "
-                             "(fast smoke tests)")
-    parser.add_argument("--a2c-settings", choices=["ours", "sb3"], default="ours",
-                        help="A2C only; ours (default): SB3's A2C defaults with ent_coef=0.01 and normalised advantages, "
-                             "which keep the policy from collapsing to one move; sb3: SB3's defaults alone")
-    parser.add_argument("--set", action="append", type=setting, default=[], metavar="KEY=VALUE", dest="settings",
-                        help="a Stable-Baselines3 argument of the algorithm over its settings (repeatable), e.g. "
-                             "n_steps=128 for a short PPO rollout; recorded in the training record")
-    parser.add_argument("--keep", choices=["best-train", "last"], default="best-train",
-                        help="which snapshot to save: best-train (default) scores the policy on the train split "
-                             "every 10000 steps and at the end (200 sampled episodes) and keeps the best; "
-                             "last keeps the last")
+    parser.add_argument(
+        "--n-envs", type=arguments.bounded(1, 256), default=8, help="parallel environments (default: 8)"
+    )
+    parser.add_argument(
+        "--arch",
+        choices=["paper", "nature", "pooled"],
+        default="paper",
+        help="network: paper (section V-B, default), nature (SB3's NatureCNN) or pooled (fast smoke tests)",
+    )
+    parser.add_argument(
+        "--a2c-settings",
+        choices=["ours", "sb3"],
+        default="ours",
+        help="A2C only; ours (default): SB3's A2C defaults with ent_coef=0.01 and normalised advantages, "
+        "which keep the policy from collapsing to one move; sb3: SB3's defaults alone",
+    )
+    parser.add_argument(
+        "--set",
+        action="append",
+        type=setting,
+        default=[],
+        metavar="KEY=VALUE",
+        dest="settings",
+        help="a Stable-Baselines3 argument of the algorithm over its settings (repeatable), e.g. "
+        "n_steps=128 for a short PPO rollout; recorded in the training record",
+    )
+    parser.add_argument(
+        "--keep",
+        choices=["best-train", "last"],
+        default="best-train",
+        help="which snapshot to save: best-train (default) scores the policy on the train split "
+        "every 10000 steps and at the end (200 sampled episodes) and keeps the best; "
+        "last keeps the last",
+    )
     parser.add_argument("--device", default="auto", help="torch device (default: auto)")
-    parser.add_argument("--cache-dir", type=arguments.path, default=None, metavar="DIR",
-                        help="observation cache folder (default: DIR/.davis_ag_cache)")
-    parser.add_argument("--out", type=arguments.path, required=True, metavar="MODEL.zip", help="where to save the model")
-    parser.add_argument("--checkpoint-every", type=arguments.whole, default=10_000, metavar="N",
-                        help="save a checkpoint beside --out every N steps (0: never); running the same "
-                             "command again resumes from it (default: 10000)")
-    parser.add_argument("--force", action="store_true",
-                        help="replace an existing model at --out, and discard a checkpoint beside it that cannot "
-                             "be resumed (another run's, or a damaged one)")
+    parser.add_argument(
+        "--cache-dir",
+        type=arguments.path,
+        default=None,
+        metavar="DIR",
+        help="observation cache folder (default: DIR/.davis_ag_cache)",
+    )
+    parser.add_argument(
+        "--out", type=arguments.path, required=True, metavar="MODEL.zip", help="where to save the model"
+    )
+    parser.add_argument(
+        "--checkpoint-every",
+        type=arguments.whole,
+        default=10_000,
+        metavar="N",
+        help="save a checkpoint beside --out every N steps (0: never); running the same "
+        "command again resumes from it (default: 10000)",
+    )
+    parser.add_argument(
+        "--force",
+        action="store_true",
+        help="replace an existing model at --out, and discard a checkpoint beside it that cannot "
+        "be resumed (another run's, or a damaged one)",
+    )
     parser.add_argument("--verbose", type=int, choices=(0, 1, 2), default=1, help="SB3 verbosity (default: 1)")
 
 
@@ -75,11 +120,24 @@ def run(args: argparse.Namespace) -> int:
     if args.cache_dir is not None:
         arguments.prove_writable_folder(args.cache_dir, "--cache-dir")
     with claim_output(model_path(args.out), force=args.force):  # the output rule
-        path = train_agent(args.dataset, args.scenario, total_timesteps=args.timesteps, seed=args.seed,
-                           out_path=args.out, n_envs=args.n_envs, crop=args.crop,
-                           cache_dir=args.cache_dir, arch=args.arch, device=args.device,
-                           verbose=args.verbose, checkpoint_every=args.checkpoint_every,
-                           settings=_settings(args), keep=args.keep, algo=args.algo, force=args.force)
+        path = train_agent(
+            args.dataset,
+            args.scenario,
+            total_timesteps=args.timesteps,
+            seed=args.seed,
+            out_path=args.out,
+            n_envs=args.n_envs,
+            crop=args.crop,
+            cache_dir=args.cache_dir,
+            arch=args.arch,
+            device=args.device,
+            verbose=args.verbose,
+            checkpoint_every=args.checkpoint_every,
+            settings=_settings(args),
+            keep=args.keep,
+            algo=args.algo,
+            force=args.force,
+        )
     print(f"saved {path}")
     return 0
 

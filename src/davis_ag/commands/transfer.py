@@ -8,22 +8,43 @@ from davis_ag.commands import arguments
 from davis_ag.errors import UserError
 
 HELP = "Table 5: YOLOv5n real-only vs pre-trained on DAVIS-Ag, over random splits"
-DESCRIPTION = ("Pre-train YOLOv5n (ultralytics, built from its YAML, nothing downloaded) on a DAVIS-Ag dataset, "
-               "then, on N random train/test splits of a real set, train it from scratch (Real-Only) and from "
-               "the pre-trained weights (DAVIS-Ag -> Real) with the same budget, and report mAP@50 and "
-               "mAP@50:95 per split like Table 5. Needs pip install 'davis-ag[detect]'.")
+DESCRIPTION = (
+    "Pre-train YOLOv5n (ultralytics, built from its YAML, nothing downloaded) on a DAVIS-Ag dataset, "
+    "then, on N random train/test splits of a real set, train it from scratch (Real-Only) and from "
+    "the pre-trained weights (DAVIS-Ag -> Real) with the same budget, and report mAP@50 and "
+    "mAP@50:95 per split like Table 5. Needs pip install 'davis-ag[detect]'."
+)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add ``transfer``'s arguments to its ``parser`` (see :mod:`davis_ag.commands`)."""
-    parser.add_argument("--pretrain", type=arguments.path, required=True, metavar="DIR",
-                        help="DAVIS-Ag dataset to pre-train on (e.g. Single-Strawberry scenes)")
-    parser.add_argument("--real", type=arguments.path, required=True, metavar="PATH",
-                        help="the real set: ultralytics data YAML, folder with images/ and labels/, or COCO JSON")
-    parser.add_argument("--real-images", type=arguments.path, default=None, metavar="DIR",
-                        help="image folder of a COCO --real (default: as its file names say)")
-    parser.add_argument("--real-label", default="real set", metavar="TEXT",
-                        help="how the results name the real set; include 'stand-in' for a synthetic one")
+    parser.add_argument(
+        "--pretrain",
+        type=arguments.path,
+        required=True,
+        metavar="DIR",
+        help="DAVIS-Ag dataset to pre-train on (e.g. Single-Strawberry scenes)",
+    )
+    parser.add_argument(
+        "--real",
+        type=arguments.path,
+        required=True,
+        metavar="PATH",
+        help="the real set: ultralytics data YAML, folder with images/ and labels/, or COCO JSON",
+    )
+    parser.add_argument(
+        "--real-images",
+        type=arguments.path,
+        default=None,
+        metavar="DIR",
+        help="image folder of a COCO --real (default: as its file names say)",
+    )
+    parser.add_argument(
+        "--real-label",
+        default="real set",
+        metavar="TEXT",
+        help="how the results name the real set; include 'stand-in' for a synthetic one",
+    )
     parser.add_argument("--out", type=arguments.path, required=True, metavar="DIR", help="work folder")
     parser.add_argument("--splits", type=arguments.count, default=3, help="random splits (default 3)")
     parser.add_argument("--train-size", type=arguments.count, default=654, help="train images per split (654)")
@@ -35,8 +56,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--batch", type=arguments.count, default=16, help="batch size (16)")
     parser.add_argument("--device", default="cpu", help="cpu (default), 0 for the first GPU, ...")
     parser.add_argument("--workers", type=arguments.whole, default=0, help="data-loading processes (0)")
-    parser.add_argument("--results", type=arguments.path, default=None, metavar="MD",
-                        help="also write a Markdown report (e.g. docs/transfer/results.md)")
+    parser.add_argument(
+        "--results",
+        type=arguments.path,
+        default=None,
+        metavar="MD",
+        help="also write a Markdown report (e.g. docs/transfer/results.md)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -48,11 +74,18 @@ def run(args: argparse.Namespace) -> int:
         raise UserError(f"--imgsz must be a multiple of 32 (YOLO's stride), at least 32; got {args.imgsz}")
     budget = Budget(args.epochs, args.imgsz, args.batch, args.device, args.workers)
     config = TransferConfig(
-        pretrain=args.pretrain, real=args.real, out=args.out, real_images=args.real_images,
-        real_label=args.real_label, splits=args.splits, train_size=args.train_size, test_size=args.test_size,
-        seed=args.seed, pretrain_budget=Budget(args.pretrain_epochs, args.imgsz, args.batch, args.device,
-                                               args.workers),
-        budget=budget)
+        pretrain=args.pretrain,
+        real=args.real,
+        out=args.out,
+        real_images=args.real_images,
+        real_label=args.real_label,
+        splits=args.splits,
+        train_size=args.train_size,
+        test_size=args.test_size,
+        seed=args.seed,
+        pretrain_budget=Budget(args.pretrain_epochs, args.imgsz, args.batch, args.device, args.workers),
+        budget=budget,
+    )
     results = run_transfer(config)
     print(table5_markdown(results))
     print(f"wrote {args.out / 'transfer.json'} ({results['wall_s']['total']:.0f} s)")

@@ -20,8 +20,9 @@ FORMATTER_CLASS = argparse.RawDescriptionHelpFormatter
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add ``view``'s arguments to its ``parser`` (see :mod:`davis_ag.commands`)."""
     parser.add_argument("dataset", type=arguments.path, metavar="DIR", help="dataset root, group or scene folder")
-    parser.add_argument("--port", type=arguments.whole, default=8765,
-                        help="TCP port on 127.0.0.1 (default 8765; 0 = any free port)")
+    parser.add_argument(
+        "--port", type=arguments.whole, default=8765, help="TCP port on 127.0.0.1 (default 8765; 0 = any free port)"
+    )
     parser.add_argument("--scene", default=None, metavar="ID", help="scene to open first (default: the first)")
 
 

@@ -174,7 +174,7 @@ def parse_entry(key: Any, entry: Any) -> ViewRecord:
             if target is None:
                 target = ""
             if not isinstance(target, str):
-                raise ValueError(f"pointer {action!r} must be an image name or \"\", got {target!r}")
+                raise ValueError(f'pointer {action!r} must be an image name or "", got {target!r}')
             pointers[action] = normalise_view_name(target)
     return ViewRecord(name, pose, boxes, pointers)
 
@@ -197,8 +197,10 @@ def boxes_from_mask(mask: np.ndarray) -> dict[int, Box]:
     starts = np.flatnonzero(np.r_[True, ids[1:] != ids[:-1]])
     x0, x1 = np.minimum.reduceat(xs, starts), np.maximum.reduceat(xs, starts)
     y0, y1 = np.minimum.reduceat(ys, starts), np.maximum.reduceat(ys, starts)
-    return {int(i): Box(int(a), int(b), int(c - a + 1), int(d - b + 1), int(i))
-            for i, a, b, c, d in zip(ids[starts], x0, y0, x1, y1)}
+    return {
+        int(i): Box(int(a), int(b), int(c - a + 1), int(d - b + 1), int(i))
+        for i, a, b, c, d in zip(ids[starts], x0, y0, x1, y1)
+    }
 
 
 def exposure_rate(mask: np.ndarray, box: Box) -> float:

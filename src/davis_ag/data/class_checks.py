@@ -33,8 +33,10 @@ def class_problems(class_path: Path, mask_path: Path | None) -> list[str]:
     problems = []
     unknown = np.unique(classes[classes >= len(ORGAN_NAMES)])
     if unknown.size:
-        problems.append(f"holds class values {unknown.tolist()[:5]}, not in the table 0..{len(ORGAN_NAMES) - 1} "
-                        f"({', '.join(ORGAN_NAMES)})")
+        problems.append(
+            f"holds class values {unknown.tolist()[:5]}, not in the table 0..{len(ORGAN_NAMES) - 1} "
+            f"({', '.join(ORGAN_NAMES)})"
+        )
     if mask_path is None:
         return problems
     try:

@@ -42,11 +42,25 @@ from davis_ag.errors import UserError
 from davis_ag.scene import specs as config
 
 __all__ = [
-    "ANNOTATIONS", "NO_FRUIT", "SCENE_METADATA", "SPLITS", "Box", "Dataset", "NotFoundError", "Scene",
-    "View", "ViewRecord", "boxes_from_mask", "exposure_rate", "normalise_view_name", "open_dataset",
-    "parse_box", "parse_entry", "parse_pose", "read_json",
+    "ANNOTATIONS",
+    "NO_FRUIT",
+    "SCENE_METADATA",
+    "SPLITS",
+    "Box",
+    "Dataset",
+    "NotFoundError",
+    "Scene",
+    "View",
+    "ViewRecord",
+    "boxes_from_mask",
+    "exposure_rate",
+    "normalise_view_name",
+    "open_dataset",
+    "parse_box",
+    "parse_entry",
+    "parse_pose",
+    "read_json",
 ]
-
 
 
 class NotFoundError(UserError, KeyError):
@@ -126,8 +140,9 @@ class View:
             return None
         classes = load_pixels(check_inside(self.class_path, self.scene.root), None)
         if classes.dtype != np.uint8 or classes.ndim != 2:
-            raise UserError(f"{self.class_path}: a class image must be an 8-bit single-channel PNG; "
-                            "regenerate the scene")
+            raise UserError(
+                f"{self.class_path}: a class image must be an 8-bit single-channel PNG; regenerate the scene"
+            )
         return classes
 
     def next(self, action: str) -> View | None:
@@ -149,8 +164,10 @@ class View:
             return None
         found = self.scene.views.get(target)
         if found is None:
-            raise UserError(f"{self.scene.path / ANNOTATIONS}: {self.name}: {action} points to {target}, "
-                            "which is not a view of this scene; run `davis-ag validate` on it")
+            raise UserError(
+                f"{self.scene.path / ANNOTATIONS}: {self.name}: {action} points to {target}, "
+                "which is not a view of this scene; run `davis-ag validate` on it"
+            )
         return found
 
     def box(self, fruit_id: int) -> Box | None:
@@ -231,8 +248,10 @@ class Scene(Sequence["View"]):
         """
         raw = read_json(check_inside(self.annotations_path, self.root), "annotations")
         if not isinstance(raw, dict):
-            raise UserError(f"{self.annotations_path}: must hold a JSON object keyed by image name, "
-                            f"got {type(raw).__name__}; re-download or regenerate the scene")
+            raise UserError(
+                f"{self.annotations_path}: must hold a JSON object keyed by image name, "
+                f"got {type(raw).__name__}; re-download or regenerate the scene"
+            )
         return raw
 
     @cached_property
@@ -247,16 +266,18 @@ class Scene(Sequence["View"]):
             try:
                 records.append(parse_entry(key, entry))
             except ValueError as error:
-                raise UserError(f"{self.annotations_path}: entry {key!r}: {error}; "
-                                "run `davis-ag validate` for every problem") from None
+                raise UserError(
+                    f"{self.annotations_path}: entry {key!r}: {error}; run `davis-ag validate` for every problem"
+                ) from None
         records.sort(key=lambda r: _view_order(r.name))
         present = {a for r in records for a in r.pointers}
         actions = tuple(a for a in config.ALL_ACTIONS if a in present)
         if not actions:
             actions = self._specs[0].actions if self._specs else config.SP_ACTIONS
         self._actions = actions
-        return {r.name: View(r.name, self, r.pose, r.boxes, {a: r.pointers.get(a, "") for a in actions})
-                for r in records}
+        return {
+            r.name: View(r.name, self, r.pose, r.boxes, {a: r.pointers.get(a, "") for a in actions}) for r in records
+        }
 
     @property
     def actions(self) -> tuple[str, ...]:
@@ -364,8 +385,10 @@ class Dataset:
         try:
             return SplitsFile.model_validate(data)
         except ValidationError as error:
-            raise UserError(f"{one_line(error, str(path))}; fix or delete it (a list of scene ids like "
-                            "\"Single-Strawberry/000\" for train and for test)") from None
+            raise UserError(
+                f"{one_line(error, str(path))}; fix or delete it (a list of scene ids like "
+                '"Single-Strawberry/000" for train and for test)'
+            ) from None
 
     def __len__(self) -> int:
         return len(self.scenes)
@@ -409,6 +432,7 @@ def open_dataset(path: str | Path) -> Dataset:
         raise UserError(
             f"{path}: not a DAVIS-Ag dataset: no {ANNOTATIONS} in it, in its sub-folders or theirs; "
             f"give the root that holds e.g. Single-Strawberry/000/{ANNOTATIONS}, a group folder "
-            "or a scene folder")
+            "or a scene folder"
+        )
     scenes.sort(key=lambda s: s.id)
     return Dataset(root, scenes)

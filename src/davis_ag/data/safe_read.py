@@ -25,8 +25,10 @@ def read_json(path: Path, what: str) -> Any:
     try:
         return json.loads(text)
     except json.JSONDecodeError as error:
-        raise UserError(f"{path}: {what} is not valid JSON (line {error.lineno} column {error.colno}: "
-                        f"{error.msg}); re-download or regenerate it") from None
+        raise UserError(
+            f"{path}: {what} is not valid JSON (line {error.lineno} column {error.colno}: "
+            f"{error.msg}); re-download or regenerate it"
+        ) from None
     except RecursionError:
         raise UserError(f"{path}: {what} is nested too deeply to be ours; re-download or regenerate it") from None
 
@@ -54,8 +56,9 @@ def check_inside(path: Path, root: Path | None) -> Path:
     except (OSError, RuntimeError) as error:  # a symlink loop
         raise UserError(f"{path}: cannot resolve ({error}); replace the link by the file") from None
     if resolved != inside and not resolved.is_relative_to(inside):
-        raise UserError(f"{path}: points outside the dataset, to {resolved}; copy the file into {root} "
-                        "instead of linking it")
+        raise UserError(
+            f"{path}: points outside the dataset, to {resolved}; copy the file into {root} instead of linking it"
+        )
     return path
 
 

@@ -82,8 +82,9 @@ class Report:
     def summary(self) -> str:
         """One line: the counts and the verdict."""
         verdict = "sound" if self.ok else _plural(len(self.problems), "problem")
-        counts = ", ".join(_plural(n, what) for n, what in
-                           ((self.scenes, "scene"), (self.views, "view"), (self.boxes, "box")))
+        counts = ", ".join(
+            _plural(n, what) for n, what in ((self.scenes, "scene"), (self.views, "view"), (self.boxes, "box"))
+        )
         return f"checked {counts}: {verdict}"
 
 
@@ -100,9 +101,13 @@ def _read_json(path: Path) -> tuple[object, str | None]:
         return None, f"cannot read ({error})"
 
 
-def validate_scene(scene: Scene, quick: bool = False, box_tolerance: int | None = None,
-                   report: Report | None = None, on_problem: Callable[[Problem], None] | None = None,
-                   ) -> Report:
+def validate_scene(
+    scene: Scene,
+    quick: bool = False,
+    box_tolerance: int | None = None,
+    report: Report | None = None,
+    on_problem: Callable[[Problem], None] | None = None,
+) -> Report:
     """Check one scene folder.
 
     Args:
@@ -139,8 +144,11 @@ def validate_scene(scene: Scene, quick: bool = False, box_tolerance: int | None 
 
     metadata: SceneFile | None = None
     if (scene.path / SCENE_METADATA).is_file():
-        raw_metadata, error = (None, outside) if (outside := _outside(scene.path / SCENE_METADATA, scene.root)) \
+        raw_metadata, error = (
+            (None, outside)
+            if (outside := _outside(scene.path / SCENE_METADATA, scene.root))
             else _read_json(scene.path / SCENE_METADATA)
+        )
         if error is None:
             try:
                 metadata = scene_file_from(raw_metadata)
@@ -201,8 +209,9 @@ def validate_scene(scene: Scene, quick: bool = False, box_tolerance: int | None 
                 for problem in _boxes_inside(record, size):
                     flag(ann_path, problem)
         elif has_image:
-            for path, problem in _pixel_problems(record, ann_path, image, mask if has_mask else None,
-                                                 metadata, tolerance):
+            for path, problem in _pixel_problems(
+                record, ann_path, image, mask if has_mask else None, metadata, tolerance
+            ):
                 flag(path, problem)
             if depth.is_file():
                 for problem in depth_problems(record, depth, mask if has_mask else None, metadata):
@@ -259,12 +268,16 @@ def _camera_size(metadata: SceneFile | None) -> tuple[int, int] | None:
 
 def _boxes_inside(record: ViewRecord, size: tuple[int, int]) -> list[str]:
     width, height = size
-    return [f"{record.name}: box {b.to_list()[:5]} reaches past the {width}x{height} image"
-            for b in record.boxes if b.xmax >= width or b.ymax >= height]
+    return [
+        f"{record.name}: box {b.to_list()[:5]} reaches past the {width}x{height} image"
+        for b in record.boxes
+        if b.xmax >= width or b.ymax >= height
+    ]
 
 
-def _pixel_problems(record: ViewRecord, ann_path: Path, image: Path, mask_path: Path | None,
-                    metadata: SceneFile | None, tolerance: int) -> list[tuple[Path, str]]:
+def _pixel_problems(
+    record: ViewRecord, ann_path: Path, image: Path, mask_path: Path | None, metadata: SceneFile | None, tolerance: int
+) -> list[tuple[Path, str]]:
     import numpy as np
     from PIL import Image
 
@@ -304,8 +317,13 @@ def _pixel_problems(record: ViewRecord, ann_path: Path, image: Path, mask_path: 
             problems.append((mask_path, f"has no pixels of fruit {fid}, which has a box in {record.name}"))
         elif not _close(box, extents[fid], tolerance):
             m = extents[fid]
-            problems.append((mask_path, f"{record.name}: box of fruit {fid} is {box.to_list()[:4]} but its mask "
-                                        f"pixels span {[m.xmin, m.ymin, m.width, m.height]} (x, y, width, height)"))
+            problems.append(
+                (
+                    mask_path,
+                    f"{record.name}: box of fruit {fid} is {box.to_list()[:4]} but its mask "
+                    f"pixels span {[m.xmin, m.ymin, m.width, m.height]} (x, y, width, height)",
+                )
+            )
     return problems
 
 
@@ -315,8 +333,9 @@ DEPTH_NEAR_MM = 50
 DEPTH_SLACK_M = 0.02
 
 
-def depth_problems(record: ViewRecord, depth_path: Path, mask_path: Path | None,
-                   metadata: SceneFile | None) -> list[str]:
+def depth_problems(
+    record: ViewRecord, depth_path: Path, mask_path: Path | None, metadata: SceneFile | None
+) -> list[str]:
     """Check a depth image: 16-bit, the image's size, a plausible range, and agreement with the
     3-D centres of the fruit scene.json records (where a fruit is boxed in the view).
 
@@ -357,8 +376,13 @@ def depth_problems(record: ViewRecord, depth_path: Path, mask_path: Path | None,
     if mask.shape != depth.shape:
         return problems
     x, y, z, yaw, pitch = (float(v) for v in record.pose[:5])
-    forward = np.array([np.cos(np.radians(pitch)) * np.cos(np.radians(yaw)),
-                        np.cos(np.radians(pitch)) * np.sin(np.radians(yaw)), np.sin(np.radians(pitch))])
+    forward = np.array(
+        [
+            np.cos(np.radians(pitch)) * np.cos(np.radians(yaw)),
+            np.cos(np.radians(pitch)) * np.sin(np.radians(yaw)),
+            np.sin(np.radians(pitch)),
+        ]
+    )
     for box in record.boxes:
         fruit = fruits.get(box.fruit_id)
         pixels = (mask == box.fruit_id) & hit
@@ -368,8 +392,10 @@ def depth_problems(record: ViewRecord, depth_path: Path, mask_path: Path | None,
         seen = float(np.median(depth[pixels])) / 1000.0
         allowed = 0.5 * float(np.linalg.norm(fruit.size or (0.0, 0.0, 0.0))) + DEPTH_SLACK_M
         if abs(seen - expected) > allowed:
-            problems.append(f"fruit {box.fruit_id} lies at {seen:.3f} m in the depth image but its centre is "
-                            f"{expected:.3f} m from the camera (scene.json), more than {allowed:.3f} m apart")
+            problems.append(
+                f"fruit {box.fruit_id} lies at {seen:.3f} m in the depth image but its centre is "
+                f"{expected:.3f} m from the camera (scene.json), more than {allowed:.3f} m apart"
+            )
     return problems
 
 
@@ -385,9 +411,12 @@ def _check_splits(dataset: Dataset, whole: bool) -> list[Problem]:
         return problems
     known = {scene.id for scene in dataset.scenes}
     # Only scenes under the opened path are known; a group or scene opened alone sees a subset.
-    problems = [Problem(path, f"{name} lists {i}, which is not a scene here")
-                for name, ids in (("train", splits.train), ("test", splits.test)) for i in ids
-                if whole and i not in known]
+    problems = [
+        Problem(path, f"{name} lists {i}, which is not a scene here")
+        for name, ids in (("train", splits.train), ("test", splits.test))
+        for i in ids
+        if whole and i not in known
+    ]
     if both := splits.in_both():
         problems.append(Problem(path, f"{len(both)} scene(s) in both train and test, e.g. {both[0]}"))
     return problems
@@ -425,14 +454,24 @@ def _check_counts(dataset: Dataset, counts: dict[str, int]) -> list[Problem]:
         common, votes = Counter(counts[s.id] for s in scenes).most_common(1)[0]
         if votes * 2 <= len(scenes):
             continue
-        problems += [Problem(s.path / ANNOTATIONS, f"has {counts[s.id]} views but {votes} of the "
-                             f"{len(scenes)} scenes of {group} have {common}")
-                     for s in scenes if counts[s.id] != common]
+        problems += [
+            Problem(
+                s.path / ANNOTATIONS,
+                f"has {counts[s.id]} views but {votes} of the {len(scenes)} scenes of {group} have {common}",
+            )
+            for s in scenes
+            if counts[s.id] != common
+        ]
     return problems
 
 
-def validate_dataset(path: str | Path, quick: bool = False, box_tolerance: int | None = None,
-                     on_problem: Callable[[Problem], None] | None = None, progress: bool = False) -> Report:
+def validate_dataset(
+    path: str | Path,
+    quick: bool = False,
+    box_tolerance: int | None = None,
+    on_problem: Callable[[Problem], None] | None = None,
+    progress: bool = False,
+) -> Report:
     """Check every scene under a dataset root, group folder or scene folder.
 
     Args:
@@ -462,8 +501,13 @@ def validate_dataset(path: str | Path, quick: bool = False, box_tolerance: int |
     whole = Path(path).expanduser().absolute() == dataset.root
     for problem in _check_splits(dataset, whole) + (_check_dataset_file(dataset) if whole else []):
         emit(problem)
-    bar = tqdm(dataset.scenes, desc="validate", unit="scene", file=sys.stderr,
-               disable=None if progress and len(dataset.scenes) > 1 else True)
+    bar = tqdm(
+        dataset.scenes,
+        desc="validate",
+        unit="scene",
+        file=sys.stderr,
+        disable=None if progress and len(dataset.scenes) > 1 else True,
+    )
     for scene in bar:
         before = report.views
         validate_scene(scene, quick, box_tolerance, report, on_problem)
@@ -472,4 +516,3 @@ def validate_dataset(path: str | Path, quick: bool = False, box_tolerance: int |
     for problem in _check_counts(dataset, counts):
         emit(problem)
     return report
-

@@ -52,9 +52,14 @@ def rle_of(mask: np.ndarray) -> dict[str, Any]:
 
 def _image_entry(item: LabelledView, image_id: int, root: Path) -> dict[str, Any]:
     view = item.view
-    entry: dict[str, Any] = {"id": image_id, "file_name": view.image_path.relative_to(root).as_posix(),
-                             "width": item.width, "height": item.height,
-                             "scene": view.scene.id, "view": view.name}
+    entry: dict[str, Any] = {
+        "id": image_id,
+        "file_name": view.image_path.relative_to(root).as_posix(),
+        "width": item.width,
+        "height": item.height,
+        "scene": view.scene.id,
+        "view": view.name,
+    }
     if item.depth is not None:
         entry["depth_file"] = item.depth.relative_to(root).as_posix()
         entry["depth_units"] = "mm"
@@ -66,8 +71,11 @@ def _annotation_entries(item: LabelledView, image_id: int, first_id: int) -> lis
     for offset, inst in enumerate(item.instances):
         box = inst.box
         entry: dict[str, Any] = {
-            "id": first_id + offset, "image_id": image_id, "category_id": inst.category,
-            "bbox": [box.xmin, box.ymin, box.width, box.height], "iscrowd": 0,
+            "id": first_id + offset,
+            "image_id": image_id,
+            "category_id": inst.category,
+            "bbox": [box.xmin, box.ymin, box.width, box.height],
+            "iscrowd": 0,
             "area": int(inst.mask.sum()) if inst.mask is not None else box.area,
             "attributes": {"fruit_id": box.fruit_id, "visible_fraction": inst.visible_fraction},
         }
@@ -86,11 +94,18 @@ def organ_annotations(item: LabelledView, image_id: int, first_id: int) -> list[
     for value, mask in organ_masks(item.view):
         rows, cols = np.nonzero(mask)
         x0, y0 = int(cols.min()), int(rows.min())
-        entries.append({"id": first_id + len(entries), "image_id": image_id,
-                        "category_id": ORGAN_CATEGORY_BASE + value,
-                        "bbox": [x0, y0, int(cols.max()) - x0 + 1, int(rows.max()) - y0 + 1], "iscrowd": 0,
-                        "area": int(mask.sum()), "segmentation": rle_of(mask),
-                        "attributes": {"organ": ORGAN_NAMES[value], "semantic": True}})
+        entries.append(
+            {
+                "id": first_id + len(entries),
+                "image_id": image_id,
+                "category_id": ORGAN_CATEGORY_BASE + value,
+                "bbox": [x0, y0, int(cols.max()) - x0 + 1, int(rows.max()) - y0 + 1],
+                "iscrowd": 0,
+                "area": int(mask.sum()),
+                "segmentation": rle_of(mask),
+                "attributes": {"organ": ORGAN_NAMES[value], "semantic": True},
+            }
+        )
     return entries
 
 
@@ -101,8 +116,9 @@ def _write_array_items(handle: IO[str], items: list[dict[str, Any]], first: bool
     return first
 
 
-def write_coco_split(scenes: list[Scene], root: Path, target: Path, split: str,
-                     progress: bool = True, organs: bool = False) -> dict[str, int]:
+def write_coco_split(
+    scenes: list[Scene], root: Path, target: Path, split: str, progress: bool = True, organs: bool = False
+) -> dict[str, int]:
     """Write one split's COCO instances file.
 
     Args:
@@ -118,14 +134,18 @@ def write_coco_split(scenes: list[Scene], root: Path, target: Path, split: str,
     """
     from tqdm import tqdm
 
-
     counts = {"images": 0, "annotations": 0, "clipped": 0, "dropped": 0}
-    header = {"info": {"description": f"DAVIS-Ag {split} split, exported by davis-ag",
-                       "image_root": str(root), "split": split, "scenes": [s.id for s in scenes]},
-              "licenses": [],
-              "categories": [{"id": i + 1, "name": name, "supercategory": "fruit"}
-                             for i, name in enumerate(CATEGORIES)]
-              + (coco_organ_categories() if organs else [])}
+    header = {
+        "info": {
+            "description": f"DAVIS-Ag {split} split, exported by davis-ag",
+            "image_root": str(root),
+            "split": split,
+            "scenes": [s.id for s in scenes],
+        },
+        "licenses": [],
+        "categories": [{"id": i + 1, "name": name, "supercategory": "fruit"} for i, name in enumerate(CATEGORIES)]
+        + (coco_organ_categories() if organs else []),
+    }
     with tempfile.TemporaryDirectory(dir=target.parent, prefix=WORK_PREFIX) as tmp:
         images_path, annotations_path = Path(tmp) / "images", Path(tmp) / "annotations"
         with open(images_path, "w") as images, open(annotations_path, "w") as annotations:
@@ -153,8 +173,13 @@ def write_coco_split(scenes: list[Scene], root: Path, target: Path, split: str,
     return counts
 
 
-def export_coco(dataset_dir: Path, out_dir: Path, splits: tuple[str, ...] = ("train", "test"),
-                progress: bool = True, organs: bool = False) -> dict[str, dict[str, int]]:
+def export_coco(
+    dataset_dir: Path,
+    out_dir: Path,
+    splits: tuple[str, ...] = ("train", "test"),
+    progress: bool = True,
+    organs: bool = False,
+) -> dict[str, dict[str, int]]:
     """Export a DAVIS-Ag dataset to COCO instances files, one per split.
 
     Args:
@@ -170,6 +195,9 @@ def export_coco(dataset_dir: Path, out_dir: Path, splits: tuple[str, ...] = ("tr
     dataset = open_dataset(dataset_dir)
     by_split = scenes_by_split(dataset)
     (out_dir / "annotations").mkdir(parents=True, exist_ok=True)
-    return {split: write_coco_split(by_split[split], dataset.root, out_dir / "annotations" /
-                                    f"instances_{split}.json", split, progress, organs)
-            for split in splits}
+    return {
+        split: write_coco_split(
+            by_split[split], dataset.root, out_dir / "annotations" / f"instances_{split}.json", split, progress, organs
+        )
+        for split in splits
+    }

@@ -32,8 +32,10 @@ def category_id(crop: str | None) -> int:
         UserError: for a scene whose group folder names no known crop.
     """
     if crop not in CATEGORIES:
-        raise UserError(f"unknown crop {crop!r}: a scene's group folder must name one of "
-                        f"{', '.join(CATEGORIES)} (e.g. Single-Strawberry)")
+        raise UserError(
+            f"unknown crop {crop!r}: a scene's group folder must name one of "
+            f"{', '.join(CATEGORIES)} (e.g. Single-Strawberry)"
+        )
     return CATEGORIES.index(crop) + 1
 
 
@@ -54,12 +56,17 @@ def scenes_by_split(dataset: Dataset) -> dict[str, list[Scene]]:
     unlisted = sorted(on_disk - listed)
     if unlisted and listed - on_disk:  # a scene folder renamed: it would silently leave its split
         missing = sorted(listed - on_disk)
-        raise UserError(f"{dataset.root}: splits.json names {len(missing)} scene(s) not there (e.g. {missing[0]}) and "
-                        f"{len(unlisted)} scene folder(s) are in no split (e.g. {unlisted[0]}): rename the folders "
-                        "back, or regenerate splits.json")
+        raise UserError(
+            f"{dataset.root}: splits.json names {len(missing)} scene(s) not there (e.g. {missing[0]}) and "
+            f"{len(unlisted)} scene folder(s) are in no split (e.g. {unlisted[0]}): rename the folders "
+            "back, or regenerate splits.json"
+        )
     if unlisted:
-        print(f"note: {len(unlisted)} scene(s) of {dataset.root} are in no split of its splits.json and are not "
-              f"exported (e.g. {unlisted[0]})", file=sys.stderr)
+        print(
+            f"note: {len(unlisted)} scene(s) of {dataset.root} are in no split of its splits.json and are not "
+            f"exported (e.g. {unlisted[0]})",
+            file=sys.stderr,
+        )
     return {split: [s for s in dataset.scenes if s.id in keep[split]] for split in EXPORT_SPLITS}
 
 
@@ -82,8 +89,12 @@ class Instance:
     @property
     def xyxy(self) -> tuple[float, float, float, float]:
         """The box in continuous pixel coordinates, ``(x1, y1, x2, y2)`` with ``x2 = xmin + width``."""
-        return (float(self.box.xmin), float(self.box.ymin), float(self.box.xmin + self.box.width),
-                float(self.box.ymin + self.box.height))
+        return (
+            float(self.box.xmin),
+            float(self.box.ymin),
+            float(self.box.xmin + self.box.width),
+            float(self.box.ymin + self.box.height),
+        )
 
 
 @dataclass(frozen=True)
@@ -167,8 +178,10 @@ def label_view(view: View, with_masks: bool = True) -> LabelledView:
     width, height = image_size(view.image_path, scene.root)
     seg = view.mask() if with_masks else None
     if seg is not None and seg.shape != (height, width):
-        raise UserError(f"{view.mask_path}: mask is {seg.shape[1]}x{seg.shape[0]}, image {width}x{height}; "
-                        "run `davis-ag validate` on the scene")
+        raise UserError(
+            f"{view.mask_path}: mask is {seg.shape[1]}x{seg.shape[0]}, image {width}x{height}; "
+            "run `davis-ag validate` on the scene"
+        )
     fractions = scene.metadata.visible_in(view.name) if scene.metadata else {}
     instances, clipped, dropped = [], 0, 0
     for published in view.boxes:
@@ -178,13 +191,18 @@ def label_view(view: View, with_masks: bool = True) -> LabelledView:
             continue
         clipped += box != published
         fraction = fractions.get(str(box.fruit_id))
-        instances.append(Instance(box, category, None if fraction is None else float(fraction),
-                                  None if seg is None else seg == box.fruit_id))
+        instances.append(
+            Instance(
+                box,
+                category,
+                None if fraction is None else float(fraction),
+                None if seg is None else seg == box.fruit_id,
+            )
+        )
     depth = view.depth_path
     if depth.is_file():
         check_inside(depth, scene.root)
-    return LabelledView(view, width, height, tuple(instances), depth if depth.is_file() else None,
-                        clipped, dropped)
+    return LabelledView(view, width, height, tuple(instances), depth if depth.is_file() else None, clipped, dropped)
 
 
 def tally(counts: dict[str, int], item: LabelledView, unit: str, found: int) -> None:

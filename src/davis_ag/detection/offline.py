@@ -47,8 +47,10 @@ def torchvision_ops_load() -> bool:
 
     spec = importlib.util.find_spec("torchvision")
     if spec is None or spec.origin is None:
-        raise UserError("torchvision is not installed: pip install 'davis-ag[detect]' "
-                        "(after torch, so that no other torch build is pulled in)")
+        raise UserError(
+            "torchvision is not installed: pip install 'davis-ag[detect]' "
+            "(after torch, so that no other torch build is pulled in)"
+        )
     libraries = sorted(Path(spec.origin).parent.glob("_C*.so"))
     if not libraries:
         return False
@@ -97,8 +99,10 @@ def prepare_ultralytics() -> ModuleType:
     import sys
 
     if "ultralytics" in sys.modules:
-        raise UserError("ultralytics was imported before davis_ag.detection.offline.prepare_ultralytics(); "
-                        "call it first so that ultralytics starts offline")
+        raise UserError(
+            "ultralytics was imported before davis_ag.detection.offline.prepare_ultralytics(); "
+            "call it first so that ultralytics starts offline"
+        )
     if importlib.util.find_spec("ultralytics") is None:
         raise UserError("ultralytics is not installed: pip install 'davis-ag[detect]'")
     for key, value in _OFFLINE_ENV.items():

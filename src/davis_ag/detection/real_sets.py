@@ -49,7 +49,9 @@ def _yolo_items(images: list[Path]) -> tuple[tuple[Path, tuple[str, ...]], ...]:
     items = []
     for image in sorted(set(images)):
         label = _label_for(image)
-        lines = tuple(line.strip() for line in label.read_text().splitlines() if line.strip()) if label.is_file() else ()
+        lines = (
+            tuple(line.strip() for line in label.read_text().splitlines() if line.strip()) if label.is_file() else ()
+        )
         items.append((image, lines))
     return tuple(items)
 
@@ -103,7 +105,8 @@ def _from_coco(path: Path, image_root: Path | None) -> Pool:
         x, y, w, h = (float(v) for v in ann["bbox"])
         iw, ih = sizes[ann["image_id"]]
         lines.setdefault(ann["image_id"], []).append(
-            f"{classes[ann['category_id']]} {(x + w / 2) / iw:.6f} {(y + h / 2) / ih:.6f} {w / iw:.6f} {h / ih:.6f}")
+            f"{classes[ann['category_id']]} {(x + w / 2) / iw:.6f} {(y + h / 2) / ih:.6f} {w / iw:.6f} {h / ih:.6f}"
+        )
     items = tuple((root / im["file_name"], tuple(lines.get(im["id"], []))) for im in data["images"])
     return Pool(items, {i: c["name"] for i, c in enumerate(categories)})
 
@@ -125,8 +128,10 @@ def load_pool(path: Path, image_root: Path | None = None) -> Pool:
         classes = {int(line.split()[0]) for _, lines in pool.items for line in lines}
         pool = Pool(pool.items, {c: f"class{c}" for c in range(max(classes, default=0) + 1)})
     else:
-        raise UserError(f"{path}: not a labelled set: give an ultralytics data YAML, a folder with images/ "
-                        "and labels/, or a COCO instances JSON")
+        raise UserError(
+            f"{path}: not a labelled set: give an ultralytics data YAML, a folder with images/ "
+            "and labels/, or a COCO instances JSON"
+        )
     if not pool.items:
         raise UserError(f"{path}: no images found; check the paths it lists")
     missing = [str(p) for p, _ in pool.items if not p.is_file()]
@@ -155,13 +160,23 @@ def write_split(pool: Pool, out_dir: Path, seed: int, train: int, test: int) -> 
     from davis_ag.detection.yolo_export import place_image
 
     order = np.random.default_rng(seed).permutation(len(pool.items))
-    for split, chosen in (("train", order[:train]), ("test", order[train:train + test])):
+    for split, chosen in (("train", order[:train]), ("test", order[train : train + test])):
         for index in chosen:
             image, lines = pool.items[index]
             name = f"{index:06d}_{image.stem}"
             (out_dir / "images" / split).mkdir(parents=True, exist_ok=True)
             place_image(image, out_dir / "images" / split / f"{name}{image.suffix.lower()}")
             write_text_atomic(out_dir / "labels" / split / f"{name}.txt", "".join(f"{x}\n" for x in lines))
-    return write_text_atomic(out_dir / "data.yaml", yaml.safe_dump(
-        {"path": str(out_dir), "train": "images/train", "val": "images/test", "test": "images/test",
-         "names": pool.names}, sort_keys=False))
+    return write_text_atomic(
+        out_dir / "data.yaml",
+        yaml.safe_dump(
+            {
+                "path": str(out_dir),
+                "train": "images/train",
+                "val": "images/test",
+                "test": "images/test",
+                "names": pool.names,
+            },
+            sort_keys=False,
+        ),
+    )

@@ -47,9 +47,14 @@ class DavisAgDetection(torch.utils.data.Dataset):
         skip_empty: Leave out views with no fruit (torchvision's R-CNNs accept them, some losses do not).
     """
 
-    def __init__(self, root: str | Path, split: str = "train",
-                 transforms: Callable[[torch.Tensor, Target], tuple[torch.Tensor, Target]] | None = None,
-                 with_masks: bool = True, skip_empty: bool = False) -> None:
+    def __init__(
+        self,
+        root: str | Path,
+        split: str = "train",
+        transforms: Callable[[torch.Tensor, Target], tuple[torch.Tensor, Target]] | None = None,
+        with_masks: bool = True,
+        skip_empty: bool = False,
+    ) -> None:
         dataset = open_dataset(root)
         if split == "all":
             self.scenes = list(dataset.scenes)
@@ -59,8 +64,9 @@ class DavisAgDetection(torch.utils.data.Dataset):
             raise UserError(f"unknown split {split!r}: choose train, test or all")
         if not self.scenes:
             raise UserError(f"{dataset.root}: the {split} split has no scene; use split='all'")
-        self.items = [(i, view.name) for i, scene in enumerate(self.scenes) for view in scene
-                      if view.boxes or not skip_empty]
+        self.items = [
+            (i, view.name) for i, scene in enumerate(self.scenes) for view in scene if view.boxes or not skip_empty
+        ]
         self.transforms = transforms
         self.with_masks = with_masks
 
@@ -75,10 +81,16 @@ class DavisAgDetection(torch.utils.data.Dataset):
         n, shape = len(item.instances), (item.height, item.width)
         boxes = torch.tensor([inst.xyxy for inst in item.instances], dtype=torch.float32).reshape(n, 4)
         masks = [inst.mask for inst in item.instances if inst.mask is not None]
-        mask_tensor = (torch.from_numpy(np.stack(masks).astype(np.uint8)) if len(masks) == n and n
-                       else torch.zeros((0, *shape), dtype=torch.uint8))
-        area = (mask_tensor.flatten(1).sum(1).float() if len(mask_tensor) == n and n
-                else (boxes[:, 2] - boxes[:, 0]) * (boxes[:, 3] - boxes[:, 1]))
+        mask_tensor = (
+            torch.from_numpy(np.stack(masks).astype(np.uint8))
+            if len(masks) == n and n
+            else torch.zeros((0, *shape), dtype=torch.uint8)
+        )
+        area = (
+            mask_tensor.flatten(1).sum(1).float()
+            if len(mask_tensor) == n and n
+            else (boxes[:, 2] - boxes[:, 0]) * (boxes[:, 3] - boxes[:, 1])
+        )
         target: Target = {
             "boxes": boxes,
             "labels": torch.tensor([inst.category for inst in item.instances], dtype=torch.int64),
@@ -87,8 +99,10 @@ class DavisAgDetection(torch.utils.data.Dataset):
             "area": area,
             "iscrowd": torch.zeros(n, dtype=torch.int64),
             "fruit_ids": torch.tensor([inst.box.fruit_id for inst in item.instances], dtype=torch.int64),
-            "visible_fraction": torch.tensor([np.nan if inst.visible_fraction is None else inst.visible_fraction
-                                              for inst in item.instances], dtype=torch.float32),
+            "visible_fraction": torch.tensor(
+                [np.nan if inst.visible_fraction is None else inst.visible_fraction for inst in item.instances],
+                dtype=torch.float32,
+            ),
             "depth": None if item.depth is None else _depth_metres(item.depth, shape),
             "scene": view.scene.id,
             "view": view.name,
@@ -101,8 +115,9 @@ class DavisAgDetection(torch.utils.data.Dataset):
 def _depth_metres(path: Path, shape: tuple[int, int]) -> torch.Tensor:
     metres = read_depth(path)
     if metres.shape != shape:
-        raise UserError(f"{path}: depth is {metres.shape[1]}x{metres.shape[0]}, "
-                        f"image {shape[1]}x{shape[0]}; regenerate the scene")
+        raise UserError(
+            f"{path}: depth is {metres.shape[1]}x{metres.shape[0]}, image {shape[1]}x{shape[0]}; regenerate the scene"
+        )
     return torch.from_numpy(metres).unsqueeze(0)
 
 

@@ -73,8 +73,9 @@ def label_lines(item: LabelledView, task: str) -> list[str]:
             lines.append(f"{cls} {coords}")
         else:
             x1, y1, x2, y2 = inst.xyxy
-            lines.append(f"{cls} {(x1 + x2) / 2 / w:.6f} {(y1 + y2) / 2 / h:.6f} "
-                         f"{(x2 - x1) / w:.6f} {(y2 - y1) / h:.6f}")
+            lines.append(
+                f"{cls} {(x1 + x2) / 2 / w:.6f} {(y1 + y2) / 2 / h:.6f} {(x2 - x1) / w:.6f} {(y2 - y1) / h:.6f}"
+            )
     return lines
 
 
@@ -82,9 +83,11 @@ def organ_lines(item: LabelledView) -> list[str]:
     """One segment line per organ class present in the view (see
     :mod:`davis_ag.detection.organ_export`); none without a class image."""
     w, h = float(item.width), float(item.height)
-    return [f"{yolo_organ_class(value)} " + " ".join(f"{(x + 0.5) / w:.6f} {(y + 0.5) / h:.6f}"
-                                                     for x, y in mask_polygon(mask))
-            for value, mask in organ_masks(item.view)]
+    return [
+        f"{yolo_organ_class(value)} "
+        + " ".join(f"{(x + 0.5) / w:.6f} {(y + 0.5) / h:.6f}" for x, y in mask_polygon(mask))
+        for value, mask in organ_masks(item.view)
+    ]
 
 
 def place_image(source: Path, target: Path) -> None:
@@ -105,12 +108,15 @@ def place_image(source: Path, target: Path) -> None:
             with open(source, "rb") as src, atomic_output(target, "wb") as handle:
                 shutil.copyfileobj(src, handle)
     except OSError as error:
-        raise MachineError(f"{target}: cannot write the image ({error.strerror or error}); the files already "
-                           "exported are kept: free the space and run the same command again") from None
+        raise MachineError(
+            f"{target}: cannot write the image ({error.strerror or error}); the files already "
+            "exported are kept: free the space and run the same command again"
+        ) from None
 
 
-def write_yolo_split(scenes: list[Scene], out_dir: Path, split: str, task: str = "detect",
-                     progress: bool = True, organs: bool = False) -> dict[str, int]:
+def write_yolo_split(
+    scenes: list[Scene], out_dir: Path, split: str, task: str = "detect", progress: bool = True, organs: bool = False
+) -> dict[str, int]:
     """Write one split's images and labels.
 
     Returns:
@@ -141,14 +147,21 @@ def data_yaml(out_dir: Path, names: dict[int, str] | None = None) -> Path:
     import yaml
 
     names = names if names is not None else dict(enumerate(CATEGORIES))
-    text = yaml.safe_dump({"path": str(out_dir), "train": "images/train", "val": "images/test",
-                           "test": "images/test", "names": names}, sort_keys=False)
+    text = yaml.safe_dump(
+        {"path": str(out_dir), "train": "images/train", "val": "images/test", "test": "images/test", "names": names},
+        sort_keys=False,
+    )
     return write_text_atomic(out_dir / "data.yaml", text)
 
 
-def export_yolo(dataset_dir: Path, out_dir: Path, task: str = "detect",
-                splits: tuple[str, ...] = ("train", "test"), progress: bool = True,
-                organs: bool = False) -> dict[str, dict[str, int]]:
+def export_yolo(
+    dataset_dir: Path,
+    out_dir: Path,
+    task: str = "detect",
+    splits: tuple[str, ...] = ("train", "test"),
+    progress: bool = True,
+    organs: bool = False,
+) -> dict[str, dict[str, int]]:
     """Export a DAVIS-Ag dataset to the ultralytics layout.
 
     Args:

@@ -64,17 +64,34 @@ def train(data_yaml: Path, out_dir: Path, budget: Budget, seed: int, start: Path
     model = YOLO(str(start) if start else MODEL_YAML, task="detect")
     carried: dict[str, float] = {}
     if start:
-        model.add_callback("on_train_start", lambda trainer: carried.update(
-            start_weights_carried=carried_fraction(start, trainer.model)))
-    model.train(data=str(data_yaml), epochs=budget.epochs, imgsz=budget.imgsz, batch=budget.batch,
-                device=budget.device, workers=budget.workers, project=str(out_dir.parent), name=out_dir.name,
-                exist_ok=True, plots=False, val=False, seed=seed, deterministic=True,
-                # ultralytics drops a checkpoint's weights when pretrained is False
-                pretrained=start is not None,
-                amp=budget.device != "cpu", verbose=False, patience=0, close_mosaic=min(10, budget.epochs // 2),
-                # One optimiser step per batch: by default ultralytics accumulates gradients up to 64
-                # images, which on a set of a few hundred images leaves a handful of steps per run.
-                nbs=budget.batch)
+        model.add_callback(
+            "on_train_start",
+            lambda trainer: carried.update(start_weights_carried=carried_fraction(start, trainer.model)),
+        )
+    model.train(
+        data=str(data_yaml),
+        epochs=budget.epochs,
+        imgsz=budget.imgsz,
+        batch=budget.batch,
+        device=budget.device,
+        workers=budget.workers,
+        project=str(out_dir.parent),
+        name=out_dir.name,
+        exist_ok=True,
+        plots=False,
+        val=False,
+        seed=seed,
+        deterministic=True,
+        # ultralytics drops a checkpoint's weights when pretrained is False
+        pretrained=start is not None,
+        amp=budget.device != "cpu",
+        verbose=False,
+        patience=0,
+        close_mosaic=min(10, budget.epochs // 2),
+        # One optimiser step per batch: by default ultralytics accumulates gradients up to 64
+        # images, which on a set of a few hundred images leaves a handful of steps per run.
+        nbs=budget.batch,
+    )
     done.write_text(json.dumps({"epochs": budget.epochs, "start": str(start) if start else None, **carried}) + "\n")
     return last
 
@@ -88,8 +105,11 @@ def carried_fraction(start: Path, model: torch.nn.Module) -> float:
 
     source = load_checkpoint(str(start))[0].float().state_dict()
     target = model.state_dict()
-    same = sum(1 for k, v in source.items() if k in target and target[k].shape == v.shape
-               and torch.equal(target[k].float().cpu(), v))
+    same = sum(
+        1
+        for k, v in source.items()
+        if k in target and target[k].shape == v.shape and torch.equal(target[k].float().cpu(), v)
+    )
     return round(same / max(len(source), 1), 4)
 
 
@@ -103,9 +123,18 @@ def evaluate(weights: Path, data_yaml: Path, budget: Budget, split: str = "test"
     from ultralytics import YOLO
 
     metrics = YOLO(str(weights), task="detect").val(
-        data=str(data_yaml), split=split, imgsz=budget.imgsz, batch=budget.batch, device=budget.device,
-        workers=budget.workers, plots=False, verbose=False, save_json=False,
-        project=str(weights.parent.parent), name=f"val-{split}", exist_ok=True)
+        data=str(data_yaml),
+        split=split,
+        imgsz=budget.imgsz,
+        batch=budget.batch,
+        device=budget.device,
+        workers=budget.workers,
+        plots=False,
+        verbose=False,
+        save_json=False,
+        project=str(weights.parent.parent),
+        name=f"val-{split}",
+        exist_ok=True,
+    )
     box = metrics.box
-    return {"map50": float(box.map50), "map50_95": float(box.map), "precision": float(box.mp),
-            "recall": float(box.mr)}
+    return {"map50": float(box.map50), "map50_95": float(box.map), "precision": float(box.mp), "recall": float(box.mr)}

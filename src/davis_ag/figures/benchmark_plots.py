@@ -24,8 +24,7 @@ OER_BINS = np.linspace(0.0, 1.0, 21)
 EPISODES_SHOWN = 100
 
 
-def plot_oer(scenes: list[Scene], out: str | Path, formats: tuple[str, ...] = FORMATS,
-             title: str = "") -> Plotted:
+def plot_oer(scenes: list[Scene], out: str | Path, formats: tuple[str, ...] = FORMATS, title: str = "") -> Plotted:
     """Fig. 4b: histogram of the OER (eq. 1) of every box of the scenes, from their masks.
 
     Args:
@@ -42,8 +41,10 @@ def plot_oer(scenes: list[Scene], out: str | Path, formats: tuple[str, ...] = FO
     """
     oers, missing = box_oers(scenes)
     if oers.size == 0:
-        raise UserError(f"{scenes[0].path.parent.parent if scenes else 'dataset'}: no box with a "
-                        "mask (images/NNNN_seg.png): the OER needs the instance masks")
+        raise UserError(
+            f"{scenes[0].path.parent.parent if scenes else 'dataset'}: no box with a "
+            "mask (images/NNNN_seg.png): the OER needs the instance masks"
+        )
     counts, edges = np.histogram(oers, bins=OER_BINS)
     below = float(np.mean(oers < START_OER))
     figure = new_figure(5.0, 3.3)
@@ -53,13 +54,20 @@ def plot_oer(scenes: list[Scene], out: str | Path, formats: tuple[str, ...] = FO
     ax.set_xlabel("object exposure rate (OER)")
     ax.set_ylabel("fruit instances (boxes)")
     ax.set_xlim(0, 1)
-    ax.set_title(title or f"{len(oers)} boxes in {len(scenes)} scene(s), {below:.1%} below {START_OER}",
-                 fontsize=9)
+    ax.set_title(title or f"{len(oers)} boxes in {len(scenes)} scene(s), {below:.1%} below {START_OER}", fontsize=9)
     ax.legend(fontsize=8)
     figure.tight_layout()
     paths = save_formats(figure, out, formats)
-    return Plotted(paths, {"boxes": int(len(oers)), "edges": edges.tolist(), "counts": counts.tolist(),
-                           "below_start": below, "masks_missing": missing})
+    return Plotted(
+        paths,
+        {
+            "boxes": int(len(oers)),
+            "edges": edges.tolist(),
+            "counts": counts.tolist(),
+            "below_start": below,
+            "masks_missing": missing,
+        },
+    )
 
 
 def action_names(results: dict[str, Any]) -> list[str]:
@@ -75,8 +83,9 @@ def action_names(results: dict[str, Any]) -> list[str]:
 def episode_records(results: dict[str, Any], policy: str, source: str) -> list[dict[str, Any]]:
     episodes = results["policies"][policy].get("episodes")
     if not isinstance(episodes, list) or not episodes:
-        raise UserError(f"{source}: policy {policy} has no per-episode records; rerun "
-                        "`davis-ag evaluate`, which now writes them")
+        raise UserError(
+            f"{source}: policy {policy} has no per-episode records; rerun `davis-ag evaluate`, which now writes them"
+        )
     return episodes
 
 
@@ -95,8 +104,7 @@ def policy_names(results: dict[str, Any], source: str, wanted: list[str] | None 
     return list(wanted) if wanted else known
 
 
-def action_frequencies(results: dict[str, Any], source: str,
-                       policies: list[str] | None = None) -> dict[str, list[int]]:
+def action_frequencies(results: dict[str, Any], source: str, policies: list[str] | None = None) -> dict[str, list[int]]:
     """Times each action was chosen per policy, in action-index order.
 
     From the per-episode records where present, else from ``action_counts``.
@@ -118,9 +126,15 @@ def action_frequencies(results: dict[str, Any], source: str,
     return out
 
 
-def plot_actions(results: dict[str, Any], out: str | Path, formats: tuple[str, ...] = FORMATS,
-                 policies: list[str] | None = None, choices_of: str | None = None,
-                 episodes_shown: int = EPISODES_SHOWN, source: str = "results") -> Plotted:
+def plot_actions(
+    results: dict[str, Any],
+    out: str | Path,
+    formats: tuple[str, ...] = FORMATS,
+    policies: list[str] | None = None,
+    choices_of: str | None = None,
+    episodes_shown: int = EPISODES_SHOWN,
+    source: str = "results",
+) -> Plotted:
     """Fig. 4c (share of each action per policy) beside Fig. 5 (one policy's choices per episode).
 
     Fig. 5 is a map: one column per episode (the first ``episodes_shown`` of session 0 onwards),
@@ -166,28 +180,42 @@ def plot_actions(results: dict[str, Any], out: str | Path, formats: tuple[str, .
     for k, (policy, values) in enumerate(counts.items()):
         total = max(sum(values), 1)
         shares[policy] = [v / total for v in values]
-        left.bar(np.arange(len(names)) - 0.4 + width * (k + 0.5), shares[policy], width=width,
-                 label=policy, color=f"C{k}")
+        left.bar(
+            np.arange(len(names)) - 0.4 + width * (k + 0.5), shares[policy], width=width, label=policy, color=f"C{k}"
+        )
     left.set_xticks(range(len(names)), [f"{i}\n{n}" for i, n in enumerate(names)], fontsize=7)
     left.set_ylabel("share of actions")
     left.set_title("(a) action frequencies", fontsize=9)
     left.legend(fontsize=7)
     right = figure.add_subplot(1, 2, 2)
     cmap = ListedColormap(palette).with_extremes(bad="white")
-    right.imshow(np.ma.masked_invalid(grid), aspect="auto", interpolation="nearest", cmap=cmap,
-                 norm=BoundaryNorm(np.arange(len(names) + 1) - 0.5, len(names)),
-                 extent=(0.5, len(chosen) + 0.5, steps + 0.5, 0.5))
+    right.imshow(
+        np.ma.masked_invalid(grid),
+        aspect="auto",
+        interpolation="nearest",
+        cmap=cmap,
+        norm=BoundaryNorm(np.arange(len(names) + 1) - 0.5, len(names)),
+        extent=(0.5, len(chosen) + 0.5, steps + 0.5, 0.5),
+    )
     right.set_yticks(range(1, steps + 1))
     right.set_xlabel("episode")
     right.set_ylabel("step t")
     right.set_title(f"(b) {choices_of}: actions in {len(chosen)} episodes", fontsize=9)
-    right.legend(handles=[Patch(color=palette[i], label=f"{i} {n}") for i, n in enumerate(names)],
-                 fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
+    right.legend(
+        handles=[Patch(color=palette[i], label=f"{i} {n}") for i, n in enumerate(names)],
+        fontsize=7,
+        loc="center left",
+        bbox_to_anchor=(1.01, 0.5),
+        frameon=False,
+    )
     protocol = results.get("protocol") or {}
-    figure.suptitle(f"{str(protocol.get('scenario', '')).upper()} {protocol.get('split', '')}: "
-                    f"{protocol.get('sessions', '?')} x {protocol.get('episodes', '?')} episodes",
-                    fontsize=9)
+    figure.suptitle(
+        f"{str(protocol.get('scenario', '')).upper()} {protocol.get('split', '')}: "
+        f"{protocol.get('sessions', '?')} x {protocol.get('episodes', '?')} episodes",
+        fontsize=9,
+    )
     figure.tight_layout()
     paths = save_formats(figure, out, formats)
-    return Plotted(paths, {"actions": names, "counts": counts, "shares": shares,
-                           "choices_of": choices_of, "choices": chosen})
+    return Plotted(
+        paths, {"actions": names, "counts": counts, "shares": shares, "choices_of": choices_of, "choices": chosen}
+    )

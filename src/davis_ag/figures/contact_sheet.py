@@ -37,11 +37,13 @@ def draw_boxes(ax: Axes, view: View, labels: bool) -> None:
 
     for box in view.boxes:
         # Pixel centres sit on integers, so a pixel's outer edge is half a unit out.
-        ax.add_patch(Rectangle((box.xmin - 0.5, box.ymin - 0.5), box.width, box.height,
-                               fill=False, edgecolor="yellow", linewidth=0.8))
+        ax.add_patch(
+            Rectangle(
+                (box.xmin - 0.5, box.ymin - 0.5), box.width, box.height, fill=False, edgecolor="yellow", linewidth=0.8
+            )
+        )
         if labels:
-            ax.text(box.xmin - 0.5, box.ymin - 1, str(box.fruit_id), color="yellow", fontsize=6,
-                    va="bottom", ha="left")
+            ax.text(box.xmin - 0.5, box.ymin - 1, str(box.fruit_id), color="yellow", fontsize=6, va="bottom", ha="left")
 
 
 def pick_views(scene: Scene, n_views: int) -> list[View]:

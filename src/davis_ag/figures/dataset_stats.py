@@ -27,8 +27,15 @@ def _summary(values: np.ndarray | list[float]) -> dict[str, Any] | None:
     if data.size == 0:
         return None
     q = np.quantile(data, [0.0, 0.25, 0.5, 0.75, 1.0])
-    return {"n": int(data.size), "mean": float(data.mean()), "min": float(q[0]), "q1": float(q[1]),
-            "median": float(q[2]), "q3": float(q[3]), "max": float(q[4])}
+    return {
+        "n": int(data.size),
+        "mean": float(data.mean()),
+        "min": float(q[0]),
+        "q1": float(q[1]),
+        "median": float(q[2]),
+        "q3": float(q[3]),
+        "max": float(q[4]),
+    }
 
 
 def table3(dataset: Dataset) -> dict[str, Any]:
@@ -45,8 +52,9 @@ def table3(dataset: Dataset) -> dict[str, Any]:
     """
     groups: dict[str, Any] = {}
     for scene in dataset.scenes:
-        entry = groups.setdefault(scene.group, {"scenario": scene.scenario, "crop": scene.crop,
-                                                "scenes": 0, "images": 0, "per_scene": []})
+        entry = groups.setdefault(
+            scene.group, {"scenario": scene.scenario, "crop": scene.crop, "scenes": 0, "images": 0, "per_scene": []}
+        )
         entry["scenes"] += 1
         entry["images"] += len(scene.views)
         entry["per_scene"].append(len(scene.views))
@@ -55,8 +63,13 @@ def table3(dataset: Dataset) -> dict[str, Any]:
         entry["images_per_scene"] = [min(per_scene), max(per_scene)]
         paper = PAPER_TABLE3.get((entry["scenario"], entry["crop"]))
         entry["paper"] = {"scenes": paper[0], "images": paper[1]} if paper else None
-    return {"groups": groups, "total": {"scenes": sum(g["scenes"] for g in groups.values()),
-                                        "images": sum(g["images"] for g in groups.values())}}
+    return {
+        "groups": groups,
+        "total": {
+            "scenes": sum(g["scenes"] for g in groups.values()),
+            "images": sum(g["images"] for g in groups.values()),
+        },
+    }
 
 
 def fruit_statistics(dataset: Dataset, with_oer: bool = True) -> dict[str, Any]:
@@ -78,8 +91,12 @@ def fruit_statistics(dataset: Dataset, with_oer: bool = True) -> dict[str, Any]:
         by_group.setdefault(scene.group, []).append(scene)
     out: dict[str, Any] = {}
     for group, scenes in by_group.items():
-        per_plant = [p.fruit_count for s in scenes for p in (s.metadata.plants if s.metadata else [])
-                     if p.fruit_count is not None]
+        per_plant = [
+            p.fruit_count
+            for s in scenes
+            for p in (s.metadata.plants if s.metadata else [])
+            if p.fruit_count is not None
+        ]
         boxed = [len({b.fruit_id for v in s.views.values() for b in v.boxes}) for s in scenes]
         per_view = [len(v.boxes) for s in scenes for v in s.views.values()]
         entry: dict[str, Any] = {
@@ -92,8 +109,10 @@ def fruit_statistics(dataset: Dataset, with_oer: bool = True) -> dict[str, Any]:
             oers, missing = box_oers(scenes)
             summary = _summary(oers)
             if summary is not None:
-                summary["histogram"] = {"edges": OER_EDGES.tolist(),
-                                        "counts": np.histogram(oers, OER_EDGES)[0].tolist()}
+                summary["histogram"] = {
+                    "edges": OER_EDGES.tolist(),
+                    "counts": np.histogram(oers, OER_EDGES)[0].tolist(),
+                }
                 summary["below_0.4"] = float(np.mean(oers < 0.4))
             entry["oer"] = summary
             entry["masks_missing"] = missing
@@ -148,8 +167,9 @@ def dataset_statistics(dataset: Dataset, with_oer: bool = True) -> dict[str, Any
 
 def _grid(rows: list[list[str]]) -> list[str]:
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
-    return ["  ".join(c.rjust(w) if i else c.ljust(w) for i, (c, w) in enumerate(zip(r, widths))).rstrip()
-            for r in rows]
+    return [
+        "  ".join(c.rjust(w) if i else c.ljust(w) for i, (c, w) in enumerate(zip(r, widths))).rstrip() for r in rows
+    ]
 
 
 def _stat(summary: dict[str, Any] | None, fmt: str = "{:.1f}") -> str:
@@ -173,17 +193,22 @@ def format_statistics(stats: dict[str, Any]) -> str:
     rows = [["Table 3", *names]]
     rows.append(["scenes", *[f"{groups[g]['scenes']:,}" for g in names]])
     rows.append(["images", *[f"{groups[g]['images']:,}" for g in names]])
-    rows.append(["images/scene", *["{}-{}".format(*groups[g]["images_per_scene"])
-                                    if len(set(groups[g]["images_per_scene"])) > 1
-                                    else str(groups[g]["images_per_scene"][0]) for g in names]])
-    rows.append(["paper scenes", *[f"{groups[g]['paper']['scenes']:,}" if groups[g]["paper"] else "-"
-                                    for g in names]])
-    rows.append(["paper images", *[f"{groups[g]['paper']['images']:,}" if groups[g]["paper"] else "-"
-                                    for g in names]])
+    rows.append(
+        [
+            "images/scene",
+            *[
+                "{}-{}".format(*groups[g]["images_per_scene"])
+                if len(set(groups[g]["images_per_scene"])) > 1
+                else str(groups[g]["images_per_scene"][0])
+                for g in names
+            ],
+        ]
+    )
+    rows.append(["paper scenes", *[f"{groups[g]['paper']['scenes']:,}" if groups[g]["paper"] else "-" for g in names]])
+    rows.append(["paper images", *[f"{groups[g]['paper']['images']:,}" if groups[g]["paper"] else "-" for g in names]])
     total = stats["table3"]["total"]
     lines = _grid(rows)
-    lines.append(f"total: {total['scenes']:,} scenes, {total['images']:,} images "
-                 "(paper: 632 scenes, 502,542 images)")
+    lines.append(f"total: {total['scenes']:,} scenes, {total['images']:,} images (paper: 632 scenes, 502,542 images)")
     fruit = stats["fruit"]
     rows = [["fruit: mean [min-max]", *names]]
     rows.append(["fruit per plant", *[_stat(fruit[g]["fruit_per_plant"]) for g in names]])
@@ -191,17 +216,28 @@ def format_statistics(stats: dict[str, Any]) -> str:
     rows.append(["boxes per view", *[_stat(fruit[g]["boxes_per_view"]) for g in names]])
     if any("oer" in fruit[g] for g in names):
         rows.append(["OER per box", *[_stat(fruit[g].get("oer"), "{:.2f}") for g in names]])
-        rows.append(["boxes with OER < 0.4", *[f"{fruit[g]['oer']['below_0.4']:.1%}"
-                                                if fruit[g].get("oer") else "-" for g in names]])
+        rows.append(
+            [
+                "boxes with OER < 0.4",
+                *[f"{fruit[g]['oer']['below_0.4']:.1%}" if fruit[g].get("oer") else "-" for g in names],
+            ]
+        )
     rows.append(["visible fraction", *[_stat(fruit[g]["visible_fraction"], "{:.2f}") for g in names]])
     refused = stats.get("refused_moves", {})
     if refused:
-        rows.append(["moves refused from starts", *[
-            f"{refused[g]['share']:.1%} of {refused[g]['moves']:,}" if refused.get(g, {}).get("share") is not None
-            else "-" for g in names]])
+        rows.append(
+            [
+                "moves refused from starts",
+                *[
+                    f"{refused[g]['share']:.1%} of {refused[g]['moves']:,}"
+                    if refused.get(g, {}).get("share") is not None
+                    else "-"
+                    for g in names
+                ],
+            ]
+        )
     lines += [""] + _grid(rows)
     missing = sum(fruit[g].get("masks_missing", 0) for g in names)
     if missing:
         lines.append(f"{missing} boxes had no mask and no OER")
     return "\n".join(lines)
-

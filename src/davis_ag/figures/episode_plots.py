@@ -44,8 +44,10 @@ def walk(scene: Scene, start: str, actions: list[str], target: int | None) -> li
     view = scene.view(start)
     if target is not None and view.box(target) is None:
         boxed = ", ".join(str(b.fruit_id) for b in view.boxes) or "none"
-        raise UserError(f"scene {scene.id}: view {view.name} has no box of fruit {target} "
-                        f"(its boxes: {boxed}); choose a target boxed in the start view")
+        raise UserError(
+            f"scene {scene.id}: view {view.name} has no box of fruit {target} "
+            f"(its boxes: {boxed}); choose a target boxed in the start view"
+        )
     path = [view.name]
     for action in actions:
         if action == "done":
@@ -63,8 +65,15 @@ def _oer(view: View, target: int | None) -> float | None:
     return exposure_rate(mask, box) if mask is not None and box is not None else None
 
 
-def plot_episode(scene: Scene, path: list[str], actions: list[str], target: int | None,
-                 out: str | Path, formats: tuple[str, ...] = FORMATS, title: str = "") -> Plotted:
+def plot_episode(
+    scene: Scene,
+    path: list[str],
+    actions: list[str],
+    target: int | None,
+    out: str | Path,
+    formats: tuple[str, ...] = FORMATS,
+    title: str = "",
+) -> Plotted:
     """Fig. 6: the episode's views in a strip beside the map of the scene with the path.
 
     Args:
@@ -97,8 +106,16 @@ def plot_episode(scene: Scene, path: list[str], actions: list[str], target: int 
         ax.imshow(view.image(), interpolation="nearest")
         for box in view.boxes:
             colour = _TARGET if box.fruit_id == target else ("red" if box.fruit_id in seen else "yellow")
-            ax.add_patch(Rectangle((box.xmin - 0.5, box.ymin - 0.5), box.width, box.height, fill=False,
-                                   edgecolor=colour, linewidth=2.0 if box.fruit_id == target else 0.8))
+            ax.add_patch(
+                Rectangle(
+                    (box.xmin - 0.5, box.ymin - 0.5),
+                    box.width,
+                    box.height,
+                    fill=False,
+                    edgecolor=colour,
+                    linewidth=2.0 if box.fruit_id == target else 0.8,
+                )
+            )
         seen.update(b.fruit_id for b in view.boxes)
         step = actions[i] if i < len(actions) else "end"
         oer = f", OER {oers[i]:.2f}" if oers[i] is not None else ""
@@ -111,26 +128,39 @@ def plot_episode(scene: Scene, path: list[str], actions: list[str], target: int 
     draw_plants(ax, scene)
     xy = [(v.pose[0], v.pose[1]) for v in views if v.pose is not None]
     if xy:
-        ax.plot([p[0] for p in xy], [p[1] for p in xy], "-o", color="tab:blue", markersize=3,
-                linewidth=1.5, label="path")
+        ax.plot(
+            [p[0] for p in xy], [p[1] for p in xy], "-o", color="tab:blue", markersize=3, linewidth=1.5, label="path"
+        )
         ax.scatter([xy[-1][0]], [xy[-1][1]], marker="D", s=60, color="red", zorder=4, label="current")
     ax.set_aspect("equal")
     ax.legend(fontsize=6, loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=2, frameon=False)
     ax.tick_params(labelsize=7)
     ax.set_title("global map (x, y in m)", fontsize=8)
     start, end = oers[0], oers[-1]
-    figure.suptitle(title or f"{scene.id}, target fruit {target}: OER "
-                    f"{'-' if start is None else f'{start:.3f}'} -> {'-' if end is None else f'{end:.3f}'}",
-                    fontsize=9)
+    figure.suptitle(
+        title
+        or f"{scene.id}, target fruit {target}: OER "
+        f"{'-' if start is None else f'{start:.3f}'} -> {'-' if end is None else f'{end:.3f}'}",
+        fontsize=9,
+    )
     figure.tight_layout()
     paths = save_formats(figure, out, formats)
-    return Plotted(paths, {"scene": scene.id, "target": target, "views": [v.name for v in views],
-                           "actions": list(actions), "poses": [list(v.pose) if v.pose else None for v in views],
-                           "oer": oers})
+    return Plotted(
+        paths,
+        {
+            "scene": scene.id,
+            "target": target,
+            "views": [v.name for v in views],
+            "actions": list(actions),
+            "poses": [list(v.pose) if v.pose else None for v in views],
+            "oer": oers,
+        },
+    )
 
 
-def episode_from_results(results: dict[str, Any], policy: str, index: int,
-                         source: str = "results") -> tuple[str, list[str], list[str], int]:
+def episode_from_results(
+    results: dict[str, Any], policy: str, index: int, source: str = "results"
+) -> tuple[str, list[str], list[str], int]:
     """Pick one recorded episode: ``(scene id, path, action names, target fruit)``.
 
     Args:

@@ -16,8 +16,9 @@ from davis_ag.figures.canvas import new_figure, save_figure
 from davis_ag.scene.organs import ORGAN_NAMES
 
 #: One colour per organ class (sky, soil, fruit, leaf, stem, trunk), for class images and clouds.
-ORGAN_COLOURS = np.array([[135, 190, 235], [120, 90, 60], [220, 30, 40], [60, 170, 60], [240, 200, 40],
-                          [110, 60, 150]], dtype=np.uint8)
+ORGAN_COLOURS = np.array(
+    [[135, 190, 235], [120, 90, 60], [220, 30, 40], [60, 170, 60], [240, 200, 40], [110, 60, 150]], dtype=np.uint8
+)
 
 
 def class_colours(classes: np.ndarray) -> np.ndarray:
@@ -35,15 +36,18 @@ def draw_organ_classes(view: View, out_path: Path) -> Path:
         raise SystemExit(f"{view.class_path}: missing; generate the scene with this version")
     height, width = classes.shape
     figure = new_figure(2 * 5.0, 5.0 * height / width + 0.7)
-    for k, (picture, title) in enumerate(((image, f"{view.scene.id} {view.name}"), (class_colours(classes),
-                                                                                    "organ classes"))):
+    for k, (picture, title) in enumerate(
+        ((image, f"{view.scene.id} {view.name}"), (class_colours(classes), "organ classes"))
+    ):
         ax = figure.add_axes((k * 0.5 + 0.005, 0.12, 0.49, 0.82))
         ax.imshow(picture, interpolation="nearest")
         ax.set_title(title, fontsize=9)
         ax.set_axis_off()
     counts = np.bincount(classes.ravel(), minlength=len(ORGAN_NAMES))
-    handles = [Patch(color=ORGAN_COLOURS[v] / 255, label=f"{v} {name} ({counts[v] / classes.size:.1%})")
-               for v, name in enumerate(ORGAN_NAMES)]
+    handles = [
+        Patch(color=ORGAN_COLOURS[v] / 255, label=f"{v} {name} ({counts[v] / classes.size:.1%})")
+        for v, name in enumerate(ORGAN_NAMES)
+    ]
     figure.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8, frameon=False)
     return save_figure(figure, out_path)
 
@@ -97,8 +101,11 @@ def main(argv: list[str] | None = None) -> int:
     view = scene.view(args[3]) if len(args) > 3 else next(v for v in scene if v.boxes)
     draw_organ_classes(view, out / "organ-classes.png")
     points = read_ply(cloud)
-    draw_point_cloud(points, out / "point-cloud.png",
-                     title=f"{scene.id}: {len(points):,} points fused from {len(scene)} views (plyfile)")
+    draw_point_cloud(
+        points,
+        out / "point-cloud.png",
+        title=f"{scene.id}: {len(points):,} points fused from {len(scene)} views (plyfile)",
+    )
     return 0
 
 

@@ -58,12 +58,19 @@ def front_view(scene: Scene, like: tuple[float, ...] | None = None) -> View:
     px, py = (plant_xy(scene) or [(0.0, 0.0)])[0]
     bottom = [v for v in posed if abs(v.pose[2] - low) < 0.01]  # type: ignore[index]
     # In front: as close to due south of the plant as the grid allows, nearest first.
-    return min(bottom, key=lambda v: (v.pose[1] > py, abs(v.pose[0] - px) + abs(v.pose[1] - py),  # type: ignore[index]
-                                      v.name))
+    return min(
+        bottom,
+        key=lambda v: (
+            v.pose[1] > py,
+            abs(v.pose[0] - px) + abs(v.pose[1] - py),  # type: ignore[index]
+            v.name,
+        ),
+    )
 
 
-def plot_phenotypes(scenes: list[Scene], out: str | Path, formats: tuple[str, ...] = FORMATS,
-                    sheet_of: Scene | None = None) -> Plotted:
+def plot_phenotypes(
+    scenes: list[Scene], out: str | Path, formats: tuple[str, ...] = FORMATS, sheet_of: Scene | None = None
+) -> Plotted:
     """For each phenotype, the scenes with the smallest and the largest value side by side, and
     a contact sheet of one scene (``<out>_contact_sheet``).
 
@@ -83,9 +90,11 @@ def plot_phenotypes(scenes: list[Scene], out: str | Path, formats: tuple[str, ..
     values = {s.id: measured(s) for s in scenes}
     keys = [k for k in PHENOTYPES if any(k in v for v in values.values())]
     if not keys:
-        raise UserError(f"{scenes[0].path.parent.parent if scenes else 'dataset'}: no scene.json with "
-                        "measured phenotypes (the original download has none); give a dataset made "
-                        "by `davis-ag generate`")
+        raise UserError(
+            f"{scenes[0].path.parent.parent if scenes else 'dataset'}: no scene.json with "
+            "measured phenotypes (the original download has none); give a dataset made "
+            "by `davis-ag generate`"
+        )
     reference = front_view(scenes[0]).pose
     figure = new_figure(8.0, 2.5 * len(keys) + 0.5)
     chosen: dict[str, Any] = {}

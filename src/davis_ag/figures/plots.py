@@ -64,8 +64,10 @@ class PlotRequest:
 def _results(path: Path) -> dict[str, Any]:
     data = read_json(path, "evaluation results")
     if not isinstance(data, dict) or not isinstance(data.get("policies"), dict):
-        raise UserError(f"{path}: not `davis-ag evaluate` results (no \"policies\"); give the JSON "
-                        "that `davis-ag evaluate --out` wrote")
+        raise UserError(
+            f'{path}: not `davis-ag evaluate` results (no "policies"); give the JSON '
+            "that `davis-ag evaluate --out` wrote"
+        )
     return data
 
 
@@ -83,18 +85,26 @@ def _episode(request: PlotRequest) -> Plotted:
         path = walk(scene, request.start, request.actions, request.target)
         return plot_episode(scene, path, request.actions, request.target, request.out, request.formats)
     if request.results is None:
-        raise UserError("plot episode needs --results RESULTS.json (a recorded episode) or --start "
-                        "VIEW --actions A,B,... (an episode to walk)")
+        raise UserError(
+            "plot episode needs --results RESULTS.json (a recorded episode) or --start "
+            "VIEW --actions A,B,... (an episode to walk)"
+        )
     results = _results(request.results)
     policy = request.policy or next(iter(results["policies"]))
-    scene_id, path, actions, target = episode_from_results(results, policy, request.episode,
-                                                           str(request.results))
+    scene_id, path, actions, target = episode_from_results(results, policy, request.episode, str(request.results))
     root = request.dataset or Path(str(results.get("protocol", {}).get("dataset", "")))
     if not str(root):
         raise UserError(f"{request.results}: names no dataset; give the dataset folder")
     scene = open_dataset(root).scene(scene_id)
-    return plot_episode(scene, path, actions, target, request.out, request.formats,
-                        title=f"{scene.id}, {policy} episode {request.episode}, target fruit {target}")
+    return plot_episode(
+        scene,
+        path,
+        actions,
+        target,
+        request.out,
+        request.formats,
+        title=f"{scene.id}, {policy} episode {request.episode}, target fruit {target}",
+    )
 
 
 def make_plot(request: PlotRequest) -> Plotted:
@@ -124,8 +134,13 @@ def make_plot(request: PlotRequest) -> Plotted:
         plotted = _episode(request)
     elif kind == "actions":
         assert request.results is not None
-        plotted = plot_actions(_results(request.results), request.out, request.formats,
-                               choices_of=request.policy, source=str(request.results))
+        plotted = plot_actions(
+            _results(request.results),
+            request.out,
+            request.formats,
+            choices_of=request.policy,
+            source=str(request.results),
+        )
     else:
         assert request.dataset is not None
         dataset = open_dataset(request.dataset)
@@ -137,8 +152,9 @@ def make_plot(request: PlotRequest) -> Plotted:
             scenes = [dataset.scene(request.scene)] if request.scene else dataset.scenes
             plotted = plot_oer(scenes, request.out, request.formats)
         else:
-            plotted = plot_phenotypes(dataset.scenes, request.out, request.formats,
-                                      sheet_of=_scene(dataset, request.scene))
+            plotted = plot_phenotypes(
+                dataset.scenes, request.out, request.formats, sheet_of=_scene(dataset, request.scene)
+            )
     base = plotted.paths[0].with_suffix("")
     numbers = base.with_name(f"{base.name}.json")
     try:
@@ -148,8 +164,13 @@ def make_plot(request: PlotRequest) -> Plotted:
     return plotted
 
 
-def paper_figures(root: Path, out_dir: Path, results: Path | None = None,
-                  formats: tuple[str, ...] = FORMATS, kinds: list[str] | None = None) -> dict[str, Plotted]:
+def paper_figures(
+    root: Path,
+    out_dir: Path,
+    results: Path | None = None,
+    formats: tuple[str, ...] = FORMATS,
+    kinds: list[str] | None = None,
+) -> dict[str, Plotted]:
     """Draw every kind a dataset (and its results) allows into ``out_dir``, named by kind.
 
     Kinds the data cannot give (one altitude only, no scene.json, no episodes) are left out

@@ -33,16 +33,17 @@ MAX_GRIDS = 6
 
 def _busiest_view(scene: Scene) -> Any:
     """The view with the most boxes, the largest total box area among those: for the mask figure."""
-    return max(scene.views.values(),
-               key=lambda v: (len(v.boxes), sum(b.width * b.height for b in v.boxes)))
+    return max(scene.views.values(), key=lambda v: (len(v.boxes), sum(b.width * b.height for b in v.boxes)))
 
 
 def _paper_figures(root: Path, out_dir: Path, results: dict[str, Any] | None) -> str:
     """Draw the paper's figures into ``out_dir/figures`` and return their HTML section."""
     results_path = out_dir / "results.json" if results else None  # written by write_report
     drawn = paper_figures(root, out_dir / "figures", results_path, kinds=[k for k in KINDS if k != "visibility"])
-    parts = ["<h2>Figures of the paper</h2><p>Drawn by <code>davis-ag plot KIND</code>; each as PNG and "
-             "SVG with the numbers behind it as JSON in <code>figures/</code>.</p>"]
+    parts = [
+        "<h2>Figures of the paper</h2><p>Drawn by <code>davis-ag plot KIND</code>; each as PNG and "
+        "SVG with the numbers behind it as JSON in <code>figures/</code>.</p>"
+    ]
     for kind, plotted in drawn.items():
         if kind == "skipped":
             continue
@@ -58,8 +59,7 @@ def _paper_figures(root: Path, out_dir: Path, results: dict[str, Any] | None) ->
 def _table(header: list[str], rows: list[list[Any]]) -> str:
     """An HTML table with escaped cells."""
     head = "".join(f"<th>{html.escape(str(h))}</th>" for h in header)
-    body = "".join("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in row) + "</tr>"
-                   for row in rows)
+    body = "".join("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in row) + "</tr>" for row in rows)
     return f"<table><tr>{head}</tr>{body}</table>"
 
 
@@ -84,20 +84,35 @@ def phenotype_rows(scenes: list[Scene]) -> tuple[list[str], list[list[Any]]]:
             keys += [k for k in measured if k not in keys]
             plants.append((scene.id, plant, measured))
     header = ["scene", "plant", "fruit", *keys]
-    rows = [[sid, "" if plant.index is None else plant.index, "" if plant.fruit_count is None else plant.fruit_count,
-             *[_fmt(measured.get(k, "")) for k in keys]] for sid, plant, measured in plants]
+    rows = [
+        [
+            sid,
+            "" if plant.index is None else plant.index,
+            "" if plant.fruit_count is None else plant.fruit_count,
+            *[_fmt(measured.get(k, "")) for k in keys],
+        ]
+        for sid, plant, measured in plants
+    ]
     return header, rows
 
 
-_STYLE = ("body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em}"
-          "img{max-width:100%;border:1px solid #ccc}table{border-collapse:collapse;margin:.5em 0}"
-          "td,th{border:1px solid #ccc;padding:2px 8px;text-align:right}pre{background:#f4f4f4;"
-          "padding:.5em;overflow-x:auto}")
+_STYLE = (
+    "body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em}"
+    "img{max-width:100%;border:1px solid #ccc}table{border-collapse:collapse;margin:.5em 0}"
+    "td,th{border:1px solid #ccc;padding:2px 8px;text-align:right}pre{background:#f4f4f4;"
+    "padding:.5em;overflow-x:auto}"
+)
 
 
-def write_report(root: Path, out_dir: Path, results: dict[str, Any] | None = None,
-                 validation: str | None = None, timer: Timer | None = None,
-                 generated: list[dict[str, Any]] | None = None, title: str = "DAVIS-Ag report") -> Path:
+def write_report(
+    root: Path,
+    out_dir: Path,
+    results: dict[str, Any] | None = None,
+    validation: str | None = None,
+    timer: Timer | None = None,
+    generated: list[dict[str, Any]] | None = None,
+    title: str = "DAVIS-Ag report",
+) -> Path:
     """Draw every figure of a dataset and write ``out_dir/index.html``.
 
     Args:
@@ -122,31 +137,38 @@ def write_report(root: Path, out_dir: Path, results: dict[str, Any] | None = Non
     scenes = dataset.scenes
     out_dir.mkdir(parents=True, exist_ok=True)
     first = scenes[0]
-    parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title>"
-             f"<style>{_STYLE}</style></head><body><h1>{html.escape(title)}</h1>",
-             f"<p>Dataset <code>{html.escape(str(dataset.root))}</code>: {len(scenes)} scene(s), "
-             f"{sum(len(s.views) for s in scenes)} views.</p>"]
+    parts = [
+        f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title>"
+        f"<style>{_STYLE}</style></head><body><h1>{html.escape(title)}</h1>",
+        f"<p>Dataset <code>{html.escape(str(dataset.root))}</code>: {len(scenes)} scene(s), "
+        f"{sum(len(s.views) for s in scenes)} views.</p>",
+    ]
     if validation:
         parts.append(f"<h2>Validation</h2><pre>{html.escape(validation)}</pre>")
     if results:
         plot_results(results, out_dir / "baselines.png")
-        parts.append("<h2>Benchmark (Table 4 style)</h2>"
-                     f"<pre>{html.escape(format_table(results))}</pre>"
-                     "<img src='baselines.png' alt='baselines bar chart'>")
+        parts.append(
+            "<h2>Benchmark (Table 4 style)</h2>"
+            f"<pre>{html.escape(format_table(results))}</pre>"
+            "<img src='baselines.png' alt='baselines bar chart'>"
+        )
         write_json_atomic(out_dir / "results.json", results, indent=2)
-        parts.append("<p><a href='results.json'>results.json</a> holds every session's and "
-                     "episode's numbers.</p>")
+        parts.append("<p><a href='results.json'>results.json</a> holds every session's and episode's numbers.</p>")
     draw_contact_sheet(first, out_dir / "contact_sheet.png")
     view = _busiest_view(first)
     draw_masks(view, out_dir / "mask.png")
-    parts.append(f"<h2>Views of {html.escape(first.id)}</h2><p>Evenly spread views with every "
-                 "fruit box:</p><img src='contact_sheet.png' alt='contact sheet'>"
-                 f"<p>View {html.escape(view.name)} ({len(view.boxes)} boxes) and its instance "
-                 "mask:</p><img src='mask.png' alt='image and instance mask'>"
-                 "<p>Drive through the scenes with the keyboard: <code>davis-ag view "
-                 f"{html.escape(str(dataset.root))}</code>, then open http://127.0.0.1:8765/.</p>")
-    parts.append("<h2>Visible fruit per camera position</h2><p>Camera positions per altitude, "
-                 "coloured by the fruit boxed from there (cf. Fig. 2), cross = plant.</p>")
+    parts.append(
+        f"<h2>Views of {html.escape(first.id)}</h2><p>Evenly spread views with every "
+        "fruit box:</p><img src='contact_sheet.png' alt='contact sheet'>"
+        f"<p>View {html.escape(view.name)} ({len(view.boxes)} boxes) and its instance "
+        "mask:</p><img src='mask.png' alt='image and instance mask'>"
+        "<p>Drive through the scenes with the keyboard: <code>davis-ag view "
+        f"{html.escape(str(dataset.root))}</code>, then open http://127.0.0.1:8765/.</p>"
+    )
+    parts.append(
+        "<h2>Visible fruit per camera position</h2><p>Camera positions per altitude, "
+        "coloured by the fruit boxed from there (cf. Fig. 2), cross = plant.</p>"
+    )
     for i, scene in enumerate(scenes[:MAX_GRIDS]):
         name = f"visibility_{i:03d}.png"
         plot_visibility(scene, out_dir / name, ("png",))
@@ -158,12 +180,22 @@ def write_report(root: Path, out_dir: Path, results: dict[str, Any] | None = Non
     if timer or generated:
         parts.append("<h2>Timing</h2>")
     if timer:
-        parts.append(_table(["stage", "seconds", "note"],
-                            [[k, f"{v:.1f}", note] for k, v, note in timer.rows()]))
+        parts.append(_table(["stage", "seconds", "note"], [[k, f"{v:.1f}", note] for k, v, note in timer.rows()]))
     if generated:
-        parts.append(_table(["scene", "views", "grow s", "s per view", "total s"],
-                            [[g["scene"], g.get("views", "reused"), _fmt(g.get("grow_s", "")),
-                              _fmt(g["views_s"] / g["views"]) if g.get("views") else "",
-                              _fmt(g.get("total_s", ""))] for g in generated]))
+        parts.append(
+            _table(
+                ["scene", "views", "grow s", "s per view", "total s"],
+                [
+                    [
+                        g["scene"],
+                        g.get("views", "reused"),
+                        _fmt(g.get("grow_s", "")),
+                        _fmt(g["views_s"] / g["views"]) if g.get("views") else "",
+                        _fmt(g.get("total_s", "")),
+                    ]
+                    for g in generated
+                ],
+            )
+        )
     parts.append("</body></html>")
     return write_text_atomic(out_dir / "index.html", "\n".join(parts) + "\n")

@@ -42,8 +42,10 @@ def plot_results(results: dict[str, Any], path: str | os.PathLike[str]) -> Path:
     protocol = results["protocol"]
     # What the bars rest on: the split's scenes and eligible starts (the grid's; drawn live otherwise).
     starts = f", {protocol['starts']} eligible starts" if protocol.get("starts") is not None else ""
-    fig.suptitle(f"{protocol['scenario'].upper()} {protocol['split']}: {len(protocol.get('scenes', []))} scene(s)"
-                 f"{starts}, {protocol['sessions']} x {protocol['episodes']} episodes")
+    fig.suptitle(
+        f"{protocol['scenario'].upper()} {protocol['split']}: {len(protocol.get('scenes', []))} scene(s)"
+        f"{starts}, {protocol['sessions']} x {protocol['episodes']} episodes"
+    )
     fig.tight_layout()
     try:
         return save_figure_atomic(fig, path, dpi=120)
@@ -75,7 +77,7 @@ def plot_training_curve(records: list[dict], path: str | os.PathLike[str], title
         ax.plot(steps, values, ".", ms=2, alpha=0.3, color="C0")
         if len(values) >= window:
             mean = np.convolve(values, np.ones(window) / window, mode="valid")
-            ax.plot(steps[window - 1:], mean, color="C1", label=f"mean of {window} episodes")
+            ax.plot(steps[window - 1 :], mean, color="C1", label=f"mean of {window} episodes")
             ax.legend(loc="upper left", fontsize=8)
         ax.set_xlabel("environment steps")
         ax.set_title(label)

@@ -123,8 +123,10 @@ def altitude_columns(scene: Scene) -> list[dict[int, set[int]]]:
     """
     levels = altitudes(scene)
     if len(levels) < 2 or "up" not in scene.actions:
-        raise UserError(f"{scene.annotations_path}: scene {scene.id} has {len(levels)} altitude(s) "
-                        "and no up/down moves; the altitude figure needs at least two altitudes")
+        raise UserError(
+            f"{scene.annotations_path}: scene {scene.id} has {len(levels)} altitude(s) "
+            "and no up/down moves; the altitude figure needs at least two altitudes"
+        )
     level_of = {lv: i for i, lv in enumerate(levels)}
     columns = []
     for view in _posed(scene):
@@ -166,8 +168,7 @@ def altitude_changes(scene: Scene) -> dict[str, Any]:
         top = len(levels) - 1
         lower = "∪".join(f"H{k + 1}" for k in range(top))
         full = [c for c in columns if all(k in c for k in range(top + 1))]
-        novel[f"H{top + 1}\\({lower})"] = [len(c[top] - set().union(*(c[k] for k in range(top))))
-                                           for c in full]
+        novel[f"H{top + 1}\\({lower})"] = [len(c[top] - set().union(*(c[k] for k in range(top)))) for c in full]
     return {"altitudes": levels, "columns": len(columns), "differences": differences, "novel": novel}
 
 
@@ -210,7 +211,10 @@ def box_oers(scenes: list[Scene]) -> tuple[np.ndarray, int]:
 
 def visible_fractions(scenes: list[Scene]) -> np.ndarray:
     """Every box's visible fraction from scene.json (ours only; empty for the original download)."""
-    values = [float(f) for s in scenes
-              for per_view in (s.metadata.visible_fraction.values() if s.metadata else ())
-              for f in per_view.values()]
+    values = [
+        float(f)
+        for s in scenes
+        for per_view in (s.metadata.visible_fraction.values() if s.metadata else ())
+        for f in per_view.values()
+    ]
     return np.asarray(values, dtype=float)

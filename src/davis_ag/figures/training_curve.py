@@ -24,8 +24,12 @@ def rolling_mean(values: np.ndarray, weights: np.ndarray, window: int) -> np.nda
     return sums / np.maximum(counts, 1e-12)
 
 
-def plot_learning_curve(records: dict[str, dict[str, Any]], out: str | Path,
-                        formats: tuple[str, ...] = FORMATS, window: int = ROLLING_POINTS) -> Plotted:
+def plot_learning_curve(
+    records: dict[str, dict[str, Any]],
+    out: str | Path,
+    formats: tuple[str, ...] = FORMATS,
+    window: int = ROLLING_POINTS,
+) -> Plotted:
     """Fig. 4a: mean episodic reward per 1K training steps, with a rolling average, per model.
 
     Args:
@@ -46,10 +50,13 @@ def plot_learning_curve(records: dict[str, dict[str, Any]], out: str | Path,
     """
     curves = {label: r["curve"] for label, r in records.items() if r.get("curve")}
     if not curves:
-        raise UserError("no training record holds a learning curve: retrain with this version of "
-                        "`davis-ag train`, which keeps one in NAME.training.json")
-    selections = {label: records[label]["selection"] for label in curves
-                  if (records[label].get("selection") or {}).get("scores")}
+        raise UserError(
+            "no training record holds a learning curve: retrain with this version of "
+            "`davis-ag train`, which keeps one in NAME.training.json"
+        )
+    selections = {
+        label: records[label]["selection"] for label in curves if (records[label].get("selection") or {}).get("scores")
+    }
     figure = new_figure(6.0, 5.6 if selections else 3.6)
     axes = figure.add_subplot(2, 1, 1) if selections else figure.add_subplot(1, 1, 1)
     data: dict[str, dict[str, Any]] = {}
@@ -60,12 +67,10 @@ def plot_learning_curve(records: dict[str, dict[str, Any]], out: str | Path,
         smoothed = rolling_mean(reward, episodes, window)
         axes.plot(steps / 1000, reward, color=f"C{k}", alpha=0.25, linewidth=0.8)
         axes.plot(steps / 1000, smoothed, color=f"C{k}", linewidth=1.8, label=label)
-        data[label] = {"steps": steps.astype(int).tolist(), "reward": reward.tolist(),
-                       "smoothed": smoothed.tolist()}
+        data[label] = {"steps": steps.astype(int).tolist(), "reward": reward.tolist(), "smoothed": smoothed.tolist()}
     axes.set_xlabel("training steps (thousands)")
     axes.set_ylabel("episodic reward")
-    axes.set_title(f"A2C learning curve: mean reward per 1K steps (faint), rolling mean of {window} (bold)",
-                   fontsize=8)
+    axes.set_title(f"A2C learning curve: mean reward per 1K steps (faint), rolling mean of {window} (bold)", fontsize=8)
     axes.legend(fontsize=8)
     if selections:
         lower = figure.add_subplot(2, 1, 2, sharex=axes)
@@ -78,14 +83,19 @@ def plot_learning_curve(records: dict[str, dict[str, Any]], out: str | Path,
             kept = selections[label].get("kept_step")
             lower.plot(steps / 1000, oer, color=f"C{k}", marker="o", markersize=3, linewidth=1, label=label)
             if kept is not None and kept in steps:
-                lower.plot(kept / 1000, oer[list(steps).index(kept)], marker="o", markersize=11,
-                           markerfacecolor="none", markeredgecolor="black", linestyle="none")
-            data[label].update(scored_steps=steps.astype(int).tolist(), scored_oer_tau=oer.tolist(),
-                               kept_step=kept)
+                lower.plot(
+                    kept / 1000,
+                    oer[list(steps).index(kept)],
+                    marker="o",
+                    markersize=11,
+                    markerfacecolor="none",
+                    markeredgecolor="black",
+                    linestyle="none",
+                )
+            data[label].update(scored_steps=steps.astype(int).tolist(), scored_oer_tau=oer.tolist(), kept_step=kept)
         lower.set_xlabel("training steps (thousands)")
         lower.set_ylabel("train-split OER_tau")
-        lower.set_title("each snapshot on the train split (200 sampled episodes); ringed: the one kept",
-                        fontsize=8)
+        lower.set_title("each snapshot on the train split (200 sampled episodes); ringed: the one kept", fontsize=8)
         lower.legend(fontsize=8)
     figure.tight_layout()
     return Plotted(save_formats(figure, out, formats), data)

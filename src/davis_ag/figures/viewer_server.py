@@ -38,8 +38,11 @@ from davis_ag.figures.scene_numbers import altitudes
 from davis_ag.figures.visibility_plots import plant_xy
 
 #: The only file names served: an image, its mask or its depth image.
-FILE_NAME = re.compile(r"\d{1,6}(" + "|".join(re.escape(end) for end in sorted(
-    {".jpg", ".png", *(suffix for suffix, _ in VIEW_FILES.values())})) + ")")
+FILE_NAME = re.compile(
+    r"\d{1,6}("
+    + "|".join(re.escape(end) for end in sorted({".jpg", ".png", *(suffix for suffix, _ in VIEW_FILES.values())}))
+    + ")"
+)
 HOST = "127.0.0.1"
 _TYPES = {".jpeg": "image/jpeg", ".jpg": "image/jpeg", ".png": "image/png"}
 
@@ -66,9 +69,15 @@ def scene_payload(scene: Scene) -> dict[str, Any]:
         }
     image_size = scene.metadata.image_size() if scene.metadata else None
     size = list(image_size) if image_size else None
-    return {"id": scene.id, "actions": list(scene.actions), "order": list(scene.views),
-            "altitudes": altitudes(scene) if any(v["pose"] for v in views.values()) else [],
-            "plants": [list(p) for p in plant_xy(scene)], "size": size, "views": views}
+    return {
+        "id": scene.id,
+        "actions": list(scene.actions),
+        "order": list(scene.views),
+        "altitudes": altitudes(scene) if any(v["pose"] for v in views.values()) else [],
+        "plants": [list(p) for p in plant_xy(scene)],
+        "size": size,
+        "views": views,
+    }
 
 
 def mask_overlay(mask: np.ndarray) -> bytes:
@@ -108,7 +117,7 @@ def classes_overlay(classes: np.ndarray) -> bytes:
 
     table = np.zeros((256, 4), dtype=np.uint8)
     table[: len(ORGAN_COLOURS), :3] = ORGAN_COLOURS
-    table[1: len(ORGAN_COLOURS), 3] = 200
+    table[1 : len(ORGAN_COLOURS), 3] = 200
     buffer = io.BytesIO()
     Image.fromarray(table[classes], "RGBA").save(buffer, format="PNG")
     return buffer.getvalue()
@@ -123,7 +132,7 @@ class Viewer:
 
     def __init__(self, dataset: Dataset) -> None:
         """Args:
-            dataset: The dataset to serve.
+        dataset: The dataset to serve.
         """
         self.dataset = dataset
         self._scenes = {s.id: s for s in dataset.scenes}
@@ -143,8 +152,12 @@ class Viewer:
 
     def scenes(self) -> bytes:
         """The scene list as JSON bytes."""
-        return json.dumps({"root": str(self.dataset.root), "scenes": [
-            {"id": s.id, "views": len(s.views)} for s in self.dataset.scenes]}).encode()
+        return json.dumps(
+            {
+                "root": str(self.dataset.root),
+                "scenes": [{"id": s.id, "views": len(s.views)} for s in self.dataset.scenes],
+            }
+        ).encode()
 
     def file(self, scene: Scene, name: str) -> Path | None:
         """The scene's ``images/<name>`` when the name is allowed and the file, symlinks
@@ -217,7 +230,12 @@ def make_handler(viewer: Viewer, page: bytes) -> type[BaseHTTPRequestHandler]:
                 if path is None:
                     return self._missing()
                 self._send(HTTPStatus.OK, path.read_bytes(), _TYPES[path.suffix], cache=True)
-            elif head == "overlay" and rest and rest[0] in ("mask", "depth", "classes") and (found := _split_scene(rest[1:])):
+            elif (
+                head == "overlay"
+                and rest
+                and rest[0] in ("mask", "depth", "classes")
+                and (found := _split_scene(rest[1:]))
+            ):
                 self._overlay(rest[0], *found)
             else:
                 self._missing()
@@ -272,8 +290,9 @@ def start_server(root: str | Path, port: int = 0) -> ThreadingHTTPServer:
     try:
         server = ThreadingHTTPServer((HOST, port), handler)
     except OSError as error:
-        raise UserError(f"{HOST}:{port}: cannot listen ({error.strerror or error}); choose another "
-                        "--port or 0 for any free one") from None
+        raise UserError(
+            f"{HOST}:{port}: cannot listen ({error.strerror or error}); choose another --port or 0 for any free one"
+        ) from None
     server.daemon_threads = True
     return server
 

@@ -52,8 +52,16 @@ def draw_plants(ax: Axes, scene: Scene) -> None:
     """Mark the scene's plants with black crosses (as Fig. 2 does)."""
     xy = plant_xy(scene)
     if xy:
-        ax.scatter([p[0] for p in xy], [p[1] for p in xy], marker="x", color="black", s=40,
-                   linewidths=1.5, label="plant", zorder=3)
+        ax.scatter(
+            [p[0] for p in xy],
+            [p[1] for p in xy],
+            marker="x",
+            color="black",
+            s=40,
+            linewidths=1.5,
+            label="plant",
+            zorder=3,
+        )
 
 
 def plot_visibility(scene: Scene, out: str | Path, formats: tuple[str, ...] = FORMATS) -> Plotted:
@@ -88,20 +96,35 @@ def plot_visibility(scene: Scene, out: str | Path, formats: tuple[str, ...] = FO
         ax = figure.add_subplot(1, len(levels), i + 1)
         for k in range(len(labels) - 1, -1, -1):
             chosen = classes == k
-            ax.scatter(np.array([p.x for p in here])[chosen], np.array([p.y for p in here])[chosen],
-                       s=46, color=CLASS_COLOURS[k], edgecolors="#303030", linewidths=0.6,
-                       label=labels[k], zorder=2)
+            ax.scatter(
+                np.array([p.x for p in here])[chosen],
+                np.array([p.y for p in here])[chosen],
+                s=46,
+                color=CLASS_COLOURS[k],
+                edgecolors="#303030",
+                linewidths=0.6,
+                label=labels[k],
+                zorder=2,
+            )
         draw_plants(ax, scene)
         ax.set_xlim(min(xs) - pad, max(xs) + pad)
         ax.set_ylim(min(ys) - pad, max(ys) + pad)
         ax.set_aspect("equal")
         ax.set_title(f"{z:.2f} m", fontsize=10)
         ax.tick_params(labelsize=7)
-        panels.append({"z": z, "x": [p.x for p in here], "y": [p.y for p in here],
-                       "count": counts.tolist(), "class": classes.tolist()})
+        panels.append(
+            {
+                "z": z,
+                "x": [p.x for p in here],
+                "y": [p.y for p in here],
+                "count": counts.tolist(),
+                "class": classes.tolist(),
+            }
+        )
     handles, names = figure.axes[0].get_legend_handles_labels()
-    figure.legend(handles, names, loc="center right", fontsize=8, frameon=False,
-                  title=f"visible of {total}", title_fontsize=8)
+    figure.legend(
+        handles, names, loc="center right", fontsize=8, frameon=False, title=f"visible of {total}", title_fontsize=8
+    )
     figure.suptitle(f"{scene.id}: visible fruit per camera position", fontsize=10)
     figure.tight_layout(rect=(0, 0, 1 - 1.1 / (3.4 * len(levels) + 1.2), 1))
     paths = save_formats(figure, out, formats)
@@ -117,8 +140,9 @@ def _grouped_histogram(ax: Axes, series: dict[str, list[int]], xlabel: str) -> d
     drawn = {}
     for k, (label, values) in enumerate(series.items()):
         counts = np.histogram(values, bins=edges)[0] if values else np.zeros(len(centres), dtype=int)
-        ax.bar(centres - 0.4 + width * (k + 0.5), counts, width=width, label=f"{label} (n={len(values)})",
-               color=f"C{k}")
+        ax.bar(
+            centres - 0.4 + width * (k + 0.5), counts, width=width, label=f"{label} (n={len(values)})", color=f"C{k}"
+        )
         drawn[label] = {"edges": edges.tolist(), "counts": counts.tolist()}
     ax.set_xlabel(xlabel, fontsize=9)
     ax.set_ylabel("locations", fontsize=9)

@@ -70,8 +70,10 @@ def view_number(name: str) -> int | None:
 
 def published_pointers(grid: ViewGrid, index: int) -> dict[str, str]:
     """The published pointer dictionary of a grid's view: action to image name, "" where invalid."""
-    return {action: "" if (target := grid.pointer(index, action)) is None else view_name(target + 1)
-            for action in grid.actions}
+    return {
+        action: "" if (target := grid.pointer(index, action)) is None else view_name(target + 1)
+        for action in grid.actions
+    }
 
 
 def view_file_name(name: str, kind: str) -> str:
@@ -117,9 +119,14 @@ def decode_depth(millimetres: np.ndarray) -> np.ndarray:
     return np.asarray(millimetres).astype(np.float32) / 1000.0
 
 
-def write_view_files(images_dir: Path, name: str, colour: np.ndarray | None = None,
-                     segmentation: np.ndarray | None = None, depth: np.ndarray | None = None,
-                     classes: np.ndarray | None = None) -> list[str]:
+def write_view_files(
+    images_dir: Path,
+    name: str,
+    colour: np.ndarray | None = None,
+    segmentation: np.ndarray | None = None,
+    depth: np.ndarray | None = None,
+    classes: np.ndarray | None = None,
+) -> list[str]:
     """Encode and write a view's files (those given) into ``images/``; not atomic by itself.
 
     Args:
@@ -167,8 +174,10 @@ def read_depth_millimetres(path: Path) -> np.ndarray:
             raise
         raise UserError(f"{path}: cannot decode ({error}); regenerate the scene") from None
     if millimetres.dtype != np.uint16 or millimetres.ndim != 2:
-        raise UserError(f"{path}: a depth image must be a uint16 single-channel PNG (millimetres), "
-                        f"got {millimetres.dtype} {millimetres.shape}; regenerate the scene")
+        raise UserError(
+            f"{path}: a depth image must be a uint16 single-channel PNG (millimetres), "
+            f"got {millimetres.dtype} {millimetres.shape}; regenerate the scene"
+        )
     return millimetres
 
 

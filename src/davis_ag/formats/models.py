@@ -85,8 +85,10 @@ def _size_from_text(value: Any) -> Any:
 
 def _drawable(size: tuple[int, int]) -> tuple[int, int]:
     if not all(MIN_IMAGE_SIDE <= side <= MAX_IMAGE_SIDE for side in size):
-        raise ValueError(f"{size[0]}x{size[1]}: each side must be from {MIN_IMAGE_SIDE} to {MAX_IMAGE_SIDE} "
-                         "pixels (the renderer's limit)")
+        raise ValueError(
+            f"{size[0]}x{size[1]}: each side must be from {MIN_IMAGE_SIDE} to {MAX_IMAGE_SIDE} "
+            "pixels (the renderer's limit)"
+        )
     return size
 
 
@@ -96,9 +98,15 @@ _IMAGE_SIZE = TypeAdapter(ImageSize)
 
 
 #: pydantic's wording where ours says more.
-_MESSAGES = {"missing": "missing", "extra_forbidden": "unknown key", "int_type": "must be a whole number",
-             "bool_type": "must be true or false", "float_type": "must be a number", "float_parsing": "must be a number",
-             "string_type": "must be a text"}
+_MESSAGES = {
+    "missing": "missing",
+    "extra_forbidden": "unknown key",
+    "int_type": "must be a whole number",
+    "bool_type": "must be true or false",
+    "float_type": "must be a number",
+    "float_parsing": "must be a number",
+    "string_type": "must be a text",
+}
 
 
 def one_line(error: ValidationError, source: str = "") -> str:
@@ -117,8 +125,11 @@ def one_line(error: ValidationError, source: str = "") -> str:
     message = str(first["msg"]).removeprefix("Value error, ").removeprefix("Assertion failed, ")
     message = _MESSAGES.get(first["type"], message).replace("Input should be", "must be")
     # Our own checks name the value already; a missing or unknown key has none worth showing.
-    if first["type"] not in ("missing", "extra_forbidden", "value_error", "assertion_error") \
-            and "input" in first and not isinstance(first["input"], (dict, list)):
+    if (
+        first["type"] not in ("missing", "extra_forbidden", "value_error", "assertion_error")
+        and "input" in first
+        and not isinstance(first["input"], (dict, list))
+    ):
         message = f"{message}, not {first['input']!r}"
     more = f" (and {len(problems) - 1} more problem{'s' if len(problems) > 2 else ''})" if len(problems) > 1 else ""
     return ": ".join(part for part in (source, path, message) if part) + more
@@ -164,8 +175,13 @@ class _Model(BaseModel):
 class GridOverride(_Model):
     """A change to the scenario's Table 2 grid (smaller scenes for quick looks and tests)."""
 
-    extent: tuple[Annotated[float, Field(gt=0, le=MAX_GRID_EXTENT, allow_inf_nan=False)],
-                  Annotated[float, Field(gt=0, le=MAX_GRID_EXTENT, allow_inf_nan=False)]] | None = None
+    extent: (
+        tuple[
+            Annotated[float, Field(gt=0, le=MAX_GRID_EXTENT, allow_inf_nan=False)],
+            Annotated[float, Field(gt=0, le=MAX_GRID_EXTENT, allow_inf_nan=False)],
+        ]
+        | None
+    ) = None
     step: Annotated[float, Field(gt=0, le=MAX_GRID_EXTENT, allow_inf_nan=False)] | None = None
     altitude_levels: list[Literal[0, 1, 2]] | None = None
     headings: whole(1, 360) | None = None
@@ -181,15 +197,19 @@ class GridOverride(_Model):
     @classmethod
     def _no_diagonal(cls, headings: int | None) -> int | None:
         # Forward moves along the grid axis nearest the heading: a diagonal would be a tie.
-        if headings is not None and headings > 1 and (
-                360 % headings or any(math.isclose((k * 360 / headings) % 90, 45) for k in range(headings))):
+        if (
+            headings is not None
+            and headings > 1
+            and (360 % headings or any(math.isclose((k * 360 / headings) % 90, 45) for k in range(headings)))
+        ):
             raise ValueError(f"{headings} does not work for multi plant: use 2, 3, 4, 6 or 12 (1 for single plant)")
         return headings
 
     def changes(self) -> dict[str, Any]:
         """The set fields, as :class:`~davis_ag.scene.specs.ScenarioSpec` takes them."""
-        return {k: tuple(v) if isinstance(v, (list, tuple)) else v
-                for k, v in self.model_dump(exclude_none=True).items()}
+        return {
+            k: tuple(v) if isinstance(v, (list, tuple)) else v for k, v in self.model_dump(exclude_none=True).items()
+        }
 
 
 class GroupEntry(_Model):
@@ -213,8 +233,7 @@ class GroupEntry(_Model):
     @model_validator(mode="after")
     def _fits_the_numbering(self) -> GroupEntry:
         if self.first + self.scenes > MAX_SCENES:
-            raise ValueError(f"scenes {self.first}..{self.first + self.scenes - 1} do not fit "
-                             f"000..{MAX_SCENES - 1}")
+            raise ValueError(f"scenes {self.first}..{self.first + self.scenes - 1} do not fit 000..{MAX_SCENES - 1}")
         return self
 
 
@@ -255,8 +274,9 @@ class DatasetConfigFile(_Model):
             key = (group.scenario, group.crop)
             if key in seen:
                 name = group_name(scenario_spec(group.scenario), crop_spec(group.crop))
-                raise ValueError(f"groups.{position}: {name} is already groups.{seen[key]}: give each scenario "
-                                 "and crop once")
+                raise ValueError(
+                    f"groups.{position}: {name} is already groups.{seen[key]}: give each scenario and crop once"
+                )
             seen[key] = position
         if self.renderer == "helios" and self.look == "default":
             raise ValueError("look: the helios renderer has only the helios look (the default look is ours)")
@@ -332,9 +352,14 @@ class SplitsFile(_Model):
 
 
 ViewName = Annotated[str, Field(pattern=r"^(\d{4,}\.jpeg)?$")]
-BoxList = tuple[Annotated[StrictInt, Field(ge=0)], Annotated[StrictInt, Field(ge=0)],
-                Annotated[StrictInt, Field(ge=1)], Annotated[StrictInt, Field(ge=1)],
-                Annotated[StrictInt, Field(ge=0, le=MAX_FRUIT_ID)], Literal[0]]
+BoxList = tuple[
+    Annotated[StrictInt, Field(ge=0)],
+    Annotated[StrictInt, Field(ge=0)],
+    Annotated[StrictInt, Field(ge=1)],
+    Annotated[StrictInt, Field(ge=1)],
+    Annotated[StrictInt, Field(ge=0, le=MAX_FRUIT_ID)],
+    Literal[0],
+]
 
 
 class AnnotationEntry(_Model):

@@ -72,12 +72,15 @@ class OutputLock:
             except BlockingIOError:
                 holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "unknown"
                 os.close(fd)
-                raise UserError(f"{self.target()} is being {self.doing} by another davis-ag run (PID {holder}): "
-                                f"wait for it to end or choose another {self.flag}") from None
+                raise UserError(
+                    f"{self.target()} is being {self.doing} by another davis-ag run (PID {holder}): "
+                    f"wait for it to end or choose another {self.flag}"
+                ) from None
             except OSError as error:
                 os.close(fd)
-                raise UserError(f"cannot lock {self.path} ({error.strerror}): use a local folder for "
-                                f"{self.flag}") from None
+                raise UserError(
+                    f"cannot lock {self.path} ({error.strerror}): use a local folder for {self.flag}"
+                ) from None
             if self._still_linked(fd):
                 break
             os.close(fd)  # its holder removed the file as it ended: lock the one there now
@@ -134,8 +137,10 @@ def check_outside_datasets(path: str | os.PathLike[str], flag: str = "--out") ->
     holder = dataset_holding(target)
     if holder is not None:
         kind = "a scene folder" if any((holder / m).is_file() for m in SCENE_MARKS) else "a dataset"
-        raise UserError(f"{flag} {target} lies in {holder}, which is {kind}: only davis-ag generate writes "
-                        "there; choose a path outside the dataset")
+        raise UserError(
+            f"{flag} {target} lies in {holder}, which is {kind}: only davis-ag generate writes "
+            "there; choose a path outside the dataset"
+        )
     return target
 
 
@@ -147,9 +152,15 @@ def _exists(path: Path, ignore: Sequence[str]) -> bool:
 
 
 @contextmanager
-def claim_output(path: str | os.PathLike[str], *, force: bool = False, flag: str = "--out",
-                 folder: bool = False, also: Sequence[tuple[Path, str]] = (),
-                 temporaries: Sequence[str] = ()) -> Iterator[Path]:
+def claim_output(
+    path: str | os.PathLike[str],
+    *,
+    force: bool = False,
+    flag: str = "--out",
+    folder: bool = False,
+    also: Sequence[tuple[Path, str]] = (),
+    temporaries: Sequence[str] = (),
+) -> Iterator[Path]:
     """Claim an output for one run by :mod:`the output rule <davis_ag.formats.outputs>`.
 
     Args:
@@ -195,6 +206,7 @@ def claim_output(path: str | os.PathLike[str], *, force: bool = False, flag: str
         if not force:
             for each, each_flag in files:
                 if _exists(each, (LOCK_FILE,)):
-                    raise UserError(f"{each_flag} {each} already exists: give --force to replace it, or "
-                                    "choose another path")
+                    raise UserError(
+                        f"{each_flag} {each} already exists: give --force to replace it, or choose another path"
+                    )
         yield target

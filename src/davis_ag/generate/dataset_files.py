@@ -38,29 +38,44 @@ def dataset_settings(requests: Sequence[SceneRequest]) -> dict[str, Any]:
     """
     first = requests[0]
     for request in requests:
-        if request.dataset_seed != first.dataset_seed or request.camera != first.camera \
-                or (request.renderer, request.look, request.plants, request.appearance) != (
-                    first.renderer, first.look, first.plants, first.appearance):
-            raise UserError("the scenes of one run must share the dataset seed, the image size, the renderer, "
-                            "the look, the plant generator and the appearance")
+        if (
+            request.dataset_seed != first.dataset_seed
+            or request.camera != first.camera
+            or (request.renderer, request.look, request.plants, request.appearance)
+            != (first.renderer, first.look, first.plants, first.appearance)
+        ):
+            raise UserError(
+                "the scenes of one run must share the dataset seed, the image size, the renderer, "
+                "the look, the plant generator and the appearance"
+            )
     groups: dict[str, Any] = {}
     for request in requests:
         groups[request.folder.split("/")[0]] = {"grid": grid_settings(request.scenario, request.crop)}
-    return DatasetFile(format=DATASET_FORMAT, seed=first.dataset_seed,
-                       image_size=(first.camera.width, first.camera.height), vfov_deg=first.camera.vfov,
-                       renderer=first.renderer, look=resolve_look(first.renderer, first.look),
-                       plants=first.plants, appearance=first.appearance,
-                       classes=organ_table() if first.classes else None, groups=groups).to_json()
+    return DatasetFile(
+        format=DATASET_FORMAT,
+        seed=first.dataset_seed,
+        image_size=(first.camera.width, first.camera.height),
+        vfov_deg=first.camera.vfov,
+        renderer=first.renderer,
+        look=resolve_look(first.renderer, first.look),
+        plants=first.plants,
+        appearance=first.appearance,
+        classes=organ_table() if first.classes else None,
+        groups=groups,
+    ).to_json()
 
 
 def complete_scenes(root: Path) -> list[str]:
     """Ids of the whole scenes under a dataset root (hidden partial folders are not scenes)."""
     if not root.is_dir():
         return []
-    return sorted(f"{group.name}/{scene.name}" for group in root.iterdir()
-                  if group.is_dir() and parse_group_name(group.name)
-                  for scene in group.iterdir()
-                  if scene.is_dir() and not scene.name.startswith(".") and (scene / ANNOTATIONS).is_file())
+    return sorted(
+        f"{group.name}/{scene.name}"
+        for group in root.iterdir()
+        if group.is_dir() and parse_group_name(group.name)
+        for scene in group.iterdir()
+        if scene.is_dir() and not scene.name.startswith(".") and (scene / ANNOTATIONS).is_file()
+    )
 
 
 def reconcile_settings(root: Path, wanted: dict[str, Any]) -> dict[str, Any]:
@@ -82,25 +97,35 @@ def reconcile_settings(root: Path, wanted: dict[str, Any]) -> dict[str, Any]:
     try:
         old = DatasetFile.model_validate_json(path.read_bytes()).to_json()
     except OSError as error:
-        raise UserError(f"{path} is unreadable ({error.strerror}): move it away if the folder holds no scenes of "
-                        "ours") from None
+        raise UserError(
+            f"{path} is unreadable ({error.strerror}): move it away if the folder holds no scenes of ours"
+        ) from None
     except ValidationError as error:
         raise UserError(f"{one_line(error, str(path))}: move it away if the folder holds no scenes of ours") from None
     present = complete_scenes(root)
     if not present:  # nothing was finished with the old settings: they may change freely
         return wanted
-    for key, flag in (("seed", "--seed"), ("image_size", "--size"), ("vfov_deg", "the field of view"),
-                      ("renderer", "--renderer"), ("look", "--look"), ("plants", "--plants"),
-                      ("appearance", "--appearance")):
+    for key, flag in (
+        ("seed", "--seed"),
+        ("image_size", "--size"),
+        ("vfov_deg", "the field of view"),
+        ("renderer", "--renderer"),
+        ("look", "--look"),
+        ("plants", "--plants"),
+        ("appearance", "--appearance"),
+    ):
         if old.get(key) != wanted[key]:
             shown = [_shown(old.get(key)), _shown(wanted[key])]
-            raise UserError(f"{root} holds scenes made with {key} {shown[0]}, not {shown[1]}: "
-                            f"use the same {flag} or another --out")
+            raise UserError(
+                f"{root} holds scenes made with {key} {shown[0]}, not {shown[1]}: use the same {flag} or another --out"
+            )
     groups = dict(old["groups"])
     for name, settings in wanted["groups"].items():
         if name in groups and groups[name] != settings and any(s.startswith(name + "/") for s in present):
-            raise UserError(f"{root}: {name} scenes were made with grid {groups[name]['grid']}, not "
-                            f"{settings['grid']}: use the same grid or another --out")
+            raise UserError(
+                f"{root}: {name} scenes were made with grid {groups[name]['grid']}, not "
+                f"{settings['grid']}: use the same grid or another --out"
+            )
         groups[name] = settings
     return {**wanted, "groups": groups}
 

@@ -44,24 +44,25 @@ from davis_ag.scene.view_grid import build_view_grid
 CONVENTIONS = {
     "units": {"length": "m", "angle": "deg"},
     "world_frame": "x east, y north, z up; ground at z = 0; single plant at the origin, "
-                   "multi-plant row along x centred on the origin",
+    "multi-plant row along x centred on the origin",
     "pose": "[x, y, z, yaw, pitch]: camera position after slip; yaw counter-clockwise from +x; "
-            "pitch above the horizon (negative looks down)",
+    "pitch above the horizon (negative looks down)",
     "box": "[xmin, ymin, width, height, fruit_id, 0]: inclusive pixel extent, row 0 at the top",
     "segmentation": "uint8 fruit_id per pixel for fruit with a box in the view, 255 elsewhere",
     "grid": "staggered lattice: rows step apart along y, numbered from -y, odd rows shifted half a "
-            "step along +x; positions within the exclusion radius (2-D) of a stem are left out",
+    "step along +x; positions within the exclusion radius (2-D) of a stem are left out",
     "actions_sp": "forward +y, backward -y to the next row at the same column index (half a step "
-                  "sideways on the staggered lattice), right +x, left -x (world-fixed), up/down "
-                  "between altitudes",
+    "sideways on the staggered lattice), right +x, left -x (world-fixed), up/down "
+    "between altitudes",
     "actions_mp": "forward along the lattice axis nearest the heading (a row move zigzags as in SP), "
-                  "backward opposite, left 90 deg counter-clockwise of forward, right clockwise; "
-                  "rotate_ccw +30 deg, rotate_cw -30 deg",
+    "backward opposite, left 90 deg counter-clockwise of forward, right clockwise; "
+    "rotate_ccw +30 deg, rotate_cw -30 deg",
     "visible_fraction": "visible pixels of a fruit over the pixels it would cover with nothing in front",
     "depth": "images/NNNN_depth.png: uint16 millimetres from the camera plane along the optical axis "
-             "(camera-space z), 0 where nothing is hit, 65535 for 65.535 m or more; row 0 at the top",
-    "classes": "images/NNNN_class.png: uint8 organ class per pixel (" + ", ".join(
-        f"{value} {name}" for value, name in enumerate(ORGAN_NAMES)) + "), from the same pass as the ids",
+    "(camera-space z), 0 where nothing is hit, 65535 for 65.535 m or more; row 0 at the top",
+    "classes": "images/NNNN_class.png: uint8 organ class per pixel ("
+    + ", ".join(f"{value} {name}" for value, name in enumerate(ORGAN_NAMES))
+    + "), from the same pass as the ids",
 }
 
 
@@ -115,8 +116,10 @@ class SceneRequest(SceneSettings):
     def __post_init__(self) -> None:
         resolve_appearance(self.appearance)
         if self.appearance != "paper" and self.renderer != "opengl":
-            raise UserError(f"appearance {self.appearance} needs our renderer: drop --renderer {self.renderer} "
-                            "or use --appearance paper")
+            raise UserError(
+                f"appearance {self.appearance} needs our renderer: drop --renderer {self.renderer} "
+                "or use --appearance paper"
+            )
 
     @property
     def seed(self) -> int:
@@ -187,13 +190,21 @@ def grow_scene(request: SceneRequest):
     appearance = draw_appearance(request.appearance, request.seed)
     model = build_scene(request.scenario, request.crop, rng, request.plants, soil_texture=appearance.soil)
     model.lighting = appearance.lighting(model.lighting)
-    grid = build_view_grid(request.scenario, request.crop, plant_centres(request.scenario, request.crop),
-                           model.aim_height, rng)
+    grid = build_view_grid(
+        request.scenario, request.crop, plant_centres(request.scenario, request.crop), model.aim_height, rng
+    )
     return model, grid
 
 
-def draw_scene(request: SceneRequest, model, grid, root: Path, on_view: Callable[[int, int], None] | None = None,
-               grow_s: float = 0.0, views: list | None = None) -> tuple[Path, dict]:
+def draw_scene(
+    request: SceneRequest,
+    model,
+    grid,
+    root: Path,
+    on_view: Callable[[int, int], None] | None = None,
+    grow_s: float = 0.0,
+    views: list | None = None,
+) -> tuple[Path, dict]:
     """Draw, label and write every view of a grown scene, then publish the folder atomically.
 
     Args:
@@ -222,8 +233,9 @@ def draw_scene(request: SceneRequest, model, grid, root: Path, on_view: Callable
     visible: dict[str, dict[str, float]] = {name: record["extras"]["visible"] for name, record in writer.done.items()}
     try:
         look = resolve_look(request.renderer, request.look)
-        with open_renderer(request.renderer, model.context, camera, model.lighting, look,
-                           request.antialiasing) as renderer:
+        with open_renderer(
+            request.renderer, model.context, camera, model.lighting, look, request.antialiasing
+        ) as renderer:
             for done, view in enumerate(viewpoints, 1):
                 if view_name(view.number) in writer.done:
                     if on_view:
@@ -233,21 +245,36 @@ def draw_scene(request: SceneRequest, model, grid, root: Path, on_view: Callable
                 classes = class_of_id[primitive_ids] if class_of_id is not None else None
                 labels = label_view(primitive_ids, lookup, request.min_fruit_pixels)
                 draw_silhouette = getattr(renderer, "silhouette_pixels", None)
-                silhouette = (lambda fruit_id, view=view, draw=draw_silhouette:
-                              draw(view, fruit_id, fruit_uuids[fruit_id])) if draw_silhouette else None
+                silhouette = (
+                    (lambda fruit_id, view=view, draw=draw_silhouette: draw(view, fruit_id, fruit_uuids[fruit_id]))
+                    if draw_silhouette
+                    else None
+                )
                 fractions = visible_fractions(camera, view, labels, polygons, silhouette)
-                entry = AnnotationEntry(bounding_boxes=labels.boxes, pose=[round(v, 5) for v in view.pose],
-                                        **published_pointers(grid, view.index)).to_json()
+                entry = AnnotationEntry(
+                    bounding_boxes=labels.boxes,
+                    pose=[round(v, 5) for v in view.pose],
+                    **published_pointers(grid, view.index),
+                ).to_json()
                 visible[view_name(view.number)] = {str(k): v for k, v in fractions.items()}
-                writer.add_view(view_name(view.number), colour, labels.segmentation, entry,
-                                depth if request.depth else None, {"visible": visible[view_name(view.number)]},
-                                classes=classes)
+                writer.add_view(
+                    view_name(view.number),
+                    colour,
+                    labels.segmentation,
+                    entry,
+                    depth if request.depth else None,
+                    {"visible": visible[view_name(view.number)]},
+                    classes=classes,
+                )
                 if on_view:
                     on_view(done, len(viewpoints))
             writer.wait()  # every image written before the Visualizer's teardown moves the cwd
         drawn = time.perf_counter()
-        timing = {"grow": round(grow_s, 3), "draw_and_label": round(drawn - grown, 3),
-                  "views_from_an_earlier_run": len(writer.done)}
+        timing = {
+            "grow": round(grow_s, 3),
+            "draw_and_label": round(drawn - grown, 3),
+            "views_from_an_earlier_run": len(writer.done),
+        }
         writer.finish(scene_metadata(request, model, grid, visible, timing))
     except Exception:
         writer.abort()  # an error (a full disk, a bug): give the space back; the next run redoes it
@@ -255,8 +282,12 @@ def draw_scene(request: SceneRequest, model, grid, root: Path, on_view: Callable
     except BaseException:
         writer.abort(keep=True)  # a stop (Ctrl-C): the next run resumes from the views written
         raise
-    stats = {"views": len(viewpoints), "grow_s": grow_s, "views_s": drawn - grown,
-             "total_s": grow_s + time.perf_counter() - grown}
+    stats = {
+        "views": len(viewpoints),
+        "grow_s": grow_s,
+        "views_s": drawn - grown,
+        "total_s": grow_s + time.perf_counter() - grown,
+    }
     return scene_dir, stats
 
 
@@ -266,8 +297,17 @@ def resume_key(request: SceneRequest, viewpoints: list) -> dict:
     The request, the views asked for and the code version (a changed generator or renderer may
     draw differently, so its views are not mixed with this one's).
     """
-    return json.loads(json.dumps({"request": asdict(request), "seed": request.seed, "code": code_version(),
-                                  "views": [view_name(view.number) for view in viewpoints]}, default=str))
+    return json.loads(
+        json.dumps(
+            {
+                "request": asdict(request),
+                "seed": request.seed,
+                "code": code_version(),
+                "views": [view_name(view.number) for view in viewpoints],
+            },
+            default=str,
+        )
+    )
 
 
 def scene_metadata(request: SceneRequest, model, grid, visible: dict, timing: dict | None = None) -> SceneFile:
@@ -283,8 +323,12 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict, timing: di
     lighting = model.lighting
     return SceneFile(
         format=SCENE_FORMAT,
-        generator={"name": "davis-ag", "version": code_version(), "pyhelios3d": pyhelios.__version__,
-                   "python": platform.python_version()},
+        generator={
+            "name": "davis-ag",
+            "version": code_version(),
+            "pyhelios3d": pyhelios.__version__,
+            "python": platform.python_version(),
+        },
         seed=request.seed,
         dataset_seed=request.dataset_seed,
         scenario=request.scenario.name,
@@ -293,28 +337,52 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict, timing: di
         plant_generator=model.plant_generator,
         conventions=CONVENTIONS,
         camera=request.camera.intrinsics(),
-        renderer={"name": request.renderer, "look": resolve_look(request.renderer, request.look),
-                  "antialiasing": ANTIALIASING_DESCRIPTIONS[request.antialiasing]
-                  if request.renderer == "opengl" else "Helios Visualizer, 4x multisampled colour"},
-        depth={"file": "images/NNNN_depth.png", "dtype": "uint16", "unit": "mm",
-               "axis": "optical (camera-space z)", "no_hit": 0} if request.depth else None,
+        renderer={
+            "name": request.renderer,
+            "look": resolve_look(request.renderer, request.look),
+            "antialiasing": ANTIALIASING_DESCRIPTIONS[request.antialiasing]
+            if request.renderer == "opengl"
+            else "Helios Visualizer, 4x multisampled colour",
+        },
+        depth={
+            "file": "images/NNNN_depth.png",
+            "dtype": "uint16",
+            "unit": "mm",
+            "axis": "optical (camera-space z)",
+            "no_hit": 0,
+        }
+        if request.depth
+        else None,
         classes={"file": "images/NNNN_class.png", "dtype": "uint8", "table": list(ORGAN_NAMES)}
-        if request.classes else None,
+        if request.classes
+        else None,
         appearance=draw_appearance(request.appearance, request.seed).summary(),
-        lighting={"model": "phong_shadowed", "sun_elevation_deg": lighting.sun_elevation,
-                  "sun_azimuth_deg": lighting.sun_azimuth, "sun_direction": lighting.direction,
-                  "sun_strength": lighting.sun_strength, "exposure": lighting.exposure,
-                  "white_balance": list(lighting.white_balance),
-                  "sky_texture": Path(lighting.sky_texture).name if lighting.sky_texture else None},
-        grid={"extent_m": list(request.scenario.extent), "step_m": request.scenario.step,
-              "altitudes_m": [request.crop.altitudes[i] for i in request.scenario.altitude_levels],
-              "headings": request.scenario.headings, "exclusion_radius_m": request.crop.exclusion_radius,
-              "aim_height_m": model.aim_height, "views": len(grid.viewpoints)},
+        lighting={
+            "model": "phong_shadowed",
+            "sun_elevation_deg": lighting.sun_elevation,
+            "sun_azimuth_deg": lighting.sun_azimuth,
+            "sun_direction": lighting.direction,
+            "sun_strength": lighting.sun_strength,
+            "exposure": lighting.exposure,
+            "white_balance": list(lighting.white_balance),
+            "sky_texture": Path(lighting.sky_texture).name if lighting.sky_texture else None,
+        },
+        grid={
+            "extent_m": list(request.scenario.extent),
+            "step_m": request.scenario.step,
+            "altitudes_m": [request.crop.altitudes[i] for i in request.scenario.altitude_levels],
+            "headings": request.scenario.headings,
+            "exclusion_radius_m": request.crop.exclusion_radius,
+            "aim_height_m": model.aim_height,
+            "views": len(grid.viewpoints),
+        },
         min_fruit_pixels=request.min_fruit_pixels,
         plants=[plant.summary() for plant in model.plants],
         fruits=[fruit.summary() for fruit in model.fruits],
-        views={view_name(v.number): {"grid": [v.ix, v.iy, v.level, v.heading], "nominal": list(v.nominal)}
-               for v in grid.viewpoints},
+        views={
+            view_name(v.number): {"grid": [v.ix, v.iy, v.level, v.heading], "nominal": list(v.nominal)}
+            for v in grid.viewpoints
+        },
         visible_fraction=visible,
         **({"timing_s": timing} if timing is not None else {}),
     )
@@ -322,6 +390,7 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict, timing: di
 
 # ---------------------------------------------------------------------------------------------
 # Output folder checks
+
 
 def check_output_root(root: Path) -> None:
     """Refuse an output folder we could damage or cannot write.
@@ -335,12 +404,18 @@ def check_output_root(root: Path) -> None:
     if root.exists() and not root.is_dir():
         raise UserError(f"{root} is a file, not a folder: choose another --out")
     if root.is_dir():
-        strangers = [p.name for p in root.iterdir()
-                     if p.name not in ROOT_FILES and not p.name.startswith(PROBE_PREFIX)
-                     and not (p.is_dir() and parse_group_name(p.name))]
+        strangers = [
+            p.name
+            for p in root.iterdir()
+            if p.name not in ROOT_FILES
+            and not p.name.startswith(PROBE_PREFIX)
+            and not (p.is_dir() and parse_group_name(p.name))
+        ]
         if strangers:
-            raise UserError(f"{root} holds other things ({', '.join(sorted(strangers)[:3])}): "
-                            "choose an empty or DAVIS-Ag folder for --out")
+            raise UserError(
+                f"{root} holds other things ({', '.join(sorted(strangers)[:3])}): "
+                "choose an empty or DAVIS-Ag folder for --out"
+            )
     prove_writable_folder(root)
 
 
@@ -355,12 +430,15 @@ def check_scene_slot(root: Path, request: SceneRequest) -> bool:
     if scene_dir.exists():
         seed = read_scene_seed(scene_dir)
         if seed != request.seed:
-            raise UserError(f"{scene_dir} already holds a scene made with other settings (seed {seed}, "
-                            f"not {request.seed}): use another --out or --seed, or move it away")
+            raise UserError(
+                f"{scene_dir} already holds a scene made with other settings (seed {seed}, "
+                f"not {request.seed}): use another --out or --seed, or move it away"
+            )
         size = read_scene_size(scene_dir)
         if size is not None and size != (request.camera.width, request.camera.height):
-            raise UserError(f"{scene_dir} was drawn at {size[0]}x{size[1]}, not {request.camera.width}x"
-                            f"{request.camera.height}: use the same --size or another --out")
+            raise UserError(
+                f"{scene_dir} was drawn at {size[0]}x{size[1]}, not {request.camera.width}x"
+                f"{request.camera.height}: use the same --size or another --out"
+            )
         return True
     return False
-

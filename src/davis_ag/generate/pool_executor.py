@@ -39,8 +39,9 @@ def mesa_threads(workers: int) -> int | None:
     return max(1, (os.cpu_count() or 1) // workers)
 
 
-def run_on_pool(todo: Sequence[SceneRequest], root: Path, options: RunOptions, progress: Progress,
-                report: RunReport) -> None:
+def run_on_pool(
+    todo: Sequence[SceneRequest], root: Path, options: RunOptions, progress: Progress, report: RunReport
+) -> None:
     """Scenes on a pool of ``options.workers`` processes, each making whole scenes.
 
     Args:
@@ -61,8 +62,12 @@ def run_on_pool(todo: Sequence[SceneRequest], root: Path, options: RunOptions, p
         started: set[str] = set()
         # A fresh queue per pool: a process killed while writing may leave a queue's lock held.
         events = context.Queue()
-        pool = ProcessPoolExecutor(options.workers, mp_context=context, initializer=_init_worker,
-                                   initargs=(events, mesa_threads(options.workers), os.getpid()))
+        pool = ProcessPoolExecutor(
+            options.workers,
+            mp_context=context,
+            initializer=_init_worker,
+            initargs=(events, mesa_threads(options.workers), os.getpid()),
+        )
         try:
             # A stop mid-spawn would cut a child's start short (its traceback on stderr): it waits
             # until the children are started, then ends them below like any stop.
@@ -84,8 +89,12 @@ def run_on_pool(todo: Sequence[SceneRequest], root: Path, options: RunOptions, p
                             progress.write(f"{request.folder}: its worker process died; trying again")
                             pending.append(request)
                         else:
-                            record_failure(report, progress, request, UserError(
-                                f"its worker process died {options.max_retries + 1} times ({error})"))
+                            record_failure(
+                                report,
+                                progress,
+                                request,
+                                UserError(f"its worker process died {options.max_retries + 1} times ({error})"),
+                            )
                     except Exception as error:
                         record_failure(report, progress, request, error)
                     else:

@@ -76,8 +76,7 @@ def require_ray() -> None:
     except (ImportError, ValueError):  # a broken or shadowed installation
         found = False
     if not found:
-        raise UserError("--executor ray needs Ray: pip install 'davis-ag[ray]' (on every machine of the "
-                        "cluster)")
+        raise UserError("--executor ray needs Ray: pip install 'davis-ag[ray]' (on every machine of the cluster)")
 
 
 def connect(address: str | None):
@@ -92,8 +91,9 @@ def connect(address: str | None):
     try:
         import ray
     except ImportError:
-        raise UserError("--executor ray needs Ray: pip install 'davis-ag[ray]' (on every machine of the "
-                        "cluster)") from None
+        raise UserError(
+            "--executor ray needs Ray: pip install 'davis-ag[ray]' (on every machine of the cluster)"
+        ) from None
     if ray.is_initialized():
         return ray, False
     try:
@@ -101,13 +101,16 @@ def connect(address: str | None):
     except Exception as error:  # ConnectionError, ValueError, RuntimeError depending on the address
         where = address or "a new local instance"
         reason = (str(error).splitlines() or [type(error).__name__])[0].rstrip(".")
-        raise UserError(f"cannot start or reach Ray at {where}: {reason}; "
-                        "start the cluster with `ray start --head` and pass --address auto or ray://HEAD:10001") from None
+        raise UserError(
+            f"cannot start or reach Ray at {where}: {reason}; "
+            "start the cluster with `ray start --head` and pass --address auto or ray://HEAD:10001"
+        ) from None
     return ray, True
 
 
-def run_on_ray(todo: Sequence[SceneRequest], root: Path, options: RunOptions, progress: Progress,
-               report: RunReport) -> None:
+def run_on_ray(
+    todo: Sequence[SceneRequest], root: Path, options: RunOptions, progress: Progress, report: RunReport
+) -> None:
     """Make scenes as Ray tasks; fills ``report.made`` and ``report.failed``.
 
     Args:
@@ -125,14 +128,19 @@ def run_on_ray(todo: Sequence[SceneRequest], root: Path, options: RunOptions, pr
     try:
         biggest = max((node["Resources"].get("CPU", 0) for node in ray.nodes() if node.get("Alive")), default=0)
         if biggest < options.cpus_per_scene:
-            raise UserError(f"no machine of the Ray cluster has {options.cpus_per_scene} CPUs for a scene "
-                            f"(the largest has {biggest:g}): lower --cpus-per-scene")
+            raise UserError(
+                f"no machine of the Ray cluster has {options.cpus_per_scene} CPUs for a scene "
+                f"(the largest has {biggest:g}): lower --cpus-per-scene"
+            )
         box = ray.remote(num_cpus=0)(ProgressBox).remote()
         # Mesa reads LP_NUM_THREADS when the worker process makes its GL context: one rasteriser
         # thread per CPU the task reserved.
         task = ray.remote(ray_scene).options(
-            num_cpus=options.cpus_per_scene, max_retries=options.max_retries, retry_exceptions=False,
-            runtime_env={"env_vars": {"LP_NUM_THREADS": str(options.cpus_per_scene)}})
+            num_cpus=options.cpus_per_scene,
+            max_retries=options.max_retries,
+            retry_exceptions=False,
+            runtime_env={"env_vars": {"LP_NUM_THREADS": str(options.cpus_per_scene)}},
+        )
         refs = {task.remote(request, str(root), box): request for request in todo}
         while refs:
             ready, _ = ray.wait(list(refs), num_returns=len(refs), timeout=0.5, fetch_local=False)
@@ -146,8 +154,12 @@ def run_on_ray(todo: Sequence[SceneRequest], root: Path, options: RunOptions, pr
                     cause = getattr(error, "cause", None)
                     record_failure(report, progress, request, cause if isinstance(cause, Exception) else error)
                 except ray.exceptions.RayError as error:  # its worker or machine died, tries used up
-                    record_failure(report, progress, request, UserError(
-                        f"its Ray worker died {options.max_retries + 1} times ({type(error).__name__})"))
+                    record_failure(
+                        report,
+                        progress,
+                        request,
+                        UserError(f"its Ray worker died {options.max_retries + 1} times ({type(error).__name__})"),
+                    )
                 else:
                     report.made.append(request.folder)
                     report.stats[request.folder] = stats

@@ -128,8 +128,11 @@ class DatasetConfig(SceneSettings):
             UserError: when an ``only`` entry names nothing of this dataset.
         """
         settings = {**self.scene_settings(), "look": resolve_look(self.renderer, self.look)}
-        everything = [SceneRequest(g.scenario, g.crop, i, self.seed, self.camera, **settings)
-                      for g in self.groups for i in g.indices]
+        everything = [
+            SceneRequest(g.scenario, g.crop, i, self.seed, self.camera, **settings)
+            for g in self.groups
+            for i in g.indices
+        ]
         if not only:
             return everything
         wanted: set[str] = set()
@@ -152,10 +155,20 @@ def _normalise_scene_id(text: str) -> str:
     return titled if not index else f"{titled}/{index}"
 
 
-def single_group_config(scenario: str, crop: str, scenes: int, first: int, seed: int,
-                        size: tuple[int, int], renderer: str = DEFAULT_RENDERER, look: str | None = None,
-                        depth: bool = True, antialiasing: str = "fxaa", plants: str = DEFAULT_PLANTS,
-                        appearance: str = "paper") -> DatasetConfig:
+def single_group_config(
+    scenario: str,
+    crop: str,
+    scenes: int,
+    first: int,
+    seed: int,
+    size: tuple[int, int],
+    renderer: str = DEFAULT_RENDERER,
+    look: str | None = None,
+    depth: bool = True,
+    antialiasing: str = "fxaa",
+    plants: str = DEFAULT_PLANTS,
+    appearance: str = "paper",
+) -> DatasetConfig:
     """The dataset the classic flags (--scenario --crop --scenes --first) describe.
 
     Returns:
@@ -171,9 +184,19 @@ def single_group_config(scenario: str, crop: str, scenes: int, first: int, seed:
     check_seed(seed, "--seed")
     size = check_image_size(size, "--size")
     resolve_look(renderer, look)
-    return DatasetConfig("command line", seed, Camera(*size), (group,), "the command line", renderer=renderer,
-                         look=look, depth=depth, antialiasing=antialiasing, plants=check_plants(plants),
-                         appearance=resolve_appearance(appearance))
+    return DatasetConfig(
+        "command line",
+        seed,
+        Camera(*size),
+        (group,),
+        "the command line",
+        renderer=renderer,
+        look=look,
+        depth=depth,
+        antialiasing=antialiasing,
+        plants=check_plants(plants),
+        appearance=resolve_appearance(appearance),
+    )
 
 
 # ---------------------------------------------------------------------------------------------
@@ -214,10 +237,14 @@ def load_dataset_config(name_or_path: str | Path) -> DatasetConfig:
     if path.is_dir():
         raise UserError(f"{path} is a folder: give a YAML file or a preset ({', '.join(presets)})")
     if path.exists():  # a device such as /dev/zero, a pipe or a socket: never read it
-        raise UserError(f"{path} is not a regular file (a device, pipe or socket): give a YAML file or a "
-                        f"preset ({', '.join(presets)})")
-    raise UserError(f"no config file {text_name!r} and no preset of that name: give a YAML file "
-                    f"or one of the presets {', '.join(presets)}")
+        raise UserError(
+            f"{path} is not a regular file (a device, pipe or socket): give a YAML file or a "
+            f"preset ({', '.join(presets)})"
+        )
+    raise UserError(
+        f"no config file {text_name!r} and no preset of that name: give a YAML file "
+        f"or one of the presets {', '.join(presets)}"
+    )
 
 
 def parse_dataset_config(text: str, source: str, default_name: str = "dataset") -> DatasetConfig:
@@ -257,9 +284,19 @@ def parse_dataset_config(text: str, source: str, default_name: str = "dataset") 
         where = f"{source}: groups.{position}.grid" if entry.grid else f"{source}: grid"
         changes = {**(model.grid.changes() if model.grid else {}), **(entry.grid.changes() if entry.grid else {})}
         groups.append(GroupConfig(apply_grid(scenario, changes, where), crop, entry.scenes, entry.first))
-    return DatasetConfig((model.name or default_name).strip(), model.seed, Camera(*model.image_size), tuple(groups),
-                         source, renderer=model.renderer, look=model.look, depth=model.depth,
-                         antialiasing=model.antialiasing, plants=model.plants, appearance=model.appearance)
+    return DatasetConfig(
+        (model.name or default_name).strip(),
+        model.seed,
+        Camera(*model.image_size),
+        tuple(groups),
+        source,
+        renderer=model.renderer,
+        look=model.look,
+        depth=model.depth,
+        antialiasing=model.antialiasing,
+        plants=model.plants,
+        appearance=model.appearance,
+    )
 
 
 def use_strawberry_altitudes(config: DatasetConfig, choice: str) -> DatasetConfig:
@@ -299,9 +336,11 @@ def apply_grid(scenario: ScenarioSpec, changes: dict[str, Any], where: str) -> S
     nx, ny = lattice_shape(changed)  # counted, not built: a tiny step must not fill the memory first
     views = nx * ny * len(changed.altitude_levels) * changed.headings
     if views > MAX_VIEWS_PER_SCENE:
-        raise UserError(f"{where}: step {step} m over {list(extent)} m gives up to {views:,} views a scene, more "
-                        f"than {MAX_VIEWS_PER_SCENE:,} (the paper's largest grid has 2,520): use a larger step "
-                        "or a smaller extent")
+        raise UserError(
+            f"{where}: step {step} m over {list(extent)} m gives up to {views:,} views a scene, more "
+            f"than {MAX_VIEWS_PER_SCENE:,} (the paper's largest grid has 2,520): use a larger step "
+            "or a smaller extent"
+        )
     return changed
 
 
@@ -316,9 +355,12 @@ def grid_settings(scenario: ScenarioSpec, crop: CropSpec | None = None) -> dict[
     Returns:
         The settings.
     """
-    settings = {"extent": list(scenario.extent), "step": scenario.step,
-                "altitude_levels": list(scenario.altitude_levels), "headings": scenario.headings}
+    settings = {
+        "extent": list(scenario.extent),
+        "step": scenario.step,
+        "altitude_levels": list(scenario.altitude_levels),
+        "headings": scenario.headings,
+    }
     if crop is not None:
         settings["altitudes_m"] = [crop.altitudes[i] for i in scenario.altitude_levels]
     return settings
-

@@ -97,8 +97,9 @@ def count_views(scenario: ScenarioSpec, crop: CropSpec) -> int:
     """Views of every scene of a scenario and crop (exclusion uses the nominal grid, not slip)."""
     from davis_ag.scene.specs import plant_centres
 
-    grid = build_view_grid(scenario, crop, plant_centres(scenario, crop), crop.plant_height / 2,
-                           np.random.default_rng(0))
+    grid = build_view_grid(
+        scenario, crop, plant_centres(scenario, crop), crop.plant_height / 2, np.random.default_rng(0)
+    )
     return len(grid.viewpoints)
 
 
@@ -128,11 +129,19 @@ class Progress:
         self._started = self._last_line = time.monotonic()
         self._finished = 0
         disable = None if enabled else True  # None: no bars when stderr is not a terminal
-        self.scenes = tqdm(total=len(todo), desc="scenes", unit="scene", position=0, disable=disable,
-                           dynamic_ncols=True)
+        self.scenes = tqdm(
+            total=len(todo), desc="scenes", unit="scene", position=0, disable=disable, dynamic_ncols=True
+        )
         # The time left comes from this bar: views are the unit of work, scenes vary tenfold.
-        self.views = tqdm(total=total_views, desc="views", unit="view", position=1, disable=disable,
-                          dynamic_ncols=True, smoothing=0.05)
+        self.views = tqdm(
+            total=total_views,
+            desc="views",
+            unit="view",
+            position=1,
+            disable=disable,
+            dynamic_ncols=True,
+            smoothing=0.05,
+        )
         self._counted: dict[str, int] = {}
 
     def event(self, event: tuple) -> None:
@@ -166,8 +175,10 @@ class Progress:
         """A scene is complete."""
         self.scenes.update(1)
         self._finished += 1
-        self.write(f"{request.folder}: {stats['views']} views, grown in {stats['grow_s']:.1f} s, "
-                   f"{stats['views_s'] / max(stats['views'], 1):.3f} s per view")
+        self.write(
+            f"{request.folder}: {stats['views']} views, grown in {stats['grow_s']:.1f} s, "
+            f"{stats['views_s'] / max(stats['views'], 1):.3f} s per view"
+        )
 
     def write(self, line: str, always: bool = False) -> None:
         """A line above the bars (``always``: even when progress is off)."""

@@ -143,8 +143,10 @@ def run_dataset(requests: Sequence[SceneRequest], root: Path, options: RunOption
             first, message = next(iter(report.failed.items()))
             # Exit status 1 when the machine failed every one of them (a full disk), 2 otherwise.
             kind = MachineError if set(report.failed) <= report.machine_failed else UserError
-            raise kind(f"{len(report.failed)} of {len(todo)} scenes failed ({first}: {message}); the others "
-                            "are complete: run the same command again to retry the failed ones")
+            raise kind(
+                f"{len(report.failed)} of {len(todo)} scenes failed ({first}: {message}); the others "
+                "are complete: run the same command again to retry the failed ones"
+            )
         report.splits = write_splits(root, settings["seed"])
     return report
 
@@ -152,9 +154,13 @@ def run_dataset(requests: Sequence[SceneRequest], root: Path, options: RunOption
 def _precheck(root: Path) -> None:
     """Refuse a folder we could damage before creating anything in it; our own temporary files,
     which a killed run may have left, are cleared later under the lock."""
-    if root.is_dir() and not any(p.name not in ROOT_FILES and p.name not in TEMPORARY_FILES
-                                 and not p.name.startswith(PROBE_PREFIX)
-                                 and not (p.is_dir() and parse_group_name(p.name)) for p in root.iterdir()):
+    if root.is_dir() and not any(
+        p.name not in ROOT_FILES
+        and p.name not in TEMPORARY_FILES
+        and not p.name.startswith(PROBE_PREFIX)
+        and not (p.is_dir() and parse_group_name(p.name))
+        for p in root.iterdir()
+    ):
         return
     check_output_root(root)
 
@@ -164,8 +170,9 @@ def _run_here(todo: Sequence[SceneRequest], root: Path, progress: Progress, repo
     for request in todo:
         progress.event(("start", request.folder))
         try:
-            _, stats = generate_scene(request, root, lambda done, total, scene=request.folder:
-                                      progress.event(("view", scene, done, total)))
+            _, stats = generate_scene(
+                request, root, lambda done, total, scene=request.folder: progress.event(("view", scene, done, total))
+            )
         except Exception as error:  # one bad scene must not stop the others
             record_failure(report, progress, request, error)
             continue

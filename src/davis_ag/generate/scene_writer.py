@@ -46,9 +46,9 @@ class SceneWriter:
 
     def __init__(self, scene_dir: Path, resume_key: dict[str, Any] | None = None) -> None:
         """Args:
-            scene_dir: Where the finished scene will be.
-            resume_key: What the scene is made from (JSON-ready); a hidden folder left with the
-                same key is resumed (:attr:`done`), any other is cleared. None: never resume.
+        scene_dir: Where the finished scene will be.
+        resume_key: What the scene is made from (JSON-ready); a hidden folder left with the
+            same key is resumed (:attr:`done`), any other is cleared. None: never resume.
         """
         # Absolute from the start: pyhelios changes the process's working directory while a
         # Visualizer or PlantArchitecture is built or destroyed, and our encoder threads may
@@ -75,9 +75,16 @@ class SceneWriter:
         # Per queued view: its name, its files' futures and its journal record.
         self._pending: list[tuple[str, list[Future], dict[str, Any]]] = []
 
-    def add_view(self, name: str, colour: np.ndarray, segmentation: np.ndarray, entry: dict,
-                 depth: np.ndarray | None = None, extras: dict[str, Any] | None = None,
-                 classes: np.ndarray | None = None) -> None:
+    def add_view(
+        self,
+        name: str,
+        colour: np.ndarray,
+        segmentation: np.ndarray,
+        entry: dict,
+        depth: np.ndarray | None = None,
+        extras: dict[str, Any] | None = None,
+        classes: np.ndarray | None = None,
+    ) -> None:
         """Queue one view's image, segmentation, depth, organ classes and annotations entry.
 
         Args:
@@ -92,16 +99,28 @@ class SceneWriter:
             classes: (height, width) uint8 organ classes, written as ``NNNN_class.png`` unless None.
         """
         images = self.tmp_dir / IMAGES
-        files = [self._pool.submit(write_view_files, images, name, colour=colour),
-                 self._pool.submit(write_view_files, images, name, segmentation=segmentation)]
+        files = [
+            self._pool.submit(write_view_files, images, name, colour=colour),
+            self._pool.submit(write_view_files, images, name, segmentation=segmentation),
+        ]
         if depth is not None:
             files.append(self._pool.submit(write_view_files, images, name, depth=depth))
         if classes is not None:
             files.append(self._pool.submit(write_view_files, images, name, classes=classes))
-        self._pending.append((name, files, {"name": name, "entry": entry, "extras": extras or {},
-                                            "files": [name, view_file_name(name, "mask")]
-                                            + ([view_file_name(name, "depth")] if depth is not None else [])
-                                            + ([view_file_name(name, "classes")] if classes is not None else [])}))
+        self._pending.append(
+            (
+                name,
+                files,
+                {
+                    "name": name,
+                    "entry": entry,
+                    "extras": extras or {},
+                    "files": [name, view_file_name(name, "mask")]
+                    + ([view_file_name(name, "depth")] if depth is not None else [])
+                    + ([view_file_name(name, "classes")] if classes is not None else []),
+                },
+            )
+        )
         self.annotations[name] = entry
         if len(self._pending) > 8:
             self._drain(keep=4)

@@ -106,17 +106,22 @@ def silhouette_pixels(camera: Camera, view: Viewpoint, polygons: list[np.ndarray
     px = lo[which, 0] + offset % spans[which, 0]
     py = lo[which, 1] + offset // spans[which, 0]
     corners = tri[which]
-    sides = np.stack([
-        (corners[:, j, 0] - corners[:, i, 0]) * (py - corners[:, i, 1])
-        - (corners[:, j, 1] - corners[:, i, 1]) * (px - corners[:, i, 0])
-        for i, j in ((0, 1), (1, 2), (2, 0))
-    ])
+    sides = np.stack(
+        [
+            (corners[:, j, 0] - corners[:, i, 0]) * (py - corners[:, i, 1])
+            - (corners[:, j, 1] - corners[:, i, 1]) * (px - corners[:, i, 0])
+            for i, j in ((0, 1), (1, 2), (2, 0))
+        ]
+    )
     inside = ((sides >= 0).all(axis=0) | (sides <= 0).all(axis=0)) & sides.any(axis=0)
     return int(len(np.unique(py[inside] * camera.width + px[inside])))
 
 
 def visible_fractions(
-    camera: Camera, view: Viewpoint, labels: ViewLabels, fruit_polygons: dict[int, list[np.ndarray]],
+    camera: Camera,
+    view: Viewpoint,
+    labels: ViewLabels,
+    fruit_polygons: dict[int, list[np.ndarray]],
     silhouette=None,
 ) -> dict[int, float]:
     """Visible pixels over unoccluded pixels for every boxed fruit, rounded to 4 digits.

@@ -42,9 +42,9 @@ class RandomAxes(SeededPolicy):
 
     def __init__(self, name: str, axes: tuple[int, ...] | None, seed: int | None = None) -> None:
         """Args:
-            name: Label in results tables.
-            axes: Action components to draw (uniform in [-1, 1]); the rest stay 0. None: all.
-            seed: Seed of the agent's generator until :meth:`reset` gets one.
+        name: Label in results tables.
+        axes: Action components to draw (uniform in [-1, 1]); the rest stay 0. None: all.
+        seed: Seed of the agent's generator until :meth:`reset` gets one.
         """
         super().__init__(seed)
         self.name, self.axes = name, axes
@@ -69,8 +69,8 @@ class Greedy(SeededPolicy):
 
     def __init__(self, candidates: int = 8, seed: int | None = None) -> None:
         """Args:
-            candidates: Actions tried per step (one render each).
-            seed: Seed of the candidate draw.
+        candidates: Actions tried per step (one render each).
+        seed: Seed of the candidate draw.
         """
         super().__init__(seed)
         self.name, self.candidates = "Greedy", int(candidates)
@@ -98,7 +98,8 @@ class Greedy(SeededPolicy):
 #: :func:`davis_ag.benchmark.policies.policy_from_spec`), and what makes each.
 BASELINES: dict[str, Any] = {
     **{name: (lambda name=name, axes=axes: RandomAxes(name, axes)) for name, axes in HEURISTIC_AXES.items()},
-    "Greedy": Greedy}
+    "Greedy": Greedy,
+}
 POLICY_NAMES: tuple[str, ...] = tuple(BASELINES)
 
 

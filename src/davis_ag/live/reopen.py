@@ -71,10 +71,17 @@ class SceneSettings:
     def cache_key(self) -> str:
         """Digest of everything that shapes the grown geometry and the grid."""
         meta = self.metadata
-        keyed = {"version": CACHE_VERSION, "seed": self.seed, "dataset_seed": self.dataset_seed,
-                 "scenario": meta.scenario, "crop": meta.crop, "scene": meta.scene,
-                 "grid": meta.grid.as_written() if meta.grid else None,
-                 "generator": meta.generator.as_written() if meta.generator else None, "plants": self.plants}
+        keyed = {
+            "version": CACHE_VERSION,
+            "seed": self.seed,
+            "dataset_seed": self.dataset_seed,
+            "scenario": meta.scenario,
+            "crop": meta.crop,
+            "scene": meta.scene,
+            "grid": meta.grid.as_written() if meta.grid else None,
+            "generator": meta.generator.as_written() if meta.generator else None,
+            "plants": self.plants,
+        }
         return hashlib.sha256(json.dumps(keyed, sort_keys=True).encode()).hexdigest()[:20]
 
 
@@ -110,24 +117,40 @@ def read_settings(scene_dir: str | Path) -> SceneSettings:
         raise UserError(f"{path}: missing; only scenes made by `davis-ag generate` can be reopened live")
     metadata = read_scene_file(path)
     if not metadata.ours:
-        raise UserError(f"{path}: not a scene.json written by `davis-ag generate` ({SCENE_FORMAT}); "
-                        "only our own scenes can be regrown")
+        raise UserError(
+            f"{path}: not a scene.json written by `davis-ag generate` ({SCENE_FORMAT}); "
+            "only our own scenes can be regrown"
+        )
     try:
         grid, renderer = _needed(metadata.grid, "grid"), _needed(metadata.renderer, "renderer")
         crop = crop_spec(_needed(metadata.crop, "crop"))
         levels = tuple(crop.altitudes.index(a) for a in _needed(grid.altitudes_m, "grid.altitudes_m"))
-        scenario = replace(scenario_spec(_needed(metadata.scenario, "scenario"), crop),
-                           extent=tuple(_needed(grid.extent_m, "grid.extent_m")),
-                           step=float(_needed(grid.step_m, "grid.step_m")), altitude_levels=levels)
+        scenario = replace(
+            scenario_spec(_needed(metadata.scenario, "scenario"), crop),
+            extent=tuple(_needed(grid.extent_m, "grid.extent_m")),
+            step=float(_needed(grid.step_m, "grid.step_m")),
+            altitude_levels=levels,
+        )
         width, height = _needed(metadata.image_size(), "camera.width and height")
         camera = Camera(width, height, float(_needed(metadata.camera.vfov_deg, "camera.vfov_deg")))  # type: ignore[union-attr]
-        settings = SceneSettings(folder, metadata, scenario, crop, _needed(metadata.index, "scene"),
-                                 _needed(metadata.seed, "seed"), _needed(metadata.dataset_seed, "dataset_seed"),
-                                 camera, str(renderer.name), str(renderer.look), antialiasing_of(renderer),
-                                 check_plants(metadata.plant_generator or "architecture"))
+        settings = SceneSettings(
+            folder,
+            metadata,
+            scenario,
+            crop,
+            _needed(metadata.index, "scene"),
+            _needed(metadata.seed, "seed"),
+            _needed(metadata.dataset_seed, "dataset_seed"),
+            camera,
+            str(renderer.name),
+            str(renderer.look),
+            antialiasing_of(renderer),
+            check_plants(metadata.plant_generator or "architecture"),
+        )
     except (ValueError, TypeError, UserError) as error:
-        raise UserError(f"{path}: lacks or mangles a setting needed to regrow the scene ({error}); "
-                        "generate the scene again") from None
+        raise UserError(
+            f"{path}: lacks or mangles a setting needed to regrow the scene ({error}); generate the scene again"
+        ) from None
     return settings
 
 
@@ -168,7 +191,7 @@ def _portable(path: str, root: Path | None) -> str:
 
 def _resolve(path: str, root: Path | None) -> str:
     if path.startswith("pyhelios:") and root is not None:
-        return str(root / path[len("pyhelios:"):])
+        return str(root / path[len("pyhelios:") :])
     return path
 
 
@@ -181,21 +204,34 @@ def regrow(settings: SceneSettings) -> SceneAssets:
     """
     from davis_ag.generate.one_scene import SceneRequest, grow_scene
 
-    request = SceneRequest(settings.scenario, settings.crop, settings.index, settings.dataset_seed,
-                           settings.camera, renderer=settings.renderer, look=settings.look, plants=settings.plants)
+    request = SceneRequest(
+        settings.scenario,
+        settings.crop,
+        settings.index,
+        settings.dataset_seed,
+        settings.camera,
+        renderer=settings.renderer,
+        look=settings.look,
+        plants=settings.plants,
+    )
     if request.seed != settings.seed:
-        raise UserError(f"{settings.folder}/scene.json: seed {settings.seed} does not follow from dataset seed "
-                        f"{settings.dataset_seed} and scene {settings.metadata.scene}; the file was edited")
+        raise UserError(
+            f"{settings.folder}/scene.json: seed {settings.seed} does not follow from dataset seed "
+            f"{settings.dataset_seed} and scene {settings.metadata.scene}; the file was edited"
+        )
     model, grid = grow_scene(request)
     stored = settings.metadata
     generator = stored.generator or GeneratorRecord()
     version = f"pyhelios3d {generator.pyhelios3d}, davis-ag {generator.version}"
     regrown_fruit = json.loads(json.dumps([f.summary() for f in model.fruits]))
     regrown_plants = json.loads(json.dumps([p.summary() for p in model.plants]))
-    if regrown_fruit != [f.as_written() for f in stored.fruits] \
-            or regrown_plants != [p.as_written() for p in stored.plants]:
-        raise UserError(f"{settings.folder}: regrowing from the seed gave other plants than scene.json records "
-                        f"(made with {version}); reopen it with those versions")
+    if regrown_fruit != [f.as_written() for f in stored.fruits] or regrown_plants != [
+        p.as_written() for p in stored.plants
+    ]:
+        raise UserError(
+            f"{settings.folder}: regrowing from the seed gave other plants than scene.json records "
+            f"(made with {version}); reopen it with those versions"
+        )
     check_grid(settings, list(grid.viewpoints))
     return assets_from_model(model, grid)
 
@@ -204,9 +240,15 @@ def assets_from_model(model, grid) -> SceneAssets:
     """A grown scene's drawable content (:func:`davis_ag.generate.one_scene.grow_scene`'s output)."""
     from davis_ag.render.scene_geometry import read_scene_geometry
 
-    return SceneAssets(read_scene_geometry(model.context), {f.id: np.asarray(f.uuids, dtype=np.int64)
-                                                            for f in model.fruits},
-                       model.uuid_count, model.lighting, float(model.aim_height), list(grid.viewpoints), False)
+    return SceneAssets(
+        read_scene_geometry(model.context),
+        {f.id: np.asarray(f.uuids, dtype=np.int64) for f in model.fruits},
+        model.uuid_count,
+        model.lighting,
+        float(model.aim_height),
+        list(grid.viewpoints),
+        False,
+    )
 
 
 def check_grid(settings: SceneSettings, views: list[Viewpoint]) -> None:
@@ -219,8 +261,10 @@ def check_grid(settings: SceneSettings, views: list[Viewpoint]) -> None:
     poses = {view_name(v.number): [round(x, 5) for x in v.pose] for v in views}
     for name, entry in annotations.items():
         if poses.get(name) != entry.get("pose"):
-            raise UserError(f"{path}: view {name} has pose {entry.get('pose')}, the regrown grid "
-                            f"{poses.get(name)}; the scene cannot be reopened as it was drawn")
+            raise UserError(
+                f"{path}: view {name} has pose {entry.get('pose')}, the regrown grid "
+                f"{poses.get(name)}; the scene cannot be reopened as it was drawn"
+            )
 
 
 def save_cache(path: Path, key: str, assets: SceneAssets) -> None:
@@ -232,16 +276,20 @@ def save_cache(path: Path, key: str, assets: SceneAssets) -> None:
     views = assets.grid_views
     arrays = {name: getattr(geometry, name) for name in _GEOMETRY_FIELDS}
     arrays.update(
-        key=np.array(key), texture_files=np.array([_portable(f, root) for f in geometry.texture_files], dtype=str),
-        fruit_ids=np.array(fruit_ids, dtype=np.int64), fruit_offsets=np.cumsum([0] + [len(u) for u in uuids]),
+        key=np.array(key),
+        texture_files=np.array([_portable(f, root) for f in geometry.texture_files], dtype=str),
+        fruit_ids=np.array(fruit_ids, dtype=np.int64),
+        fruit_offsets=np.cumsum([0] + [len(u) for u in uuids]),
         fruit_uuids=np.concatenate(uuids + [np.zeros(0, np.int64)]).astype(np.int64),
-        uuid_count=np.array(assets.uuid_count), aim_height=np.array(assets.aim_height),
+        uuid_count=np.array(assets.uuid_count),
+        aim_height=np.array(assets.aim_height),
         sun=np.array([assets.lighting.sun_elevation, assets.lighting.sun_azimuth]),
         sky=np.array(assets.lighting.sky_texture or ""),
         view_grid=np.array([[v.ix, v.iy, v.level, v.heading] for v in views], dtype=np.int64).reshape(-1, 4),
         view_nominal=np.array([v.nominal for v in views], dtype=np.float64).reshape(-1, 3),
         view_position=np.array([v.position for v in views], dtype=np.float64).reshape(-1, 3),
-        view_angles=np.array([(v.yaw, v.pitch) for v in views], dtype=np.float64).reshape(-1, 2))
+        view_angles=np.array([(v.yaw, v.pitch) for v in views], dtype=np.float64).reshape(-1, 2),
+    )
     with atomic_output(path) as handle:
         np.savez(handle, **arrays)
 
@@ -260,16 +308,35 @@ def load_cache(path: Path, key: str) -> SceneAssets | None:
                 return None
             geometry = SceneGeometry(**{name: data[name] for name in _GEOMETRY_FIELDS}, texture_files=files)
             offsets = data["fruit_offsets"]
-            fruit_uuids = {int(f): data["fruit_uuids"][offsets[k]:offsets[k + 1]]
-                           for k, f in enumerate(data["fruit_ids"])}
+            fruit_uuids = {
+                int(f): data["fruit_uuids"][offsets[k] : offsets[k + 1]] for k, f in enumerate(data["fruit_ids"])
+            }
             sun = data["sun"]
-            views = [Viewpoint(k, int(g[0]), int(g[1]), int(g[2]), int(g[3]), tuple(map(float, n)),
-                               tuple(map(float, p)), float(a[0]), float(a[1]))
-                     for k, (g, n, p, a) in enumerate(zip(data["view_grid"], data["view_nominal"],
-                                                          data["view_position"], data["view_angles"]))]
-            return SceneAssets(geometry, fruit_uuids, int(data["uuid_count"]),
-                               Lighting(float(sun[0]), float(sun[1]), str(data["sky"]) or None),
-                               float(data["aim_height"]), views, True)
+            views = [
+                Viewpoint(
+                    k,
+                    int(g[0]),
+                    int(g[1]),
+                    int(g[2]),
+                    int(g[3]),
+                    tuple(map(float, n)),
+                    tuple(map(float, p)),
+                    float(a[0]),
+                    float(a[1]),
+                )
+                for k, (g, n, p, a) in enumerate(
+                    zip(data["view_grid"], data["view_nominal"], data["view_position"], data["view_angles"])
+                )
+            ]
+            return SceneAssets(
+                geometry,
+                fruit_uuids,
+                int(data["uuid_count"]),
+                Lighting(float(sun[0]), float(sun[1]), str(data["sky"]) or None),
+                float(data["aim_height"]),
+                views,
+                True,
+            )
     except (OSError, ValueError, KeyError, IndexError, TypeError):
         return None
 
@@ -291,6 +358,9 @@ def reopen_assets(settings: SceneSettings, use_cache: bool = True) -> SceneAsset
     try:
         save_cache(path, key, assets)
     except OSError as error:
-        print(f"davis-ag: cannot cache the scene's geometry in {path} ({error.strerror or error}); "
-              "the next reopening will grow it again", file=sys.stderr)
+        print(
+            f"davis-ag: cannot cache the scene's geometry in {path} ({error.strerror or error}); "
+            "the next reopening will grow it again",
+            file=sys.stderr,
+        )
     return assets

@@ -67,8 +67,10 @@ def exposure_rates(labels_boxes: list[list[int]], visible_pixels: dict[int, int]
 
 def min_pixels_for(settings: SceneSettings, width: int, height: int) -> int:
     """The box threshold at an image size: scene.json's at its own size, else the crop's scaled."""
-    if (width, height) == (settings.camera.width, settings.camera.height) \
-            and settings.metadata.min_fruit_pixels is not None:
+    if (width, height) == (
+        settings.camera.width,
+        settings.camera.height,
+    ) and settings.metadata.min_fruit_pixels is not None:
         return settings.metadata.min_fruit_pixels
     return settings.crop.min_fruit_pixels_at(width, height)
 
@@ -86,14 +88,18 @@ def merge_ground(geometry):
     from davis_ag.render.scene_geometry import SceneGeometry
 
     ground = ~geometry.caster
-    if ground.sum() <= 2 or len(np.unique(geometry.texture[ground])) != 1 \
-            or len(np.unique(geometry.colours[ground], axis=0)) != 1:
+    if (
+        ground.sum() <= 2
+        or len(np.unique(geometry.texture[ground])) != 1
+        or len(np.unique(geometry.colours[ground], axis=0)) != 1
+    ):
         return geometry
     first = int(np.flatnonzero(ground)[0])
     lo = geometry.positions[ground].reshape(-1, 3).min(axis=0)
     hi = geometry.positions[ground].reshape(-1, 3).max(axis=0)
-    corners = np.array([[lo[0], lo[1], 0.0], [hi[0], lo[1], 0.0], [hi[0], hi[1], 0.0], [lo[0], hi[1], 0.0]],
-                       dtype=np.float32)
+    corners = np.array(
+        [[lo[0], lo[1], 0.0], [hi[0], lo[1], 0.0], [hi[0], hi[1], 0.0], [lo[0], hi[1], 0.0]], dtype=np.float32
+    )
     quad = corners[[[0, 1, 2], [0, 2, 3]]]
     keep = np.flatnonzero(~ground)
     pick = np.concatenate([keep, [first, first]])
@@ -105,10 +111,17 @@ def merge_ground(geometry):
         return out
 
     return SceneGeometry(
-        positions=merged(geometry.positions, quad), uvs=merged(geometry.uvs, np.zeros((2, 3, 2), np.float32)),
-        normals=merged(geometry.normals, np.tile(np.float32([0, 0, 1]), (2, 3, 1))), uuids=merged(geometry.uuids),
-        colours=merged(geometry.colours), texture=merged(geometry.texture), mode=merged(geometry.mode),
-        caster=merged(geometry.caster), patch=merged(geometry.patch), texture_files=list(geometry.texture_files))
+        positions=merged(geometry.positions, quad),
+        uvs=merged(geometry.uvs, np.zeros((2, 3, 2), np.float32)),
+        normals=merged(geometry.normals, np.tile(np.float32([0, 0, 1]), (2, 3, 1))),
+        uuids=merged(geometry.uuids),
+        colours=merged(geometry.colours),
+        texture=merged(geometry.texture),
+        mode=merged(geometry.mode),
+        caster=merged(geometry.caster),
+        patch=merged(geometry.patch),
+        texture_files=list(geometry.texture_files),
+    )
 
 
 class LiveScene:
@@ -116,8 +129,8 @@ class LiveScene:
 
     def __init__(self, settings: SceneSettings, assets: SceneAssets) -> None:
         """Args:
-            settings: The scene's scene.json settings.
-            assets: Its geometry, fruit and grid (:func:`davis_ag.live.reopen.reopen_assets`).
+        settings: The scene's scene.json settings.
+        assets: Its geometry, fruit and grid (:func:`davis_ag.live.reopen.reopen_assets`).
         """
         self.settings, self.assets = settings, assets
         self.lookup = fruit_lookup(assets.fruit_uuids, assets.uuid_count)
@@ -142,8 +155,7 @@ class LiveScene:
         position = (float(x), float(y), float(z))
         return Viewpoint(-1, 0, 0, 0, 0, position, position, float(yaw), float(pitch))
 
-    def aimed_pose(self, x: float, y: float, z: float,
-                   target: tuple[float, float, float] | None = None) -> Viewpoint:
+    def aimed_pose(self, x: float, y: float, z: float, target: tuple[float, float, float] | None = None) -> Viewpoint:
         """A pose at (x, y, z) looking at ``target`` (default the plant, as single-plant views do)."""
         tx, ty, tz = target if target is not None else self.aim_point
         dx, dy, dz = tx - x, ty - y, tz - z
@@ -164,8 +176,14 @@ class LiveScene:
 
     # ------------------------------------------------------------------------------ drawing
 
-    def renderer(self, width: int, height: int, vfov: float | None = None, antialiasing: str | None = None,
-                 fast_ground: bool = False):
+    def renderer(
+        self,
+        width: int,
+        height: int,
+        vfov: float | None = None,
+        antialiasing: str | None = None,
+        fast_ground: bool = False,
+    ):
         """The renderer for an image size (made once, kept until :meth:`close`); ``fast_ground``
         draws the soil as one quad (:func:`merge_ground`)."""
         from davis_ag.render.backends import resolve_antialiasing
@@ -180,13 +198,22 @@ class LiveScene:
             geometry = self.assets.geometry
             if fast_ground and settings.look == "default":
                 geometry = merge_ground(geometry)
-            self._renderers[key] = OpenGLRenderer(geometry, camera, self.assets.lighting,
-                                                  look=settings.look, antialiasing=aa)
+            self._renderers[key] = OpenGLRenderer(
+                geometry, camera, self.assets.lighting, look=settings.look, antialiasing=aa
+            )
         return self._renderers[key]
 
-    def render(self, view: Viewpoint, width: int | None = None, height: int | None = None,
-               vfov: float | None = None, antialiasing: str | None = None, fractions: bool = True,
-               fast_ground: bool = False, depth: bool = True) -> LiveView:
+    def render(
+        self,
+        view: Viewpoint,
+        width: int | None = None,
+        height: int | None = None,
+        vfov: float | None = None,
+        antialiasing: str | None = None,
+        fractions: bool = True,
+        fast_ground: bool = False,
+        depth: bool = True,
+    ) -> LiveView:
         """Draw and label one pose.
 
         Args:
@@ -211,10 +238,19 @@ class LiveScene:
         visible = None
         if fractions:
             uuids = self.assets.fruit_uuids
-            visible = visible_fractions(renderer.camera, view, labels, {},
-                                        lambda fruit: renderer.silhouette_pixels(view, fruit, uuids[fruit]))
-        return LiveView([*view.position, view.yaw, view.pitch], colour, labels.segmentation, labels.boxes,
-                        labels.visible_pixels, exposure_rates(labels.boxes, labels.visible_pixels), visible, depth_image)
+            visible = visible_fractions(
+                renderer.camera, view, labels, {}, lambda fruit: renderer.silhouette_pixels(view, fruit, uuids[fruit])
+            )
+        return LiveView(
+            [*view.position, view.yaw, view.pitch],
+            colour,
+            labels.segmentation,
+            labels.boxes,
+            labels.visible_pixels,
+            exposure_rates(labels.boxes, labels.visible_pixels),
+            visible,
+            depth_image,
+        )
 
     def close(self) -> None:
         """Release every renderer."""

@@ -27,7 +27,7 @@ class EpisodeLog(gym.Wrapper):
 
     def __init__(self, env: gym.Env) -> None:
         """Args:
-            env: A TVMContinuous-v0 environment (its info carries ``oer_0`` and ``oer_t``).
+        env: A TVMContinuous-v0 environment (its info carries ``oer_0`` and ``oer_t``).
         """
         super().__init__(env)
         self.records: list[dict] = []
@@ -40,8 +40,14 @@ class EpisodeLog(gym.Wrapper):
         self._steps += 1
         self._reward += float(reward)
         if terminated or truncated:
-            self.records.append({"timestep": self._steps, "reward": self._reward,
-                                 "oer_0": float(info["oer_0"]), "oer_tau": float(info["oer_t"])})
+            self.records.append(
+                {
+                    "timestep": self._steps,
+                    "reward": self._reward,
+                    "oer_0": float(info["oer_0"]),
+                    "oer_tau": float(info["oer_t"]),
+                }
+            )
             self._reward = 0.0
         return obs, reward, terminated, truncated, info
 
@@ -67,17 +73,29 @@ def _progress_printer(log: EpisodeLog, total: int, every: int):
         def _on_step(self) -> bool:
             if self.num_timesteps % every == 0 or self.num_timesteps == total:
                 recent = [r["reward"] for r in log.records[-100:]]
-                print(f"PPO: {self.num_timesteps:,}/{total:,} steps, {len(log.records):,} episodes, mean reward "
-                      f"of the last {len(recent)}: {np.mean(recent) if recent else 0.0:.4f}", flush=True)
+                print(
+                    f"PPO: {self.num_timesteps:,}/{total:,} steps, {len(log.records):,} episodes, mean reward "
+                    f"of the last {len(recent)}: {np.mean(recent) if recent else 0.0:.4f}",
+                    flush=True,
+                )
             return True
 
     return Progress()
 
 
-def train_continuous(dataset: Any, scenario: str = "sp", total_timesteps: int = 10_000, seed: int = 0,
-                     out_path: str | os.PathLike[str] = "ppo.zip", arch: str = "paper", n_steps: int = 128,
-                     batch_size: int = 32, verbose: int = 0, progress_every: int = 0,
-                     **env_kwargs: Any) -> tuple[Path, list[dict]]:
+def train_continuous(
+    dataset: Any,
+    scenario: str = "sp",
+    total_timesteps: int = 10_000,
+    seed: int = 0,
+    out_path: str | os.PathLike[str] = "ppo.zip",
+    arch: str = "paper",
+    n_steps: int = 128,
+    batch_size: int = 32,
+    verbose: int = 0,
+    progress_every: int = 0,
+    **env_kwargs: Any,
+) -> tuple[Path, list[dict]]:
     """Train PPO on the train split (or one scene folder) and save it.
 
     Args:
@@ -109,10 +127,20 @@ def train_continuous(dataset: Any, scenario: str = "sp", total_timesteps: int = 
     prove_writable_file(final)
     env, log = make_logged_env(dataset, scenario, seed, **env_kwargs)
     try:
-        model = PPO("CnnPolicy", env, n_steps=n_steps, batch_size=batch_size, seed=seed, device="cpu",
-                    verbose=verbose, policy_kwargs=dict(ARCHITECTURES[arch]))
-        model.learn(total_timesteps=total_timesteps,
-                    callback=_progress_printer(log, total_timesteps, progress_every) if progress_every else None)
+        model = PPO(
+            "CnnPolicy",
+            env,
+            n_steps=n_steps,
+            batch_size=batch_size,
+            seed=seed,
+            device="cpu",
+            verbose=verbose,
+            policy_kwargs=dict(ARCHITECTURES[arch]),
+        )
+        model.learn(
+            total_timesteps=total_timesteps,
+            callback=_progress_printer(log, total_timesteps, progress_every) if progress_every else None,
+        )
     finally:
         env.close()
     records = list(log.records)

@@ -58,8 +58,15 @@ START_TRIES = 200
 PITCH_RANGE = (-85.0, 45.0)
 #: The grid's move names as (action component, sign) (:meth:`TVMContinuousEnv.action_for`).
 NAMED_MOVES: dict[str, tuple[int, float]] = {
-    "left": (0, -1.0), "right": (0, 1.0), "backward": (1, -1.0), "forward": (1, 1.0),
-    "down": (2, -1.0), "up": (2, 1.0), "rotate_ccw": (3, 1.0), "rotate_cw": (3, -1.0)}
+    "left": (0, -1.0),
+    "right": (0, 1.0),
+    "backward": (1, -1.0),
+    "forward": (1, 1.0),
+    "down": (2, -1.0),
+    "up": (2, 1.0),
+    "rotate_ccw": (3, 1.0),
+    "rotate_cw": (3, -1.0),
+}
 
 
 def scene_folders(source: str | os.PathLike[str], scenario: str, split: str, crop: str | None) -> list[Path]:
@@ -79,11 +86,22 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 2}
 
-    def __init__(self, dataset: str | os.PathLike[str], scenario: str = "sp", split: str = "train",
-                 crop: str | None = None, aim: str | None = None, tau: int | None = None,
-                 max_move: float | None = None, max_climb: float | None = None, max_turn: float = 30.0,
-                 max_start_oer: float = MAX_START_OER, size: int = OBS_SIZE, antialiasing: str = "none",
-                 render_mode: str | None = None) -> None:
+    def __init__(
+        self,
+        dataset: str | os.PathLike[str],
+        scenario: str = "sp",
+        split: str = "train",
+        crop: str | None = None,
+        aim: str | None = None,
+        tau: int | None = None,
+        max_move: float | None = None,
+        max_climb: float | None = None,
+        max_turn: float = 30.0,
+        max_start_oer: float = MAX_START_OER,
+        size: int = OBS_SIZE,
+        antialiasing: str = "none",
+        render_mode: str | None = None,
+    ) -> None:
         """Open (regrow or load) the scenes.
 
         Args:
@@ -129,8 +147,10 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
             for folder in folders:
                 scene = open_live_scene(folder)
                 if scene.settings.scenario.name != spec.name:
-                    raise UserError(f"{folder} is a {scene.settings.scenario.name} scene, not {spec.name}: "
-                                    f"pass scenario={scene.settings.scenario.name!r}")
+                    raise UserError(
+                        f"{folder} is a {scene.settings.scenario.name} scene, not {spec.name}: "
+                        f"pass scenario={scene.settings.scenario.name!r}"
+                    )
                 self.scenes.append(scene)
         except BaseException:
             self.close()
@@ -168,8 +188,10 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         settings = (scene or self.scene).settings
         ex, ey = settings.scenario.extent
         altitudes = [settings.crop.altitudes[i] for i in settings.scenario.altitude_levels]
-        return (np.array([-ex / 2, -ey / 2, min(altitudes)]),
-                np.array([ex / 2 + settings.scenario.step / 2, ey / 2, max(altitudes)]))
+        return (
+            np.array([-ex / 2, -ey / 2, min(altitudes)]),
+            np.array([ex / 2 + settings.scenario.step / 2, ey / 2, max(altitudes)]),
+        )
 
     def blocked(self, start: np.ndarray, end: np.ndarray) -> str:
         """Why a straight move from ``start`` to ``end`` is not allowed ("" when it is)."""
@@ -193,13 +215,15 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
     def _draw(self, view: Viewpoint) -> LiveView:
         self.draws += 1
         # No depth: the task never looks at it, and leaving it out makes each draw cheaper.
-        return self.scene.render(view, self.size, self.size, antialiasing=self.antialiasing, fractions=False,
-                                 fast_ground=True, depth=False)
+        return self.scene.render(
+            view, self.size, self.size, antialiasing=self.antialiasing, fractions=False, fast_ground=True, depth=False
+        )
 
     # ----------------------------------------------------------------------------- episode
 
-    def reset(self, *, seed: int | None = None,
-              options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
         """Start an episode.
 
         Args:
@@ -215,8 +239,9 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         if options and "pose" in options:
             self._scene = int(options.get("scene", 0))
             if not 0 <= self._scene < len(self.scenes) or len(options["pose"]) != 5:
-                raise UserError(f"start {options}: give a scene index below {len(self.scenes)} and a pose "
-                                "[x, y, z, yaw, pitch]")
+                raise UserError(
+                    f"start {options}: give a scene index below {len(self.scenes)} and a pose [x, y, z, yaw, pitch]"
+                )
             x, y, z, yaw, pitch = (float(v) for v in options["pose"])
             self._view = self._pose(np.array([x, y, z]), yaw, pitch)
             self._labels = self._draw(self._view)
@@ -252,8 +277,10 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
                 self._view, self._labels = view, labels
                 self._target = int(eligible[int(rng.integers(len(eligible)))])
                 return
-        raise UserError(f"{self.scene.settings.folder}: no start pose with a fruit of OER < {self.max_start_oer} "
-                        f"in {START_TRIES} tries; use another scene or a higher max_start_oer")
+        raise UserError(
+            f"{self.scene.settings.folder}: no start pose with a fruit of OER < {self.max_start_oer} "
+            f"in {START_TRIES} tries; use another scene or a higher max_start_oer"
+        )
 
     def action_for(self, name: str) -> np.ndarray:
         """A grid move's name as a full unit move along its axis (a policy may answer with names):
@@ -270,24 +297,32 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         axis, sign = NAMED_MOVES.get(name, (size, 0.0))
         if axis >= size:
             names = [n for n, (a, _) in NAMED_MOVES.items() if a < size] + ["done"]
-            raise UserError(f"invalid action {name!r}: this environment takes {', '.join(names)} or "
-                            f"{size} numbers in [-1, 1]")
+            raise UserError(
+                f"invalid action {name!r}: this environment takes {', '.join(names)} or {size} numbers in [-1, 1]"
+            )
         action[axis] = sign
         return action
 
     def describe(self) -> dict[str, Any]:
         """What an evaluation's protocol records of this environment (its starts are drawn poses,
         so there is no start count)."""
-        return {"environment": "davis_ag/TVMContinuous-v0", "scenario": self.scenario, "split": self.split,
-                "tau": self.tau, "aim": self.aim, "scenes": [s.settings.metadata.scene for s in self.scenes],
-                "dataset": self.dataset_root,
-                "actions": ["dx", "dy", "dz", "dyaw", "dpitch"][: self.action_space.shape[0]]}
+        return {
+            "environment": "davis_ag/TVMContinuous-v0",
+            "scenario": self.scenario,
+            "split": self.split,
+            "tau": self.tau,
+            "aim": self.aim,
+            "scenes": [s.settings.metadata.scene for s in self.scenes],
+            "dataset": self.dataset_root,
+            "actions": ["dx", "dy", "dz", "dyaw", "dpitch"][: self.action_space.shape[0]],
+        }
 
     def _action(self, action: Any) -> np.ndarray:
         a = np.asarray(action, dtype=np.float64).reshape(-1)
         if a.shape != self.action_space.shape or not np.all(np.isfinite(a)):
-            raise UserError(f"invalid action {action!r}: expected {self.action_space.shape[0]} finite numbers "
-                            "in [-1, 1]")
+            raise UserError(
+                f"invalid action {action!r}: expected {self.action_space.shape[0]} finite numbers in [-1, 1]"
+            )
         return np.clip(a, -1.0, 1.0)
 
     def proposed(self, action: Any, slip: bool = True) -> Viewpoint:
@@ -358,13 +393,19 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         obs = np.zeros((self.size, self.size, 4), dtype=np.uint8)
         obs[..., :3] = self._labels.colour
         x0, y0, w, h = self._labels.box(self._target)[:4]
-        obs[y0:y0 + h, x0:x0 + w, 3] = 255
+        obs[y0 : y0 + h, x0 : x0 + w, 3] = 255
         return obs
 
     def _info(self) -> dict[str, Any]:
-        return {"oer_0": self._oer_0, "oer_t": self.oer, "path": [list(p) for p in self._path],
-                "refused": self._refused, "target_fruit": self._target,
-                "scene": self.scene.settings.metadata.scene, "steps": self._t}
+        return {
+            "oer_0": self._oer_0,
+            "oer_t": self.oer,
+            "path": [list(p) for p in self._path],
+            "refused": self._refused,
+            "target_fruit": self._target,
+            "scene": self.scene.settings.metadata.scene,
+            "steps": self._t,
+        }
 
     def render(self) -> np.ndarray | None:
         """``rgb_array``: the current view with the target's box outlined in red."""
@@ -373,8 +414,8 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         frame = np.array(self._labels.colour)
         x0, y0, w, h = self._labels.box(self._target)[:4]
         x1, y1 = x0 + w - 1, y0 + h - 1
-        frame[y0, x0:x1 + 1] = frame[y1, x0:x1 + 1] = (255, 0, 0)
-        frame[y0:y1 + 1, x0] = frame[y0:y1 + 1, x1] = (255, 0, 0)
+        frame[y0, x0 : x1 + 1] = frame[y1, x0 : x1 + 1] = (255, 0, 0)
+        frame[y0 : y1 + 1, x0] = frame[y0 : y1 + 1, x1] = (255, 0, 0)
         return frame
 
     def close(self) -> None:
@@ -418,6 +459,12 @@ def steps_per_second(env: gym.Env, n: int = 500, seed: int = 0) -> dict[str, flo
     seconds = time.perf_counter() - start
     used = os.times()
     cpu_s = (used.user - cpu.user) + (used.system - cpu.system)  # every thread, Mesa's included
-    return {"steps_per_second": n / seconds, "cpu_ms_per_step": 1000 * cpu_s / n, "steps": n, "resets": resets,
-            "refused": refused / n, "draws_per_step": (counted.draws - first_draw) / n,
-            "draws_per_reset": reset_draws / max(resets, 1)}
+    return {
+        "steps_per_second": n / seconds,
+        "cpu_ms_per_step": 1000 * cpu_s / n,
+        "steps": n,
+        "resets": resets,
+        "refused": refused / n,
+        "draws_per_step": (counted.draws - first_draw) / n,
+        "draws_per_reset": reset_draws / max(resets, 1),
+    }

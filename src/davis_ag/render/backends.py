@@ -70,8 +70,14 @@ def resolve_antialiasing(value: str | int | None) -> str:
     return text
 
 
-def open_renderer(renderer: str, context, camera: Camera, lighting: Lighting, look: str | None = None,
-                  antialiasing: str = DEFAULT_ANTIALIASING):
+def open_renderer(
+    renderer: str,
+    context,
+    camera: Camera,
+    lighting: Lighting,
+    look: str | None = None,
+    antialiasing: str = DEFAULT_ANTIALIASING,
+):
     """A renderer of a scene; use it as a context manager.
 
     Args:

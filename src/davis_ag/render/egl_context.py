@@ -36,8 +36,13 @@ def egl_current() -> tuple | None:
     if not display:
         return None
     draw_surface, read_surface = 0x3059, 0x305A  # EGL_DRAW, EGL_READ
-    return (egl, display, egl.eglGetCurrentSurface(draw_surface), egl.eglGetCurrentSurface(read_surface),
-            egl.eglGetCurrentContext())
+    return (
+        egl,
+        display,
+        egl.eglGetCurrentSurface(draw_surface),
+        egl.eglGetCurrentSurface(read_surface),
+        egl.eglGetCurrentContext(),
+    )
 
 
 def egl_restore(state: tuple | None) -> None:
@@ -69,6 +74,8 @@ def create_context():
     try:
         return moderngl.create_standalone_context(backend="egl", require=330, **options)
     except Exception as error:  # noqa: BLE001 - moderngl raises plain Exceptions
-        raise UserError(f"cannot open a headless OpenGL context through EGL ({error}): install the "
-                        "system's EGL and GL libraries (Debian: libegl1 libgl1 libgl1-mesa-dri)"
-                        + (f", or choose another {EGL_DEVICE_VARIABLE}" if device else "")) from None
+        raise UserError(
+            f"cannot open a headless OpenGL context through EGL ({error}): install the "
+            "system's EGL and GL libraries (Debian: libegl1 libgl1 libgl1-mesa-dri)"
+            + (f", or choose another {EGL_DEVICE_VARIABLE}" if device else "")
+        ) from None

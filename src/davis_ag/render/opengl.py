@@ -88,8 +88,9 @@ class OpenGLRenderer:
         antialiasing: ``"fxaa"``, ``"msaa"`` or ``"none"`` (see the module docstring).
     """
 
-    def __init__(self, context, camera: Camera, lighting: Lighting, look: str = "default",
-                 antialiasing: str = "fxaa") -> None:
+    def __init__(
+        self, context, camera: Camera, lighting: Lighting, look: str = "default", antialiasing: str = "fxaa"
+    ) -> None:
         if look not in LOOKS:
             raise ValueError(f"look {look!r}: choose one of {', '.join(LOOKS)}")
         if antialiasing not in ("fxaa", "msaa", "none"):
@@ -122,16 +123,20 @@ class OpenGLRenderer:
         noisy = (*look, "SENSOR_NOISE") if self.lighting.noise_sigma > 0 else look
         self._programs = {
             "scene": ctx.program(vertex_shader=_shader("scene.vert"), fragment_shader=_fragment("scene.frag", noisy)),
-            "ids": ctx.program(vertex_shader=_shader("scene.vert"),
-                               fragment_shader=_fragment("scene.frag", ("IDS_ONLY", *look))),
+            "ids": ctx.program(
+                vertex_shader=_shader("scene.vert"), fragment_shader=_fragment("scene.frag", ("IDS_ONLY", *look))
+            ),
             "shadow": ctx.program(vertex_shader=_shader("shadow.vert"), fragment_shader=_fragment("shadow.frag", look)),
             "sky": ctx.program(vertex_shader=_shader("sky.vert"), fragment_shader=_fragment("sky.frag", noisy)),
         }
         if self.antialiasing == "fxaa":
-            self._programs["fxaa"] = ctx.program(vertex_shader=_shader("sky.vert"), fragment_shader=_shader("fxaa.frag"))
+            self._programs["fxaa"] = ctx.program(
+                vertex_shader=_shader("sky.vert"), fragment_shader=_shader("fxaa.frag")
+            )
         if self.antialiasing == "none":  # colour and ids without the depth output, for render(depth=False)
-            self._programs["no_depth"] = ctx.program(vertex_shader=_shader("scene.vert"),
-                                                     fragment_shader=_fragment("scene.frag", ("NO_DEPTH", *noisy)))
+            self._programs["no_depth"] = ctx.program(
+                vertex_shader=_shader("scene.vert"), fragment_shader=_fragment("scene.frag", ("NO_DEPTH", *noisy))
+            )
         # The programs that shade the scene: the same uniforms for each.
         self._shading = [self._programs[k] for k in ("scene", "no_depth") if k in self._programs]
         # Samplers first: the shadow pass below samples leaf textures already.
@@ -144,8 +149,18 @@ class OpenGLRenderer:
         # (GL_LEQUAL), so keep that order.
         order = np.lexsort((geometry.uuids, geometry.patch))
         n = geometry.triangle_count
-        vertex = np.zeros(n * 3, dtype=[("position", "f4", 3), ("uv", "f4", 2), ("normal", "f4", 3),
-                                        ("colour", "f4", 4), ("id", "u4"), ("texture", "i4"), ("mode", "i4")])
+        vertex = np.zeros(
+            n * 3,
+            dtype=[
+                ("position", "f4", 3),
+                ("uv", "f4", 2),
+                ("normal", "f4", 3),
+                ("colour", "f4", 4),
+                ("id", "u4"),
+                ("texture", "i4"),
+                ("mode", "i4"),
+            ],
+        )
         vertex["position"] = geometry.positions[order].reshape(-1, 3)
         uvs = geometry.uvs[order]
         if not helios:  # the soil's image laid at a fixed size on the ground, not stretched over the tile
@@ -166,11 +181,15 @@ class OpenGLRenderer:
         self._scene = ctx.vertex_array(self._programs["scene"], [(self._vbo, layout, *names)], skip_errors=True)
         self._ids = ctx.vertex_array(self._programs["ids"], [(self._vbo, layout, *names)], skip_errors=True)
         if "no_depth" in self._programs:
-            self._no_depth = ctx.vertex_array(self._programs["no_depth"], [(self._vbo, layout, *names)],
-                                              skip_errors=True)
+            self._no_depth = ctx.vertex_array(
+                self._programs["no_depth"], [(self._vbo, layout, *names)], skip_errors=True
+            )
         shadow_layout = "3f 2f 12x 16x 4x 1i 1i"
-        self._shadow = ctx.vertex_array(self._programs["shadow"], [
-            (self._vbo, shadow_layout, "in_position", "in_uv", "in_texture", "in_mode")], skip_errors=True)
+        self._shadow = ctx.vertex_array(
+            self._programs["shadow"],
+            [(self._vbo, shadow_layout, "in_position", "in_uv", "in_texture", "in_mode")],
+            skip_errors=True,
+        )
         self._sky = ctx.vertex_array(self._programs["sky"], [])
 
         # One shadow map for the scene, fitted to the casters.
@@ -182,8 +201,11 @@ class OpenGLRenderer:
         caster_first = np.lexsort((~geometry.caster[order],))  # casters only, drawn alone
         caster_vertex = vertex.reshape(-1, 3)[caster_first][: int(geometry.caster.sum())].reshape(-1)
         self._caster_vbo = ctx.buffer(caster_vertex.tobytes())
-        caster_vao = ctx.vertex_array(self._programs["shadow"], [
-            (self._caster_vbo, shadow_layout, "in_position", "in_uv", "in_texture", "in_mode")], skip_errors=True)
+        caster_vao = ctx.vertex_array(
+            self._programs["shadow"],
+            [(self._caster_vbo, shadow_layout, "in_position", "in_uv", "in_texture", "in_mode")],
+            skip_errors=True,
+        )
         shadow_fbo = ctx.framebuffer(depth_attachment=self._shadow_map)
         shadow_fbo.use()
         shadow_fbo.clear(depth=1.0)
@@ -219,8 +241,9 @@ class OpenGLRenderer:
         if self.antialiasing == "msaa":
             samples = min(4, ctx.max_samples)
             # Colour only: the shader's id and depth outputs have no attachment here and are dropped.
-            self._ms_fbo = ctx.framebuffer([ctx.renderbuffer((w, h), 4, samples=samples)],
-                                           ctx.depth_renderbuffer((w, h), samples=samples))
+            self._ms_fbo = ctx.framebuffer(
+                [ctx.renderbuffer((w, h), 4, samples=samples)], ctx.depth_renderbuffer((w, h), samples=samples)
+            )
             self._resolve_fbo = ctx.framebuffer([self._colour])
             self._ids_fbo = ctx.framebuffer([self._id_buffer, self._depth_buffer], ctx.depth_renderbuffer((w, h)))
 
@@ -233,13 +256,17 @@ class OpenGLRenderer:
         self._set(self._programs["sky"], "white_balance", white_balance)
         for program in (*self._shading, self._programs["sky"]):
             self._set(program, "noise_sigma", float(self.lighting.noise_sigma))
-        for name, value in (("sun", self.lighting.direction), ("exposure", exposure),
-                            ("sun_strength", float(self.lighting.sun_strength)),
-                            ("white_balance", white_balance),
-                            ("sky_ambient", SKY_AMBIENT),
-                            ("ground_ambient", GROUND_AMBIENT), ("material", MATERIAL),
-                            ("shadow_bias", SHADOW_BIAS),
-                            ("light_depth_range", float(1.0 / np.linalg.norm(self._light[2, :3])))):
+        for name, value in (
+            ("sun", self.lighting.direction),
+            ("exposure", exposure),
+            ("sun_strength", float(self.lighting.sun_strength)),
+            ("white_balance", white_balance),
+            ("sky_ambient", SKY_AMBIENT),
+            ("ground_ambient", GROUND_AMBIENT),
+            ("material", MATERIAL),
+            ("shadow_bias", SHADOW_BIAS),
+            ("light_depth_range", float(1.0 / np.linalg.norm(self._light[2, :3]))),
+        ):
             for program in self._shading:
                 self._set(program, name, value)
 
@@ -305,8 +332,11 @@ class OpenGLRenderer:
             seed = derived_seed(self.lighting.noise_seed, view.index)
             for program in (*self._shading, self._programs["sky"]):
                 self._set(program, "noise_seed", seed)
-        self._set(self._programs["sky"], "inverse_rotation_projection",
-                  gl_matrix(np.linalg.inv(projection.astype(np.float64) @ rotation)))
+        self._set(
+            self._programs["sky"],
+            "inverse_rotation_projection",
+            gl_matrix(np.linalg.inv(projection.astype(np.float64) @ rotation)),
+        )
 
     def draw(self, view: Viewpoint, depth: bool = True) -> None:
         """Draw a view into the renderer's buffers (read them with :meth:`read`); without
@@ -428,9 +458,24 @@ class OpenGLRenderer:
             return None
         indices = (triangles[:, None] * 3 + np.arange(3)).astype(np.uint32)
         vao = self.ctx.vertex_array(
-            self._programs["ids"], [(self._vbo, "3f 2f 3f 4f 1u 1i 1i", "in_position", "in_uv", "in_normal",
-                                     "in_colour", "in_id", "in_texture", "in_mode")],
-            index_buffer=self.ctx.buffer(indices.tobytes()), index_element_size=4, skip_errors=True)
+            self._programs["ids"],
+            [
+                (
+                    self._vbo,
+                    "3f 2f 3f 4f 1u 1i 1i",
+                    "in_position",
+                    "in_uv",
+                    "in_normal",
+                    "in_colour",
+                    "in_id",
+                    "in_texture",
+                    "in_mode",
+                )
+            ],
+            index_buffer=self.ctx.buffer(indices.tobytes()),
+            index_element_size=4,
+            skip_errors=True,
+        )
         # The eight corners of the triangles' bounding box: their projection bounds the fruit's.
         points = self._positions[triangles].reshape(-1, 3)
         lo, hi = points.min(axis=0).astype(np.float64), points.max(axis=0).astype(np.float64)

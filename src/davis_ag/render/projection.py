@@ -77,8 +77,13 @@ def matmul32(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return out
 
 
-def light_matrix(direction: tuple[float, float, float], lo: np.ndarray, hi: np.ndarray, margin: float | None = None,
-                 exact: np.ndarray | None = None) -> np.ndarray:
+def light_matrix(
+    direction: tuple[float, float, float],
+    lo: np.ndarray,
+    hi: np.ndarray,
+    margin: float | None = None,
+    exact: np.ndarray | None = None,
+) -> np.ndarray:
     """World to the shadow map's [0, 1]^3 (x, y across the map, z depth from the sun), fitted to a
     box (or to the points ``exact``), enlarged by ``margin`` of its extent on every side."""
     towards = np.asarray(direction, dtype=np.float64)
@@ -125,5 +130,3 @@ def helios_shadow_box(camera: Camera, eye: np.ndarray, target: np.ndarray, sun) 
 def gl_matrix(matrix: np.ndarray) -> bytes:
     """A matrix as GLSL reads it (column-major float32)."""
     return np.asarray(matrix, dtype=np.float32).T.tobytes()
-
-

@@ -70,9 +70,19 @@ class SceneGeometry:
 
     def save(self, path: Path) -> None:
         """Write to an ``.npz`` file (for tools and tests that draw without growing a scene)."""
-        np.savez_compressed(path, positions=self.positions, uvs=self.uvs, normals=self.normals, uuids=self.uuids,
-                            colours=self.colours, texture=self.texture, mode=self.mode, caster=self.caster, patch=self.patch,
-                            texture_files=np.array(self.texture_files, dtype=object))
+        np.savez_compressed(
+            path,
+            positions=self.positions,
+            uvs=self.uvs,
+            normals=self.normals,
+            uuids=self.uuids,
+            colours=self.colours,
+            texture=self.texture,
+            mode=self.mode,
+            caster=self.caster,
+            patch=self.patch,
+            texture_files=np.array(self.texture_files, dtype=object),
+        )
 
     @classmethod
     def load(cls, path: Path) -> "SceneGeometry":
@@ -123,8 +133,9 @@ def _smooth_normals(context, object_ids: list[int], object_uuids: list[np.ndarra
         if not smooth:
             continue
         if kind == POLYMESH:  # a polymesh's normals per face corner, from its shared vertices
-            vertex_normals = np.asarray([[v.x, v.y, v.z] for v in context.getPolymeshObjectVertexNormals(object_id)],
-                                        dtype=np.float32)
+            vertex_normals = np.asarray(
+                [[v.x, v.y, v.z] for v in context.getPolymeshObjectVertexNormals(object_id)], dtype=np.float32
+            )
             faces = np.asarray([[f.x, f.y, f.z] for f in context.getPolymeshObjectFaces(object_id)], dtype=np.int64)
             face_index = np.asarray([context.getPolymeshObjectFaceIndexForPrimitive(object_id, int(u)) for u in uuids])
             for uuid, face in zip(uuids, faces[face_index]):
@@ -134,8 +145,9 @@ def _smooth_normals(context, object_ids: list[int], object_uuids: list[np.ndarra
         array = (ctypes.c_uint * len(uuids))(*[int(u) for u in uuids])
         counts_ptr = ctypes.POINTER(ctypes.c_uint)()
         size = ctypes.c_uint()
-        pointer = helios_lib.getObjectPrimitiveVertexNormalsBatch(raw, int(object_id), array, len(uuids),
-                                                                  ctypes.byref(counts_ptr), ctypes.byref(size))
+        pointer = helios_lib.getObjectPrimitiveVertexNormalsBatch(
+            raw, int(object_id), array, len(uuids), ctypes.byref(counts_ptr), ctypes.byref(size)
+        )
         if not size.value:
             continue
         values = np.ctypeslib.as_array(pointer, shape=(size.value,)).astype(np.float32).reshape(-1, 3)
@@ -143,7 +155,7 @@ def _smooth_normals(context, object_ids: list[int], object_uuids: list[np.ndarra
         starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
         for uuid, start, count in zip(uuids, starts, counts):
             if count == 3:
-                normals[int(uuid)] = values[start:start + 3]
+                normals[int(uuid)] = values[start : start + 3]
     return normals
 
 
@@ -195,8 +207,11 @@ def read_scene_geometry(context) -> SceneGeometry:
     position_of = np.full(int(uuids.max()) + 1 if len(uuids) else 1, -1, dtype=np.int64)
     position_of[uuids] = np.arange(len(uuids))
     for object_id, members in zip(object_ids, object_uuids):
-        if len(members) and primitive_texture[position_of[members[0]]] >= 0 \
-                and context.isPrimitiveTextureColorOverridden(int(members[0])):
+        if (
+            len(members)
+            and primitive_texture[position_of[members[0]]] >= 0
+            and context.isPrimitiveTextureColorOverridden(int(members[0]))
+        ):
             mode[position_of[members]] = COLOUR_MASKED
     smooth = _smooth_normals(context, object_ids, object_uuids)
     if smooth:

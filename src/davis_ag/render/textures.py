@@ -38,8 +38,9 @@ def helios_resize(image: np.ndarray, width: int, height: int) -> np.ndarray:
     old_h, old_w = image.shape[:2]
     # warpAffine maps each destination pixel through the inverse of this matrix: src = dst * ratio.
     matrix = np.array([[width / old_w, 0.0, 0.0], [0.0, height / old_h, 0.0]])
-    value = cv2.warpAffine(image.astype(np.float32), matrix, (width, height), flags=cv2.INTER_LINEAR,
-                           borderMode=cv2.BORDER_REPLICATE)
+    value = cv2.warpAffine(
+        image.astype(np.float32), matrix, (width, height), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE
+    )
     return np.clip(np.round(value + 0.5), 0, 255).astype(np.uint8)
 
 

@@ -75,17 +75,26 @@ class Appearance:
 
         if self.mode == "paper":
             return base
-        return replace(base, sun_elevation=self.sun_elevation, sun_azimuth=self.sun_azimuth,
-                       sky_texture=helios_texture(self.sky) if self.sky else None,
-                       sun_strength=self.sun_strength, exposure=self.exposure, white_balance=self.white_balance,
-                       noise_sigma=self.noise_sigma, noise_seed=self.seed)
+        return replace(
+            base,
+            sun_elevation=self.sun_elevation,
+            sun_azimuth=self.sun_azimuth,
+            sky_texture=helios_texture(self.sky) if self.sky else None,
+            sun_strength=self.sun_strength,
+            exposure=self.exposure,
+            white_balance=self.white_balance,
+            noise_sigma=self.noise_sigma,
+            noise_seed=self.seed,
+        )
 
     def summary(self) -> dict:
         """JSON-ready record for scene.json."""
         record = asdict(self)
         record.pop("seed")
         record["white_balance"] = list(self.white_balance)
-        record["noise"] = "gaussian per pixel, per view, seeded by (scene seed, view number)" if self.noise_sigma else None
+        record["noise"] = (
+            "gaussian per pixel, per view, seeded by (scene seed, view number)" if self.noise_sigma else None
+        )
         return record
 
 

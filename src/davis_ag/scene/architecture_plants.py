@@ -51,13 +51,16 @@ def load_architecture_model(context, crop: CropSpec) -> ArchitectureModel:
             shoot_defaults = load_vine_model(plant_architecture)
         else:
             plant_architecture.loadPlantModelFromLibrary(crop.helios_model)
-            shoot_defaults = {label: plant_architecture.getCurrentShootParameters(label)
-                              for label in plant_architecture.listShootTypeLabels()}
+            shoot_defaults = {
+                label: plant_architecture.getCurrentShootParameters(label)
+                for label in plant_architecture.listShootTypeLabels()
+            }
     return ArchitectureModel(context, plant_architecture, crop, shoot_defaults)
 
 
-def grow_architecture_plant(model: ArchitectureModel, index: int, position: tuple[float, float],
-                            target: Phenotype, seed: int) -> GrownPlant:
+def grow_architecture_plant(
+    model: ArchitectureModel, index: int, position: tuple[float, float], target: Phenotype, seed: int
+) -> GrownPlant:
     """Grow one plant of the model's crop: a goblet vine or a library strawberry or tomato.
 
     Args:
@@ -71,8 +74,9 @@ def grow_architecture_plant(model: ArchitectureModel, index: int, position: tupl
     return grow(model, index, position, target, seed)
 
 
-def grow_library_plant(model: ArchitectureModel, index: int, position: tuple[float, float],
-                       target: Phenotype, seed: int) -> GrownPlant:
+def grow_library_plant(
+    model: ArchitectureModel, index: int, position: tuple[float, float], target: Phenotype, seed: int
+) -> GrownPlant:
     """Grow a strawberry or tomato from the PlantArchitecture library to a target phenotype.
 
     Returns:
@@ -86,7 +90,8 @@ def grow_library_plant(model: ArchitectureModel, index: int, position: tuple[flo
         prepare_build(context, plant_architecture, model.shoot_defaults, crop, knobs, seed)
         with quiet_stdout():
             plant_id = plant_architecture.buildPlantInstanceFromLibrary(
-                vec3(position[0], position[1], 0.0), crop.age_days)
+                vec3(position[0], position[1], 0.0), crop.age_days
+            )
         lift_to_ground(context, plant_architecture, plant_id)
         return plant_id, None
 
@@ -97,5 +102,4 @@ def grow_library_plant(model: ArchitectureModel, index: int, position: tuple[flo
         "leaf_length": target.leaf_length / DEFAULT_SIZES[crop.name][1],
     }
     blades = LEAF_UNIT.get(crop.name, blades_per_leaf(model.shoot_defaults))
-    return grow_to_target(context, plant_architecture, crop, index, position, target, seed, build,
-                          first_knobs, blades)
+    return grow_to_target(context, plant_architecture, crop, index, position, target, seed, build, first_knobs, blades)

@@ -136,18 +136,33 @@ def add_ground(context, soil_texture: str = "dirt.jpg") -> None:
 
     texture = helios_texture(soil_texture)
     patches = int(round(NEAR_SIZE / NEAR_PATCH))
-    tiles = [context.addTileObject(center=vec3(0.0, 0.0, 0.0), size=vec2(NEAR_SIZE, NEAR_SIZE),
-                                   subdiv=int2(patches, patches), texturefile=texture)]
+    tiles = [
+        context.addTileObject(
+            center=vec3(0.0, 0.0, 0.0),
+            size=vec2(NEAR_SIZE, NEAR_SIZE),
+            subdiv=int2(patches, patches),
+            texturefile=texture,
+        )
+    ]
     band = (GROUND_SIZE - NEAR_SIZE) / 2
     offset = (NEAR_SIZE + band) / 2
     strips = [  # (centre x, centre y, size x, size y): north, south, east, west
-        (0.0, offset, GROUND_SIZE, band), (0.0, -offset, GROUND_SIZE, band),
-        (offset, 0.0, band, NEAR_SIZE), (-offset, 0.0, band, NEAR_SIZE),
+        (0.0, offset, GROUND_SIZE, band),
+        (0.0, -offset, GROUND_SIZE, band),
+        (offset, 0.0, band, NEAR_SIZE),
+        (-offset, 0.0, band, NEAR_SIZE),
     ]
     for x, y, width, depth in strips:
         repeats = int2(max(1, round(width / FAR_REPEAT)), max(1, round(depth / FAR_REPEAT)))
-        tiles.append(context.addTileObject(center=vec3(x, y, 0.0), size=vec2(width, depth), subdiv=int2(1, 1),
-                                           texturefile=texture, texture_repeat=repeats))
+        tiles.append(
+            context.addTileObject(
+                center=vec3(x, y, 0.0),
+                size=vec2(width, depth),
+                subdiv=int2(1, 1),
+                texturefile=texture,
+                texture_repeat=repeats,
+            )
+        )
     label_soil(context, tiles)
 
 
@@ -160,12 +175,14 @@ def _fruit(context, fruit_id: int, plant: int, body: list[int]) -> Fruit:
     polygons = [np.stack(group).astype(np.float64) for group in by_count.values()]
     points = np.concatenate(parts)
     lo, hi = points.min(axis=0), points.max(axis=0)
-    return Fruit(fruit_id, plant, uuids, polygons,
-                 tuple(float(v) for v in (lo + hi) / 2), tuple(float(v) for v in hi - lo))
+    return Fruit(
+        fruit_id, plant, uuids, polygons, tuple(float(v) for v in (lo + hi) / 2), tuple(float(v) for v in hi - lo)
+    )
 
 
-def _grow_architecture_plants(context, scenario: ScenarioSpec, crop: CropSpec,
-                              rng: np.random.Generator) -> list[GrownPlant]:
+def _grow_architecture_plants(
+    context, scenario: ScenarioSpec, crop: CropSpec, rng: np.random.Generator
+) -> list[GrownPlant]:
     """PlantArchitecture plants grown towards their phenotypes (``--plants architecture``)."""
     from davis_ag.scene.architecture_plants import grow_architecture_plant, load_architecture_model
 
@@ -191,8 +208,13 @@ def _grow_canopy_plants(context, scenario: ScenarioSpec, crop: CropSpec, rng: np
     return plants
 
 
-def build_scene(scenario: ScenarioSpec, crop: CropSpec, rng: np.random.Generator,
-                plants: str = DEFAULT_PLANTS, soil_texture: str = "dirt.jpg") -> SceneModel:
+def build_scene(
+    scenario: ScenarioSpec,
+    crop: CropSpec,
+    rng: np.random.Generator,
+    plants: str = DEFAULT_PLANTS,
+    soil_texture: str = "dirt.jpg",
+) -> SceneModel:
     """Grow a scene's plants on soil, choose the sun and number the fruit.
 
     Args:

@@ -74,12 +74,20 @@ GRAPE_LEAF_TIP_UV = (0.98, 0.5)
 STEM_COLOUR = (0.35, 0.45, 0.2)
 TOMATO_COLOUR = (0.7, 0.28, 0.2)
 GRAPE_COLOUR = (0.18, 0.2, 0.25)
-STRAWBERRY = {"stems": 50, "clusters_per_stem": 0.6, "stem_radius": 0.005, "subdivisions": 10,
-              "fruit_subdivisions": 12}
+STRAWBERRY = {"stems": 50, "clusters_per_stem": 0.6, "stem_radius": 0.005, "subdivisions": 10, "fruit_subdivisions": 12}
 TOMATO = {"subdivisions": 10, "fruit_subdivisions": 8, "stem_radius": 0.02, "shoot_radius": 0.005}
-GOBLET = {"trunk_radius": 0.05, "cordon_height": 0.9, "shoot_length": 0.9, "shoot_radius": 0.0025,
-          "shoots_per_cordon": 10, "leaf_spacing_fraction": 0.6, "cluster_radius": 0.03,
-          "cluster_height_max": 0.1, "grape_subdivisions": 8, "wood_subdivisions": 10}
+GOBLET = {
+    "trunk_radius": 0.05,
+    "cordon_height": 0.9,
+    "shoot_length": 0.9,
+    "shoot_radius": 0.0025,
+    "shoots_per_cordon": 10,
+    "leaf_spacing_fraction": 0.6,
+    "cluster_radius": 0.03,
+    "cluster_height_max": 0.1,
+    "grape_subdivisions": 8,
+    "wood_subdivisions": 10,
+}
 #: Strawberry fruit: heights of the tube's nodes and their radii, in units of R.
 STRAWBERRY_PROFILE = ((0.6, 1e-3), (0.45, 0.4), (0.3, 0.5), (0.1, 0.45), (-0.2, 0.2), (-0.4, 0.15), (-0.5, 1e-3))
 #: Tomato shoots: where they leave the stem, as fractions of its length.
@@ -142,8 +150,9 @@ def strawberry_parts(phenotype: Phenotype, origin: np.ndarray, rng: np.random.Ge
             centre = interpolate_tube(nodes, 0.35) + sphere2cart(0.1 + 0.2 * rng.random(), 0.0, 2 * PI * rng.random())
             profile = np.array(STRAWBERRY_PROFILE) * radius
             fruit_nodes = centre + np.outer(profile[:, 0], [0.0, 0.0, 1.0])
-            parts.fruits.append([Tube(fruit_nodes, profile[:, 1], FRUIT, STRAWBERRY["fruit_subdivisions"],
-                                      texture=fruit_texture)])
+            parts.fruits.append(
+                [Tube(fruit_nodes, profile[:, 1], FRUIT, STRAWBERRY["fruit_subdivisions"], texture=fruit_texture)]
+            )
     return parts
 
 
@@ -168,8 +177,15 @@ def tomato_parts(phenotype: Phenotype, origin: np.ndarray, rng: np.random.Genera
     subdivisions = TOMATO["subdivisions"]
     count = max(2, round(2 * height * subdivisions))
     stem = origin + np.outer(np.linspace(0.0, height, count), [0.0, 0.0, 1.0])
-    parts.tubes.append(Tube(stem, tapering(count, TOMATO["stem_radius"], TOMATO["stem_radius"] * height, 0.9),
-                            STEM, subdivisions, colour=STEM_COLOUR))
+    parts.tubes.append(
+        Tube(
+            stem,
+            tapering(count, TOMATO["stem_radius"], TOMATO["stem_radius"] * height, 0.9),
+            STEM,
+            subdivisions,
+            colour=STEM_COLOUR,
+        )
+    )
     last = len(TOMATO_SHOOTS) - 1
     for i, at in enumerate(TOMATO_SHOOTS):
         order = i / last
@@ -180,8 +196,11 @@ def tomato_parts(phenotype: Phenotype, origin: np.ndarray, rng: np.random.Genera
         parts.tubes.append(Tube(nodes, radii, STEM, subdivisions, colour=STEM_COLOUR))
         theta, azimuth = final_elevation(direction, bend), cart2sphere(direction)[2]
         tip = nodes[-1] + sphere2cart(0.45 * leaf, theta, azimuth)
-        parts.leaves.append(flat_tile(leaf, 0.5 * leaf, 4, 3, flip=True).transformed(
-            np.ones(3), [(-theta, "y"), (-azimuth + 0.5 * PI, "z")], tip))
+        parts.leaves.append(
+            flat_tile(leaf, 0.5 * leaf, 4, 3, flip=True).transformed(
+                np.ones(3), [(-theta, "y"), (-azimuth + 0.5 * PI, "z")], tip
+            )
+        )
         for fraction, size in TOMATO_LATERALS:
             parts.leaves.extend(_tomato_lateral_leaves(nodes, fraction, size * leaf))
         if rng.random() < 0.66:
@@ -240,13 +259,18 @@ def _goblet_leaves(cane: np.ndarray, origin: np.ndarray, width: float, rng: np.r
         at = interpolate_tube(cane, fraction)
         normal = interpolate_tube(cane, max(0.0, fraction - 0.001)) - at
         normal /= max(np.linalg.norm(normal), 1e-12)
-        offset = rotate_about_line(np.array([0.0, size * (0.3 + vary(rng, 0.25)), 0.0]), np.zeros(3), normal,
-                                   flip * PI + rng.random() * 0.25 * PI)
+        offset = rotate_about_line(
+            np.array([0.0, size * (0.3 + vary(rng, 0.25)), 0.0]),
+            np.zeros(3),
+            normal,
+            flip * PI + rng.random() * 0.25 * PI,
+        )
         side = 1.0 if flip % 2 == 0 else -1.0
         r_phi = -side * 0.5 * PI * (1.0 + vary(rng, 0.4))
         r_theta = 0.4 * PI * (1.0 + vary(rng, 0.1))
-        leaves.append(tile.transformed(np.array([size, size, 1.0]), [(-r_theta, "y"), (-r_phi, "z")],
-                                       origin + at - offset))
+        leaves.append(
+            tile.transformed(np.array([size, size, 1.0]), [(-r_theta, "y"), (-r_phi, "z")], origin + at - offset)
+        )
         fraction -= GOBLET["leaf_spacing_fraction"] * size * (1.0 + vary(rng, 0.25))
         flip += 1
     return leaves
@@ -271,7 +295,9 @@ def goblet_vine_parts(phenotype: Phenotype, origin: np.ndarray, rng: np.random.G
             dz = ((1.0 + vary(rng, 0.1)) * top - cordon_height) / segments
             nodes = [np.array([0.0, 0.0, trunk_height])]
             for k in range(1, segments):
-                step = rotate_point(np.array([0.0, 0.0, dz]), theta0 + (theta_end - theta0) * k / (segments - 1), PI * side)
+                step = rotate_point(
+                    np.array([0.0, 0.0, dz]), theta0 + (theta_end - theta0) * k / (segments - 1), PI * side
+                )
                 nodes.append(nodes[-1] + step + np.array([vary(rng, 0.02), vary(rng, 0.01), 0.0]))
             cane = np.array(nodes)
             radii = np.full(len(cane), GOBLET["shoot_radius"])

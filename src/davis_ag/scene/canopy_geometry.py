@@ -20,8 +20,9 @@ import numpy as np
 
 def sphere2cart(radius: float, elevation: float, azimuth: float) -> np.ndarray:
     """Helios's ``sphere2cart``: a vector from its length, elevation and azimuth (radians)."""
-    return radius * np.array([math.cos(elevation) * math.sin(azimuth),
-                              math.cos(elevation) * math.cos(azimuth), math.sin(elevation)])
+    return radius * np.array(
+        [math.cos(elevation) * math.sin(azimuth), math.cos(elevation) * math.cos(azimuth), math.sin(elevation)]
+    )
 
 
 def cart2sphere(vector: np.ndarray) -> tuple[float, float, float]:
@@ -74,8 +75,7 @@ def interpolate_tube(nodes: np.ndarray, fraction: float) -> np.ndarray:
     return nodes[i] + step * (nodes[i + 1] - nodes[i])
 
 
-def bent_shoot(base: np.ndarray, direction: np.ndarray, length: float, bend: float,
-               subdivisions: int) -> np.ndarray:
+def bent_shoot(base: np.ndarray, direction: np.ndarray, length: float, bend: float, subdivisions: int) -> np.ndarray:
     """Nodes of a shoot that leaves ``base`` along ``direction`` and bends down by ``bend`` radians.
 
     The Canopy Generator's strawberry stem and tomato shoot: ``round(2 * length * subdivisions)``

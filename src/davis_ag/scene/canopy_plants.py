@@ -66,8 +66,12 @@ def _add_tube(context, tube: Tube) -> list[int]:
 def _add_sphere(context, sphere: Sphere) -> list[int]:
     from pyhelios.types import RGBcolor, vec3
 
-    obj = context.addSphereObject(center=vec3(*map(float, sphere.centre)), radius=float(sphere.radius),
-                                  ndivs=sphere.subdivisions, color=RGBcolor(*sphere.colour))
+    obj = context.addSphereObject(
+        center=vec3(*map(float, sphere.centre)),
+        radius=float(sphere.radius),
+        ndivs=sphere.subdivisions,
+        color=RGBcolor(*sphere.colour),
+    )
     return list(context.getObjectPrimitiveUUIDs(obj))
 
 
@@ -82,8 +86,10 @@ def add_parts(context, parts: PlantParts) -> PlacedPlant:
     stems = [_add_tube(context, tube) for tube in parts.tubes]
     for tube, uuids in zip(parts.tubes, stems):
         context.setPrimitiveDataUInt(uuids, ORGAN_DATA, tube.organ)
-    fruit_parts = [[_add_tube(context, p) if isinstance(p, Tube) else _add_sphere(context, p) for p in fruit]
-                   for fruit in parts.fruits]
+    fruit_parts = [
+        [_add_tube(context, p) if isinstance(p, Tube) else _add_sphere(context, p) for p in fruit]
+        for fruit in parts.fruits
+    ]
     fruits = [[u for piece in fruit for u in piece] for fruit in fruit_parts]
     if fruits:
         context.setPrimitiveDataUInt([u for f in fruits for u in f], ORGAN_DATA, FRUIT)
@@ -92,12 +98,17 @@ def add_parts(context, parts: PlantParts) -> PlacedPlant:
         triangles = np.concatenate([leaf.triangles for leaf in parts.leaves])
         uvs = np.concatenate([leaf.uvs for leaf in parts.leaves])
         faces = np.arange(3 * len(triangles), dtype=np.int32).reshape(-1, 3)
-        added = list(context.addTrianglesFromArraysTextured(
-            triangles.reshape(-1, 3).astype(np.float32), faces, uvs.reshape(-1, 2).astype(np.float32),
-            parts.leaf_texture))
+        added = list(
+            context.addTrianglesFromArraysTextured(
+                triangles.reshape(-1, 3).astype(np.float32),
+                faces,
+                uvs.reshape(-1, 2).astype(np.float32),
+                parts.leaf_texture,
+            )
+        )
         context.setPrimitiveDataUInt(added, ORGAN_DATA, LEAF)
         bounds = np.cumsum([0] + [len(leaf.triangles) for leaf in parts.leaves])
-        leaves = [added[bounds[i]:bounds[i + 1]] for i in range(len(parts.leaves))]
+        leaves = [added[bounds[i] : bounds[i + 1]] for i in range(len(parts.leaves))]
     uuids = [u for group in stems + fruits + leaves for u in group]
     return PlacedPlant(uuids, fruits, fruit_parts, leaves, stems)
 
@@ -119,11 +130,14 @@ def measure_placed(context, placed: PlacedPlant, crop: CropSpec) -> Phenotype:
     unit = UNIT_LEAVES[crop.name]()
     unit_size = unit.diameter()
     sizes = [diameter(np.concatenate(primitive_vertices(context, leaf))) for leaf in placed.leaves]
-    return Phenotype(plant_height=height, fruit_radius=radius, leaf_length=max(sizes) / unit_size if sizes else float("nan"))
+    return Phenotype(
+        plant_height=height, fruit_radius=radius, leaf_length=max(sizes) / unit_size if sizes else float("nan")
+    )
 
 
-def grow_canopy_plant(context, crop: CropSpec, index: int, position: tuple[float, float], target: Phenotype,
-                      seed: int) -> GrownPlant:
+def grow_canopy_plant(
+    context, crop: CropSpec, index: int, position: tuple[float, float], target: Phenotype, seed: int
+) -> GrownPlant:
     """Build one Canopy Generator plant with the phenotype drawn for it, and measure it.
 
     Args:
@@ -149,6 +163,15 @@ def grow_canopy_plant(context, crop: CropSpec, index: int, position: tuple[float
         raise UserError(f"{crop.name}: no plant with {crop.min_fruit}+ fruit in {MAX_DRAWS} draws")
     placed = add_parts(context, parts)
     measured = measure_placed(context, placed, crop)
-    return GrownPlant(index=index, seed=seed, position=position, target=target, measured=measured,
-                      fruit_objects=[], uuids=placed.uuids, builds=draw, fruit_bodies=placed.fruits,
-                      build_s=time.perf_counter() - started)
+    return GrownPlant(
+        index=index,
+        seed=seed,
+        position=position,
+        target=target,
+        measured=measured,
+        fruit_objects=[],
+        uuids=placed.uuids,
+        builds=draw,
+        fruit_bodies=placed.fruits,
+        build_s=time.perf_counter() - started,
+    )

@@ -51,12 +51,14 @@ def load_vine_model(plant_architecture) -> dict[str, dict]:
     arm["max_nodes"] = {"distribution": "constant", "parameters": [float(ARM_NODES)]}
     arm["internode_length_max"] = {"distribution": "constant", "parameters": [0.09]}
     plant_architecture.defineShootType("goblet_arm", arm)
-    return {label: plant_architecture.getCurrentShootParameters(label)
-            for label in plant_architecture.listShootTypeLabels()}
+    return {
+        label: plant_architecture.getCurrentShootParameters(label) for label in plant_architecture.listShootTypeLabels()
+    }
 
 
-def grow_goblet_vine(model: ArchitectureModel, index: int, position: tuple[float, float],
-                     target: Phenotype, seed: int) -> GrownPlant:
+def grow_goblet_vine(
+    model: ArchitectureModel, index: int, position: tuple[float, float], target: Phenotype, seed: int
+) -> GrownPlant:
     """Grow one goblet vine to a target trunk height, berry radius and leaf length.
 
     ``model`` holds the shoot types :func:`load_vine_model` loaded; the other arguments are as for
@@ -74,16 +76,28 @@ def grow_goblet_vine(model: ArchitectureModel, index: int, position: tuple[float
         internode = knobs["plant_height"] * crop.plant_height / TRUNK_NODES
         lean = AxisRotation(float(rng.uniform(0.0, 0.03 * math.pi)), float(rng.uniform(0, 2 * math.pi)), 0.0)
         trunk = plant_architecture.addBaseStemShoot(
-            plant_id, TRUNK_NODES, lean, 0.04, internode, 1.0, 1.0, 0.5, "grapevine_trunk")
+            plant_id, TRUNK_NODES, lean, 0.04, internode, 1.0, 1.0, 0.5, "grapevine_trunk"
+        )
         arm_count = int(rng.integers(ARM_COUNT[0], ARM_COUNT[1] + 1))
         first_yaw = rng.uniform(0, 2 * math.pi)
         arms = []
         for k in range(arm_count):
             yaw = first_yaw + 2 * math.pi * k / arm_count + rng.uniform(-0.3, 0.3)
             tilt = rng.uniform(0.25, 0.35) * math.pi  # from vertical: arms rise outwards
-            arms.append(plant_architecture.appendShoot(
-                plant_id, trunk, ARM_NODES, AxisRotation(float(tilt), float(yaw), math.pi),
-                0.015, 0.09, 1.0, 1.0, 0.6, "goblet_arm"))
+            arms.append(
+                plant_architecture.appendShoot(
+                    plant_id,
+                    trunk,
+                    ARM_NODES,
+                    AxisRotation(float(tilt), float(yaw), math.pi),
+                    0.015,
+                    0.09,
+                    1.0,
+                    1.0,
+                    0.6,
+                    "goblet_arm",
+                )
+            )
         for shoot in [trunk, *arms]:
             plant_architecture.removeShootLeaves(plant_id, shoot)
         # The library VSP vine's phenology (days): fruit set and maturity 45 days after budbreak.
@@ -99,8 +113,19 @@ def grow_goblet_vine(model: ArchitectureModel, index: int, position: tuple[float
         "fruit_radius": target.fruit_radius / DEFAULT_SIZES[0],
         "leaf_length": target.leaf_length / DEFAULT_SIZES[1],
     }
-    vine = grow_to_target(context, plant_architecture, crop, index, position, target, seed, build,
-                          first_knobs, blades_per_leaf(shoot_defaults), woody_shoots=WOODY_SHOOTS)
+    vine = grow_to_target(
+        context,
+        plant_architecture,
+        crop,
+        index,
+        position,
+        target,
+        seed,
+        build,
+        first_knobs,
+        blades_per_leaf(shoot_defaults),
+        woody_shoots=WOODY_SHOOTS,
+    )
     # The library's berries are near black (0.05, 0.08, 0.1) and render as silhouettes.
     from pyhelios.types import RGBcolor
 

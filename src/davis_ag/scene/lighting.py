@@ -33,7 +33,11 @@ class Lighting:
     def is_paper(self) -> bool:
         """Whether only the sun's direction and sky differ from the paper's look (what Helios draws)."""
         return (self.sun_strength, self.exposure, tuple(self.white_balance), self.noise_sigma) == (
-            1.0, 1.0, (1.0, 1.0, 1.0), 0.0)
+            1.0,
+            1.0,
+            (1.0, 1.0, 1.0),
+            0.0,
+        )
 
     @property
     def direction(self) -> tuple[float, float, float]:

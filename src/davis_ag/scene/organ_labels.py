@@ -27,6 +27,7 @@ import numpy as np
 from davis_ag.scene.organs import FRUIT, LEAF, ORGAN_DATA, SOIL, STEM, TRUNK
 from davis_ag.scene.plant_geometry import fruit_body_uuids
 
+
 def set_organ(context, uuids: Iterable[int], organ: int) -> None:
     """Give primitives an organ class (one native call)."""
     uuids = [int(u) for u in uuids]

@@ -180,15 +180,22 @@ def measure_plant(
     if crop.name == "vine":
         radii = np.concatenate([berry_radii(context, f) for f in fruit_ids]) if fruit_ids else np.zeros(0)
     else:
-        radii = np.array([
-            fruit_radius(np.concatenate(primitive_vertices(context, fruit_body_uuids(context, f))))
-            for f in fruit_ids
-        ]) / crop.fruit_size_per_radius
+        radii = (
+            np.array(
+                [
+                    fruit_radius(np.concatenate(primitive_vertices(context, fruit_body_uuids(context, f))))
+                    for f in fruit_ids
+                ]
+            )
+            / crop.fruit_size_per_radius
+        )
     blades = plant_architecture.getPlantLeafObjectIDs(plant_id)
-    lengths = np.array([
-        leaf_length(np.concatenate([object_vertices(context, b) for b in group]))
-        for group in leaf_groups(blades, blades_per_leaf)
-    ])
+    lengths = np.array(
+        [
+            leaf_length(np.concatenate([object_vertices(context, b) for b in group]))
+            for group in leaf_groups(blades, blades_per_leaf)
+        ]
+    )
     if trunk_top is not None:
         height = trunk_top
     else:
@@ -280,8 +287,7 @@ def in_table_range(measured: Phenotype, crop: CropSpec, slack: float = 0.0) -> b
     """Whether every measured trait lies within Table 1's value +- the paper's spread (+ slack)."""
     nominal = {"plant_height": crop.plant_height, "fruit_radius": crop.fruit_radius, "leaf_length": crop.leaf_length}
     return all(
-        abs(getattr(measured, name) / value - 1.0) <= PHENOTYPE_SPREAD[name] + slack
-        for name, value in nominal.items()
+        abs(getattr(measured, name) / value - 1.0) <= PHENOTYPE_SPREAD[name] + slack for name, value in nominal.items()
     )
 
 
@@ -357,9 +363,17 @@ def grow_to_target(
             on_target = max(relative_error(measured, target).values()) <= TOLERANCE and in_range
             if on_target or (attempt == MAX_BUILDS - 1 and in_range):
                 label_architecture_plant(context, plant_architecture, plant_id, woody_shoots)
-                return GrownPlant(index, seed, position, target, measured, list(fruit),
-                                  list(plant_architecture.getAllPlantUUIDs(plant_id)), builds,
-                                  build_s=time.perf_counter() - started)
+                return GrownPlant(
+                    index,
+                    seed,
+                    position,
+                    target,
+                    measured,
+                    list(fruit),
+                    list(plant_architecture.getAllPlantUUIDs(plant_id)),
+                    builds,
+                    build_s=time.perf_counter() - started,
+                )
             history.append((knobs["plant_height"], measured.plant_height))
             knobs["plant_height"] = _next_height_knob(history, target.plant_height)
             # Fruit and leaf size are proportional to their prototype scales.
@@ -377,8 +391,9 @@ def blades_per_leaf(shoot_defaults: dict[str, dict]) -> int:
     return int(first_shoot["phytomer_parameters"]["leaf"]["leaves_per_petiole"]["parameters"][0])
 
 
-def prepare_build(context, plant_architecture, shoot_defaults: dict[str, dict], crop: CropSpec,
-                  knobs: dict[str, float], seed: int) -> None:
+def prepare_build(
+    context, plant_architecture, shoot_defaults: dict[str, dict], crop: CropSpec, knobs: dict[str, float], seed: int
+) -> None:
     """Redefine every shoot type with the knobs applied and seed Helios, before a build."""
     internode = CROWN_INTERNODE.get(crop.name)
     for label, defaults in shoot_defaults.items():

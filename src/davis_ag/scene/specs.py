@@ -34,9 +34,12 @@ PAPER_IMAGE_SIZE = (1280, 720)
 PAPER_PIXELS = PAPER_IMAGE_SIZE[0] * PAPER_IMAGE_SIZE[1]
 #: Table 3 of the paper: (scenario, crop) -> (scenes, images).
 PAPER_TABLE3: dict[tuple[str, str], tuple[int, int]] = {
-    ("sp", "strawberry"): (86, 24_510), ("mp", "strawberry"): (77, 86_856),
-    ("sp", "tomato"): (130, 45_240), ("mp", "tomato"): (113, 203_400),
-    ("sp", "vine"): (182, 63_336), ("mp", "vine"): (44, 79_200),
+    ("sp", "strawberry"): (86, 24_510),
+    ("mp", "strawberry"): (77, 86_856),
+    ("sp", "tomato"): (130, 45_240),
+    ("mp", "tomato"): (113, 203_400),
+    ("sp", "vine"): (182, 63_336),
+    ("mp", "vine"): (44, 79_200),
 }
 
 
@@ -107,23 +110,55 @@ class CropSpec:
 # These are inferences from the counts and the figure (docs/dataset-format.md), not the paper's.
 CROPS: dict[str, CropSpec] = {
     "strawberry": CropSpec(
-        name="strawberry", title="Strawberry", plant_height=0.40, fruit_radius=0.025,
-        leaf_length=0.10, altitudes=(0.25, 0.40, 0.55), min_fruit_pixels=210,
-        exclusion_radius=0.75, centre_height=0.20, mp_plants=5, mp_spacing=0.30, min_fruit=4,
-        helios_model="strawberry", age_days=90.0, sp_extent=(2.5, 2.5), mp_extent=(4.0, 3.0),
+        name="strawberry",
+        title="Strawberry",
+        plant_height=0.40,
+        fruit_radius=0.025,
+        leaf_length=0.10,
+        altitudes=(0.25, 0.40, 0.55),
+        min_fruit_pixels=210,
+        exclusion_radius=0.75,
+        centre_height=0.20,
+        mp_plants=5,
+        mp_spacing=0.30,
+        min_fruit=4,
+        helios_model="strawberry",
+        age_days=90.0,
+        sp_extent=(2.5, 2.5),
+        mp_extent=(4.0, 3.0),
         fruit_size_per_radius=(0.5 + 0.5 + 0.55) / 3,
     ),
     "tomato": CropSpec(
-        name="tomato", title="Tomato", plant_height=1.00, fruit_radius=0.030,
-        leaf_length=0.20, altitudes=(0.70, 1.10, 1.50), min_fruit_pixels=240,
-        exclusion_radius=1.00, centre_height=0.50, mp_plants=3, mp_spacing=2.00, min_fruit=4,
-        helios_model="tomato", age_days=100.0,
+        name="tomato",
+        title="Tomato",
+        plant_height=1.00,
+        fruit_radius=0.030,
+        leaf_length=0.20,
+        altitudes=(0.70, 1.10, 1.50),
+        min_fruit_pixels=240,
+        exclusion_radius=1.00,
+        centre_height=0.50,
+        mp_plants=3,
+        mp_spacing=2.00,
+        min_fruit=4,
+        helios_model="tomato",
+        age_days=100.0,
     ),
     "vine": CropSpec(
-        name="vine", title="Vine", plant_height=0.70, fruit_radius=0.0075,
-        leaf_length=0.18, altitudes=(0.50, 0.75, 1.00), min_fruit_pixels=700,
-        exclusion_radius=1.00, centre_height=1.00, mp_plants=3, mp_spacing=2.00, min_fruit=4,
-        helios_model="grapevine_VSP", age_days=95.0,
+        name="vine",
+        title="Vine",
+        plant_height=0.70,
+        fruit_radius=0.0075,
+        leaf_length=0.18,
+        altitudes=(0.50, 0.75, 1.00),
+        min_fruit_pixels=700,
+        exclusion_radius=1.00,
+        centre_height=1.00,
+        mp_plants=3,
+        mp_spacing=2.00,
+        min_fruit=4,
+        helios_model="grapevine_VSP",
+        age_days=95.0,
     ),
 }
 
@@ -157,8 +192,10 @@ def with_strawberry_altitudes(crop: CropSpec, choice: str) -> CropSpec:
         UserError: for an unknown choice.
     """
     if choice not in STRAWBERRY_ALTITUDES:
-        raise UserError(f"unknown strawberry altitudes {choice!r}: choose {' or '.join(STRAWBERRY_ALTITUDES)} "
-                        "(Table 1's 25/40/55 cm, or the README's 0.50/0.75/1.00 m)")
+        raise UserError(
+            f"unknown strawberry altitudes {choice!r}: choose {' or '.join(STRAWBERRY_ALTITUDES)} "
+            "(Table 1's 25/40/55 cm, or the README's 0.50/0.75/1.00 m)"
+        )
     return replace(crop, altitudes=STRAWBERRY_ALTITUDES[choice]) if crop.name == "strawberry" else crop
 
 
@@ -212,12 +249,24 @@ class ScenarioSpec:
 
 SCENARIOS: dict[str, ScenarioSpec] = {
     "sp": ScenarioSpec(
-        name="sp", title="Single", extent=(3.0, 3.0), step=0.25, altitude_levels=(0, 1, 2),
-        headings=1, actions=SP_ACTIONS, tau=3,
+        name="sp",
+        title="Single",
+        extent=(3.0, 3.0),
+        step=0.25,
+        altitude_levels=(0, 1, 2),
+        headings=1,
+        actions=SP_ACTIONS,
+        tau=3,
     ),
     "mp": ScenarioSpec(
-        name="mp", title="Multi", extent=(7.0, 3.0), step=0.50, altitude_levels=(0, 2),
-        headings=12, actions=MP_ACTIONS, tau=5,
+        name="mp",
+        title="Multi",
+        extent=(7.0, 3.0),
+        step=0.50,
+        altitude_levels=(0, 2),
+        headings=12,
+        actions=MP_ACTIONS,
+        tau=5,
     ),
 }
 

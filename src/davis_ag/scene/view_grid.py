@@ -217,8 +217,9 @@ def build_view_grid(
                     key = (ix, iy, level, heading)
                     index_of[key] = len(viewpoints)
                     viewpoints.append(
-                        Viewpoint(len(viewpoints), ix, iy, level, heading, nominal, position,
-                                  round(yaw, 4), round(pitch, 4))
+                        Viewpoint(
+                            len(viewpoints), ix, iy, level, heading, nominal, position, round(yaw, 4), round(pitch, 4)
+                        )
                     )
 
     next_view = np.full((len(viewpoints), len(scenario.actions)), -1, dtype=np.int32)
@@ -239,8 +240,7 @@ def views_per_scene(scenario: ScenarioSpec, crop: CropSpec) -> int:
     Returns:
         The number of views.
     """
-    grid = build_view_grid(scenario, crop, plant_centres(scenario, crop), crop.centre_height,
-                           np.random.default_rng(0))
+    grid = build_view_grid(scenario, crop, plant_centres(scenario, crop), crop.centre_height, np.random.default_rng(0))
     return len(grid.viewpoints)
 
 

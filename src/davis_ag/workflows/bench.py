@@ -41,14 +41,23 @@ from davis_ag.generate.one_scene import SceneRequest, draw_scene, grow_scene
 from davis_ag.generate.run_progress import count_views
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import CROPS, SCENARIOS
-from davis_ag.workflows.bench_report import PAPER_HOURS_TARGET, SEED, TARGETS, continuous_table, projection, write_continuous
+from davis_ag.workflows.bench_report import (
+    PAPER_HOURS_TARGET,
+    SEED,
+    TARGETS,
+    continuous_table,
+    projection,
+    write_continuous,
+)
 
 CAMERA = Camera(1280, 720)
 #: Views timed per crop: the strawberry's grid every 0.5 m at the middle altitude, the others'
 #: every 1 m at the lowest (the first ``VIEWS`` of each).
-GRIDS = {"strawberry": dataclasses.replace(SCENARIOS["sp"], extent=(2.5, 3.0), step=0.5, altitude_levels=(1,)),
-         "tomato": dataclasses.replace(SCENARIOS["sp"], step=1.0, altitude_levels=(0,)),
-         "vine": dataclasses.replace(SCENARIOS["sp"], step=1.0, altitude_levels=(0,))}
+GRIDS = {
+    "strawberry": dataclasses.replace(SCENARIOS["sp"], extent=(2.5, 3.0), step=0.5, altitude_levels=(1,)),
+    "tomato": dataclasses.replace(SCENARIOS["sp"], step=1.0, altitude_levels=(0,)),
+    "vine": dataclasses.replace(SCENARIOS["sp"], step=1.0, altitude_levels=(0,)),
+}
 VIEWS = {"strawberry": 12, "tomato": 8, "vine": 8}
 REPEATS = 3
 
@@ -103,15 +112,20 @@ def bench_crop(crop: str, scratch: Path, repeats: int, documented: bool = True, 
     helios = HeliosRenderer(model.context, request.camera, model.lighting) if documented else None
     ours_renderer = OpenGLRenderer(model.context, request.camera, model.lighting, antialiasing=antialiasing)
     try:
+
         def documented_view(view) -> None:
             helios.set_view(view)
             jpeg = str(images / view.image_name)
             helios._vis.printWindow(jpeg)
-            helios._vis.writeImageBoundingBoxes(object_data_labels="fruit_id", object_class_ids=0,
-                                                image_file=view.image_name, image_path=str(images))
-            helios._vis.writeImageSegmentationMasks(object_data_labels="fruit_id", object_class_ids=0,
-                                                    json_filename=str(images / f"{view.image_name[:-5]}.json"),
-                                                    image_file=jpeg)
+            helios._vis.writeImageBoundingBoxes(
+                object_data_labels="fruit_id", object_class_ids=0, image_file=view.image_name, image_path=str(images)
+            )
+            helios._vis.writeImageSegmentationMasks(
+                object_data_labels="fruit_id",
+                object_class_ids=0,
+                json_filename=str(images / f"{view.image_name[:-5]}.json"),
+                image_file=jpeg,
+            )
 
         for repeat in range(repeats):
             per_view, before = time_ours(request, model, grid, views, scratch / f"{crop}-ours-{repeat}")
@@ -127,9 +141,15 @@ def bench_crop(crop: str, scratch: Path, repeats: int, documented: bool = True, 
         if helios is not None:
             helios.close()
     median = {path: statistics.median(values) for path, values in times.items() if values}
-    result = {"views_timed": len(views) - 1, "repeats": repeats, "primitives": len(model.context.getAllUUIDs()),
-              "grow_s": round(grow_s, 2), "setup_and_first_view_s": round(statistics.median(setup), 2),
-              "seconds_per_view": median, "all_repeats": times}
+    result = {
+        "views_timed": len(views) - 1,
+        "repeats": repeats,
+        "primitives": len(model.context.getAllUUIDs()),
+        "grow_s": round(grow_s, 2),
+        "setup_and_first_view_s": round(statistics.median(setup), 2),
+        "seconds_per_view": median,
+        "all_repeats": times,
+    }
     result["classes_cost"] = median["ours"] / median["no_classes"]
     if "documented" in median:
         result["documented_over_ours"] = median["documented"] / median["ours"]
@@ -152,10 +172,13 @@ def pool_gain(scratch: Path) -> dict:
         start = time.perf_counter()
         run_dataset(requests, scratch / f"pool-{workers}", RunOptions(workers=workers, progress=False))
         seconds[workers] = time.perf_counter() - start
-    return {"scenes": len(requests), "views": len(requests) * count_views(requests[0].scenario, crop),
-            "seconds_one_worker": round(seconds[1], 1), "seconds_two_workers": round(seconds[2], 1),
-            "gain": round(seconds[1] / seconds[2], 3)}
-
+    return {
+        "scenes": len(requests),
+        "views": len(requests) * count_views(requests[0].scenario, crop),
+        "seconds_one_worker": round(seconds[1], 1),
+        "seconds_two_workers": round(seconds[2], 1),
+        "gain": round(seconds[1] / seconds[2], 3),
+    }
 
 
 def env_speed(dataset: Path, steps: int = 20_000) -> dict:
@@ -214,13 +237,20 @@ def continuous_env_speed(scratch: Path, steps: int = 600) -> dict:
         rate = steps_per_second(env, steps, seed=SEED)
     finally:
         env.close()
-    return {"steps_per_second": round(rate["steps_per_second"], 1), "cpu_ms_per_step": round(rate["cpu_ms_per_step"], 1),
-            "steps": steps, "resets": rate["resets"],
-            "refused_share": round(rate["refused"], 3), "render_and_label_ms": round(render_ms, 1),
-            "draws_per_step": round(rate["draws_per_step"], 2), "draws_per_reset": round(rate["draws_per_reset"], 2),
-            "open_and_first_reset_s": round(setup_s, 2), "target_min": CONTINUOUS_TARGET,
-            "triangles": int(env.scenes[0].assets.geometry.triangle_count),
-            "triangles_drawn": int(merge_ground(env.scenes[0].assets.geometry).triangle_count)}
+    return {
+        "steps_per_second": round(rate["steps_per_second"], 1),
+        "cpu_ms_per_step": round(rate["cpu_ms_per_step"], 1),
+        "steps": steps,
+        "resets": rate["resets"],
+        "refused_share": round(rate["refused"], 3),
+        "render_and_label_ms": round(render_ms, 1),
+        "draws_per_step": round(rate["draws_per_step"], 2),
+        "draws_per_reset": round(rate["draws_per_reset"], 2),
+        "open_and_first_reset_s": round(setup_s, 2),
+        "target_min": CONTINUOUS_TARGET,
+        "triangles": int(env.scenes[0].assets.geometry.triangle_count),
+        "triangles_drawn": int(merge_ground(env.scenes[0].assets.geometry).triangle_count),
+    }
 
 
 def run_continuous(out: Path, doc: Path | None) -> dict:
@@ -240,10 +270,17 @@ def run_continuous(out: Path, doc: Path | None) -> dict:
 def run(out: Path, crops: list[str], repeats: int, antialiasing: str = "fxaa") -> dict:
     """Run every measurement; return the JSON report."""
     load_start = os.getloadavg()
-    report: dict = {"machine": {"cpus": os.cpu_count(), "platform": platform.platform(),
-                                "LP_NUM_THREADS": os.environ.get("LP_NUM_THREADS")},
-                    "image_size": [CAMERA.width, CAMERA.height], "seed": SEED, "antialiasing": antialiasing,
-                    "crops": {}}
+    report: dict = {
+        "machine": {
+            "cpus": os.cpu_count(),
+            "platform": platform.platform(),
+            "LP_NUM_THREADS": os.environ.get("LP_NUM_THREADS"),
+        },
+        "image_size": [CAMERA.width, CAMERA.height],
+        "seed": SEED,
+        "antialiasing": antialiasing,
+        "crops": {},
+    }
     per_view: dict[str, float] = {}
     overhead: dict[str, float] = {}
     floor: dict[str, float] = {}
@@ -266,8 +303,10 @@ def run(out: Path, crops: list[str], repeats: int, antialiasing: str = "fxaa") -
     report["scene_overhead_s"] = {k: round(v, 1) for k, v in overhead.items()}
     report["paper_projection"] = projection(per_view, overhead, floor, grow, report.get("pool", {}).get("gain"))
     report["targets"] = {"documented_over_ours_min": TARGETS, "paper_hours_one_machine_max": PAPER_HOURS_TARGET}
-    report["machine"]["load_average"] = {"start": [round(x, 2) for x in load_start],
-                                         "end": [round(x, 2) for x in os.getloadavg()]}
+    report["machine"]["load_average"] = {
+        "start": [round(x, 2) for x in load_start],
+        "end": [round(x, 2) for x in os.getloadavg()],
+    }
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps(report, indent=1) + "\n")
     return report

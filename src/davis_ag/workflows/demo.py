@@ -34,8 +34,9 @@ BASELINES: tuple[str, ...] = ("LRD", "UDD", "Rand", "Oracle")
 DEMO_SIZE: tuple[int, int] = (1280, 720)
 
 
-def generate_scenes(requests: list[SceneRequest], root: Path, workers: int | None = None,
-                    progress: bool = True) -> list[dict[str, Any]]:
+def generate_scenes(
+    requests: list[SceneRequest], root: Path, workers: int | None = None, progress: bool = True
+) -> list[dict[str, Any]]:
     """Make the scenes not yet complete under ``root`` through the one dataset runner.
 
     :func:`davis_ag.generate.runner.run_dataset` locks the folder (a second run on it is
@@ -58,8 +59,9 @@ def generate_scenes(requests: list[SceneRequest], root: Path, workers: int | Non
     """
     workers = workers or max(1, min(default_workers(), len(requests)))
     report = run_dataset(requests, root, RunOptions(workers=workers, progress=progress))
-    return [{"scene": r.folder, "skipped": r.folder in report.skipped, **report.stats.get(r.folder, {})}
-            for r in requests]
+    return [
+        {"scene": r.folder, "skipped": r.folder in report.skipped, **report.stats.get(r.folder, {})} for r in requests
+    ]
 
 
 def evaluation_split(root: Path, scenario: str, crop: str) -> str:
@@ -83,8 +85,16 @@ def evaluation_split(root: Path, scenario: str, crop: str) -> str:
     return "test"
 
 
-def run_baselines(root: Path, scenario: str, crop: str, split: str, episodes: int, sessions: int,
-                  seed: int = 0, model: Path | None = None) -> dict[str, Any]:
+def run_baselines(
+    root: Path,
+    scenario: str,
+    crop: str,
+    split: str,
+    episodes: int,
+    sessions: int,
+    seed: int = 0,
+    model: Path | None = None,
+) -> dict[str, Any]:
     """Evaluate LRD, UDD, Rand, Oracle, the Best fixed action (and A2C when ``model`` is given)
     as in Table 4.
 
@@ -111,14 +121,30 @@ def run_baselines(root: Path, scenario: str, crop: str, split: str, episodes: in
     if model:
         sampled = ModelPolicy(model)
         policies = [sampled, ModelPolicy(sampled.model, deterministic=True, name="A2C (deterministic)")]
-    results = evaluate(policies, root, scenario=scenario, split=split, sessions=sessions, episodes=episodes,
-                       seed=seed, crop=crop, baselines=list(BASELINES))
+    results = evaluate(
+        policies,
+        root,
+        scenario=scenario,
+        split=split,
+        sessions=sessions,
+        episodes=episodes,
+        seed=seed,
+        crop=crop,
+        baselines=list(BASELINES),
+    )
     return results.as_json()
 
 
-def run_demo(out: Path, scenes: int = 2, size: tuple[int, int] = DEMO_SIZE, seed: int = 0,
-             episodes: int = 200, sessions: int = 3, scenario: ScenarioSpec | None = None,
-             crop: CropSpec | None = None) -> int:
+def run_demo(
+    out: Path,
+    scenes: int = 2,
+    size: tuple[int, int] = DEMO_SIZE,
+    seed: int = 0,
+    episodes: int = 200,
+    sessions: int = 3,
+    scenario: ScenarioSpec | None = None,
+    crop: CropSpec | None = None,
+) -> int:
     """The whole demo: generate, validate, split, benchmark the baselines, report.
 
     Defaults: 2 SP strawberry scenes (one train and one test scene under the 70/30 split by
@@ -159,8 +185,10 @@ def run_demo(out: Path, scenes: int = 2, size: tuple[int, int] = DEMO_SIZE, seed
     timer = Timer()
     camera = Camera(*size)
     requests = [SceneRequest(scenario, crop, i, seed, camera) for i in range(scenes)]
-    print(f"[1/5] generating {scenes} {scenario.name.upper()} {crop.name} scene(s) at "
-          f"{size[0]}x{size[1]} in {root}", flush=True)
+    print(
+        f"[1/5] generating {scenes} {scenario.name.upper()} {crop.name} scene(s) at {size[0]}x{size[1]} in {root}",
+        flush=True,
+    )
     with timer.stage("generate"):
         generated = generate_scenes(requests, root)
     if all(g["skipped"] for g in generated):
@@ -185,10 +213,16 @@ def run_demo(out: Path, scenes: int = 2, size: tuple[int, int] = DEMO_SIZE, seed
     write_or_rescue(report_dir / "results.json", lambda path: write_json(results, path), "the results")
     print("[5/5] writing the report", flush=True)
     with timer.stage("report"):
-        index = write_report(root, report_dir, results=results, validation=report.summary(),
-                             timer=timer, generated=generated, title="DAVIS-Ag demo")
+        index = write_report(
+            root,
+            report_dir,
+            results=results,
+            validation=report.summary(),
+            timer=timer,
+            generated=generated,
+            title="DAVIS-Ag demo",
+        )
     print(f"report: {index}  (open it in a browser; total {timer.total:.0f} s)", flush=True)
     print(f"figures of the paper (PNG, SVG, numbers as JSON): {report_dir / 'figures'}", flush=True)
-    print(f"drive through a scene: davis-ag view {root}  (then open http://127.0.0.1:8765/)",
-          flush=True)
+    print(f"drive through a scene: davis-ag view {root}  (then open http://127.0.0.1:8765/)", flush=True)
     return 0

@@ -57,12 +57,21 @@ class ReproduceConfig:
 #: Scene counts of Table 3 (SP strawberry, MP vine), what a configuration is measured against.
 PAPER_SCENES = (PAPER_TABLE3["sp", "strawberry"][0], PAPER_TABLE3["mp", "vine"][0])
 CONFIGS: dict[str, ReproduceConfig] = {
-    "small": ReproduceConfig("small", (640, 360), sp_scenes=3, mp_scenes=2, mp_extent=(3.0, 2.0),
-                             sp_timesteps=30_000, mp_timesteps=15_000),
-    "medium": ReproduceConfig("medium", (640, 360), sp_scenes=10, mp_scenes=10, mp_extent=None,
-                              sp_timesteps=300_000, mp_timesteps=300_000),
-    "paper-scale": ReproduceConfig("paper-scale", PAPER_IMAGE_SIZE, sp_scenes=PAPER_SCENES[0], mp_scenes=PAPER_SCENES[1],
-                                   mp_extent=None, sp_timesteps=300_000, mp_timesteps=300_000),
+    "small": ReproduceConfig(
+        "small", (640, 360), sp_scenes=3, mp_scenes=2, mp_extent=(3.0, 2.0), sp_timesteps=30_000, mp_timesteps=15_000
+    ),
+    "medium": ReproduceConfig(
+        "medium", (640, 360), sp_scenes=10, mp_scenes=10, mp_extent=None, sp_timesteps=300_000, mp_timesteps=300_000
+    ),
+    "paper-scale": ReproduceConfig(
+        "paper-scale",
+        PAPER_IMAGE_SIZE,
+        sp_scenes=PAPER_SCENES[0],
+        mp_scenes=PAPER_SCENES[1],
+        mp_extent=None,
+        sp_timesteps=300_000,
+        mp_timesteps=300_000,
+    ),
 }
 
 #: Bytes one 1280x720 view writes (JPEG 0.36 MB, depth 0.07 MB, masks and classes), measured on
@@ -87,23 +96,33 @@ def configurations_table() -> str:
     Returns:
         A Markdown table: scenes, grid, image size, A2C steps and disk space of each configuration.
     """
-    rows = ["| configuration | SP strawberry | MP vine | images | A2C steps (SP / MP) | disk (views and caches) "
-            "| beside Table 4 |", "|---|---|---|---|---|---|---|"]
+    rows = [
+        "| configuration | SP strawberry | MP vine | images | A2C steps (SP / MP) | disk (views and caches) "
+        "| beside Table 4 |",
+        "|---|---|---|---|---|---|---|",
+    ]
     for config in CONFIGS.values():
-        grid = (f"{config.mp_extent[0]:g} x {config.mp_extent[1]:g} m grid" if config.mp_extent
-                else "the paper's 7 x 3 m grid")
+        grid = (
+            f"{config.mp_extent[0]:g} x {config.mp_extent[1]:g} m grid"
+            if config.mp_extent
+            else "the paper's 7 x 3 m grid"
+        )
         scenes = (config.sp_scenes, config.mp_scenes)
         if scenes == PAPER_SCENES and config.size == (1280, 720):
             verdict = "Table 3's scenes and images"
         elif config.mp_extent is None and (config.sp_timesteps, config.mp_timesteps) == (300_000, 300_000):
-            verdict = (f"grids, protocol and training as the paper's; {sum(scenes)} scenes instead of "
-                       f"{sum(PAPER_SCENES)}, {config.size[0]}x{config.size[1]} images")
+            verdict = (
+                f"grids, protocol and training as the paper's; {sum(scenes)} scenes instead of "
+                f"{sum(PAPER_SCENES)}, {config.size[0]}x{config.size[1]} images"
+            )
         else:
             verdict = "not comparable: a smoke test of every stage"
-        rows.append(f"| `{config.name}` | {config.sp_scenes} scenes | {config.mp_scenes} scenes, {grid} | "
-                    f"{config.size[0]}x{config.size[1]} | {config.sp_timesteps // 1000}K / "
-                    f"{config.mp_timesteps // 1000}K | {disk_needed(config) / 1e9:.1f} GB "
-                    f"| {verdict} |")
+        rows.append(
+            f"| `{config.name}` | {config.sp_scenes} scenes | {config.mp_scenes} scenes, {grid} | "
+            f"{config.size[0]}x{config.size[1]} | {config.sp_timesteps // 1000}K / "
+            f"{config.mp_timesteps // 1000}K | {disk_needed(config) / 1e9:.1f} GB "
+            f"| {verdict} |"
+        )
     return "\n".join(rows)
 
 
@@ -118,8 +137,11 @@ def load_state(path: Path) -> dict[str, Any]:
         return {}
 
 
-def disk_needed(config: ReproduceConfig, root: Path | None = None,
-                pairs: list[tuple[str, str]] | tuple[tuple[str, str], ...] = SCENARIO_CROPS) -> int:
+def disk_needed(
+    config: ReproduceConfig,
+    root: Path | None = None,
+    pairs: list[tuple[str, str]] | tuple[tuple[str, str], ...] = SCENARIO_CROPS,
+) -> int:
     """Bytes the run still has to write under its dataset ``root``: the scenes not yet complete
     and the observation caches not yet built.
 
@@ -142,8 +164,11 @@ def disk_needed(config: ReproduceConfig, root: Path | None = None,
     written = [p for scene in done for p in (root / scene).rglob("*") if p.is_file()]
     done_views = sum(1 for p in written if p.suffix == ".jpeg")
     width, height = config.size
-    per_view = (sum(p.stat().st_size for p in written) / done_views if done_views
-                else BYTES_PER_VIEW_720P * width * height / (1280 * 720))
+    per_view = (
+        sum(p.stat().st_size for p in written) / done_views
+        if done_views
+        else BYTES_PER_VIEW_720P * width * height / (1280 * 720)
+    )
     needed = 0.0
     for scenario_name, crop_name in pairs:
         crop = crop_spec(crop_name)
@@ -166,8 +191,9 @@ def _among_first(folder: str, group: str, n: int) -> bool:
     return name == group and index.isdigit() and int(index) < n
 
 
-def check_disk(config: ReproduceConfig, out: Path,
-               pairs: list[tuple[str, str]] | tuple[tuple[str, str], ...] = SCENARIO_CROPS) -> None:
+def check_disk(
+    config: ReproduceConfig, out: Path, pairs: list[tuple[str, str]] | tuple[tuple[str, str], ...] = SCENARIO_CROPS
+) -> None:
     """Refuse, before anything is written, a run whose files the disk under ``out`` cannot hold.
 
     Raises:
@@ -181,12 +207,18 @@ def check_disk(config: ReproduceConfig, out: Path,
     probe = out if out.exists() else next(p for p in out.parents if p.exists())
     free = shutil.disk_usage(probe).free
     if free < needed:
-        raise UserError(f"reproduce --config {config.name} needs about {needed / 1e9:.1f} GB more under {out} "
-                        f"and the disk has {free / 1e9:.1f} GB free: free space, or pass --out on a larger disk")
+        raise UserError(
+            f"reproduce --config {config.name} needs about {needed / 1e9:.1f} GB more under {out} "
+            f"and the disk has {free / 1e9:.1f} GB free: free space, or pass --out on a larger disk"
+        )
 
 
-def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
-              pairs: list[tuple[str, str]] | tuple[tuple[str, str], ...] = SCENARIO_CROPS) -> int:
+def reproduce(
+    config: ReproduceConfig,
+    out: Path,
+    results_md: Path,
+    pairs: list[tuple[str, str]] | tuple[tuple[str, str], ...] = SCENARIO_CROPS,
+) -> int:
     """Generate, validate, split, train and benchmark each scenario; write ``results_md``.
 
     Args:
@@ -218,8 +250,11 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
     state_path = out / "state.json"
     state = load_state(state_path)
     if state.get("config") and state["config"] != json.loads(json.dumps(asdict(config))):
-        print(f"note: {out} was started with another configuration; finished stages are reused "
-              "only where their files match", flush=True)
+        print(
+            f"note: {out} was started with another configuration; finished stages are reused "
+            "only where their files match",
+            flush=True,
+        )
     state["config"] = asdict(config)
     state.setdefault("stages", {})
     state.setdefault("results", {})
@@ -244,16 +279,22 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
         scene_log = state.setdefault("scenes", {})
         for g in generated:
             if not g["skipped"]:
-                scene_log[g["scene"]] = {"seconds": round(g["total_s"], 1), "views": g["views"],
-                                         "s_per_view": round(g["views_s"] / g["views"], 3)}
+                scene_log[g["scene"]] = {
+                    "seconds": round(g["total_s"], 1),
+                    "views": g["views"],
+                    "s_per_view": round(g["views_s"] / g["views"], 3),
+                }
         timed = [scene_log[r.folder] for r in requests if r.folder in scene_log]
         if timed:
             views = sum(t["views"] for t in timed)
             missing = len(requests) - len(timed)
-            record(f"{key}: generate", sum(t["seconds"] for t in timed),
-                   f"{len(timed)} scene(s), {views} views, "
-                   f"{sum(t['s_per_view'] * t['views'] for t in timed) / views:.2f} s per view"
-                   + (f"; {missing} scene(s) made earlier, not timed" if missing else ""))
+            record(
+                f"{key}: generate",
+                sum(t["seconds"] for t in timed),
+                f"{len(timed)} scene(s), {views} views, "
+                f"{sum(t['s_per_view'] * t['views'] for t in timed) / views:.2f} s per view"
+                + (f"; {missing} scene(s) made earlier, not timed" if missing else ""),
+            )
         start = time.perf_counter()
         group = root / requests[0].folder.split("/")[0]
         report = validate_dataset(group)
@@ -274,20 +315,33 @@ def reproduce(config: ReproduceConfig, out: Path, results_md: Path,
         if not model.is_file() or any(made.get(k) != v for k, v in wanted.items()):
             print(f"training A2C (the paper's network) on {key} train split for {timesteps} steps", flush=True)
             start = time.perf_counter()
-            train_a2c(root, scenario_name, total_timesteps=timesteps, seed=config.seed,
-                      out_path=model, n_envs=config.n_envs, crop=crop_name, device="cpu", keep=KEEP,
-                      force=True)  # its own work folder: a checkpoint of other settings is redone, as said above
+            train_a2c(
+                root,
+                scenario_name,
+                total_timesteps=timesteps,
+                seed=config.seed,
+                out_path=model,
+                n_envs=config.n_envs,
+                crop=crop_name,
+                device="cpu",
+                keep=KEEP,
+                force=True,
+            )  # its own work folder: a checkpoint of other settings is redone, as said above
             seconds = time.perf_counter() - start
             write_json_atomic(stamp, {**wanted, "seconds": seconds})
-            record(f"{key}: train A2C", seconds,
-                   f"{timesteps} steps, {timesteps / seconds:.1f} steps/s (incl. cache build)")
+            record(
+                f"{key}: train A2C",
+                seconds,
+                f"{timesteps} steps, {timesteps / seconds:.1f} steps/s (incl. cache build)",
+            )
         print(f"benchmark on split {split!r}: {config.sessions} x {config.episodes} episodes", flush=True)
         results_json = out / "results" / f"{key}.json"
         results = _reusable_results(results_json, model, split, config)
         if results is None:
             start = time.perf_counter()
-            results = run_baselines(root, scenario_name, crop_name, split, config.episodes,
-                                    config.sessions, config.seed, model=model)
+            results = run_baselines(
+                root, scenario_name, crop_name, split, config.episodes, config.sessions, config.seed, model=model
+            )
             write_or_rescue(results_json, partial(write_json, results), "the results")
             plot_results(results, results_json.with_suffix(".png"))
             record(f"{key}: evaluate", time.perf_counter() - start, f"split {split}")
@@ -313,8 +367,12 @@ def _reusable_results(path: Path, model: Path, split: str, config: ReproduceConf
         fresh = path.stat().st_mtime >= model.stat().st_mtime
     except OSError:
         return None
-    same = (protocol.get("split") == split and protocol.get("episodes") == config.episodes
-            and protocol.get("sessions") == config.sessions and protocol.get("seed") == config.seed)
+    same = (
+        protocol.get("split") == split
+        and protocol.get("episodes") == config.episodes
+        and protocol.get("sessions") == config.sessions
+        and protocol.get("seed") == config.seed
+    )
     # Evaluations from before the Best fixed action row and the uniform start rule are run anew.
     current = protocol.get("start_rule") == "pairs" and "Best fixed action" in results.get("policies", {})
     return results if fresh and same and current and "A2C" in results.get("policies", {}) else None
@@ -343,15 +401,23 @@ def _summary(results: dict[str, Any]) -> dict[str, Any]:
     from davis_ag.benchmark.paired import PAIRED_KEY, a2c_against_best_fixed
 
     kept = ("exact", "action_counts", "play", "action")
-    summary = {"protocol": results["protocol"],
-               "policies": {name: {**{k: {s: v[s] for s in ("mean", "std", "sem") if s in v}
-                                      for k, v in stats.items() if isinstance(v, dict) and "mean" in v},
-                                   **{k: stats[k] for k in kept if k in stats}}
-                            for name, stats in results["policies"].items()}}
+    summary = {
+        "protocol": results["protocol"],
+        "policies": {
+            name: {
+                **{
+                    k: {s: v[s] for s in ("mean", "std", "sem") if s in v}
+                    for k, v in stats.items()
+                    if isinstance(v, dict) and "mean" in v
+                },
+                **{k: stats[k] for k in kept if k in stats},
+            }
+            for name, stats in results["policies"].items()
+        },
+    }
     for key in ("fixed_actions", "train_split"):
         if key in results:
             summary[key] = results[key]
     if paired := a2c_against_best_fixed(results):  # needs the episodes, which the summary leaves out
         summary[PAIRED_KEY] = paired
     return summary
-

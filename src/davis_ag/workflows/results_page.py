@@ -31,21 +31,29 @@ from davis_ag.workflows.results_policies import (
 
 #: Table 4 of the paper: scenario -> metric -> policy -> value.
 PAPER_TABLE4: dict[str, dict[str, dict[str, float]]] = {
-    "sp": {"oer_tau": {"A2C": .520, "LRD": .433, "UDD": .371, "Rand": .438},
-           "reward": {"A2C": .052, "LRD": .026, "UDD": .008, "Rand": .027},
-           "length": {"A2C": 2.987, "LRD": 2.157, "UDD": 2.137, "Rand": 2.652}},
-    "mp": {"oer_tau": {"A2C": .369, "LRD": .316, "UDD": .313, "Rand": .340},
-           "reward": {"A2C": .020, "LRD": .006, "UDD": .004, "Rand": .012},
-           "length": {"A2C": 5.000, "LRD": 2.558, "UDD": 2.683, "Rand": 4.163}},
+    "sp": {
+        "oer_tau": {"A2C": 0.520, "LRD": 0.433, "UDD": 0.371, "Rand": 0.438},
+        "reward": {"A2C": 0.052, "LRD": 0.026, "UDD": 0.008, "Rand": 0.027},
+        "length": {"A2C": 2.987, "LRD": 2.157, "UDD": 2.137, "Rand": 2.652},
+    },
+    "mp": {
+        "oer_tau": {"A2C": 0.369, "LRD": 0.316, "UDD": 0.313, "Rand": 0.340},
+        "reward": {"A2C": 0.020, "LRD": 0.006, "UDD": 0.004, "Rand": 0.012},
+        "length": {"A2C": 5.000, "LRD": 2.558, "UDD": 2.683, "Rand": 4.163},
+    },
 }
 #: Table 4's standard deviations (over its three sets of 200 episodes), in the same layout.
 PAPER_TABLE4_STD: dict[str, dict[str, dict[str, float]]] = {
-    "sp": {"oer_tau": {"A2C": .004, "LRD": .007, "UDD": .008, "Rand": .101},
-           "reward": {"A2C": .001, "LRD": .002, "UDD": .002, "Rand": .002},
-           "length": {"A2C": .008, "LRD": .043, "UDD": .036, "Rand": .056}},
-    "mp": {"oer_tau": {"A2C": .009, "LRD": .008, "UDD": .006, "Rand": .002},
-           "reward": {"A2C": .003, "LRD": .002, "UDD": .001, "Rand": .002},
-           "length": {"A2C": .000, "LRD": .097, "UDD": .118, "Rand": .058}},
+    "sp": {
+        "oer_tau": {"A2C": 0.004, "LRD": 0.007, "UDD": 0.008, "Rand": 0.101},
+        "reward": {"A2C": 0.001, "LRD": 0.002, "UDD": 0.002, "Rand": 0.002},
+        "length": {"A2C": 0.008, "LRD": 0.043, "UDD": 0.036, "Rand": 0.056},
+    },
+    "mp": {
+        "oer_tau": {"A2C": 0.009, "LRD": 0.008, "UDD": 0.006, "Rand": 0.002},
+        "reward": {"A2C": 0.003, "LRD": 0.002, "UDD": 0.001, "Rand": 0.002},
+        "length": {"A2C": 0.000, "LRD": 0.097, "UDD": 0.118, "Rand": 0.058},
+    },
 }
 #: The orderings of OER_tau that section VI reads from Table 4: each step is ``>`` (better) or
 #: ``~`` (about equal), left to right.
@@ -72,12 +80,15 @@ def machine_description() -> str:
     except OSError:
         pass
     gpu = torch.cuda.get_device_name(0) if torch.cuda.is_available() else "no GPU"
-    return (f"{os.cpu_count()} CPU cores ({cpu}), {gpu}; Python {platform.python_version()}, "
-            f"torch {torch.__version__}, {platform.system()} {platform.release()}")
+    return (
+        f"{os.cpu_count()} CPU cores ({cpu}), {gpu}; Python {platform.python_version()}, "
+        f"torch {torch.__version__}, {platform.system()} {platform.release()}"
+    )
 
 
-def ordering_failures(order: tuple[str, ...], policies: dict[str, dict[str, Any]],
-                      metric: str = "oer_tau") -> list[str] | None:
+def ordering_failures(
+    order: tuple[str, ...], policies: dict[str, dict[str, Any]], metric: str = "oer_tau"
+) -> list[str] | None:
     """The steps of an ordering such as ``A2C > Rand ~ LRD > UDD`` that measured means and stds break.
 
     ``a > b`` holds when a's mean exceeds b's; ``a ~ b`` when the means differ by no more than the
@@ -98,13 +109,14 @@ def ordering_failures(order: tuple[str, ...], policies: dict[str, dict[str, Any]
             failures.append(f"{left} > {right} fails: {cell(a['mean'])} is not above {cell(b['mean'])}")
         gap, spread = abs(a["mean"] - b["mean"]), a["std"] + b["std"]
         if relation == "~" and gap > spread:
-            failures.append(f"{left} ~ {right} fails: {cell(a['mean'])} and {cell(b['mean'])} are "
-                            f"{cell(gap)} apart, more than their stds added ({cell(spread)})")
+            failures.append(
+                f"{left} ~ {right} fails: {cell(a['mean'])} and {cell(b['mean'])} are "
+                f"{cell(gap)} apart, more than their stds added ({cell(spread)})"
+            )
     return failures
 
 
-def ordering_holds(order: tuple[str, ...], policies: dict[str, dict[str, Any]],
-                   metric: str = "oer_tau") -> bool | None:
+def ordering_holds(order: tuple[str, ...], policies: dict[str, dict[str, Any]], metric: str = "oer_tau") -> bool | None:
     """Whether an ordering holds for measured means and stds (:func:`ordering_failures`).
 
     Returns:
@@ -116,11 +128,20 @@ def ordering_holds(order: tuple[str, ...], policies: dict[str, dict[str, Any]],
 
 def _a2c_play(state: dict[str, Any]) -> str:
     """How the run's A2C played: ``sampled``, ``deterministic`` (the default before it was recorded)."""
-    plays = {r["policies"]["A2C"].get("play", "deterministic")
-             for r in state.get("results", {}).values() if "A2C" in r.get("policies", {})}
+    plays = {
+        r["policies"]["A2C"].get("play", "deterministic")
+        for r in state.get("results", {}).values()
+        if "A2C" in r.get("policies", {})
+    }
     if not plays:
         return "not evaluated yet"
-    return "sampled" if plays == {"sampled"} else "deterministic" if plays <= {"deterministic"} else "sampled and deterministic"
+    return (
+        "sampled"
+        if plays == {"sampled"}
+        else "deterministic"
+        if plays <= {"deterministic"}
+        else "sampled and deterministic"
+    )
 
 
 def _counted(counter: Counter) -> str:
@@ -136,14 +157,18 @@ def scene_provenance(dataset: Path, scenes: list[str]) -> list[str]:
         # Scenes from before the Canopy Generator plants record no generator: PlantArchitecture's.
         plants[f"`--plants {meta.plant_generator or 'architecture'}`"] += 1
         renderer = meta.renderer or RendererRecord()
-        renderers[f"{renderer.name or '?'} renderer, {renderer.look or '?'} look, antialiasing: "
-                  f"{renderer.antialiasing or '?'}"] += 1
+        renderers[
+            f"{renderer.name or '?'} renderer, {renderer.look or '?'} look, antialiasing: "
+            f"{renderer.antialiasing or '?'}"
+        ] += 1
         camera = meta.camera or CameraRecord()
         sizes[f"{camera.width or '?'}x{camera.height or '?'}"] += 1
-    lines = [f"code: {_counted(versions)}"
-             + (" — made by more than one version of the code" if len(versions) > 1 else ""),
-             f"plants grown by {_counted(plants)}",
-             f"drawn with the {_counted(renderers)}", f"image size {_counted(sizes)}"]
+    lines = [
+        f"code: {_counted(versions)}" + (" — made by more than one version of the code" if len(versions) > 1 else ""),
+        f"plants grown by {_counted(plants)}",
+        f"drawn with the {_counted(renderers)}",
+        f"image size {_counted(sizes)}",
+    ]
     return lines
 
 
@@ -157,13 +182,18 @@ def training_provenance(record: dict[str, Any]) -> str:
     """A sentence on how a model was trained: steps, sittings, the code of each, steps per second."""
     sittings = record.get("sittings", [])
     codes = Counter(s.get("code", "unrecorded") for s in sittings)
-    text = (f"{record.get('timesteps', 0):,} steps in {len(sittings)} sitting(s), "
-            f"{record.get('seconds', 0) / 3600:.2f} h, {record.get('steps_per_second', 0):.1f} steps/s; "
-            f"network `{record.get('arch', '?')}`, {record.get('n_envs', '?')} environments, settings "
-            + (", ".join(f"{k}={v}" for k, v in record["a2c_settings"].items()) if "a2c_settings" in record
-               else "not recorded (SB3's defaults)")
-            + " over SB3's A2C defaults, code "
-            + ", ".join(codes))
+    text = (
+        f"{record.get('timesteps', 0):,} steps in {len(sittings)} sitting(s), "
+        f"{record.get('seconds', 0) / 3600:.2f} h, {record.get('steps_per_second', 0):.1f} steps/s; "
+        f"network `{record.get('arch', '?')}`, {record.get('n_envs', '?')} environments, settings "
+        + (
+            ", ".join(f"{k}={v}" for k, v in record["a2c_settings"].items())
+            if "a2c_settings" in record
+            else "not recorded (SB3's defaults)"
+        )
+        + " over SB3's A2C defaults, code "
+        + ", ".join(codes)
+    )
     if len(codes) > 1:
         text += " — the code changed between sittings"
     selection = record.get("selection")
@@ -171,10 +201,12 @@ def training_provenance(record: dict[str, Any]) -> str:
         scores = selection["scores"]
         kept = next(s for s in scores if s["step"] == selection["kept_step"])
         last = max(scores, key=lambda s: s["step"])
-        text += (f"; kept the snapshot at {kept['step']:,} steps, the best of {len(scores)} scored on the "
-                 f"train split ({selection['episodes']} {selection['play']} episodes each, every "
-                 f"{selection['every']:,} steps): train OER_tau {kept['oer_tau']:.3f}, the last snapshot's "
-                 f"{last['oer_tau']:.3f}")
+        text += (
+            f"; kept the snapshot at {kept['step']:,} steps, the best of {len(scores)} scored on the "
+            f"train split ({selection['episodes']} {selection['play']} episodes each, every "
+            f"{selection['every']:,} steps): train OER_tau {kept['oer_tau']:.3f}, the last snapshot's "
+            f"{last['oer_tau']:.3f}"
+        )
     else:
         text += "; kept the last snapshot"
     return text
@@ -187,40 +219,57 @@ def _notes(config: Any, state: dict[str, Any], out: Path | None) -> list[str]:
         record = training_record(out, key)
         steps, rate = record.get("timesteps"), record.get("steps_per_second")
         if steps and rate and steps < PAPER_TIMESTEPS:
-            notes.append(f"A2C on {key} trained for {steps:,} environment steps, {steps / PAPER_TIMESTEPS:.1%} of "
-                         f"the paper's 300K, at {rate:.1f} steps/s on this machine: the A2C column is an "
-                         "under-trained agent, not the paper's.")
+            notes.append(
+                f"A2C on {key} trained for {steps:,} environment steps, {steps / PAPER_TIMESTEPS:.1%} of "
+                f"the paper's 300K, at {rate:.1f} steps/s on this machine: the A2C column is an "
+                "under-trained agent, not the paper's."
+            )
         result = state.get("results", {}).get(scenario)
         if result:
             protocol = result["protocol"]
             scenes = protocol.get("scenes", [])
             if protocol["split"] == "all":
-                notes.append(f"{key}: only {len(scenes)} scene(s), so no test scene exists; the "
-                             "benchmark ran on split `all`, i.e. on the scene(s) A2C trained on "
-                             "(in-sample for A2C; the heuristics and the Oracle do not learn).")
+                notes.append(
+                    f"{key}: only {len(scenes)} scene(s), so no test scene exists; the "
+                    "benchmark ran on split `all`, i.e. on the scene(s) A2C trained on "
+                    "(in-sample for A2C; the heuristics and the Oracle do not learn)."
+                )
             else:
-                notes.append(f"{key}: evaluated on the test split, {len(scenes)} scene(s): "
-                             f"{', '.join(scenes)} (70/30 split by scene, seeded).")
+                notes.append(
+                    f"{key}: evaluated on the test split, {len(scenes)} scene(s): "
+                    f"{', '.join(scenes)} (70/30 split by scene, seeded)."
+                )
     for scenario, result in state.get("results", {}).items():
         lengths = {n: p.get("length", {}).get("mean") for n, p in result["policies"].items()}
         if lengths.get("LRD") is not None and lengths.get("LRD") == lengths.get("UDD"):
-            notes.append(f"{scenario.upper()}: LRD and UDD have the same episode lengths because every "
-                         "policy plays the same seeded episodes with the same agent seeds, and both "
-                         "draw `done` with probability 1/3 at each step (common random numbers).")
-    notes.append("Stage times are wall times; a resumed run keeps each scene's own time. Other "
-                 "work may share the machine, so rates (e.g. A2C steps/s) can vary between stages.")
-    notes.append("Oracle is not in the paper: it plays the best reachable final OER within tau "
-                 "steps from the environment's tables, an upper bound for any policy.")
+            notes.append(
+                f"{scenario.upper()}: LRD and UDD have the same episode lengths because every "
+                "policy plays the same seeded episodes with the same agent seeds, and both "
+                "draw `done` with probability 1/3 at each step (common random numbers)."
+            )
+    notes.append(
+        "Stage times are wall times; a resumed run keeps each scene's own time. Other "
+        "work may share the machine, so rates (e.g. A2C steps/s) can vary between stages."
+    )
+    notes.append(
+        "Oracle is not in the paper: it plays the best reachable final OER within tau "
+        "steps from the environment's tables, an upper bound for any policy."
+    )
     for scenario, result in state.get("results", {}).items():
         protocol = result["protocol"]
         rule = protocol.get("start_rule", "scene")
-        how = ("uniform over every eligible (view, target) pair of the split's scenes" if rule == "pairs" else
-               "a scene first, then a view of it, then a target, each uniformly (the rule before; a scene "
-               "with few eligible starts gets as many episodes as one with many)")
+        how = (
+            "uniform over every eligible (view, target) pair of the split's scenes"
+            if rule == "pairs"
+            else "a scene first, then a view of it, then a target, each uniformly (the rule before; a scene "
+            "with few eligible starts gets as many episodes as one with many)"
+        )
         count = f" ({protocol['starts']} eligible starts)" if "starts" in protocol else ""
-        notes.append(f"{scenario.upper()} episode starts{count}: {how}. Eligible (section V-C): a boxed target "
-                     "with OER < 0.4 and at least the crop's pixel threshold; reward max(OER_end - OER_0, 0)^2 "
-                     "at the end.")
+        notes.append(
+            f"{scenario.upper()} episode starts{count}: {how}. Eligible (section V-C): a boxed target "
+            "with OER < 0.4 and at least the crop's pixel threshold; reward max(OER_end - OER_0, 0)^2 "
+            "at the end."
+        )
     return notes
 
 
@@ -257,8 +306,11 @@ def stage_rows(state: dict[str, Any], out: Path | None) -> list[tuple[str, float
         key, _, step = stage.partition(": ")
         seconds, code, note = entry["seconds"], entry.get("code", "unrecorded"), entry["note"]
         if out is not None and step == "generate" and state.get("scene_folders", {}).get(key):
-            code = _counted(Counter(_code_version(out / "dataset" / scene / SCENE_METADATA)
-                                    for scene in state["scene_folders"][key]))
+            code = _counted(
+                Counter(
+                    _code_version(out / "dataset" / scene / SCENE_METADATA) for scene in state["scene_folders"][key]
+                )
+            )
         record: dict[str, Any] = {}
         if step == "train A2C" and out is not None:  # only a training stage has a record
             record = training_record(out, key)
@@ -266,27 +318,35 @@ def stage_rows(state: dict[str, Any], out: Path | None) -> list[tuple[str, float
             sittings = record["sittings"]
             seconds = record.get("seconds", seconds)
             code = ", ".join(dict.fromkeys(s.get("code", "unrecorded") for s in sittings))
-            note = (f"{record.get('timesteps', 0):,} steps in {len(sittings)} sitting(s), "
-                    f"{record.get('steps_per_second', 0):.1f} steps/s over the sittings' wall time")
+            note = (
+                f"{record.get('timesteps', 0):,} steps in {len(sittings)} sitting(s), "
+                f"{record.get('steps_per_second', 0):.1f} steps/s over the sittings' wall time"
+            )
         rows.append((stage, seconds, code, note))
     return rows
 
 
 def _comparison(scenario: str, policies: dict[str, dict[str, Any]]) -> str:
     order = PAPER_ORDERINGS[scenario]
-    paper = {name: {"oer_tau": {"mean": value, "std": PAPER_TABLE4_STD[scenario]["oer_tau"][name]}}
-             for name, value in PAPER_TABLE4[scenario]["oer_tau"].items()}
+    paper = {
+        name: {"oer_tau": {"mean": value, "std": PAPER_TABLE4_STD[scenario]["oer_tau"][name]}}
+        for name, value in PAPER_TABLE4[scenario]["oer_tau"].items()
+    }
     failures = ordering_failures(order, policies)
     text = " ".join(order)
     if failures is None:
         return f"The paper's ordering of OER_tau, {text}, cannot be checked: a policy was not run."
-    measured = ", ".join(f"{name} {cell(policies[name]['oer_tau']['mean'])} ± {cell(policies[name]['oer_tau']['std'])}"
-                         for name in order[::2])
+    measured = ", ".join(
+        f"{name} {cell(policies[name]['oer_tau']['mean'])} ± {cell(policies[name]['oer_tau']['std'])}"
+        for name in order[::2]
+    )
     verdict = "holds" if not failures else "does not hold"
     paper_note = "" if ordering_holds(order, paper) else " (nor does it hold in Table 4's own numbers)"
     where = "" if not failures else " " + "; ".join(failures) + "."
-    return (f"The paper's ordering of OER_tau, {text} (`>`: higher mean; `~`: means within the two standard "
-            f"deviations added), **{verdict}** in this run{paper_note}: {measured}.{where}")
+    return (
+        f"The paper's ordering of OER_tau, {text} (`>`: higher mean; `~`: means within the two standard "
+        f"deviations added), **{verdict}** in this run{paper_note}: {measured}.{where}"
+    )
 
 
 #: The README's block that holds the run's OER_tau beside Table 4's (see :func:`readme_block`).
@@ -304,40 +364,72 @@ def readme_block(config: Any, state: dict[str, Any]) -> str:
         Markdown: a line on the run, a table, a line per ordering.
     """
     results = state.get("results", {})
-    head = (f"`{config.name}` run (docs/results.md): {config.sp_scenes} SP strawberry and {config.mp_scenes} "
-            f"MP vine scenes at {config.size[0]}x{config.size[1]}, A2C {config.sp_timesteps:,} (SP) and "
-            f"{config.mp_timesteps:,} (MP) steps; OER_tau, mean ± std over {config.sessions} sessions of "
-            f"{config.episodes} episodes on the split each row names. Table 4's rows are the paper's.")
-    lines = [head, "", "| | A2C | LRD | UDD | Rand | Oracle (ours only) | Best fixed action (ours only) |",
-             "|---|---|---|---|---|---|---|"]
+    head = (
+        f"`{config.name}` run (docs/results.md): {config.sp_scenes} SP strawberry and {config.mp_scenes} "
+        f"MP vine scenes at {config.size[0]}x{config.size[1]}, A2C {config.sp_timesteps:,} (SP) and "
+        f"{config.mp_timesteps:,} (MP) steps; OER_tau, mean ± std over {config.sessions} sessions of "
+        f"{config.episodes} episodes on the split each row names. Table 4's rows are the paper's."
+    )
+    lines = [
+        head,
+        "",
+        "| | A2C | LRD | UDD | Rand | Oracle (ours only) | Best fixed action (ours only) |",
+        "|---|---|---|---|---|---|---|",
+    ]
     verdicts = []
     for scenario in ("sp", "mp"):
         result = results.get(scenario)
         if result:
             policies = result["policies"]
             scenes, split = len(result["protocol"].get("scenes", [])), result["protocol"]["split"]
-            cells = [f"{cell(policies[n]['oer_tau']['mean'])} ± {cell(policies[n]['oer_tau']['std'])}"
-                     if n in policies else "–" for n in ("A2C", "LRD", "UDD", "Rand", "Oracle", BEST_FIXED)]
-            lines.append(f"| {TITLES[scenario]}, ours ({scenes} {split} scene{'s' if scenes != 1 else ''}) | "
-                         + " | ".join(cells) + " |")
+            cells = [
+                f"{cell(policies[n]['oer_tau']['mean'])} ± {cell(policies[n]['oer_tau']['std'])}"
+                if n in policies
+                else "–"
+                for n in ("A2C", "LRD", "UDD", "Rand", "Oracle", BEST_FIXED)
+            ]
+            lines.append(
+                f"| {TITLES[scenario]}, ours ({scenes} {split} scene{'s' if scenes != 1 else ''}) | "
+                + " | ".join(cells)
+                + " |"
+            )
             failures = ordering_failures(PAPER_ORDERINGS[scenario], policies)
-            verdict = ("not checked" if failures is None else "**holds**" if not failures
-                       else "**does not hold** (" + "; ".join(failures) + ")")
+            verdict = (
+                "not checked"
+                if failures is None
+                else "**holds**"
+                if not failures
+                else "**does not hold** (" + "; ".join(failures) + ")"
+            )
             verdicts.append(f"{TITLES[scenario]}: {' '.join(PAPER_ORDERINGS[scenario])} {verdict}.")
         else:
             lines.append(f"| {TITLES[scenario]}, ours | not run | | | | | |")
         paper = PAPER_TABLE4[scenario]["oer_tau"]
-        lines.append(f"| {TITLES[scenario]}, paper (Table 4) | "
-                     + " | ".join(f"{cell(paper[n])} ± {cell(PAPER_TABLE4_STD[scenario]['oer_tau'][n])}"
-                                  for n in ("A2C", "LRD", "UDD", "Rand")) + " | - | - |")
+        lines.append(
+            f"| {TITLES[scenario]}, paper (Table 4) | "
+            + " | ".join(
+                f"{cell(paper[n])} ± {cell(PAPER_TABLE4_STD[scenario]['oer_tau'][n])}"
+                for n in ("A2C", "LRD", "UDD", "Rand")
+            )
+            + " | - | - |"
+        )
     if verdicts:
-        lines += ["", "The paper's orderings in this run (`~`: means within their two standard deviations "
-                  "added): " + " ".join(verdicts)]
-    gaps = [f"{TITLES[s]} {signed(p['gap'])} ({signed(p['low'])} to {signed(p['high'])})"
-            for s in ("sp", "mp") if (p := results.get(s, {}).get(PAIRED_KEY))]
+        lines += [
+            "",
+            "The paper's orderings in this run (`~`: means within their two standard deviations "
+            "added): " + " ".join(verdicts),
+        ]
+    gaps = [
+        f"{TITLES[s]} {signed(p['gap'])} ({signed(p['low'])} to {signed(p['high'])})"
+        for s in ("sp", "mp")
+        if (p := results.get(s, {}).get(PAIRED_KEY))
+    ]
     if gaps:
-        lines += ["", f"A2C minus `{BEST_FIXED}` on the same episodes ({CONFIDENCE:.0%} bootstrap interval over "
-                  "the test episodes): " + ", ".join(gaps) + "."]
+        lines += [
+            "",
+            f"A2C minus `{BEST_FIXED}` on the same episodes ({CONFIDENCE:.0%} bootstrap interval over "
+            "the test episodes): " + ", ".join(gaps) + ".",
+        ]
     return "\n".join(lines)
 
 
@@ -361,8 +453,11 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
     strawberry, vine = crop_spec("strawberry"), crop_spec("vine")
     sp_views = views_per_scene(scenario_spec("sp", strawberry), strawberry)
     mp_views = views_per_scene(scenario_spec("mp", vine), vine)
-    mp_grid = (f"{config.mp_extent[0]:g} x {config.mp_extent[1]:g} m around the middle vine"
-               if config.mp_extent else f"Table 2's 7 x 3 m, {mp_views} views each")
+    mp_grid = (
+        f"{config.mp_extent[0]:g} x {config.mp_extent[1]:g} m around the middle vine"
+        if config.mp_extent
+        else f"Table 2's 7 x 3 m, {mp_views} views each"
+    )
     lines = [
         "# Table 4 reproduction",
         "",
@@ -391,19 +486,26 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
             lines += ["Not run (yet): the run stopped before this benchmark.", ""]
             continue
         protocol, policies = result["protocol"], result["policies"]
-        lines += [f"Split `{protocol['split']}` ({len(protocol.get('scenes', []))} scene(s)), "
-                  f"tau = {protocol['tau']}; ours: mean ± std over {protocol['sessions']} "
-                  f"sessions of {protocol['episodes']} episodes.", "",
-                  "| Policy | OER_tau ours | OER_tau paper | Cum. reward ours | Cum. reward paper "
-                  "| Ep. length ours | Ep. length paper |", "|---|---|---|---|---|---|---|"]
+        lines += [
+            f"Split `{protocol['split']}` ({len(protocol.get('scenes', []))} scene(s)), "
+            f"tau = {protocol['tau']}; ours: mean ± std over {protocol['sessions']} "
+            f"sessions of {protocol['episodes']} episodes.",
+            "",
+            "| Policy | OER_tau ours | OER_tau paper | Cum. reward ours | Cum. reward paper "
+            "| Ep. length ours | Ep. length paper |",
+            "|---|---|---|---|---|---|---|",
+        ]
         for name in ordered(policies):
             cells = [name]
             for metric in ("oer_tau", "reward", "length"):
                 stat = policies[name][metric]
                 cells.append(f"{cell(stat['mean'])} ± {cell(stat['std'])}")
                 paper_mean = PAPER_TABLE4[scenario][metric].get(name)
-                cells.append(cell(paper_mean) if paper_mean is None
-                             else f"{cell(paper_mean)} ± {cell(PAPER_TABLE4_STD[scenario][metric][name])}")
+                cells.append(
+                    cell(paper_mean)
+                    if paper_mean is None
+                    else f"{cell(paper_mean)} ± {cell(PAPER_TABLE4_STD[scenario][metric][name])}"
+                )
             lines.append("| " + " | ".join(cells) + " |")
         lines += ["", _comparison(scenario, policies)]
         if "oer_0" in policies.get("LRD", {}):
@@ -411,9 +513,11 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
             done = result.get("fixed_actions", {}).get("done")
             if done:
                 # Always `done` ends where it starts: its exact OER_tau is the mean OER_0 of all starts.
-                text += (f", against {cell(done['oer_tau'])} over every eligible start of the split (exact). "
-                         "Every policy plays the same drawn starts, so the draw moves all their sampled "
-                         "means together; the exact values below do not depend on it")
+                text += (
+                    f", against {cell(done['oer_tau'])} over every eligible start of the split (exact). "
+                    "Every policy plays the same drawn starts, so the draw moves all their sampled "
+                    "means together; the exact values below do not depend on it"
+                )
             lines += ["", text + "."]
         lines.append("")
         lines += policy_sections(scenario, result, out, Path(path))

@@ -63,11 +63,12 @@ def versus_best_fixed(policies: dict[str, Any]) -> str | None:
     a, b = policies["A2C"]["oer_tau"], policies[BEST_FIXED]["oer_tau"]
     gap, spread = a["mean"] - b["mean"], a["std"] + b["std"]
     action = policies[BEST_FIXED].get("action", "?")
-    verdict = ("**beats** it" if gap > spread else
-               "**does not beat** it by more than their standard deviations added")
-    return (f"A2C against `{BEST_FIXED}` (always `{action}`): OER_tau {cell(a['mean'])} ± {cell(a['std'])} "
-            f"against {cell(b['mean'])} ± {cell(b['std'])}, {cell(gap) if gap >= 0 else '-' + cell(-gap)} "
-            f"apart, stds added {cell(spread)}: A2C {verdict}.")
+    verdict = "**beats** it" if gap > spread else "**does not beat** it by more than their standard deviations added"
+    return (
+        f"A2C against `{BEST_FIXED}` (always `{action}`): OER_tau {cell(a['mean'])} ± {cell(a['std'])} "
+        f"against {cell(b['mean'])} ± {cell(b['std'])}, {cell(gap) if gap >= 0 else '-' + cell(-gap)} "
+        f"apart, stds added {cell(spread)}: A2C {verdict}."
+    )
 
 
 def signed(value: float) -> str:
@@ -82,15 +83,20 @@ def paired_line(result: dict[str, Any]) -> str | None:
         return None
     scenes = paired["per_scene"]
     ahead = sum(s["gap"] > 0 for s in scenes)
-    per_scene = "; ".join(f"{s['scene']} {signed(s['gap'])} ({s['episodes']} episodes, {s['starts']:,} "
-                          f"start{'s' if s['starts'] != 1 else ''})" for s in scenes)
+    per_scene = "; ".join(
+        f"{s['scene']} {signed(s['gap'])} ({s['episodes']} episodes, {s['starts']:,} "
+        f"start{'s' if s['starts'] != 1 else ''})"
+        for s in scenes
+    )
     side = "above" if paired["low"] > 0 else "below" if paired["high"] < 0 else "on both sides of"
-    return (f"Episode by episode (every policy plays the same {paired['episodes']} episodes), A2C minus "
-            f"`{BEST_FIXED}`: {signed(paired['gap'])}, {CONFIDENCE:.0%} bootstrap interval over episodes "
-            f"{signed(paired['low'])} to {signed(paired['high'])} ({RESAMPLES:,} resamples), {side} zero. "
-            f"Per test scene: {per_scene}; A2C is ahead on {ahead} of {len(scenes)}. The interval covers the "
-            "starts these test scenes hold, not other scenes; the per-scene gaps hint at how much the scene "
-            "matters.")
+    return (
+        f"Episode by episode (every policy plays the same {paired['episodes']} episodes), A2C minus "
+        f"`{BEST_FIXED}`: {signed(paired['gap'])}, {CONFIDENCE:.0%} bootstrap interval over episodes "
+        f"{signed(paired['low'])} to {signed(paired['high'])} ({RESAMPLES:,} resamples), {side} zero. "
+        f"Per test scene: {per_scene}; A2C is ahead on {ahead} of {len(scenes)}. The interval covers the "
+        "starts these test scenes hold, not other scenes; the per-scene gaps hint at how much the scene "
+        "matters."
+    )
 
 
 def exact_table(policies: dict[str, Any], fixed: dict[str, dict[str, float]] | None) -> list[str]:
@@ -98,11 +104,14 @@ def exact_table(policies: dict[str, Any], fixed: dict[str, dict[str, float]] | N
     names = [n for n in ordered(policies) if "exact" in policies[n]]
     if not names:
         return []
-    lines = ["Exact expectations (dynamic programming over the environment's move tables, every start "
-             "of the split weighted as episodes draw it) beside the sampled means (± standard error of "
-             "the mean over all episodes):", "",
-             "| Policy | OER_tau sampled | OER_tau exact | Reward sampled | Reward exact "
-             "| Length sampled | Length exact |", "|---|---|---|---|---|---|---|"]
+    lines = [
+        "Exact expectations (dynamic programming over the environment's move tables, every start "
+        "of the split weighted as episodes draw it) beside the sampled means (± standard error of "
+        "the mean over all episodes):",
+        "",
+        "| Policy | OER_tau sampled | OER_tau exact | Reward sampled | Reward exact | Length sampled | Length exact |",
+        "|---|---|---|---|---|---|---|",
+    ]
     for name in names:
         row = [name]
         for key in ("oer_tau", "reward", "length"):
@@ -110,8 +119,12 @@ def exact_table(policies: dict[str, Any], fixed: dict[str, dict[str, float]] | N
             row += [f"{cell(stat['mean'])} ± {cell(stat.get('sem'))}", cell(policies[name]["exact"][key])]
         lines.append("| " + " | ".join(row) + " |")
     if fixed:
-        lines += ["", "Exact OER_tau of every fixed action on this split: "
-                  + ", ".join(f"{action} {cell(v['oer_tau'])}" for action, v in fixed.items()) + "."]
+        lines += [
+            "",
+            "Exact OER_tau of every fixed action on this split: "
+            + ", ".join(f"{action} {cell(v['oer_tau'])}" for action, v in fixed.items())
+            + ".",
+        ]
     return lines + [""]
 
 
@@ -120,8 +133,12 @@ def action_table(policies: dict[str, Any], actions: list[str]) -> list[str]:
     names = [n for n in ordered(policies) if "action_counts" in policies[n]]
     if not names or not actions:
         return []
-    lines = ["Share of each action over every step played (%):", "",
-             "| Policy | " + " | ".join(actions) + " |", "|---" * (len(actions) + 1) + "|"]
+    lines = [
+        "Share of each action over every step played (%):",
+        "",
+        "| Policy | " + " | ".join(actions) + " |",
+        "|---" * (len(actions) + 1) + "|",
+    ]
     for name in names:
         counts = policies[name]["action_counts"]
         total = max(sum(counts.values()), 1)
@@ -137,14 +154,21 @@ def a2c_line(scenario: str, policies: dict[str, Any], out: Path | None) -> str |
         return None
     record = training_record(out, GROUPS[scenario])
     settings = record.get("a2c_settings", SB3_DEFAULT_SETTINGS if record else None)
-    trained = ("settings not recorded" if settings is None else
-               ", ".join(f"{k}={v}" for k, v in settings.items()) + " over Stable-Baselines3's A2C defaults"
-               " (learning rate 7e-4, n_steps 5, gamma .99, vf_coef .5, max_grad_norm .5, RMSprop)")
+    trained = (
+        "settings not recorded"
+        if settings is None
+        else ", ".join(f"{k}={v}" for k, v in settings.items()) + " over Stable-Baselines3's A2C defaults"
+        " (learning rate 7e-4, n_steps 5, gamma .99, vf_coef .5, max_grad_norm .5, RMSprop)"
+    )
     play = policies["A2C"].get("play", "deterministic")
-    how = ("actions sampled from the policy" if play == "sampled"
-           else "the most likely action at every step (deterministic)")
-    text = (f"A2C: trained with {trained}, on starts drawn by the `{record.get('start_rule', 'scene')}` rule; "
-            f"plays {how}.")
+    how = (
+        "actions sampled from the policy"
+        if play == "sampled"
+        else "the most likely action at every step (deterministic)"
+    )
+    text = (
+        f"A2C: trained with {trained}, on starts drawn by the `{record.get('start_rule', 'scene')}` rule; plays {how}."
+    )
     if "A2C (deterministic)" in policies:
         text += " `A2C (deterministic)` is the same model taking its most likely action."
     text += " The settings and the play were chosen on training scenes only (docs/benchmark.md)."
@@ -168,13 +192,15 @@ def train_split_line(scenario: str, result: dict[str, Any], out: Path | None) ->
     kept, best = scores[selection["kept_step"]], fixed[action]["oer_tau"]
     last_step = max(scores)
     gap = kept - best
-    return (f"On the train split ({train['starts']:,} eligible starts), where the snapshot was chosen: A2C's "
-            f"kept snapshot ({selection['kept_step']:,} steps) scores OER_tau {cell(kept)} "
-            f"({selection['episodes']} {selection['play']} episodes), the best fixed action there "
-            f"(always `{action}`) {cell(best)} exactly, {cell(abs(gap))} {'above' if gap >= 0 else 'below'} it; "
-            f"the last snapshot ({last_step:,} steps) {cell(scores[last_step])}. "
-            "Above it on train but not on test: a policy that does not carry over to unseen scenes; "
-            "not above it on train: a policy that did not learn.")
+    return (
+        f"On the train split ({train['starts']:,} eligible starts), where the snapshot was chosen: A2C's "
+        f"kept snapshot ({selection['kept_step']:,} steps) scores OER_tau {cell(kept)} "
+        f"({selection['episodes']} {selection['play']} episodes), the best fixed action there "
+        f"(always `{action}`) {cell(best)} exactly, {cell(abs(gap))} {'above' if gap >= 0 else 'below'} it; "
+        f"the last snapshot ({last_step:,} steps) {cell(scores[last_step])}. "
+        "Above it on train but not on test: a policy that does not carry over to unseen scenes; "
+        "not above it on train: a policy that did not learn."
+    )
 
 
 def action_figure(scenario: str, out: Path | None, page: Path) -> str | None:
@@ -208,16 +234,28 @@ def learning_curve_section(out: Path | None, page: Path) -> list[str]:
     try:
         plotted = plot_learning_curve(records, target, formats=("png",))
     except UserError:
-        return ["## A2C learning curve", "", "The training records hold no learning curve (models trained "
-                "before curves were kept).", ""]
-    lines = ["## A2C learning curve", "",
-             "Mean episodic reward per 1,000 training steps on the train split (Fig. 4a), read from "
-             "each model's training record:", "", f"![A2C learning curve](images/{target.name}.png)", ""]
+        return [
+            "## A2C learning curve",
+            "",
+            "The training records hold no learning curve (models trained before curves were kept).",
+            "",
+        ]
+    lines = [
+        "## A2C learning curve",
+        "",
+        "Mean episodic reward per 1,000 training steps on the train split (Fig. 4a), read from "
+        "each model's training record:",
+        "",
+        f"![A2C learning curve](images/{target.name}.png)",
+        "",
+    ]
     for key, data in plotted.data.items():
         smoothed = data["smoothed"]
         if smoothed:
-            lines.append(f"- {key}: rolling mean {cell(smoothed[0])} at {data['steps'][0]:,} steps, "
-                         f"{cell(smoothed[-1])} at {data['steps'][-1]:,} steps.")
+            lines.append(
+                f"- {key}: rolling mean {cell(smoothed[0])} at {data['steps'][0]:,} steps, "
+                f"{cell(smoothed[-1])} at {data['steps'][-1]:,} steps."
+            )
     return lines + [""]
 
 
@@ -229,9 +267,12 @@ def policy_sections(scenario: str, result: dict[str, Any], out: Path | None, pag
         if line:
             lines += [line, ""]
     if BEST_FIXED in policies:
-        lines += [f"`{BEST_FIXED}` is the best of the policies that always play the same action, chosen "
-                  "by exact OER_tau on this split and played on the same episodes: a learner that "
-                  "collapsed to one move scores no better than it.", ""]
+        lines += [
+            f"`{BEST_FIXED}` is the best of the policies that always play the same action, chosen "
+            "by exact OER_tau on this split and played on the same episodes: a learner that "
+            "collapsed to one move scores no better than it.",
+            "",
+        ]
     for line in (train_split_line(scenario, result, out), a2c_line(scenario, policies, out)):
         if line:
             lines += [line, ""]

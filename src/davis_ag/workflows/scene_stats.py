@@ -39,8 +39,10 @@ def measure_views() -> dict:
     rows = {}
     for (scenario, crop_name), (scenes, images) in PAPER_TABLE3.items():
         crop = CROPS[crop_name]
-        rows[f"{scenario}-{crop_name}"] = {"ours": views_per_scene(scenario_spec(scenario, crop), crop),
-                                            "paper": images // scenes}
+        rows[f"{scenario}-{crop_name}"] = {
+            "ours": views_per_scene(scenario_spec(scenario, crop), crop),
+            "paper": images // scenes,
+        }
     return rows
 
 
@@ -58,8 +60,14 @@ def measure_plants(count: int, crops: list[str]) -> dict:
             seed = SceneRequest(scenario, crop, index, 0).seed
             model = build_scene(scenario, crop, np.random.default_rng(seed))
             plant = model.plants[0]
-            plants.append({**plant.summary(), "build_s": None if plant.build_s is None else round(plant.build_s, 3),
-                           "scene_seed": seed, "grow_s": round(time.perf_counter() - started, 1)})
+            plants.append(
+                {
+                    **plant.summary(),
+                    "build_s": None if plant.build_s is None else round(plant.build_s, 3),
+                    "scene_seed": seed,
+                    "grow_s": round(time.perf_counter() - started, 1),
+                }
+            )
             print(f"{crop.name} {index}: {plant.fruit_count} fruit", file=sys.stderr, flush=True)
             del model
         out["crops"][crop.name] = plants
@@ -90,9 +98,13 @@ def measure_findings(count: int, size: tuple[int, int], step: float) -> dict:
             request = SceneRequest(scenario, seeable(crop), index, 0, Camera(*size))
             scene_dir, stats = generate_scene(request, root)
             scene = open_dataset(root).scene(f"Single-Strawberry/{index:03d}")
-            scenes.append({**visibility_findings(scene),
-                           "box_oer": published_oer(scene, root, request),
-                           "seconds": round(stats["total_s"], 1)})
+            scenes.append(
+                {
+                    **visibility_findings(scene),
+                    "box_oer": published_oer(scene, root, request),
+                    "seconds": round(stats["total_s"], 1),
+                }
+            )
             print(f"scene {index}: {scenes[-1]['fruit']} fruit", file=sys.stderr, flush=True)
     return {"size": list(size), "step": step, "scenes": scenes}
 
@@ -117,16 +129,17 @@ def measure_refused(count: int, size: tuple[int, int], generators: list[str]) ->
             for crop in CROPS.values():
                 started = time.perf_counter()
                 for index in range(count):
-                    generate_scene(SceneRequest(scenario_spec("sp", crop), crop, index, 0, Camera(*size),
-                                                plants=generator), root)
+                    generate_scene(
+                        SceneRequest(scenario_spec("sp", crop), crop, index, 0, Camera(*size), plants=generator), root
+                    )
                 seconds[crop.name] = round(time.perf_counter() - started, 1)
                 print(f"{generator} {crop.name}: {count} scenes", file=sys.stderr, flush=True)
             groups = refused_move_statistics(open_dataset(root))
-            out["generators"][generator] = {crop.name: {**groups[group_name(scenario_spec("sp"), crop)],
-                                                        "seconds": seconds[crop.name]} for crop in CROPS.values()}
+            out["generators"][generator] = {
+                crop.name: {**groups[group_name(scenario_spec("sp"), crop)], "seconds": seconds[crop.name]}
+                for crop in CROPS.values()
+            }
     return out
-
-
 
 
 def seeable(crop):
@@ -173,8 +186,7 @@ def visibility_findings(scene: Scene) -> dict:
         ix, iy, level, _ = meta.views[view.name].grid or (0, 0, 0, 0)
         seen[ix, iy, level] = {box.fruit_id for box in view.boxes}
     fruit = len(meta.fruits)
-    pairs = [(below, seen[ix, iy, level + 1]) for (ix, iy, level), below in seen.items()
-             if (ix, iy, level + 1) in seen]
+    pairs = [(below, seen[ix, iy, level + 1]) for (ix, iy, level), below in seen.items() if (ix, iy, level + 1) in seen]
     return {
         "fruit": fruit,
         "fruit_per_plant": [p.fruit_count for p in meta.plants],
@@ -184,4 +196,3 @@ def visibility_findings(scene: Scene) -> dict:
         "up_loses": sum(bool(low - high) for low, high in pairs),
         "up_gains": sum(bool(high - low) for low, high in pairs),
     }
-

@@ -86,8 +86,10 @@ def run_transfer(config: TransferConfig, say: Callable[[str], None] = print) -> 
     pool = load_pool(config.real, config.real_images)
     n_train, n_test = split_sizes(len(pool.items), config.train_size, config.test_size)
     if (n_train, n_test) != (config.train_size, config.test_size):
-        say(f"the real set has {len(pool.items)} images: splits of {n_train} train / {n_test} test "
-            f"(the paper's {config.train_size}/{config.test_size} proportions)")
+        say(
+            f"the real set has {len(pool.items)} images: splits of {n_train} train / {n_test} test "
+            f"(the paper's {config.train_size}/{config.test_size} proportions)"
+        )
     with timer.stage("export DAVIS-Ag"):
         say(f"exporting {config.pretrain} for pre-training")
         counts = export_yolo(config.pretrain, out / "pretrain-data", "detect")
@@ -95,13 +97,18 @@ def run_transfer(config: TransferConfig, say: Callable[[str], None] = print) -> 
         raise UserError(f"{config.pretrain}: its train split has no view; give a dataset with train scenes")
     with timer.stage("pre-train"):
         say("pre-training YOLOv5n on DAVIS-Ag")
-        pretrained = train(out / "pretrain-data" / "data.yaml", out / "runs" / "pretrain",
-                           config.pretrain_budget, config.seed)
+        pretrained = train(
+            out / "pretrain-data" / "data.yaml", out / "runs" / "pretrain", config.pretrain_budget, config.seed
+        )
     results: dict[str, Any] = {
         "what": "Table 5 (section VI-B): YOLOv5n, Real-Only vs DAVIS-Ag -> Real",
-        "real_set": config.real_label, "config": _jsonable(config),
-        "pretrain_images": counts, "real_images": len(pool.items),
-        "split_sizes": {"train": n_train, "test": n_test}, "splits": [], "paper_table5": PAPER_TABLE5,
+        "real_set": config.real_label,
+        "config": _jsonable(config),
+        "pretrain_images": counts,
+        "real_images": len(pool.items),
+        "split_sizes": {"train": n_train, "test": n_test},
+        "splits": [],
+        "paper_table5": PAPER_TABLE5,
     }
     for k in range(config.splits):
         seed = config.seed + k
@@ -116,13 +123,20 @@ def run_transfer(config: TransferConfig, say: Callable[[str], None] = print) -> 
             scores: dict[str, Any] = {"split": k + 1, "seed": seed}
             for arm, title in ARMS:
                 say(f"split {k + 1}/{config.splits}: {title}")
-                weights = train(data_yaml, split_dir / "runs" / arm, config.budget, seed,
-                                start=pretrained if arm == "transfer" else None)
+                weights = train(
+                    data_yaml,
+                    split_dir / "runs" / arm,
+                    config.budget,
+                    seed,
+                    start=pretrained if arm == "transfer" else None,
+                )
                 scores[arm] = evaluate(weights, data_yaml, config.budget)
             write_json_atomic(scores_path, scores)
             results["splits"].append(scores)
-    results["wall_s"] = {**{name: round(s, 1) for name, s in timer.stages.items()},
-                         "total": round(time.perf_counter() - started, 1)}
+    results["wall_s"] = {
+        **{name: round(s, 1) for name, s in timer.stages.items()},
+        "total": round(time.perf_counter() - started, 1),
+    }
     write_json_atomic(out / "transfer.json", results)
     return results
 
@@ -131,8 +145,13 @@ def table5_markdown(results: dict[str, Any]) -> str:
     """Our scores in the shape of Table 5, with the paper's Table 5 below for reference."""
     splits = results["splits"]
     n = len(splits)
-    head = ("| | " + " | ".join(f"Real-Only {s['split']}" for s in splits) + " | "
-            + " | ".join(f"DAVIS-Ag -> Real {s['split']}" for s in splits) + " |")
+    head = (
+        "| | "
+        + " | ".join(f"Real-Only {s['split']}" for s in splits)
+        + " | "
+        + " | ".join(f"DAVIS-Ag -> Real {s['split']}" for s in splits)
+        + " |"
+    )
     rule = "|---" * (2 * n + 1) + "|"
     rows = []
     for metric, title in (("map50", "mAP@50"), ("map50_95", "mAP@50:95")):
@@ -142,8 +161,9 @@ def table5_markdown(results: dict[str, Any]) -> str:
     for metric, title in (("map50", "mAP@50"), ("map50_95", "mAP@50:95")):
         cells = [f"{v:.3f}" for arm, _ in ARMS for v in PAPER_TABLE5[arm][metric]]
         paper.append(f"| {title} | " + " | ".join(cells) + " |")
-    return "\n".join([head, rule, *rows, "", "The paper's Table 5 (its real strawberry set, 654/159 images):",
-                      "", *paper])
+    return "\n".join(
+        [head, rule, *rows, "", "The paper's Table 5 (its real strawberry set, 654/159 images):", "", *paper]
+    )
 
 
 def write_results_md(results: dict[str, Any], path: Path, how: str = "") -> Path:
@@ -158,11 +178,12 @@ def write_results_md(results: dict[str, Any], path: Path, how: str = "") -> Path
     pre, bud = cfg["pretrain_budget"], cfg["budget"]
     wall = results["wall_s"]
     lines = [
-        "# Sim-to-real transfer (Table 5, section VI-B)", "",
-        "Written by `davis-ag transfer --results`; every number below was measured by that run.", "",
-        f"**Real set: {results['real_set']}.** " + (
-            "These are stand-in numbers, not comparable to the paper's." if "stand-in" in results["real_set"]
-            else ""),
+        "# Sim-to-real transfer (Table 5, section VI-B)",
+        "",
+        "Written by `davis-ag transfer --results`; every number below was measured by that run.",
+        "",
+        f"**Real set: {results['real_set']}.** "
+        + ("These are stand-in numbers, not comparable to the paper's." if "stand-in" in results["real_set"] else ""),
         "",
         f"- Pre-training: {cfg['pretrain']} ({results['pretrain_images']['train']['images']} train images); "
         f"{pre['epochs']} epochs at {pre['imgsz']} px, batch {pre['batch']}, device {pre['device']}.",
@@ -170,8 +191,11 @@ def write_results_md(results: dict[str, Any], path: Path, how: str = "") -> Path
         f"{results['split_sizes']['train']} train / {results['split_sizes']['test']} test; "
         f"every run {bud['epochs']} epochs at {bud['imgsz']} px, batch {bud['batch']}; last-epoch weights scored.",
         "- Model: ultralytics' YOLOv5n built from `yolov5n.yaml` (anchor-free head), no downloaded weights.",
-        *([f"- Machine: {how}"] if how else []), "",
-        table5_markdown(results), "",
-        "Wall time: " + ", ".join(f"{k} {v:.0f} s" for k, v in wall.items()) + ".", "",
+        *([f"- Machine: {how}"] if how else []),
+        "",
+        table5_markdown(results),
+        "",
+        "Wall time: " + ", ".join(f"{k} {v:.0f} s" for k, v in wall.items()) + ".",
+        "",
     ]
     return write_text_atomic(path, "\n".join(lines))
