@@ -182,7 +182,7 @@ def add_renderer_flags(parser: argparse.ArgumentParser) -> None:
 
 
 def add_dataset_flags(parser: argparse.ArgumentParser, verb: str) -> None:
-    """Add ``--dataset``, ``--scenario`` and ``--crop``, shared by train and evaluate.
+    """Add ``--dataset``, ``--scenario``, ``--crop`` and ``--cache-dir``, shared by train and evaluate.
 
     Args:
         parser: the sub-command's parser.
@@ -193,3 +193,10 @@ def add_dataset_flags(parser: argparse.ArgumentParser, verb: str) -> None:
         "--scenario", required=True, choices=["sp", "mp"], help="single plant (tau=3) or multi plant (tau=5)"
     )
     parser.add_argument("--crop", default=None, help=f"{verb} on one crop only (default: all)")
+    parser.add_argument(
+        "--cache-dir",
+        type=path,
+        default=None,
+        metavar="DIR",
+        help="observation cache folder (default: DIR/.davis_ag_cache)",
+    )

@@ -80,13 +80,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--episodes", type=arguments.bounded(1, 10**6), default=200, help="episodes per session (200)")
     parser.add_argument("--sessions", type=arguments.bounded(1, 1000), default=3, help="sessions (3)")
     parser.add_argument("--seed", type=arguments.seed, default=0, help="base seed of the episodes (0)")
-    parser.add_argument(
-        "--cache-dir",
-        type=arguments.path,
-        default=None,
-        metavar="DIR",
-        help="observation cache folder (default: DIR/.davis_ag_cache)",
-    )
     parser.add_argument("--out", type=arguments.path, required=True, metavar="RESULTS.json", help="results file")
     parser.add_argument(
         "--plot", type=arguments.path, default=None, metavar="PNG", help="bar chart (default: the --out path with .png)"

@@ -84,13 +84,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--device", default="auto", help="torch device (default: auto)")
     parser.add_argument(
-        "--cache-dir",
-        type=arguments.path,
-        default=None,
-        metavar="DIR",
-        help="observation cache folder (default: DIR/.davis_ag_cache)",
-    )
-    parser.add_argument(
         "--out", type=arguments.path, required=True, metavar="MODEL.zip", help="where to save the model"
     )
     parser.add_argument(
