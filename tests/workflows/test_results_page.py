@@ -310,7 +310,8 @@ def test_a_run_with_ppo_shows_its_row_gap_settings_and_stage(tmp_path: Path, sp_
 
     from davis_ag.benchmark.training import train_agent
     from davis_ag.workflows.demo import run_baselines
-    from davis_ag.workflows.reproduce import _reusable_results, _summary
+    from davis_ag.figures.result_charts import plot_results
+    from davis_ag.workflows.reproduce import _reusable_results, _summary, add_train_split
     from davis_ag.workflows.results_policies import model_path
 
     (tmp_path / "docs").mkdir()
@@ -346,6 +347,8 @@ def test_a_run_with_ppo_shows_its_row_gap_settings_and_stage(tmp_path: Path, sp_
     assert _reusable_results(results_json, [models["a2c"], models["ppo"]], "test", config) is None
     results_json.write_text(json.dumps(both))
     assert _reusable_results(results_json, [models["a2c"], models["ppo"]], "test", config) is not None
+    assert plot_results(both, results_json.with_suffix(".png")).is_file()  # the stage's chart, PPO's bar in it
+    add_train_split(both, sp_root, "sp", "strawberry")
 
     state = {
         "scene_folders": {"sp-strawberry": ["Single-Strawberry/000", "Single-Strawberry/001"]},
@@ -364,6 +367,8 @@ def test_a_run_with_ppo_shows_its_row_gap_settings_and_stage(tmp_path: Path, sp_
     assert f"PPO is ahead on {ahead} of 1." in text and "A2C is ahead on" in text
     assert "PPO: trained with n_steps=16, batch_size=32 over Stable-Baselines3's PPO defaults" in text
     assert "PPO beside it (SB3's PPO defaults" in text
+    assert "where the snapshot was chosen: A2C's kept snapshot (70 steps)" in text
+    assert "where the snapshot was chosen: PPO's kept snapshot (64 steps)" in text
     how = text.split("## How this run was made", 1)[1]
     assert "  - A2C: 70 steps in 1 sitting(s)" in how and "  - PPO: 64 steps in 1 sitting(s)" in how
     assert "over SB3's PPO defaults" in how
