@@ -79,3 +79,42 @@ def test_a_run_the_disk_cannot_hold_is_refused_before_anything_is_written(tmp_pa
     with pytest.raises(UserError, match=r"needs about .* GB more under .* GB free: free space, or pass --out"):
         reproduce(huge, out, tmp_path / "results.md")
     assert not out.exists() and not (tmp_path / "results.md").exists()
+
+
+#: PPO at a test's size: a rollout of 16 steps per environment instead of SB3's 2,048.
+SHORT_PPO = {"n_steps": 16, "batch_size": 32}
+
+
+def test_ppo_trains_beside_a2c_resumes_a_killed_run_and_reuses_a_finished_one(
+    tmp_path: Path, sp_root: Path, one_thread: None, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # Issue 32: reproduce trains PPO with A2C's budget; a killed PPO run resumes from its
+    # checkpoint, a finished one is reused, and A2C's models of before PPO stay reusable.
+    import json
+    from dataclasses import replace
+
+    from davis_ag.benchmark.training import A2C_SETTINGS, training_record_path
+    from davis_ag.workflows.reproduce import CONFIGS
+    from davis_ag.workflows.reproduce_learners import KEEP, learner_stamp, train_learner
+    from davis_ag.workflows.results_policies import model_path
+
+    assert CONFIGS["paper-scale"].learners == ("a2c", "ppo")
+    # A2C's stamp is the one models made before PPO carry, so they are not trained again.
+    assert learner_stamp("a2c", 300_000) == {"timesteps": 300_000, "a2c_settings": A2C_SETTINGS, "keep": KEEP}
+    config = replace(CONFIGS["small"], n_envs=2, seed=1)
+    model = model_path(tmp_path, "sp-strawberry", "ppo")
+    assert model.name == "ppo_sp-strawberry.zip"
+    kwargs = dict(settings=SHORT_PPO, arch="pooled", checkpoint_every=32, progress=False)
+    with pytest.raises(KeyboardInterrupt):
+        train_learner("ppo", sp_root, "sp", "strawberry", model, 128, config, callback=KillAfter(70), **kwargs)
+    assert not model.exists()
+    assert train_learner("ppo", sp_root, "sp", "strawberry", model, 128, config, **kwargs) is not None
+    assert "resuming ppo_sp-strawberry.zip from its checkpoint at 64 of 128 steps" in capsys.readouterr().out
+    record = json.loads(training_record_path(model).read_text())
+    assert record["algorithm"] == "PPO" and record["timesteps"] == 128 and record["keep"] == "best-train"
+    assert record["sb3_settings"] == SHORT_PPO and record["seed"] == 1 and len(record["sittings"]) == 2
+    made = model.stat().st_mtime_ns
+    assert train_learner("ppo", sp_root, "sp", "strawberry", model, 128, config, **kwargs) is None
+    assert model.stat().st_mtime_ns == made
+    # Another budget is another model: trained anew, not reused.
+    assert train_learner("ppo", sp_root, "sp", "strawberry", model, 96, config, **kwargs) is not None

@@ -220,6 +220,7 @@ def test_the_readme_block_beside_docs_is_rewritten_from_the_run(tmp_path: Path) 
     ) in page
     text = readme.read_text()
     assert "stale" not in text and text.startswith("# p\n\nbefore\n") and text.endswith("after\n")
+    assert "PPO" not in text and "PPO" not in page  # a run without PPO (medium's), whatever CONFIGS now lists
     assert "| SP strawberry, ours (2 test scenes) | .600 ± .010 | .440 ± .010 | .300 ± .010 | .450 ± .010 | – |" in text
     assert "| SP strawberry, paper (Table 4) | .520 ± .004 | .433 ± .007 | .371 ± .008 | .438 ± .101 | - |" in text
     assert "| MP vine, ours | not run |" in text and "| MP vine, paper (Table 4) | .369 ± .009 |" in text
@@ -299,6 +300,82 @@ def test_the_page_shows_what_each_policy_does(tmp_path: Path, sp_root: Path, one
     assert "| Best fixed action | " + " | ".join("100" if a == best["action"] else "0" for a in counts) + " |" in text
     for picture in ("results-sp-strawberry-actions.png", "results-learning-curve.png"):
         assert f"(images/{picture})" in text and (tmp_path / "docs" / "images" / picture).is_file()
+    assert "PPO" not in text  # this run trained A2C only
+
+
+def test_a_run_with_ppo_shows_its_row_gap_settings_and_stage(tmp_path: Path, sp_root: Path, one_thread: None) -> None:
+    # Issue 32: PPO trained beside A2C is a row of the same evaluation; adding it leaves the other
+    # rows as they were, and the page and README give its paired gap as they give A2C's.
+    from dataclasses import replace
+
+    from davis_ag.benchmark.training import train_agent
+    from davis_ag.workflows.demo import run_baselines
+    from davis_ag.figures.result_charts import plot_results
+    from davis_ag.workflows.reproduce import _reusable_results, _summary, add_train_split
+    from davis_ag.workflows.results_policies import model_path
+
+    (tmp_path / "docs").mkdir()
+    (tmp_path / "README.md").write_text("<!-- results-table4:start -->\n<!-- results-table4:end -->\n")
+    (tmp_path / "dataset").symlink_to(sp_root)
+    models = {}
+    for algo, settings in (("a2c", "ours"), ("ppo", {"n_steps": 16, "batch_size": 32})):
+        models[algo] = train_agent(
+            sp_root,
+            "sp",
+            total_timesteps=64,
+            seed=0,
+            out_path=model_path(tmp_path, "sp-strawberry", algo),
+            n_envs=2,
+            arch="pooled",
+            device="cpu",
+            checkpoint_every=0,
+            algo=algo,
+            settings=settings,
+            progress=False,
+        )
+    before = run_baselines(sp_root, "sp", "strawberry", "test", 20, 3, model=models["a2c"])
+    both = run_baselines(sp_root, "sp", "strawberry", "test", 20, 3, model=models["a2c"], learners=(models["ppo"],))
+    assert set(both["policies"]) - set(before["policies"]) == {"PPO"}
+    for name, row in before["policies"].items():  # seeded episodes: the rows of before PPO, unchanged
+        assert both["policies"][name] == row, name
+    # An evaluation from before PPO is not reused for a run that trains it.
+    results_json = tmp_path / "results" / "sp-strawberry.json"
+    results_json.parent.mkdir()
+    results_json.write_text(json.dumps(before))
+    config = replace(CONFIGS["small"], episodes=20, sessions=3)
+    assert _reusable_results(results_json, [models["a2c"]], "test", config) is not None
+    assert _reusable_results(results_json, [models["a2c"], models["ppo"]], "test", config) is None
+    results_json.write_text(json.dumps(both))
+    assert _reusable_results(results_json, [models["a2c"], models["ppo"]], "test", config) is not None
+    assert plot_results(both, results_json.with_suffix(".png")).is_file()  # the stage's chart, PPO's bar in it
+    add_train_split(both, sp_root, "sp", "strawberry")
+
+    state = {
+        "scene_folders": {"sp-strawberry": ["Single-Strawberry/000", "Single-Strawberry/001"]},
+        "results": {"sp": _summary(both)},
+        "stages": {
+            "sp-strawberry: train A2C": {"seconds": 1.0, "note": "64 steps", "code": "x"},
+            "sp-strawberry: train PPO": {"seconds": 1.0, "note": "64 steps", "code": "x"},
+        },
+    }
+    text = write_results_md(tmp_path / "docs" / "results.md", config, state, tmp_path).read_text()
+    ppo = both["policies"]["PPO"]
+    assert f"| PPO | {_c(ppo['oer_tau']['mean'])} ± {_c(ppo['oer_tau']['std'])} | – |" in text
+    gap = state["results"]["sp"]["ppo_vs_best_fixed"]
+    ahead = sum(s["gap"] > 0 for s in gap["per_scene"])
+    assert f"PPO minus `Best fixed action`: {'+' if gap['gap'] >= 0 else '-'}{_c(abs(gap['gap']))}" in text
+    assert f"PPO is ahead on {ahead} of 1." in text and "A2C is ahead on" in text
+    assert "PPO: trained with n_steps=16, batch_size=32 over Stable-Baselines3's PPO defaults" in text
+    assert "PPO beside it (SB3's PPO defaults" in text
+    assert "where the snapshot was chosen: A2C's kept snapshot (70 steps)" in text
+    assert "where the snapshot was chosen: PPO's kept snapshot (64 steps)" in text
+    how = text.split("## How this run was made", 1)[1]
+    assert "  - A2C: 70 steps in 1 sitting(s)" in how and "  - PPO: 64 steps in 1 sitting(s)" in how
+    assert "over SB3's PPO defaults" in how
+    assert "| sp-strawberry: train PPO |" in text and "| sp-strawberry: train A2C |" in text
+    readme = (tmp_path / "README.md").read_text()
+    assert "| | A2C | PPO (ours only) | LRD |" in readme and "paper (Table 4) | .520 ± .004 | - | .433" in readme
+    assert "PPO minus `Best fixed action` on the same episodes" in readme
 
 
 def _c(value: float) -> str:

@@ -22,8 +22,15 @@ from davis_ag.benchmark.exact import BEST_FIXED
 RESAMPLES = 10_000
 #: Two-sided confidence of the interval.
 CONFIDENCE = 0.95
+
+
+def paired_key(learner: str) -> str:
+    """Key of a learner (``A2C``, ``PPO``) against the Best fixed action in a results summary."""
+    return f"{learner.lower()}_vs_best_fixed"
+
+
 #: Key of A2C against the Best fixed action (:func:`a2c_against_best_fixed`) in a results summary.
-PAIRED_KEY = "a2c_vs_best_fixed"
+PAIRED_KEY = paired_key("A2C")
 
 
 @dataclass(frozen=True)
@@ -111,19 +118,21 @@ def paired_gap(first: list[dict[str, Any]], second: list[dict[str, Any]], seed: 
     return PairedGap(float(differences.mean()), low, high, len(differences), tuple(per_scene))
 
 
-def a2c_against_best_fixed(results: dict[str, Any]) -> dict[str, Any] | None:
-    """:func:`paired_gap` of ``A2C`` and ``Best fixed action`` in an evaluation's results, as JSON.
+def a2c_against_best_fixed(results: dict[str, Any], learner: str = "A2C") -> dict[str, Any] | None:
+    """:func:`paired_gap` of ``A2C`` (or another ``learner``'s row, e.g. ``PPO``) and ``Best fixed
+    action`` in an evaluation's results, as JSON.
 
     Args:
         results: An evaluation's results (``policies`` with their ``episodes``, ``protocol``).
+        learner: The row compared with the Best fixed action.
 
     Returns:
         The gap as a dict, or None when either policy or its episode records are missing.
     """
     policies = results.get("policies", {})
-    if kept := policies.get("A2C", {}).get("paired", {}).get(BEST_FIXED):  # the evaluation's own, same seed
+    if kept := policies.get(learner, {}).get("paired", {}).get(BEST_FIXED):  # the evaluation's own, same seed
         return kept
-    records = [policies.get(name, {}).get("episodes") for name in ("A2C", BEST_FIXED)]
+    records = [policies.get(name, {}).get("episodes") for name in (learner, BEST_FIXED)]
     if not all(records):
         return None
     return asdict(paired_gap(*records, seed=int(results.get("protocol", {}).get("seed", 0))))

@@ -1,8 +1,9 @@
 """``davis-ag reproduce``: the paper's Table 4 (section VI) end to end, at a size that fits.
 
 Stages (each resumable: finished scenes are skipped, a trained model's zip and an evaluation's
-JSON are reused): SP strawberry data, its validation and split, A2C on SP, the SP benchmark,
-then the same for MP vine; ``--results`` (Markdown) is rewritten after every benchmark, so a
+JSON are reused, a killed training resumes from its checkpoint): SP strawberry data, its
+validation and split, A2C and PPO beside it (the same budget) on SP, the SP benchmark, then the
+same for MP vine; ``--results`` (Markdown) is rewritten after every benchmark, so a
 run cut short still leaves what it measured.
 """
 
@@ -22,7 +23,7 @@ from davis_ag.workflows.reproduce import (
 )
 from davis_ag.workflows.results_page import write_results_md
 
-HELP = "reproduce Table 4: generate, train A2C, benchmark, write results.md"
+HELP = "reproduce Table 4: generate, train A2C and PPO, benchmark, write results.md"
 DESCRIPTION = __doc__
 FORMATTER_CLASS = argparse.RawDescriptionHelpFormatter
 
@@ -73,7 +74,11 @@ def run(args: argparse.Namespace) -> int:
         if not state.get("config"):
             raise UserError(f"{args.out / 'state.json'}: no finished run to write results from")
         saved = state["config"]
-        saved.update(size=tuple(saved["size"]), mp_extent=tuple(saved["mp_extent"]) if saved.get("mp_extent") else None)
+        saved.update(
+            size=tuple(saved["size"]),
+            mp_extent=tuple(saved["mp_extent"]) if saved.get("mp_extent") else None,
+            learners=tuple(saved.get("learners", ("a2c",))),  # a run from before PPO trained A2C alone
+        )
         write_results_md(args.results, ReproduceConfig(**saved), state, args.out)
         print(f"wrote {args.results}")
         return 0

@@ -94,9 +94,10 @@ def run_baselines(
     sessions: int,
     seed: int = 0,
     model: Path | None = None,
+    learners: tuple[Path, ...] = (),
 ) -> dict[str, Any]:
-    """Evaluate LRD, UDD, Rand, Oracle, the Best fixed action (and A2C when ``model`` is given)
-    as in Table 4.
+    """Evaluate LRD, UDD, Rand, Oracle, the Best fixed action (and A2C when ``model`` is given,
+    and other learners' models beside it) as in Table 4.
 
     A2C plays as :data:`davis_ag.benchmark.policies.DETERMINISTIC_PLAY` says (sampled); the same model
     taking its most likely action is the extra row ``A2C (deterministic)``.
@@ -110,6 +111,9 @@ def run_baselines(
         sessions: Sessions.
         seed: Base seed of the episodes.
         model: A trained A2C ``.zip``; adds the A2C column.
+        learners: Other trained models (e.g. PPO's ``.zip``), each a row named by its algorithm,
+            played as A2C is. Every policy plays the same seeded episodes with its own seeded
+            randomness, so adding one leaves the other rows' numbers as they were.
 
     Returns:
         What :func:`davis_ag.benchmark.evaluation.evaluate_policies` returns, as its JSON.
@@ -121,6 +125,7 @@ def run_baselines(
     if model:
         sampled = ModelPolicy(model)
         policies = [sampled, ModelPolicy(sampled.model, deterministic=True, name="A2C (deterministic)")]
+    policies += [ModelPolicy(path) for path in learners]
     results = evaluate(
         policies,
         root,

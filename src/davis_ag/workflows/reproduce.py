@@ -1,8 +1,9 @@
 """The ``davis-ag reproduce`` workflow: the paper's Table 4 (section VI) end to end, at a size that fits.
 
 Stages (each resumable: finished scenes are skipped, a trained model's zip and an evaluation's
-JSON are reused): SP strawberry data, its validation and split, A2C on SP, the SP benchmark,
-then the same for MP vine; ``--results`` (Markdown) is rewritten after every benchmark, so a
+JSON are reused, a killed training resumes from its checkpoint): SP strawberry data, its
+validation and split, A2C (and PPO beside it, same budget) on SP, the SP benchmark, then the same
+for MP vine; ``--results`` (Markdown) is rewritten after every benchmark, so a
 run cut short still leaves what it measured.
 """
 
@@ -28,10 +29,13 @@ class ReproduceConfig:
         size: Image width and height.
         sp_scenes, mp_scenes: SP strawberry and MP vine scenes.
         mp_extent: MP grid extent (x, y) in metres; ``None`` keeps Table 2's 7 x 3 m.
-        sp_timesteps, mp_timesteps: A2C environment steps per scenario.
-        n_envs: A2C parallel environments.
+        sp_timesteps, mp_timesteps: Environment steps per scenario of each learner.
+        n_envs: Parallel environments of each learner.
         episodes, sessions: Evaluation protocol (200 x 3 in the paper).
         seed: Dataset, training and evaluation seed.
+        learners: The algorithms trained (:data:`davis_ag.benchmark.algorithms.ALGORITHMS`), each
+            with the same steps, seed, network, train split and keep rule: the paper's ``a2c``
+            and, beside it, ``ppo`` with SB3's defaults.
     """
 
     name: str
@@ -45,6 +49,7 @@ class ReproduceConfig:
     episodes: int = 200
     sessions: int = 3
     seed: int = 0
+    learners: tuple[str, ...] = ("a2c", "ppo")
 
 
 #: ``small``: 43 min of stages measured on a 2-core CPU machine without GPU (docs/results.md);
@@ -83,9 +88,6 @@ CACHE_BYTES_PER_VIEW = 224 * 224 * 4
 #: Room left free beyond the estimate, for models, results and the estimate's error.
 DISK_MARGIN = 1.1
 
-#: Which snapshot of each A2C run is evaluated: the best on the train split
-#: (:mod:`davis_ag.benchmark.selection`).
-KEEP = "best-train"
 #: Marker of docs/benchmark.md's table of the configurations (:func:`configurations_table`).
 CONFIGS_MARKER = "reproduce-configs"
 
@@ -94,12 +96,13 @@ def configurations_table() -> str:
     """docs/benchmark.md's table of :data:`CONFIGS`, written from them so the page follows the code.
 
     Returns:
-        A Markdown table: scenes, grid, image size, A2C steps and disk space of each configuration.
+        A Markdown table: scenes, grid, image size, learners, their steps and disk space of each
+        configuration.
     """
     rows = [
-        "| configuration | SP strawberry | MP vine | images | A2C steps (SP / MP) | disk (views and caches) "
-        "| beside Table 4 |",
-        "|---|---|---|---|---|---|---|",
+        "| configuration | SP strawberry | MP vine | images | learners | steps each (SP / MP) "
+        "| disk (views and caches) | beside Table 4 |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for config in CONFIGS.values():
         grid = (
@@ -119,7 +122,8 @@ def configurations_table() -> str:
             verdict = "not comparable: a smoke test of every stage"
         rows.append(
             f"| `{config.name}` | {config.sp_scenes} scenes | {config.mp_scenes} scenes, {grid} | "
-            f"{config.size[0]}x{config.size[1]} | {config.sp_timesteps // 1000}K / "
+            f"{config.size[0]}x{config.size[1]} | {', '.join(a.upper() for a in config.learners)} "
+            f"| {config.sp_timesteps // 1000}K / "
             f"{config.mp_timesteps // 1000}K | {disk_needed(config) / 1e9:.1f} GB "
             f"| {verdict} |"
         )
@@ -232,7 +236,6 @@ def reproduce(
     """
     from davis_ag.atomic_files import prove_writable_file, prove_writable_folder, write_or_rescue
     from davis_ag.benchmark.evaluation import format_table, write_json
-    from davis_ag.benchmark.training import A2C_SETTINGS, train_a2c
     from davis_ag.figures.result_charts import plot_results
     from davis_ag.data.validate import validate_dataset
     from davis_ag.generate.one_scene import SceneRequest
@@ -241,6 +244,7 @@ def reproduce(
     from davis_ag.provenance import code_version
     from davis_ag.workflows.demo import evaluation_split, generate_scenes, run_baselines
     from davis_ag.workflows.results_page import write_results_md
+    from davis_ag.workflows.reproduce_learners import train_learner
     from davis_ag.workflows.results_policies import model_path
 
     check_disk(config, Path(out).expanduser().absolute(), pairs)
@@ -305,42 +309,32 @@ def reproduce(
                 print(problem, flush=True)
             return 1
         split = evaluation_split(root, scenario_name, crop_name)
-        model = model_path(out, key)
         timesteps = config.sp_timesteps if scenario_name == "sp" else config.mp_timesteps
-        stamp = model.with_suffix(".json")
-        # A model made with other A2C settings or keep rule (or before they were recorded:
-        # those kept the last snapshot) is trained anew.
-        made = {"keep": "last", **load_state(stamp)}
-        wanted = {"timesteps": timesteps, "a2c_settings": A2C_SETTINGS, "keep": KEEP}
-        if not model.is_file() or any(made.get(k) != v for k, v in wanted.items()):
-            print(f"training A2C (the paper's network) on {key} train split for {timesteps} steps", flush=True)
-            start = time.perf_counter()
-            train_a2c(
-                root,
-                scenario_name,
-                total_timesteps=timesteps,
-                seed=config.seed,
-                out_path=model,
-                n_envs=config.n_envs,
-                crop=crop_name,
-                device="cpu",
-                keep=KEEP,
-                force=True,
-            )  # its own work folder: a checkpoint of other settings is redone, as said above
-            seconds = time.perf_counter() - start
-            write_json_atomic(stamp, {**wanted, "seconds": seconds})
-            record(
-                f"{key}: train A2C",
-                seconds,
-                f"{timesteps} steps, {timesteps / seconds:.1f} steps/s (incl. cache build)",
-            )
+        models = {}
+        for algo in config.learners:
+            models[algo] = model_path(out, key, algo)
+            seconds = train_learner(algo, root, scenario_name, crop_name, models[algo], timesteps, config)
+            if seconds is not None:
+                record(
+                    f"{key}: train {algo.upper()}",
+                    seconds,
+                    f"{timesteps} steps, {timesteps / seconds:.1f} steps/s (incl. cache build)",
+                )
         print(f"benchmark on split {split!r}: {config.sessions} x {config.episodes} episodes", flush=True)
         results_json = out / "results" / f"{key}.json"
-        results = _reusable_results(results_json, model, split, config)
+        results = _reusable_results(results_json, list(models.values()), split, config)
         if results is None:
             start = time.perf_counter()
             results = run_baselines(
-                root, scenario_name, crop_name, split, config.episodes, config.sessions, config.seed, model=model
+                root,
+                scenario_name,
+                crop_name,
+                split,
+                config.episodes,
+                config.sessions,
+                config.seed,
+                model=models.get("a2c"),
+                learners=tuple(path for algo, path in models.items() if algo != "a2c"),
             )
             write_or_rescue(results_json, partial(write_json, results), "the results")
             plot_results(results, results_json.with_suffix(".png"))
@@ -359,12 +353,17 @@ def reproduce(
     return 0
 
 
-def _reusable_results(path: Path, model: Path, split: str, config: ReproduceConfig) -> dict[str, Any] | None:
-    """An earlier evaluation of the same model and protocol, or ``None`` to evaluate anew."""
+def _reusable_results(path: Path, models: list[Path], split: str, config: ReproduceConfig) -> dict[str, Any] | None:
+    """An earlier evaluation of the same models and protocol, or ``None`` to evaluate anew.
+
+    One made before a learner of the run (PPO) existed is run anew with every row: the episodes
+    are seeded, so the rows it had come out as they were, and the page is never half one
+    evaluation, half another.
+    """
     results = load_state(path)
     protocol = results.get("protocol", {})
     try:
-        fresh = path.stat().st_mtime >= model.stat().st_mtime
+        fresh = all(path.stat().st_mtime >= model.stat().st_mtime for model in models)
     except OSError:
         return None
     same = (
@@ -375,7 +374,14 @@ def _reusable_results(path: Path, model: Path, split: str, config: ReproduceConf
     )
     # Evaluations from before the Best fixed action row and the uniform start rule are run anew.
     current = protocol.get("start_rule") == "pairs" and "Best fixed action" in results.get("policies", {})
-    return results if fresh and same and current and "A2C" in results.get("policies", {}) else None
+    rows = results.get("policies", {})
+    every = all(_row_name(model) in rows for model in models)
+    return results if fresh and same and current and every else None
+
+
+def _row_name(model: Path) -> str:
+    """The evaluation row of a run's model (``models/ppo_sp-strawberry.zip``: ``PPO``)."""
+    return model.name.split("_", 1)[0].upper()
 
 
 def add_train_split(results: dict[str, Any], root: Path, scenario: str, crop: str) -> bool:
@@ -398,7 +404,8 @@ def _summary(results: dict[str, Any]) -> dict[str, Any]:
     and standard error, the exact expectations, action counts, how A2C played, the fixed action;
     the exact values of every fixed action, on the evaluated split and on train; and A2C against
     the Best fixed action episode by episode."""
-    from davis_ag.benchmark.paired import PAIRED_KEY, a2c_against_best_fixed
+    from davis_ag.benchmark.paired import a2c_against_best_fixed, paired_key
+    from davis_ag.workflows.results_policies import LEARNERS
 
     kept = ("exact", "action_counts", "play", "action")
     summary = {
@@ -418,6 +425,7 @@ def _summary(results: dict[str, Any]) -> dict[str, Any]:
     for key in ("fixed_actions", "train_split"):
         if key in results:
             summary[key] = results[key]
-    if paired := a2c_against_best_fixed(results):  # needs the episodes, which the summary leaves out
-        summary[PAIRED_KEY] = paired
+    for learner in LEARNERS:
+        if paired := a2c_against_best_fixed(results, learner):  # needs the episodes, which the summary lacks
+            summary[paired_key(learner)] = paired
     return summary

@@ -16,11 +16,12 @@ from pathlib import Path
 from typing import Any
 
 from davis_ag.benchmark.exact import BEST_FIXED
-from davis_ag.benchmark.paired import CONFIDENCE, PAIRED_KEY
+from davis_ag.benchmark.paired import CONFIDENCE, paired_key
 from davis_ag.formats.layout import SCENE_METADATA
 from davis_ag.formats.scene_file import CameraRecord, RendererRecord, read_scene_file_or_empty
 from davis_ag.scene.specs import PAPER_TABLE3
 from davis_ag.workflows.results_policies import (
+    LEARNERS,
     cell,
     learning_curve_section,
     ordered,
@@ -144,6 +145,17 @@ def _a2c_play(state: dict[str, Any]) -> str:
     )
 
 
+def learners_run(state: dict[str, Any], out: Path | None = None) -> list[str]:
+    """The learners (:data:`LEARNERS`) this run evaluated or trained, from its records only (a run
+    from before PPO names A2C alone, whatever the configuration now lists)."""
+    rows = {name for result in state.get("results", {}).values() for name in result.get("policies", {})}
+    return [
+        learner
+        for learner in LEARNERS
+        if learner in rows or any(training_record(out, key, learner) for key in GROUPS.values())
+    ]
+
+
 def _counted(counter: Counter) -> str:
     return "; ".join(f"{value} ({n} scene{'s' if n > 1 else ''})" for value, n in counter.most_common())
 
@@ -182,16 +194,18 @@ def training_provenance(record: dict[str, Any]) -> str:
     """A sentence on how a model was trained: steps, sittings, the code of each, steps per second."""
     sittings = record.get("sittings", [])
     codes = Counter(s.get("code", "unrecorded") for s in sittings)
+    algorithm = record.get("algorithm", "A2C")
+    settings = record.get("a2c_settings" if algorithm == "A2C" else "sb3_settings")
     text = (
         f"{record.get('timesteps', 0):,} steps in {len(sittings)} sitting(s), "
         f"{record.get('seconds', 0) / 3600:.2f} h, {record.get('steps_per_second', 0):.1f} steps/s; "
         f"network `{record.get('arch', '?')}`, {record.get('n_envs', '?')} environments, settings "
         + (
-            ", ".join(f"{k}={v}" for k, v in record["a2c_settings"].items())
-            if "a2c_settings" in record
+            ", ".join(f"{k}={v}" for k, v in settings.items()) or "none changed"
+            if settings is not None
             else "not recorded (SB3's defaults)"
         )
-        + " over SB3's A2C defaults, code "
+        + f" over SB3's {algorithm} defaults, code "
         + ", ".join(codes)
     )
     if len(codes) > 1:
@@ -216,14 +230,15 @@ def _notes(config: Any, state: dict[str, Any], out: Path | None) -> list[str]:
     """Plain statements of where this run differs from the paper's, from what it measured."""
     notes = []
     for scenario, key in GROUPS.items():
-        record = training_record(out, key)
-        steps, rate = record.get("timesteps"), record.get("steps_per_second")
-        if steps and rate and steps < PAPER_TIMESTEPS:
-            notes.append(
-                f"A2C on {key} trained for {steps:,} environment steps, {steps / PAPER_TIMESTEPS:.1%} of "
-                f"the paper's 300K, at {rate:.1f} steps/s on this machine: the A2C column is an "
-                "under-trained agent, not the paper's."
-            )
+        for learner in LEARNERS:
+            record = training_record(out, key, learner)
+            steps, rate = record.get("timesteps"), record.get("steps_per_second")
+            if steps and rate and steps < PAPER_TIMESTEPS:
+                notes.append(
+                    f"{learner} on {key} trained for {steps:,} environment steps, {steps / PAPER_TIMESTEPS:.1%} "
+                    f"of the paper's 300K, at {rate:.1f} steps/s on this machine: the {learner} row is an "
+                    "under-trained agent" + (", not the paper's." if learner == "A2C" else ".")
+                )
         result = state.get("results", {}).get(scenario)
         if result:
             protocol = result["protocol"]
@@ -284,9 +299,10 @@ def _how_made(state: dict[str, Any], out: Path | None) -> list[str]:
             continue
         lines.append(f"- **{key}**, {len(scenes)} scene(s):")
         lines += [f"  - {line}" for line in scene_provenance(out / "dataset", scenes)]
-        record = training_record(out, key)
-        if record:
-            lines.append(f"  - A2C: {training_provenance(record)}")
+        for learner in LEARNERS:
+            record = training_record(out, key, learner)
+            if record:
+                lines.append(f"  - {learner}: {training_provenance(record)}")
     return lines + [""]
 
 
@@ -312,8 +328,9 @@ def stage_rows(state: dict[str, Any], out: Path | None) -> list[tuple[str, float
                 )
             )
         record: dict[str, Any] = {}
-        if step == "train A2C" and out is not None:  # only a training stage has a record
-            record = training_record(out, key)
+        learner = step.removeprefix("train ")
+        if step.startswith("train ") and learner in LEARNERS and out is not None:  # only training has a record
+            record = training_record(out, key, learner)
         if record.get("sittings"):
             sittings = record["sittings"]
             seconds = record.get("seconds", seconds)
@@ -364,17 +381,23 @@ def readme_block(config: Any, state: dict[str, Any]) -> str:
         Markdown: a line on the run, a table, a line per ordering.
     """
     results = state.get("results", {})
+    learners = [n for n in LEARNERS if n == "A2C" or n in learners_run(state)]
     head = (
         f"`{config.name}` run (docs/results.md): {config.sp_scenes} SP strawberry and {config.mp_scenes} "
-        f"MP vine scenes at {config.size[0]}x{config.size[1]}, A2C {config.sp_timesteps:,} (SP) and "
+        f"MP vine scenes at {config.size[0]}x{config.size[1]}, {' and '.join(learners)} "
+        f"{config.sp_timesteps:,} (SP) and "
         f"{config.mp_timesteps:,} (MP) steps; OER_tau, mean ± std over {config.sessions} sessions of "
         f"{config.episodes} episodes on the split each row names. Table 4's rows are the paper's."
     )
+    extra = [n for n in learners if n != "A2C"]  # learners the paper did not train: ours only
+    columns = ["A2C", *extra, "LRD", "UDD", "Rand", "Oracle", BEST_FIXED]
     lines = [
         head,
         "",
-        "| | A2C | LRD | UDD | Rand | Oracle (ours only) | Best fixed action (ours only) |",
-        "|---|---|---|---|---|---|---|",
+        "| | A2C | "
+        + "".join(f"{n} (ours only) | " for n in extra)
+        + "LRD | UDD | Rand | Oracle (ours only) | Best fixed action (ours only) |",
+        "|---" * (len(columns) + 1) + "|",
     ]
     verdicts = []
     for scenario in ("sp", "mp"):
@@ -386,7 +409,7 @@ def readme_block(config: Any, state: dict[str, Any]) -> str:
                 f"{cell(policies[n]['oer_tau']['mean'])} ± {cell(policies[n]['oer_tau']['std'])}"
                 if n in policies
                 else "–"
-                for n in ("A2C", "LRD", "UDD", "Rand", "Oracle", BEST_FIXED)
+                for n in columns
             ]
             lines.append(
                 f"| {TITLES[scenario]}, ours ({scenes} {split} scene{'s' if scenes != 1 else ''}) | "
@@ -403,13 +426,13 @@ def readme_block(config: Any, state: dict[str, Any]) -> str:
             )
             verdicts.append(f"{TITLES[scenario]}: {' '.join(PAPER_ORDERINGS[scenario])} {verdict}.")
         else:
-            lines.append(f"| {TITLES[scenario]}, ours | not run | | | | | |")
+            lines.append(f"| {TITLES[scenario]}, ours | not run |" + " |" * (len(columns) - 1))
         paper = PAPER_TABLE4[scenario]["oer_tau"]
         lines.append(
             f"| {TITLES[scenario]}, paper (Table 4) | "
             + " | ".join(
-                f"{cell(paper[n])} ± {cell(PAPER_TABLE4_STD[scenario]['oer_tau'][n])}"
-                for n in ("A2C", "LRD", "UDD", "Rand")
+                f"{cell(paper[n])} ± {cell(PAPER_TABLE4_STD[scenario]['oer_tau'][n])}" if n in paper else "-"
+                for n in columns[:-2]
             )
             + " | - | - |"
         )
@@ -419,17 +442,18 @@ def readme_block(config: Any, state: dict[str, Any]) -> str:
             "The paper's orderings in this run (`~`: means within their two standard deviations "
             "added): " + " ".join(verdicts),
         ]
-    gaps = [
-        f"{TITLES[s]} {signed(p['gap'])} ({signed(p['low'])} to {signed(p['high'])})"
-        for s in ("sp", "mp")
-        if (p := results.get(s, {}).get(PAIRED_KEY))
-    ]
-    if gaps:
-        lines += [
-            "",
-            f"A2C minus `{BEST_FIXED}` on the same episodes ({CONFIDENCE:.0%} bootstrap interval over "
-            "the test episodes): " + ", ".join(gaps) + ".",
+    for learner in learners:
+        gaps = [
+            f"{TITLES[s]} {signed(p['gap'])} ({signed(p['low'])} to {signed(p['high'])})"
+            for s in ("sp", "mp")
+            if (p := results.get(s, {}).get(paired_key(learner)))
         ]
+        if gaps:
+            lines += [
+                "",
+                f"{learner} minus `{BEST_FIXED}` on the same episodes ({CONFIDENCE:.0%} bootstrap interval over "
+                "the test episodes): " + ", ".join(gaps) + ".",
+            ]
     return "\n".join(lines)
 
 
@@ -470,7 +494,13 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
         f"step, 12 headings, 2 altitudes) at {config.size[0]}x{config.size[1]}, dataset seed "
         f"{config.seed}; box thresholds scaled by image area; A2C (Stable-Baselines3, the paper's "
         f"network of section V-B, {config.n_envs} environments; its settings under each scenario) for {config.sp_timesteps:,} (SP) and "
-        f"{config.mp_timesteps:,} (MP) environment steps; evaluation {config.sessions} sessions x "
+        f"{config.mp_timesteps:,} (MP) environment steps"
+        + (
+            "; PPO beside it (SB3's PPO defaults, the same network, steps, seed, train split and keep-best-train rule)"
+            if "PPO" in learners_run(state, out)
+            else ""
+        )
+        + f"; evaluation {config.sessions} sessions x "
         f"{config.episodes} episodes, seed {config.seed}, A2C {_a2c_play(state)}.",
         f"- **Paper**: {PAPER_TABLE3['sp', 'strawberry'][0]} SP strawberry and {PAPER_TABLE3['mp', 'vine'][0]} "
         "MP vine scenes at 1280x720 "

@@ -1,10 +1,11 @@
 """The parts of ``docs/results.md`` that show what each policy does, from a run's own records.
 
-Per scenario: whether A2C beats the ``Best fixed action`` row (on test, with the paired gap's
-bootstrap interval and the gap per test scene, and its kept snapshot on the train split it was
-chosen on), the exact expectations of the image-blind policies beside
-their sampled means, each policy's action histogram (a table and Fig. 4c as a picture), and how
-A2C was trained and played; then the learning curve (Fig. 4a) from the training records.
+Per scenario: whether each learner (A2C, and PPO where the run trained it) beats the ``Best fixed
+action`` row (on test, with the paired gap's bootstrap interval and the gap per test scene, and its
+kept snapshot on the train split it was chosen on), the exact expectations of the image-blind
+policies beside their sampled means, each policy's action histogram (a table and Fig. 4c as a
+picture), and how each learner was trained and played; then the learning curves (Fig. 4a) from
+the training records.
 Pictures go to ``images/`` beside the page.
 """
 
@@ -15,11 +16,18 @@ from pathlib import Path
 from typing import Any
 
 from davis_ag.benchmark.exact import BEST_FIXED, best_fixed_action
-from davis_ag.benchmark.paired import CONFIDENCE, PAIRED_KEY, RESAMPLES
+from davis_ag.benchmark.paired import CONFIDENCE, RESAMPLES, paired_key
 
+#: The learners a run may train, as their rows are named (the paper's A2C first).
+LEARNERS = ("A2C", "PPO")
 #: Row order of the policies on the page.
-POLICY_ORDER = ("A2C", "A2C (deterministic)", "LRD", "UDD", "Rand", BEST_FIXED, "Oracle")
+POLICY_ORDER = ("A2C", "A2C (deterministic)", "PPO", "LRD", "UDD", "Rand", BEST_FIXED, "Oracle")
 GROUPS = {"sp": "sp-strawberry", "mp": "mp-vine"}
+#: What each learner trains with besides the settings its record names (the SB3 defaults).
+SB3_DEFAULTS_TEXT = {
+    "A2C": "learning rate 7e-4, n_steps 5, gamma .99, vf_coef .5, max_grad_norm .5, RMSprop",
+    "PPO": "learning rate 3e-4, n_steps 2048, batch 64, 10 epochs, gamma .99, gae_lambda .95, clip .2, Adam",
+}
 
 
 def cell(value: float | None) -> str:
@@ -39,16 +47,22 @@ def load_json_object(path: Path) -> dict[str, Any]:
     return data if isinstance(data, dict) else {}
 
 
-def model_path(out: Path, group: str) -> Path:
-    """Where a run keeps a group's A2C model (``models/a2c_<group>.zip``)."""
-    return out / "models" / f"a2c_{group}.zip"
+def model_path(out: Path, group: str, learner: str = "A2C") -> Path:
+    """Where a run keeps a group's model of a learner (``models/a2c_<group>.zip``, ``ppo_...``)."""
+    return out / "models" / f"{learner.lower()}_{group}.zip"
 
 
-def training_record(out: Path | None, group: str) -> dict[str, Any]:
-    """A run's A2C training record for a group; {} without a run folder or a record."""
+def training_record(out: Path | None, group: str, learner: str = "A2C") -> dict[str, Any]:
+    """A run's training record of a learner (A2C by default) for a group; {} without a run
+    folder or a record."""
     from davis_ag.benchmark.training import training_record_path
 
-    return load_json_object(training_record_path(model_path(out, group))) if out else {}
+    return load_json_object(training_record_path(model_path(out, group, learner))) if out else {}
+
+
+def learners_in(policies: dict[str, Any]) -> list[str]:
+    """The learners (:data:`LEARNERS`) an evaluation has a row of, in page order."""
+    return [name for name in LEARNERS if name in policies]
 
 
 def ordered(policies: dict[str, Any]) -> list[str]:
@@ -56,18 +70,18 @@ def ordered(policies: dict[str, Any]) -> list[str]:
     return [n for n in POLICY_ORDER if n in policies] + [n for n in policies if n not in POLICY_ORDER]
 
 
-def versus_best_fixed(policies: dict[str, Any]) -> str | None:
-    """Whether A2C's OER_tau beats the Best fixed action's by more than their stds added."""
-    if "A2C" not in policies or BEST_FIXED not in policies:
+def versus_best_fixed(policies: dict[str, Any], learner: str = "A2C") -> str | None:
+    """Whether a learner's OER_tau beats the Best fixed action's by more than their stds added."""
+    if learner not in policies or BEST_FIXED not in policies:
         return None
-    a, b = policies["A2C"]["oer_tau"], policies[BEST_FIXED]["oer_tau"]
+    a, b = policies[learner]["oer_tau"], policies[BEST_FIXED]["oer_tau"]
     gap, spread = a["mean"] - b["mean"], a["std"] + b["std"]
     action = policies[BEST_FIXED].get("action", "?")
     verdict = "**beats** it" if gap > spread else "**does not beat** it by more than their standard deviations added"
     return (
-        f"A2C against `{BEST_FIXED}` (always `{action}`): OER_tau {cell(a['mean'])} ± {cell(a['std'])} "
+        f"{learner} against `{BEST_FIXED}` (always `{action}`): OER_tau {cell(a['mean'])} ± {cell(a['std'])} "
         f"against {cell(b['mean'])} ± {cell(b['std'])}, {cell(gap) if gap >= 0 else '-' + cell(-gap)} "
-        f"apart, stds added {cell(spread)}: A2C {verdict}."
+        f"apart, stds added {cell(spread)}: {learner} {verdict}."
     )
 
 
@@ -76,9 +90,10 @@ def signed(value: float) -> str:
     return ("+" if value >= 0 else "-") + cell(abs(value))
 
 
-def paired_line(result: dict[str, Any]) -> str | None:
-    """A2C minus the Best fixed action on the same episodes: the bootstrap interval and each test scene."""
-    paired = result.get(PAIRED_KEY)
+def paired_line(result: dict[str, Any], learner: str = "A2C") -> str | None:
+    """A learner minus the Best fixed action on the same episodes: the bootstrap interval and each
+    test scene."""
+    paired = result.get(paired_key(learner))
     if not paired:
         return None
     scenes = paired["per_scene"]
@@ -90,10 +105,10 @@ def paired_line(result: dict[str, Any]) -> str | None:
     )
     side = "above" if paired["low"] > 0 else "below" if paired["high"] < 0 else "on both sides of"
     return (
-        f"Episode by episode (every policy plays the same {paired['episodes']} episodes), A2C minus "
+        f"Episode by episode (every policy plays the same {paired['episodes']} episodes), {learner} minus "
         f"`{BEST_FIXED}`: {signed(paired['gap'])}, {CONFIDENCE:.0%} bootstrap interval over episodes "
         f"{signed(paired['low'])} to {signed(paired['high'])} ({RESAMPLES:,} resamples), {side} zero. "
-        f"Per test scene: {per_scene}; A2C is ahead on {ahead} of {len(scenes)}. The interval covers the "
+        f"Per test scene: {per_scene}; {learner} is ahead on {ahead} of {len(scenes)}. The interval covers the "
         "starts these test scenes hold, not other scenes; the per-scene gaps hint at how much the scene "
         "matters."
     )
@@ -146,43 +161,56 @@ def action_table(policies: dict[str, Any], actions: list[str]) -> list[str]:
     return lines + [""]
 
 
-def a2c_line(scenario: str, policies: dict[str, Any], out: Path | None) -> str | None:
-    """How A2C was trained (its settings, from the training record) and how it played."""
+def a2c_line(scenario: str, policies: dict[str, Any], out: Path | None, learner: str = "A2C") -> str | None:
+    """How A2C (or another ``learner``) was trained (its settings, from the training record) and how
+    it played."""
     from davis_ag.benchmark.training import SB3_DEFAULT_SETTINGS
 
-    if "A2C" not in policies:
+    if learner not in policies:
         return None
-    record = training_record(out, GROUPS[scenario])
-    settings = record.get("a2c_settings", SB3_DEFAULT_SETTINGS if record else None)
+    record = training_record(out, GROUPS[scenario], learner)
+    if learner == "A2C":
+        settings = record.get("a2c_settings", SB3_DEFAULT_SETTINGS if record else None)
+    else:
+        settings = record.get("sb3_settings")
+    changed = ", ".join(f"{k}={v}" for k, v in (settings or {}).items())
     trained = (
         "settings not recorded"
         if settings is None
-        else ", ".join(f"{k}={v}" for k, v in settings.items()) + " over Stable-Baselines3's A2C defaults"
-        " (learning rate 7e-4, n_steps 5, gamma .99, vf_coef .5, max_grad_norm .5, RMSprop)"
+        else (f"{changed} over " if changed else "")
+        + f"Stable-Baselines3's {learner} defaults ({SB3_DEFAULTS_TEXT.get(learner, 'as SB3 sets them')})"
     )
-    play = policies["A2C"].get("play", "deterministic")
+    play = policies[learner].get("play", "deterministic")
     how = (
         "actions sampled from the policy"
         if play == "sampled"
         else "the most likely action at every step (deterministic)"
     )
     text = (
-        f"A2C: trained with {trained}, on starts drawn by the `{record.get('start_rule', 'scene')}` rule; plays {how}."
+        f"{learner}: trained with {trained}, on starts drawn by the `{record.get('start_rule', 'scene')}` rule; "
+        f"plays {how}."
     )
-    if "A2C (deterministic)" in policies:
-        text += " `A2C (deterministic)` is the same model taking its most likely action."
-    text += " The settings and the play were chosen on training scenes only (docs/benchmark.md)."
+    if f"{learner} (deterministic)" in policies:
+        text += f" `{learner} (deterministic)` is the same model taking its most likely action."
+    if learner == "A2C":
+        text += " The settings and the play were chosen on training scenes only (docs/benchmark.md)."
+    else:
+        text += (
+            " Trained beside A2C on the same train split with the same steps, seed, network and "
+            "keep-best-train rule; not tuned."
+        )
     return text
 
 
-def train_split_line(scenario: str, result: dict[str, Any], out: Path | None) -> str | None:
-    """A2C's kept snapshot against the best fixed action on the train split, where it was chosen.
+def train_split_line(scenario: str, result: dict[str, Any], out: Path | None, learner: str = "A2C") -> str | None:
+    """A learner's (A2C's) kept snapshot against the best fixed action on the train split, where it
+    was chosen.
 
     Beside the test verdict this separates a policy that did not learn (no better than one move
     on the scenes it trained on) from one that does not carry over to unseen scenes.
     """
     train = result.get("train_split")
-    record = training_record(out, GROUPS[scenario])
+    record = training_record(out, GROUPS[scenario], learner)
     selection = record.get("selection") or {}
     scores = {s["step"]: s["oer_tau"] for s in selection.get("scores", [])}
     if not train or not train.get("fixed_actions") or selection.get("kept_step") not in scores:
@@ -193,7 +221,7 @@ def train_split_line(scenario: str, result: dict[str, Any], out: Path | None) ->
     last_step = max(scores)
     gap = kept - best
     return (
-        f"On the train split ({train['starts']:,} eligible starts), where the snapshot was chosen: A2C's "
+        f"On the train split ({train['starts']:,} eligible starts), where the snapshot was chosen: {learner}'s "
         f"kept snapshot ({selection['kept_step']:,} steps) scores OER_tau {cell(kept)} "
         f"({selection['episodes']} {selection['play']} episodes), the best fixed action there "
         f"(always `{action}`) {cell(best)} exactly, {cell(abs(gap))} {'above' if gap >= 0 else 'below'} it; "
@@ -226,8 +254,14 @@ def learning_curve_section(out: Path | None, page: Path) -> list[str]:
 
     if out is None:
         return []
-    records = {key: training_record(out, key) for key in GROUPS.values()}
+    # A2C's curves keep the group's name as their label, as on pages from before PPO.
+    records = {
+        key if learner == "A2C" else f"{key} ({learner})": training_record(out, key, learner)
+        for key in GROUPS.values()
+        for learner in LEARNERS
+    }
     records = {key: r for key, r in records.items() if r}
+    title = "A2C learning curve" if all(" (" not in key for key in records) else "Learning curves"
     if not records:
         return []
     target = page.parent / "images" / "results-learning-curve"
@@ -235,18 +269,18 @@ def learning_curve_section(out: Path | None, page: Path) -> list[str]:
         plotted = plot_learning_curve(records, target, formats=("png",))
     except UserError:
         return [
-            "## A2C learning curve",
+            f"## {title}",
             "",
             "The training records hold no learning curve (models trained before curves were kept).",
             "",
         ]
     lines = [
-        "## A2C learning curve",
+        f"## {title}",
         "",
         "Mean episodic reward per 1,000 training steps on the train split (Fig. 4a), read from "
         "each model's training record:",
         "",
-        f"![A2C learning curve](images/{target.name}.png)",
+        f"![{title}](images/{target.name}.png)",
         "",
     ]
     for key, data in plotted.data.items():
@@ -262,10 +296,12 @@ def learning_curve_section(out: Path | None, page: Path) -> list[str]:
 def policy_sections(scenario: str, result: dict[str, Any], out: Path | None, page: Path) -> list[str]:
     """Everything the page shows per scenario about what the policies do."""
     policies = result["policies"]
+    learners = learners_in(policies) or ["A2C"]
     lines: list[str] = []
-    for line in (versus_best_fixed(policies), paired_line(result)):
-        if line:
-            lines += [line, ""]
+    for learner in learners:
+        for line in (versus_best_fixed(policies, learner), paired_line(result, learner)):
+            if line:
+                lines += [line, ""]
     if BEST_FIXED in policies:
         lines += [
             f"`{BEST_FIXED}` is the best of the policies that always play the same action, chosen "
@@ -273,9 +309,10 @@ def policy_sections(scenario: str, result: dict[str, Any], out: Path | None, pag
             "collapsed to one move scores no better than it.",
             "",
         ]
-    for line in (train_split_line(scenario, result, out), a2c_line(scenario, policies, out)):
-        if line:
-            lines += [line, ""]
+    for learner in learners:
+        for line in (train_split_line(scenario, result, out, learner), a2c_line(scenario, policies, out, learner)):
+            if line:
+                lines += [line, ""]
     lines += exact_table(policies, result.get("fixed_actions"))
     lines += action_table(policies, list(result["protocol"].get("actions", [])))
     figure = action_figure(scenario, out, page)

@@ -1,0 +1,88 @@
+"""The learners' stage of ``davis-ag reproduce``: each learner (the paper's A2C, PPO beside it)
+trained on the train split with the same budget, reused when finished, resumed when killed."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Any
+
+from davis_ag.atomic_files import write_json_atomic
+from davis_ag.workflows.results_policies import load_json_object
+
+#: Which snapshot of each learner's run is evaluated: the best on the train split
+#: (:mod:`davis_ag.benchmark.selection`).
+KEEP = "best-train"
+
+
+def learner_stamp(algo: str, timesteps: int, settings: dict[str, Any] | None = None) -> dict[str, Any]:
+    """What a finished model of ``algo`` must have been made with to be reused (its stamp
+    ``MODEL.json``): steps, settings (``settings``, default ours: A2C's tuned ones, SB3's defaults
+    for PPO) and keep rule. A2C's stamp keeps the keys it had before PPO, so its models are reused."""
+    from davis_ag.benchmark.algorithms import SB3_SETTINGS
+    from davis_ag.benchmark.training import A2C_SETTINGS
+
+    if algo == "a2c":
+        return {"timesteps": timesteps, "a2c_settings": A2C_SETTINGS if settings is None else settings, "keep": KEEP}
+    chosen = SB3_SETTINGS[algo] if settings is None else {**SB3_SETTINGS[algo], **settings}
+    return {"algorithm": algo.upper(), "timesteps": timesteps, "sb3_settings": chosen, "keep": KEEP}
+
+
+def train_learner(
+    algo: str,
+    root: Path,
+    scenario: str,
+    crop: str,
+    model: Path,
+    timesteps: int,
+    config: Any,
+    settings: dict[str, Any] | None = None,
+    **train_kwargs: Any,
+) -> float | None:
+    """Train one learner of a run on the train split, unless its finished model is reusable.
+
+    A model made with other settings, steps or keep rule (or before they were recorded: those
+    kept the last snapshot) is trained anew; a killed run resumes from its checkpoint, which
+    :func:`davis_ag.benchmark.training.train_agent` keeps beside the model.
+
+    Args:
+        algo: ``a2c`` or ``ppo`` (:data:`davis_ag.benchmark.algorithms.ALGORITHMS`).
+        root: The dataset root.
+        scenario, crop: What to train on.
+        model: The model's ``.zip`` (:func:`davis_ag.workflows.results_policies.model_path`).
+        timesteps: Environment steps.
+        config: The run's :class:`~davis_ag.workflows.reproduce.ReproduceConfig` (seed, environments).
+        settings: The algorithm's settings over ours (tests: a short PPO rollout); None: ours.
+        **train_kwargs: Passed on to ``train_agent`` (tests: a small network, a callback).
+
+    Returns:
+        The seconds this sitting trained, or None when the finished model was reused.
+    """
+    from davis_ag.benchmark.training import train_agent
+
+    stamp = model.with_suffix(".json")
+    made = {"keep": "last", **load_json_object(stamp)}
+    wanted = learner_stamp(algo, timesteps, settings)
+    if model.is_file() and all(made.get(k) == v for k, v in wanted.items()):
+        return None
+    network = "the paper's network" + (" as features extractor" if algo != "a2c" else "")
+    print(f"training {algo.upper()} ({network}) on {scenario} train split for {timesteps} steps", flush=True)
+    start = time.perf_counter()
+    train_agent(
+        root,
+        scenario,
+        total_timesteps=timesteps,
+        seed=config.seed,
+        out_path=model,
+        n_envs=config.n_envs,
+        crop=crop,
+        device="cpu",
+        keep=KEEP,
+        algo=algo,
+        settings="ours" if settings is None else settings,
+        force=True,
+        **train_kwargs,
+    )  # its own work folder: a checkpoint of other settings is redone, as said above
+    seconds = time.perf_counter() - start
+    write_json_atomic(stamp, {**wanted, "seconds": seconds})
+    return seconds

@@ -1,0 +1,39 @@
+"""``davis-ag reproduce --rewrite-results``: the page from a run's records, a run from before PPO included."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict
+from pathlib import Path
+
+import pytest
+
+from davis_ag import cli
+from davis_ag.workflows.reproduce import CONFIGS
+
+
+def test_a_run_from_before_ppo_is_rewritten_without_claiming_ppo(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # Issue 32: medium's state.json predates ReproduceConfig.learners; its page still renders, and
+    # nothing on it says PPO ran, although the configuration now trains it.
+    config = asdict(CONFIGS["medium"])
+    del config["learners"]
+    stat = {"mean": 0.5, "std": 0.01}
+    policies = {
+        name: {"oer_tau": dict(stat, mean=m), "reward": stat, "length": stat}
+        for name, m in (("A2C", 0.6), ("Rand", 0.45), ("LRD", 0.44), ("UDD", 0.3))
+    }
+    protocol = {"split": "test", "tau": 3, "sessions": 3, "episodes": 200, "scenes": ["Single-Strawberry/003"]}
+    state = {
+        "config": config,
+        "results": {"sp": {"protocol": protocol, "policies": policies}},
+        "stages": {"sp-strawberry: train A2C": {"seconds": 7200.0, "note": "300000 steps", "code": "x"}},
+    }
+    (tmp_path / "state.json").write_text(json.dumps(state))
+    page = tmp_path / "results.md"
+    assert cli.main(["reproduce", "--out", str(tmp_path), "--rewrite-results", "--results", str(page)]) == 0
+    text = page.read_text()
+    assert "| A2C | .600 ± .010 |" in text and "| sp-strawberry: train A2C | 7200 |" in text
+    assert "PPO" not in text
+    assert capsys.readouterr().out.strip() == f"wrote {page}"
