@@ -10,13 +10,9 @@ from kill_callback import KillAfter
 from layout_factory import write_tiny_dataset
 from stable_baselines3 import A2C
 
+from davis_ag.benchmark.algorithms import A2C_SETTINGS
 from davis_ag.benchmark.selection import snapshot_path
-from davis_ag.benchmark.training import (
-    check_device,
-    checkpoint_paths,
-    train_a2c,
-    training_record_path,
-)
+from davis_ag.benchmark.training import check_device, checkpoint_paths, train_a2c, training_record_path
 from davis_ag.errors import MachineError, UserError
 from davis_ag.provenance import code_version
 
@@ -195,7 +191,7 @@ def test_the_record_keeps_the_settings_and_a_learning_curve_across_sittings(
     first = json.loads(checkpoint_paths(out)[1].read_text())["curve"]
     train_a2c(root, "sp", **kwargs)
     record = json.loads(training_record_path(out).read_text())
-    assert record["a2c_settings"] == training.A2C_SETTINGS and record["start_rule"] == "pairs"
+    assert record["a2c_settings"] == A2C_SETTINGS and record["start_rule"] == "pairs"
     curve = record["curve"]
     steps = [p["step"] for p in curve]
     assert steps == sorted(set(steps)) and steps[-1] == 240
@@ -205,14 +201,14 @@ def test_the_record_keeps_the_settings_and_a_learning_curve_across_sittings(
     assert sum(p["episodes"] for p in curve) >= 240 // 3 - 2
     assert all(0 <= p["reward"] <= 1 and 1 <= p["length"] <= 3 for p in curve)
     model = A2C.load(out, device="cpu")
-    assert model.ent_coef == training.A2C_SETTINGS["ent_coef"]
-    assert model.normalize_advantage == training.A2C_SETTINGS["normalize_advantage"]
+    assert model.ent_coef == A2C_SETTINGS["ent_coef"]
+    assert model.normalize_advantage == A2C_SETTINGS["normalize_advantage"]
 
 
 def test_settings_choose_the_sb3_defaults_or_refuse_unknown_ones(
     tmp_path: Path, one_thread: None, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from davis_ag.benchmark.training import SB3_DEFAULT_SETTINGS
+    from davis_ag.benchmark.algorithms import SB3_DEFAULT_SETTINGS
 
     root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2)
     out = tmp_path / "a2c.zip"

@@ -93,7 +93,8 @@ def test_ppo_trains_beside_a2c_resumes_a_killed_run_and_reuses_a_finished_one(
     import json
     from dataclasses import replace
 
-    from davis_ag.benchmark.training import A2C_SETTINGS, training_record_path
+    from davis_ag.benchmark.training import training_record_path
+    from davis_ag.benchmark.algorithms import A2C_SETTINGS
     from davis_ag.workflows.reproduce import CONFIGS
     from davis_ag.workflows.reproduce_learners import KEEP, learner_stamp, train_learner
     from davis_ag.workflows.results_policies import model_path

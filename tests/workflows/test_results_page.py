@@ -252,7 +252,8 @@ def test_a_broken_ordering_names_the_steps_that_break() -> None:
 
 def test_the_page_shows_what_each_policy_does(tmp_path: Path, sp_root: Path, one_thread: None) -> None:
     # A real (tiny) run's records: a model, its training record, an evaluation with every row.
-    from davis_ag.benchmark.training import A2C_SETTINGS, train_a2c
+    from davis_ag.benchmark.training import train_a2c
+    from davis_ag.benchmark.algorithms import A2C_SETTINGS
     from davis_ag.workflows.demo import run_baselines
     from davis_ag.workflows.reproduce import _summary
 

@@ -1,5 +1,5 @@
-"""The algorithms ``davis-ag train --algo`` trains besides the paper's A2C, and their settings
-(A2C's own, tuned on the train split, are in :mod:`davis_ag.benchmark.training`)."""
+"""The algorithms ``davis-ag train --algo`` trains and their settings: the paper's A2C (its settings
+chosen on the train split) and PPO and DQN (Stable-Baselines3's defaults)."""
 
 from __future__ import annotations
 
@@ -22,6 +22,50 @@ SB3_SETTINGS: dict[str, dict[str, Any]] = {
         "replay_buffer_kwargs": {"handle_timeout_termination": False},
     },
 }
+
+
+#: The A2C settings we train with, on top of Stable-Baselines3's defaults (the paper gives none).
+#: ``normalize_advantage`` scales each update's advantages to unit variance, so the size of the
+#: reward (``max(OER_tau - OER_0, 0)**2``, about .02 on average) stops setting the step size;
+#: ``ent_coef=0.01`` is then the usual entropy bonus, which keeps the policy from turning into a
+#: point mass on one move over a long run. Measured on the train split only
+#: (docs/benchmark.md): after enough steps A2C learns policies whose most likely move differs
+#: from start to start with these settings, with SB3's defaults and with the bonus alone (which
+#: left the flattest policy and the lowest sampled score); these learnt a little faster early on.
+#: What made the evaluated A2C a fixed action was chiefly too little training played
+#: deterministically (see ``DETERMINISTIC_PLAY`` in policies.py).
+A2C_SETTINGS: dict[str, Any] = {"ent_coef": 0.01, "normalize_advantage": True}
+#: Stable-Baselines3's own A2C defaults for the settings above (what ``--a2c-settings sb3`` trains).
+SB3_DEFAULT_SETTINGS: dict[str, Any] = {"ent_coef": 0.0, "normalize_advantage": False}
+#: Named setting sets of :func:`davis_ag.benchmark.training.train_a2c`.
+SETTINGS_PRESETS: dict[str, dict[str, Any]] = {"ours": A2C_SETTINGS, "sb3": SB3_DEFAULT_SETTINGS}
+#: SB3 A2C keyword arguments a setting set may change.
+TUNABLE = (
+    "ent_coef",
+    "normalize_advantage",
+    "learning_rate",
+    "n_steps",
+    "gamma",
+    "vf_coef",
+    "max_grad_norm",
+    "gae_lambda",
+)
+
+
+def resolve_settings(settings: str | dict[str, Any]) -> dict[str, Any]:
+    """The SB3 A2C arguments a setting set names (see :data:`SETTINGS_PRESETS`).
+
+    Raises:
+        UserError: for an unknown preset or an argument outside :data:`TUNABLE`.
+    """
+    if isinstance(settings, str):
+        if settings not in SETTINGS_PRESETS:
+            raise UserError(f"unknown A2C settings {settings!r}: choose one of {', '.join(SETTINGS_PRESETS)}")
+        return dict(SETTINGS_PRESETS[settings])
+    wrong = [k for k in settings if k not in TUNABLE]
+    if wrong:
+        raise UserError(f"A2C setting {wrong[0]!r} cannot be changed here: use {', '.join(TUNABLE)}")
+    return {**SB3_DEFAULT_SETTINGS, **settings}
 
 
 def resolve_sb3_settings(algo: str, settings: str | dict[str, Any]) -> dict[str, Any]:

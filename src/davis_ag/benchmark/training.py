@@ -13,7 +13,6 @@ to an uninterrupted one.
 
 from __future__ import annotations
 
-import json
 import os
 import time
 from pathlib import Path
@@ -29,7 +28,8 @@ from davis_ag.atomic_files import (
     write_or_rescue,
 )
 from davis_ag.benchmark import TVMEnv
-from davis_ag.benchmark.algorithms import ALGORITHMS, resolve_sb3_settings
+from davis_ag.benchmark.algorithms import ALGORITHMS, resolve_sb3_settings, resolve_settings
+from davis_ag.benchmark.checkpoints import check_checkpoint, load_checkpoint
 from davis_ag.benchmark.networks import ARCHITECTURES
 from davis_ag.benchmark.progress import TrainingProgress
 from davis_ag.benchmark.selection import KeepBestOnTrain, check_keep, snapshot_path
@@ -45,33 +45,6 @@ CURVE_EVERY = 1_000
 #: Steps between train-split scores of the policy when a run keeps its best snapshot
 #: (:mod:`davis_ag.benchmark.selection`): 30 scores over 300K steps, a few per cent of the time.
 SELECT_EVERY = 10_000
-
-#: The A2C settings we train with, on top of Stable-Baselines3's defaults (the paper gives none).
-#: ``normalize_advantage`` scales each update's advantages to unit variance, so the size of the
-#: reward (``max(OER_tau - OER_0, 0)**2``, about .02 on average) stops setting the step size;
-#: ``ent_coef=0.01`` is then the usual entropy bonus, which keeps the policy from turning into a
-#: point mass on one move over a long run. Measured on the train split only
-#: (docs/benchmark.md): after enough steps A2C learns policies whose most likely move differs
-#: from start to start with these settings, with SB3's defaults and with the bonus alone (which
-#: left the flattest policy and the lowest sampled score); these learnt a little faster early on.
-#: What made the evaluated A2C a fixed action was chiefly too little training played
-#: deterministically (see ``DETERMINISTIC_PLAY`` in policies.py).
-A2C_SETTINGS: dict[str, Any] = {"ent_coef": 0.01, "normalize_advantage": True}
-#: Stable-Baselines3's own A2C defaults for the settings above (what ``--a2c-settings sb3`` trains).
-SB3_DEFAULT_SETTINGS: dict[str, Any] = {"ent_coef": 0.0, "normalize_advantage": False}
-#: Named setting sets of :func:`train_a2c`.
-SETTINGS_PRESETS: dict[str, dict[str, Any]] = {"ours": A2C_SETTINGS, "sb3": SB3_DEFAULT_SETTINGS}
-#: SB3 A2C keyword arguments a setting set may change.
-TUNABLE = (
-    "ent_coef",
-    "normalize_advantage",
-    "learning_rate",
-    "n_steps",
-    "gamma",
-    "vf_coef",
-    "max_grad_norm",
-    "gae_lambda",
-)
 
 
 def make_vec_tvm(
@@ -232,33 +205,6 @@ class _Checkpoint(BaseCallback):
             if self.selection:  # the checkpoint now names the best snapshot: older ones can go
                 self.selection.prune()
         return True
-
-
-def _resumable(settings_file: Path, model_file: Path, settings: dict[str, Any]) -> tuple[int, list, list, list] | None:
-    """Steps done, sittings, learning curve and snapshot scores so far of a checkpoint of a run
-    with the same settings, else None."""
-    try:
-        saved = json.loads(settings_file.read_text())
-    except (OSError, ValueError):
-        return None
-    if not model_file.is_file() or not isinstance(saved, dict):
-        return None
-    done = saved.pop("timesteps_done", None)
-    sittings = saved.pop("sittings", [])
-    curve = saved.pop("curve", [])
-    scores = saved.pop("selection", [])
-    # Checkpoints from before settings were recorded trained A2C with SB3's defaults.
-    if saved.get("algorithm", "A2C") == "A2C":
-        saved.setdefault("a2c_settings", SB3_DEFAULT_SETTINGS)
-    saved.setdefault("start_rule", "scene")  # and drew starts scene first
-    saved.setdefault("keep", "last")  # and kept the last snapshot
-    if saved.get("dataset") == "/":
-        # Checkpoints before this version recorded Path.root ("/") for any dataset given as a
-        # path; they are taken as they were then, for whatever dataset the run names.
-        saved["dataset"] = settings["dataset"]
-    if saved != settings or not isinstance(done, int) or not isinstance(sittings, list):
-        return None
-    return done, sittings, curve if isinstance(curve, list) else [], scores if isinstance(scores, list) else []
 
 
 def train_a2c(dataset: Any, scenario: str, **kwargs: Any) -> Path:
@@ -463,92 +409,6 @@ def what_survives(error: OSError, final: Path, selection: KeepBestOnTrain | None
     else:
         kept = "no snapshot was finished yet"
     return f"training stopped: {reason}; {kept}: free the space and run the same command again to finish"
-
-
-def check_checkpoint(
-    settings_file: Path, model_file: Path, settings: dict[str, Any], force: bool
-) -> tuple[int, list, list, list] | None:
-    """What to resume from a checkpoint beside the output, by the output rule: the same run's is
-    resumed; one of another run, or a damaged one, is discarded only with ``force``.
-
-    Returns:
-        As :func:`_resumable`, or None to start afresh (no checkpoint, or ``force`` discarded one).
-
-    Raises:
-        UserError: for a damaged checkpoint or one of other settings, without ``force``: one line
-            with both ways on (start over with --force, or keep it).
-    """
-    if not settings_file.exists() and not model_file.exists():
-        return None
-    problem = _checkpoint_problem(settings_file, model_file, settings)
-    if problem is None:
-        return _resumable(settings_file, model_file, settings)
-    if not force:
-        raise UserError(
-            f"{model_file}: {problem}: run again with --force to discard it and start over, or stop here to keep it"
-        )
-    print(f"note: {model_file.name}: {problem}; --force: starting over", flush=True)
-    model_file.unlink(missing_ok=True)
-    settings_file.unlink(missing_ok=True)
-    return None
-
-
-def _checkpoint_problem(settings_file: Path, model_file: Path, settings: dict[str, Any]) -> str | None:
-    """Why a checkpoint cannot be resumed by a run of ``settings``, or None when it can."""
-    import zipfile
-
-    if not model_file.is_file() or not zipfile.is_zipfile(model_file):
-        return "the checkpoint is damaged (its model is missing or not a zip file), so it cannot be resumed"
-    if _resumable(settings_file, model_file, settings) is not None:
-        return None
-    try:
-        saved = json.loads(settings_file.read_text())
-    except (OSError, ValueError):
-        return f"the checkpoint is damaged ({settings_file.name} is unreadable), so it cannot be resumed"
-    if not isinstance(saved, dict):
-        return f"the checkpoint is damaged ({settings_file.name} is not a record), so it cannot be resumed"
-    differ = [
-        f"{key} {saved.get(key)!r}, not {settings[key]!r}"
-        for key in settings
-        if key in saved and saved[key] != settings[key] and key != "dataset"
-    ]
-    differ += ["another dataset"] if saved.get("dataset") not in (settings["dataset"], "/", None) else []
-    return f"it is the checkpoint of another run ({'; '.join(differ[:3]) or 'older settings'}), which this one cannot resume"
-
-
-def load_checkpoint(algorithm: Any, model_file: Path, env: Any, device: str) -> Any:
-    """Load a checkpoint's model with its SB3 ``algorithm`` class, a damaged one as one line with
-    both ways on.
-
-    Raises:
-        UserError: when SB3 cannot read it.
-    """
-    try:
-        return algorithm.load(model_file, env=env, device=device)
-    except Exception as error:  # zipfile, pickle, torch and SB3 each raise their own
-        if isinstance(error, (MemoryError, OSError)):
-            raise
-        raise UserError(
-            f"{model_file}: the checkpoint is damaged ({type(error).__name__}: {error}), so it "
-            "cannot be resumed: run again with --force to discard it and start over, or stop "
-            "here to keep it"
-        ) from None
-
-
-def resolve_settings(settings: str | dict[str, Any]) -> dict[str, Any]:
-    """The SB3 A2C arguments a setting set names (see :data:`SETTINGS_PRESETS`).
-
-    Raises:
-        UserError: for an unknown preset or an argument outside :data:`TUNABLE`.
-    """
-    if isinstance(settings, str):
-        if settings not in SETTINGS_PRESETS:
-            raise UserError(f"unknown A2C settings {settings!r}: choose one of {', '.join(SETTINGS_PRESETS)}")
-        return dict(SETTINGS_PRESETS[settings])
-    wrong = [k for k in settings if k not in TUNABLE]
-    if wrong:
-        raise UserError(f"A2C setting {wrong[0]!r} cannot be changed here: use {', '.join(TUNABLE)}")
-    return {**SB3_DEFAULT_SETTINGS, **settings}
 
 
 def check_device(device: str) -> None:

@@ -138,7 +138,7 @@ def run(args: argparse.Namespace) -> int:
 def _settings(args: argparse.Namespace) -> str | dict[str, object]:
     """What :func:`davis_ag.benchmark.training.train_agent` takes as ``settings``: the A2C preset,
     with ``--set`` values over it (over PPO's or DQN's own settings for those)."""
-    from davis_ag.benchmark.training import SETTINGS_PRESETS
+    from davis_ag.benchmark.algorithms import SETTINGS_PRESETS
 
     chosen = dict(args.settings)
     if args.algo != "a2c":

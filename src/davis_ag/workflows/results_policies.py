@@ -164,7 +164,7 @@ def action_table(policies: dict[str, Any], actions: list[str]) -> list[str]:
 def a2c_line(scenario: str, policies: dict[str, Any], out: Path | None, learner: str = "A2C") -> str | None:
     """How A2C (or another ``learner``) was trained (its settings, from the training record) and how
     it played."""
-    from davis_ag.benchmark.training import SB3_DEFAULT_SETTINGS
+    from davis_ag.benchmark.algorithms import SB3_DEFAULT_SETTINGS
 
     if learner not in policies:
         return None

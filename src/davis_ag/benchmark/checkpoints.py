@@ -1,0 +1,114 @@
+"""A training run's checkpoint beside its output: whether a run may resume it, and loading it.
+
+A checkpoint is SB3's zip of the model (with its optimiser state and step count) beside a JSON
+record of the run's settings, steps done, sittings, learning curve and snapshot scores
+(:mod:`davis_ag.benchmark.training` writes both). By the output rule (docs/errors.md) the same
+run's checkpoint is resumed; one of another run, or a damaged one, is discarded only with
+``--force``, and otherwise refused in one line offering both ways on.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from davis_ag.benchmark.algorithms import SB3_DEFAULT_SETTINGS
+from davis_ag.errors import UserError
+
+
+def resumable(settings_file: Path, model_file: Path, settings: dict[str, Any]) -> tuple[int, list, list, list] | None:
+    """Steps done, sittings, learning curve and snapshot scores so far of a checkpoint of a run
+    with the same settings, else None."""
+    try:
+        saved = json.loads(settings_file.read_text())
+    except (OSError, ValueError):
+        return None
+    if not model_file.is_file() or not isinstance(saved, dict):
+        return None
+    done = saved.pop("timesteps_done", None)
+    sittings = saved.pop("sittings", [])
+    curve = saved.pop("curve", [])
+    scores = saved.pop("selection", [])
+    # Checkpoints from before settings were recorded trained A2C with SB3's defaults.
+    if saved.get("algorithm", "A2C") == "A2C":
+        saved.setdefault("a2c_settings", SB3_DEFAULT_SETTINGS)
+    saved.setdefault("start_rule", "scene")  # and drew starts scene first
+    saved.setdefault("keep", "last")  # and kept the last snapshot
+    if saved.get("dataset") == "/":
+        # Checkpoints before this version recorded Path.root ("/") for any dataset given as a
+        # path; they are taken as they were then, for whatever dataset the run names.
+        saved["dataset"] = settings["dataset"]
+    if saved != settings or not isinstance(done, int) or not isinstance(sittings, list):
+        return None
+    return done, sittings, curve if isinstance(curve, list) else [], scores if isinstance(scores, list) else []
+
+
+def check_checkpoint(
+    settings_file: Path, model_file: Path, settings: dict[str, Any], force: bool
+) -> tuple[int, list, list, list] | None:
+    """What to resume from a checkpoint beside the output, by the output rule: the same run's is
+    resumed; one of another run, or a damaged one, is discarded only with ``force``.
+
+    Returns:
+        As :func:`resumable`, or None to start afresh (no checkpoint, or ``force`` discarded one).
+
+    Raises:
+        UserError: for a damaged checkpoint or one of other settings, without ``force``: one line
+            with both ways on (start over with --force, or keep it).
+    """
+    if not settings_file.exists() and not model_file.exists():
+        return None
+    problem = _checkpoint_problem(settings_file, model_file, settings)
+    if problem is None:
+        return resumable(settings_file, model_file, settings)
+    if not force:
+        raise UserError(
+            f"{model_file}: {problem}: run again with --force to discard it and start over, or stop here to keep it"
+        )
+    print(f"note: {model_file.name}: {problem}; --force: starting over", flush=True)
+    model_file.unlink(missing_ok=True)
+    settings_file.unlink(missing_ok=True)
+    return None
+
+
+def _checkpoint_problem(settings_file: Path, model_file: Path, settings: dict[str, Any]) -> str | None:
+    """Why a checkpoint cannot be resumed by a run of ``settings``, or None when it can."""
+    import zipfile
+
+    if not model_file.is_file() or not zipfile.is_zipfile(model_file):
+        return "the checkpoint is damaged (its model is missing or not a zip file), so it cannot be resumed"
+    if resumable(settings_file, model_file, settings) is not None:
+        return None
+    try:
+        saved = json.loads(settings_file.read_text())
+    except (OSError, ValueError):
+        return f"the checkpoint is damaged ({settings_file.name} is unreadable), so it cannot be resumed"
+    if not isinstance(saved, dict):
+        return f"the checkpoint is damaged ({settings_file.name} is not a record), so it cannot be resumed"
+    differ = [
+        f"{key} {saved.get(key)!r}, not {settings[key]!r}"
+        for key in settings
+        if key in saved and saved[key] != settings[key] and key != "dataset"
+    ]
+    differ += ["another dataset"] if saved.get("dataset") not in (settings["dataset"], "/", None) else []
+    return f"it is the checkpoint of another run ({'; '.join(differ[:3]) or 'older settings'}), which this one cannot resume"
+
+
+def load_checkpoint(algorithm: Any, model_file: Path, env: Any, device: str) -> Any:
+    """Load a checkpoint's model with its SB3 ``algorithm`` class, a damaged one as one line with
+    both ways on.
+
+    Raises:
+        UserError: when SB3 cannot read it.
+    """
+    try:
+        return algorithm.load(model_file, env=env, device=device)
+    except Exception as error:  # zipfile, pickle, torch and SB3 each raise their own
+        if isinstance(error, (MemoryError, OSError)):
+            raise
+        raise UserError(
+            f"{model_file}: the checkpoint is damaged ({type(error).__name__}: {error}), so it "
+            "cannot be resumed: run again with --force to discard it and start over, or stop "
+            "here to keep it"
+        ) from None
