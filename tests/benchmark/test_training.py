@@ -16,6 +16,9 @@ from davis_ag.benchmark.training import check_device, checkpoint_paths, train_a2
 from davis_ag.errors import MachineError, UserError
 from davis_ag.provenance import code_version
 
+#: The smallest real training run: two environments, the tiny network, a checkpoint every 20 steps.
+TINY_RUN = dict(n_envs=2, arch="pooled", device="cpu", checkpoint_every=20)
+
 
 def test_a_killed_run_resumes_from_its_checkpoint(
     tmp_path: Path, one_thread: None, capsys: pytest.CaptureFixture[str]
@@ -61,10 +64,7 @@ def test_a_checkpoint_of_another_dataset_is_not_resumed(
             total_timesteps=200,
             seed=1,
             out_path=out,
-            n_envs=2,
-            arch="pooled",
-            device="cpu",
-            checkpoint_every=20,
+            **TINY_RUN,
             callback=KillAfter(60),
         )
     saved = json.loads(checkpoint_paths(out)[1].read_text())
@@ -76,10 +76,7 @@ def test_a_checkpoint_of_another_dataset_is_not_resumed(
             total_timesteps=100,
             seed=1,
             out_path=out,
-            n_envs=2,
-            arch="pooled",
-            device="cpu",
-            checkpoint_every=20,
+            **TINY_RUN,
         )  # never discarded without a word
     train_a2c(
         second,
@@ -87,10 +84,7 @@ def test_a_checkpoint_of_another_dataset_is_not_resumed(
         total_timesteps=100,
         seed=1,
         out_path=out,
-        n_envs=2,
-        arch="pooled",
-        device="cpu",
-        checkpoint_every=20,
+        **TINY_RUN,
         force=True,
     )
     assert "resuming" not in capsys.readouterr().out
@@ -108,10 +102,7 @@ def test_a_checkpoint_from_before_datasets_were_recorded_still_resumes(
             total_timesteps=200,
             seed=1,
             out_path=out,
-            n_envs=2,
-            arch="pooled",
-            device="cpu",
-            checkpoint_every=20,
+            **TINY_RUN,
             callback=KillAfter(60),
         )
     settings_file = checkpoint_paths(out)[1]
@@ -123,10 +114,7 @@ def test_a_checkpoint_from_before_datasets_were_recorded_still_resumes(
         total_timesteps=200,
         seed=1,
         out_path=out,
-        n_envs=2,
-        arch="pooled",
-        device="cpu",
-        checkpoint_every=20,
+        **TINY_RUN,
     )
     assert "resuming" in capsys.readouterr().out
 
@@ -143,10 +131,7 @@ def test_other_settings_never_resume_a_checkpoint(
             total_timesteps=200,
             seed=1,
             out_path=out,
-            n_envs=2,
-            arch="pooled",
-            device="cpu",
-            checkpoint_every=20,
+            **TINY_RUN,
             callback=KillAfter(60),
         )
     with pytest.raises(UserError, match="seed 1, not 2"):
@@ -156,10 +141,7 @@ def test_other_settings_never_resume_a_checkpoint(
             total_timesteps=100,
             seed=2,
             out_path=out,
-            n_envs=2,
-            arch="pooled",
-            device="cpu",
-            checkpoint_every=20,
+            **TINY_RUN,
         )
     path = train_a2c(
         root,
@@ -167,10 +149,7 @@ def test_other_settings_never_resume_a_checkpoint(
         total_timesteps=100,
         seed=2,
         out_path=out,
-        n_envs=2,
-        arch="pooled",
-        device="cpu",
-        checkpoint_every=20,
+        **TINY_RUN,
         force=True,
     )
     assert "resuming" not in capsys.readouterr().out
@@ -225,10 +204,7 @@ def test_settings_choose_the_sb3_defaults_or_refuse_unknown_ones(
             total_timesteps=200,
             seed=1,
             out_path=out,
-            n_envs=2,
-            arch="pooled",
-            device="cpu",
-            checkpoint_every=20,
+            **TINY_RUN,
             callback=KillAfter(60),
             settings="sb3",
         )
@@ -261,10 +237,7 @@ def test_a_damaged_checkpoint_offers_both_ways_on(tmp_path: Path, one_thread: No
         total_timesteps=60,
         seed=1,
         out_path=out,
-        n_envs=2,
-        arch="pooled",
-        device="cpu",
-        checkpoint_every=20,
+        **TINY_RUN,
         keep="last",
     )
     with pytest.raises(KeyboardInterrupt):
@@ -317,10 +290,7 @@ def test_a_full_disk_at_the_end_never_loses_the_model(
             total_timesteps=60,
             seed=1,
             out_path=out,
-            n_envs=2,
-            arch="pooled",
-            device="cpu",
-            checkpoint_every=20,
+            **TINY_RUN,
             keep=keep,
             select_every=20,
             callback=DiskFillsAt(),
