@@ -361,3 +361,5 @@ def test_ppo_and_dqn_train_resume_and_keep_the_best(
     kept = record["selection"]
     assert kept["kept_step"] == max(kept["scores"], key=lambda s: (s["oer_tau"], -s["step"]))["step"]
     assert model.num_timesteps == kept["kept_step"]
+    if algo == "ppo":  # the zoo's lin_ schedules survive the checkpoint: 2.5e-4 falling to 0
+        assert model.lr_schedule(1.0) == pytest.approx(2.5e-4) and model.lr_schedule(0.0) == 0.0

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from davis_ag.workflows.bench_report import POOL_GAIN, projection
@@ -29,3 +31,31 @@ def test_a_measured_pool_gain_replaces_the_helios_one() -> None:
     costs = ({c: 1.0 for c in CROPS}, {c: 0.0 for c in CROPS})
     assert projection(*costs, gain=2.0)["hours_one_machine"] == pytest.approx(502_542 / 3600 / 2, abs=0.1)
     assert "measured by this bench" in projection(*costs, gain=2.0)["assumptions"]
+
+
+def test_the_training_rates_reach_performance_md_and_ppos_line_in_benchmark_md(tmp_path: Path) -> None:
+    """What ``make bench`` writes from the learners' rates: the table between performance.md's
+    markers and PPO's two settings in one sentence between benchmark.md's, the rest untouched."""
+    from davis_ag.workflows.bench_training import LEARNERS, write_training
+
+    rows = [row for row, _, _ in LEARNERS]
+    result = {
+        "steps": 2048,
+        "seed": 0,
+        "learners": {
+            rows[0]: {"steps_per_second": 50.0, "over_reference": 1.0, "hours_300k": 1.7},
+            rows[1]: {"steps_per_second": 25.0, "over_reference": 0.5, "hours_300k": 3.3},
+            rows[2]: {"steps_per_second": 10.0, "over_reference": 0.2, "hours_300k": 8.3},
+        },
+    }
+    performance = tmp_path / "performance.md"
+    performance.write_text("before\n<!-- bench-training:start -->\nold\n<!-- bench-training:end -->\nafter\n")
+    benchmark = tmp_path / "benchmark.md"
+    benchmark.write_text("# B\n<!-- ppo-rate:start -->\nold\n<!-- ppo-rate:end -->\nend\n")
+    write_training(result, (1.0, 2.0), performance)
+    table = performance.read_text()
+    assert table.startswith("before\n") and table.endswith("after\n") and "old" not in table
+    assert "| PPO (SB3's defaults) | **10.0** | 0.20x | 8.3 |" in table and "load average 1.00 at the start" in table
+    line = benchmark.read_text()
+    assert "SB3's defaults train at 10.0 steps/s" in line and "the zoo's settings at 25.0 (2.5 times as fast)" in line
+    assert line.startswith("# B\n") and line.endswith("end\n")

@@ -81,7 +81,7 @@ def test_a_run_the_disk_cannot_hold_is_refused_before_anything_is_written(tmp_pa
     assert not out.exists() and not (tmp_path / "results.md").exists()
 
 
-#: PPO at a test's size: a rollout of 16 steps per environment instead of SB3's 2,048.
+#: PPO at a test's size: a rollout of 16 steps per environment instead of the zoo's 128.
 SHORT_PPO = {"n_steps": 16, "batch_size": 32}
 
 
@@ -94,7 +94,7 @@ def test_ppo_trains_beside_a2c_resumes_a_killed_run_and_reuses_a_finished_one(
     from dataclasses import replace
 
     from davis_ag.benchmark.training import training_record_path
-    from davis_ag.benchmark.algorithms import A2C_SETTINGS
+    from davis_ag.benchmark.algorithms import A2C_SETTINGS, SB3_SETTINGS
     from davis_ag.workflows.reproduce import CONFIGS
     from davis_ag.workflows.reproduce_learners import KEEP, learner_stamp, train_learner
     from davis_ag.workflows.results_policies import model_path
@@ -113,9 +113,51 @@ def test_ppo_trains_beside_a2c_resumes_a_killed_run_and_reuses_a_finished_one(
     assert "resuming ppo_sp-strawberry.zip from its checkpoint at 64 of 128 steps" in capsys.readouterr().out
     record = json.loads(training_record_path(model).read_text())
     assert record["algorithm"] == "PPO" and record["timesteps"] == 128 and record["keep"] == "best-train"
-    assert record["sb3_settings"] == SHORT_PPO and record["seed"] == 1 and len(record["sittings"]) == 2
+    assert (
+        record["sb3_settings"] == {**SB3_SETTINGS["ppo"], **SHORT_PPO}
+        and record["seed"] == 1
+        and len(record["sittings"]) == 2
+    )
     made = model.stat().st_mtime_ns
     assert train_learner("ppo", sp_root, "sp", "strawberry", model, 128, config, **kwargs) is None
     assert model.stat().st_mtime_ns == made
     # Another budget is another model: trained anew, not reused.
     assert train_learner("ppo", sp_root, "sp", "strawberry", model, 96, config, **kwargs) is not None
+
+
+SP_ONLY = (("sp", "strawberry"),)
+
+
+@pytest.mark.slow
+def test_a_whole_run_times_every_stage_on_its_clock_and_a_rerun_adds_no_sitting(
+    tmp_path: Path, one_thread: None
+) -> None:
+    """``reproduce`` end to end at the smallest size (SP strawberry, A2C and PPO, the paper's
+    network): every stage that worked is on the clock and in the page's stage table; a second
+    sitting over the finished run reuses everything and adds no sitting to any stage."""
+    import json
+    from dataclasses import replace
+
+    from davis_ag.workflows.reproduce import CONFIGS, reproduce
+    from davis_ag.workflows.stage_clock import CLOCK_FILE, read_clock
+
+    config = replace(
+        CONFIGS["small"],
+        name="tiny",
+        size=(160, 90),
+        sp_timesteps=256,
+        n_envs=2,
+        episodes=4,
+        sessions=1,
+    )
+    out, page = tmp_path / "run", tmp_path / "results.md"
+    assert reproduce(config, out, page, SP_ONLY) == 0
+    clock = read_clock(out / CLOCK_FILE)
+    worked = [f"sp-strawberry: {stage}" for stage in ("generate", "train A2C", "train PPO", "evaluate")]
+    assert sorted(clock) == sorted(worked) and all(len(clock[s]) == 1 for s in worked)
+    state = json.loads((out / "state.json").read_text())
+    for stage in worked:
+        assert state["stages"][stage]["seconds"] == pytest.approx(clock[stage][0]["seconds"], abs=0.2)
+        assert f"| {stage} | {clock[stage][0]['seconds']:.0f} |" in page.read_text()
+    assert reproduce(config, out, page, SP_ONLY) == 0
+    assert read_clock(out / CLOCK_FILE) == clock

@@ -366,7 +366,7 @@ def test_a_run_with_ppo_shows_its_row_gap_settings_and_stage(tmp_path: Path, sp_
     ahead = sum(s["gap"] > 0 for s in gap["per_scene"])
     assert f"PPO minus `Best fixed action`: {'+' if gap['gap'] >= 0 else '-'}{_c(abs(gap['gap']))}" in text
     assert f"PPO is ahead on {ahead} of 1." in text and "A2C is ahead on" in text
-    assert "PPO: trained with n_steps=16, batch_size=32 over Stable-Baselines3's PPO defaults" in text
+    assert "PPO: trained with n_steps=16, n_epochs=4, batch_size=32, learning_rate=lin_2.5e-4" in text
     assert "PPO beside it (SB3's PPO defaults" in text
     assert "where the snapshot was chosen: A2C's kept snapshot (70 steps)" in text
     assert "where the snapshot was chosen: PPO's kept snapshot (64 steps)" in text

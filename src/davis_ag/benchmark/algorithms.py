@@ -9,19 +9,59 @@ from davis_ag.errors import UserError
 
 #: The algorithms :func:`davis_ag.benchmark.training.train_agent` trains (``davis-ag train --algo``).
 ALGORITHMS: tuple[str, ...] = ("a2c", "ppo", "dqn")
-#: PPO's and DQN's settings on top of Stable-Baselines3's defaults. PPO: none. DQN: SB3's replay
+#: PPO's and DQN's settings on top of Stable-Baselines3's defaults. PPO: RL Baselines3 Zoo's
+#: settings for Atari (``hyperparams/ppo.yml``, the zoo's set for a ``CnnPolicy`` on images with
+#: our 8 environments), not SB3's defaults, which are made for small vector observations: with
+#: 8 environments SB3's 2,048-step rollouts leave 300K steps 18 policy updates (the zoo's
+#: 128-step rollouts, 292), and its 10 epochs of 64-sample batches cost about 2.5 times the
+#: zoo's 4 epochs of 256 per step on this network (docs/benchmark.md). ``lin_X``: X falling
+#: linearly to 0 over the run (:func:`sb3_arguments`). DQN: SB3's replay
 #: buffer holds 1M transitions, which at 224x224x4 bytes per observation (twice: the next one
 #: too) is 400 GB; 10,000 keep it near 2 GB (one copy, ``optimize_memory_usage``, which needs
 #: ``handle_timeout_termination`` off: our episodes end with terminated, never truncated).
 #: Not tuned: the paper trains A2C only, and no change was measured on the train split.
 SB3_SETTINGS: dict[str, dict[str, Any]] = {
-    "ppo": {},
+    "ppo": {
+        "n_steps": 128,
+        "n_epochs": 4,
+        "batch_size": 256,
+        "learning_rate": "lin_2.5e-4",
+        "clip_range": "lin_0.1",
+        "vf_coef": 0.5,
+        "ent_coef": 0.01,
+    },
     "dqn": {
         "buffer_size": 10_000,
         "optimize_memory_usage": True,
         "replay_buffer_kwargs": {"handle_timeout_termination": False},
     },
 }
+#: The settings a ``lin_X`` value may be given to: those SB3 takes as a schedule.
+SCHEDULES = ("learning_rate", "clip_range", "clip_range_vf")
+
+
+def sb3_arguments(settings: dict[str, Any]) -> dict[str, Any]:
+    """The keyword arguments SB3 takes for a setting set: each ``lin_X`` (RL Baselines3 Zoo's
+    notation, kept as text so settings stay JSON in records and checkpoints) as SB3's own
+    schedule from X at the start to 0 at the end.
+
+    Raises:
+        UserError: for a ``lin_`` value that is not a number or is given to another setting.
+    """
+    from stable_baselines3.common.utils import LinearSchedule
+
+    arguments = dict(settings)
+    for key, value in settings.items():
+        if not (isinstance(value, str) and value.startswith("lin_")):
+            continue
+        try:
+            start = float(value.removeprefix("lin_"))
+        except ValueError:
+            start = None
+        if key not in SCHEDULES or start is None:
+            raise UserError(f"setting {key}={value}: lin_X (X a number) is for {', '.join(SCHEDULES)} only")
+        arguments[key] = LinearSchedule(start, 0.0, 1.0)
+    return arguments
 
 
 #: The A2C settings we train with, on top of Stable-Baselines3's defaults (the paper gives none).
@@ -81,7 +121,9 @@ def resolve_sb3_settings(algo: str, settings: str | dict[str, Any]) -> dict[str,
 
     if isinstance(settings, str):
         if settings != "ours":
-            raise UserError(f"--a2c-settings {settings} is for --algo a2c; {algo} trains with SB3's defaults")
+            raise UserError(
+                f"--a2c-settings {settings} is for --algo a2c; {algo} trains with its own settings and --set"
+            )
         return dict(SB3_SETTINGS[algo])
     known = inspect.signature(getattr(stable_baselines3, algo.upper())).parameters
     wrong = [k for k in settings if k not in known or k in ("policy", "env", "seed", "device", "verbose")]

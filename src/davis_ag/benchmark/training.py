@@ -28,7 +28,7 @@ from davis_ag.atomic_files import (
     write_or_rescue,
 )
 from davis_ag.benchmark import TVMEnv
-from davis_ag.benchmark.algorithms import ALGORITHMS, resolve_sb3_settings, resolve_settings
+from davis_ag.benchmark.algorithms import ALGORITHMS, resolve_sb3_settings, resolve_settings, sb3_arguments
 from davis_ag.benchmark.checkpoints import check_checkpoint, load_checkpoint
 from davis_ag.benchmark.networks import ARCHITECTURES
 from davis_ag.benchmark.progress import TrainingProgress
@@ -236,7 +236,8 @@ def train_agent(
     """Train an agent on the train split and save it; resume a killed run.
 
     PPO and DQN: Stable-Baselines3's defaults changed only by
-    :data:`davis_ag.benchmark.algorithms.SB3_SETTINGS` (and a ``settings`` dict), ``CnnPolicy``
+    :data:`davis_ag.benchmark.algorithms.SB3_SETTINGS` (PPO: RL Baselines3 Zoo's Atari settings)
+    and a ``settings`` dict, ``CnnPolicy``
     with the same ``arch`` network as A2C; DQN acts on the environment's discrete moves (``done``
     included). Everything else below holds for all three.
     A2C's hyperparameters (the paper gives none) are Stable-Baselines3's A2C defaults, learning rate
@@ -298,6 +299,7 @@ def train_agent(
     check_seed(seed, "--seed")
     check_device(device)
     chosen = resolve_settings(settings) if algo == "a2c" else resolve_sb3_settings(algo, settings)
+    arguments = sb3_arguments(chosen)  # a bad lin_X refused here, before the data is opened
     final = model_path(Path(out_path).expanduser().absolute())
     prove_writable_file(final)  # before hours of training, not after
     model_file, settings_file = checkpoint_paths(final)
@@ -331,7 +333,7 @@ def train_agent(
             device=device,
             verbose=verbose,
             policy_kwargs=dict(ARCHITECTURES[arch]),
-            **chosen,
+            **arguments,
         )
         done, earlier, points = 0, [], []
     sittings = _Sittings(earlier, done)

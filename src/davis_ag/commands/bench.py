@@ -42,9 +42,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--only",
-        choices=("all", "continuous"),
+        choices=("all", "continuous", "training"),
         default="all",
-        help="continuous: only TVMContinuous-v0's steps/s (about a minute)",
+        help="continuous: only TVMContinuous-v0's steps/s (about a minute); training: only the "
+        "learners' training steps/s (about 8 minutes)",
     )
 
 
@@ -54,14 +55,15 @@ def _is_report(path: Path) -> bool:
         data = json.loads(path.read_text())
     except (OSError, ValueError):
         return False
-    return isinstance(data, dict) and bool({"machine", "continuous_env"} & set(data))
+    return isinstance(data, dict) and bool({"machine", "continuous_env", "training"} & set(data))
 
 
 def run(args: argparse.Namespace) -> int:
     """Measure, print and write the report (and the doc's sections)."""
     from davis_ag.atomic_files import write_marked_section
     from davis_ag.workflows.bench import run as run_bench
-    from davis_ag.workflows.bench import run_continuous
+    from davis_ag.workflows.bench import run_continuous, run_training
+    from davis_ag.workflows.bench_training import write_training
     from davis_ag.workflows.bench_report import table, write_continuous
 
     from davis_ag.atomic_files import prove_writable_folder
@@ -77,8 +79,8 @@ def run(args: argparse.Namespace) -> int:
             f"--doc {args.doc}: not a Markdown page with <!-- bench:start --> and <!-- bench:end --> "
             "markers; give docs/performance.md or leave --doc out"
         )
-    if args.only == "continuous":
-        run_continuous(args.out, args.doc)
+    if args.only in ("continuous", "training"):
+        (run_continuous if args.only == "continuous" else run_training)(args.out, args.doc)
         print(f"written {args.out}" + (f" and {args.doc}" if args.doc else ""))
         return 0
     report = run_bench(args.out, args.crops, args.repeats, args.antialiasing)
@@ -89,6 +91,9 @@ def run(args: argparse.Namespace) -> int:
         if "continuous_env" in report:
             load = report["machine"]["load_average"]
             write_continuous(report["continuous_env"], (load["start"][0], load["end"][0]), args.doc)
+        if "training" in report:
+            load = report["machine"]["load_average"]
+            write_training(report["training"], (load["start"][0], load["end"][0]), args.doc)
         print(f"written {args.doc}")
     print(f"written {args.out}")
     return 0

@@ -10,8 +10,8 @@ from davis_ag.errors import UserError
 HELP = "train an A2C (or PPO, DQN) agent for target visibility maximisation"
 DESCRIPTION = (
     "Train a Stable-Baselines3 agent (--algo a2c, the paper's, by default; ppo; dqn) with the paper's network "
-    "(CnnPolicy; A2C: SB3's default hyperparameters with an entropy bonus and normalised advantages; PPO "
-    "and DQN: SB3's defaults, DQN with a smaller replay buffer) on the train split of the TVM environment "
+    "(CnnPolicy; A2C: SB3's default hyperparameters with an entropy bonus and normalised advantages; PPO: "
+    "RL Baselines3 Zoo's Atari settings; DQN: SB3's defaults with a smaller replay buffer) on the train split of the TVM environment "
     "and save a .zip (the snapshot that scored best on the train split), with a training record "
     "(settings, sittings, learning curve) beside it. Shows steps, rate, time left and the last "
     "train-split score: a bar on a terminal, a line a minute in a log."
@@ -72,7 +72,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="KEY=VALUE",
         dest="settings",
         help="a Stable-Baselines3 argument of the algorithm over its settings (repeatable), e.g. "
-        "n_steps=128 for a short PPO rollout; recorded in the training record",
+        "n_steps=32 for a short PPO rollout; recorded in the training record",
     )
     parser.add_argument(
         "--keep",
@@ -143,6 +143,6 @@ def _settings(args: argparse.Namespace) -> str | dict[str, object]:
     chosen = dict(args.settings)
     if args.algo != "a2c":
         if args.a2c_settings != "ours":
-            raise UserError(f"--a2c-settings is for --algo a2c; {args.algo} trains with SB3's defaults and --set")
+            raise UserError(f"--a2c-settings is for --algo a2c; {args.algo} trains with its own settings and --set")
         return chosen or "ours"
     return {**SETTINGS_PRESETS[args.a2c_settings], **chosen} if chosen else args.a2c_settings

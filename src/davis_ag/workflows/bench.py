@@ -17,8 +17,9 @@ For each crop (a single-plant strawberry and a single goblet vine, dataset seed 
   it is a look-up on the id image the same pass drew, not a second render.
 
 Per path the median over repetitions of the mean seconds per view is reported. With strawberry,
-also the grid environment's steps/s and TVMContinuous-v0's at 224x224 (``--only continuous``
-measures only the latter, in about a minute). Then the hours the
+also the grid environment's steps/s, TVMContinuous-v0's at 224x224 (``--only continuous``
+measures only the latter, in about a minute) and each learner's training steps/s
+(:mod:`davis_ag.workflows.bench_training`, ``--only training``). Then the hours the
 ``paper`` preset would take on one machine like this one and on a Ray cluster of such machines.
 With ``--doc docs/performance.md`` the tables are written into that file between its
 ``<!-- bench:start -->`` and ``<!-- bench:end -->`` markers.
@@ -49,6 +50,7 @@ from davis_ag.workflows.bench_report import (
     projection,
     write_continuous,
 )
+from davis_ag.workflows.bench_training import training_speed, training_table, write_training
 
 CAMERA = Camera(1280, 720)
 #: Views timed per crop: the strawberry's grid every 0.5 m at the middle altitude, the others'
@@ -267,6 +269,20 @@ def run_continuous(out: Path, doc: Path | None) -> dict:
     return result
 
 
+def run_training(out: Path, doc: Path | None) -> dict:
+    """Only the learners' training rates (``--only training``, about 8 minutes): JSON, the doc's
+    section and docs/benchmark.md's PPO line."""
+    start = os.getloadavg()[0]
+    with tempfile.TemporaryDirectory(prefix="davis-ag-bench-") as scratch:
+        result = training_speed(Path(scratch))
+    load = (start, os.getloadavg()[0])
+    print(training_table(result, load))
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(json.dumps({"training": result}, indent=1) + "\n")
+    write_training(result, load, doc)
+    return result
+
+
 def run(out: Path, crops: list[str], repeats: int, antialiasing: str = "fxaa") -> dict:
     """Run every measurement; return the JSON report."""
     load_start = os.getloadavg()
@@ -297,6 +313,7 @@ def run(out: Path, crops: list[str], repeats: int, antialiasing: str = "fxaa") -
             report["env_steps_per_second"] = env_speed(Path(scratch) / "strawberry-ours-0")
             report["continuous_env"] = continuous_env_speed(Path(scratch))
             report["pool"] = pool_gain(Path(scratch))
+            report["training"] = training_speed(Path(scratch))
     for name in CROPS:  # a crop not measured this time: assume the slowest one measured
         for measured in (per_view, overhead, floor, grow):
             measured.setdefault(name, max(measured.values()))

@@ -35,7 +35,7 @@ class ReproduceConfig:
         seed: Dataset, training and evaluation seed.
         learners: The algorithms trained (:data:`davis_ag.benchmark.algorithms.ALGORITHMS`), each
             with the same steps, seed, network, train split and keep rule: the paper's ``a2c``
-            and, beside it, ``ppo`` with SB3's defaults.
+            and, beside it, ``ppo`` with RL Baselines3 Zoo's Atari settings.
     """
 
     name: str
@@ -245,6 +245,7 @@ def reproduce(
     from davis_ag.workflows.demo import evaluation_split, generate_scenes, run_baselines
     from davis_ag.workflows.results_page import write_results_md
     from davis_ag.workflows.reproduce_learners import train_learner
+    from davis_ag.workflows.stage_clock import CLOCK_FILE, StageClock, generation_seconds
     from davis_ag.workflows.results_policies import model_path
 
     check_disk(config, Path(out).expanduser().absolute(), pairs)
@@ -262,6 +263,7 @@ def reproduce(
     state["config"] = asdict(config)
     state.setdefault("stages", {})
     state.setdefault("results", {})
+    clock = StageClock(out / CLOCK_FILE, code_version())
 
     def record(stage: str, seconds: float, note: str = "", code: str | None = None) -> None:
         state["stages"][stage] = {"seconds": round(seconds, 1), "note": note, "code": code or code_version()}
@@ -278,27 +280,11 @@ def reproduce(
         requests = [SceneRequest(scenario, crop, i, config.seed, camera) for i in range(n)]
         state.setdefault("scene_folders", {})[key] = [r.folder for r in requests]
         print(f"== {key}: {n} scene(s) at {config.size[0]}x{config.size[1]}", flush=True)
-        generated = generate_scenes(requests, root)  # also writes splits.json
-        # Per-scene times survive resumed runs, so the stage time covers every scene it used.
-        scene_log = state.setdefault("scenes", {})
-        for g in generated:
-            if not g["skipped"]:
-                scene_log[g["scene"]] = {
-                    "seconds": round(g["total_s"], 1),
-                    "views": g["views"],
-                    "s_per_view": round(g["views_s"] / g["views"], 3),
-                }
-        timed = [scene_log[r.folder] for r in requests if r.folder in scene_log]
-        if timed:
-            views = sum(t["views"] for t in timed)
-            missing = len(requests) - len(timed)
-            record(
-                f"{key}: generate",
-                sum(t["seconds"] for t in timed),
-                f"{len(timed)} scene(s), {views} views, "
-                f"{sum(t['s_per_view'] * t['views'] for t in timed) / views:.2f} s per view"
-                + (f"; {missing} scene(s) made earlier, not timed" if missing else ""),
-            )
+        with clock.timing(f"{key}: generate") as sitting:
+            generated = generate_scenes(requests, root)  # also writes splits.json
+            if all(g["skipped"] for g in generated):
+                sitting.discard()
+        record(f"{key}: generate", *generation_seconds(root, [r.folder for r in requests], clock, f"{key}: generate"))
         start = time.perf_counter()
         group = root / requests[0].folder.split("/")[0]
         report = validate_dataset(group)
@@ -313,32 +299,33 @@ def reproduce(
         models = {}
         for algo in config.learners:
             models[algo] = model_path(out, key, algo)
-            seconds = train_learner(algo, root, scenario_name, crop_name, models[algo], timesteps, config)
-            if seconds is not None:
+            stage = f"{key}: train {algo.upper()}"
+            with clock.timing(stage) as sitting:
+                if train_learner(algo, root, scenario_name, crop_name, models[algo], timesteps, config) is None:
+                    sitting.discard()
+            if clock.seconds(stage):
                 record(
-                    f"{key}: train {algo.upper()}",
-                    seconds,
-                    f"{timesteps} steps, {timesteps / seconds:.1f} steps/s (incl. cache build)",
+                    stage, clock.seconds(stage), f"{timesteps} steps, {clock.sittings(stage)} sitting(s) on the clock"
                 )
         print(f"benchmark on split {split!r}: {config.sessions} x {config.episodes} episodes", flush=True)
         results_json = out / "results" / f"{key}.json"
         results = _reusable_results(results_json, list(models.values()), split, config)
         if results is None:
-            start = time.perf_counter()
-            results = run_baselines(
-                root,
-                scenario_name,
-                crop_name,
-                split,
-                config.episodes,
-                config.sessions,
-                config.seed,
-                model=models.get("a2c"),
-                learners=tuple(path for algo, path in models.items() if algo != "a2c"),
-            )
-            write_or_rescue(results_json, partial(write_json, results), "the results")
-            plot_results(results, results_json.with_suffix(".png"))
-            record(f"{key}: evaluate", time.perf_counter() - start, f"split {split}")
+            with clock.timing(f"{key}: evaluate"):
+                results = run_baselines(
+                    root,
+                    scenario_name,
+                    crop_name,
+                    split,
+                    config.episodes,
+                    config.sessions,
+                    config.seed,
+                    model=models.get("a2c"),
+                    learners=tuple(path for algo, path in models.items() if algo != "a2c"),
+                )
+                write_or_rescue(results_json, partial(write_json, results), "the results")
+                plot_results(results, results_json.with_suffix(".png"))
+            record(f"{key}: evaluate", clock.seconds(f"{key}: evaluate"), f"split {split}")
         else:
             print(f"reusing {results_json}", flush=True)
         if add_train_split(results, root, scenario_name, crop_name):

@@ -311,12 +311,17 @@ def stage_rows(state: dict[str, Any], out: Path | None) -> list[tuple[str, float
 
     A stage's entry in ``state.json`` is rewritten by every sitting that passes it, even one that
     only skipped finished scenes or resumed a training run. So the code of a generate stage is read
-    from its scenes' ``scene.json``, and a training stage's time, rate and code from the model's
-    training record (every sitting), where those exist.
+    from its scenes' ``scene.json``, and a training stage's rate and code from the model's
+    training record (every sitting); its time is the run's clock's (every sitting, the time redone
+    after a kill included: :mod:`davis_ag.workflows.stage_clock`), or the record's for a run from
+    before the clock.
 
     Returns:
         ``(stage, seconds, code, note)`` rows in the run's order.
     """
+    from davis_ag.workflows.stage_clock import CLOCK_FILE, read_clock
+
+    clock = read_clock(out / CLOCK_FILE) if out is not None else {}
     rows = []
     for stage, entry in state.get("stages", {}).items():
         key, _, step = stage.partition(": ")
@@ -333,11 +338,13 @@ def stage_rows(state: dict[str, Any], out: Path | None) -> list[tuple[str, float
             record = training_record(out, key, learner)
         if record.get("sittings"):
             sittings = record["sittings"]
-            seconds = record.get("seconds", seconds)
+            timed = clock.get(stage, [])
+            seconds = sum(s["seconds"] for s in timed) if timed else record.get("seconds", seconds)
             code = ", ".join(dict.fromkeys(s.get("code", "unrecorded") for s in sittings))
             note = (
                 f"{record.get('timesteps', 0):,} steps in {len(sittings)} sitting(s), "
                 f"{record.get('steps_per_second', 0):.1f} steps/s over the sittings' wall time"
+                + (f"; {len(timed)} sitting(s) on the run's clock" if timed else "")
             )
         rows.append((stage, seconds, code, note))
     return rows

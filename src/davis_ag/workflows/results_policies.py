@@ -26,7 +26,7 @@ GROUPS = {"sp": "sp-strawberry", "mp": "mp-vine"}
 #: What each learner trains with besides the settings its record names (the SB3 defaults).
 SB3_DEFAULTS_TEXT = {
     "A2C": "learning rate 7e-4, n_steps 5, gamma .99, vf_coef .5, max_grad_norm .5, RMSprop",
-    "PPO": "learning rate 3e-4, n_steps 2048, batch 64, 10 epochs, gamma .99, gae_lambda .95, clip .2, Adam",
+    "PPO": "gamma .99, gae_lambda .95, max_grad_norm .5, Adam; lin_X: X falling linearly to 0 over the run",
 }
 
 

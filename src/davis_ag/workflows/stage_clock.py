@@ -1,0 +1,154 @@
+"""The wall time of a long run's stages, summed over the sittings that worked on them.
+
+A ``paper-scale`` run spans many sittings, and each one ends when its session is stopped: a stage's
+time known only at its end would be lost with every sitting that did not reach it. The clock
+therefore writes its file (``OUT/clock.json``) every minute while a stage runs, so a killed sitting
+still counts up to its last minute, and its sittings add up to the stage's wall time, the time
+redone after a kill included.
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any
+
+from davis_ag.atomic_files import write_json_atomic
+
+#: The clock's file in a run's work folder.
+CLOCK_FILE = "clock.json"
+#: Seconds between the clock's writes while a stage runs: what a killed sitting may go uncounted.
+WRITE_EVERY_S = 60.0
+
+
+class Sitting:
+    """One sitting's work on a stage; :meth:`discard` it when the stage found nothing to do."""
+
+    def __init__(self) -> None:
+        self.discarded = False
+
+    def discard(self) -> None:
+        """Leave this sitting out of the stage's time (everything it would do was done before)."""
+        self.discarded = True
+
+
+class StageClock:
+    """Per stage, the wall seconds of every sitting that worked on it, kept in one JSON file."""
+
+    def __init__(self, path: Path, code: str, every_s: float = WRITE_EVERY_S) -> None:
+        """Args:
+        path: The clock's file (``OUT/clock.json``); its earlier sittings are kept.
+        code: The code version this sitting runs, recorded with each of its sittings.
+        every_s: Seconds between writes while a stage runs.
+        """
+        self.path = Path(path)
+        self.code = code
+        self.every_s = every_s
+        self.stages: dict[str, list[dict[str, Any]]] = read_clock(self.path)
+        if self.path.is_file() and not self.stages and self.path.read_bytes().strip():
+            # Unreadable: kept aside, never overwritten, and the stages timed from here on.
+            kept = self.path.with_name(self.path.name + ".unreadable")
+            self.path.replace(kept)
+            print(f"note: {self.path} could not be read; kept as {kept}, stages timed from now on", flush=True)
+        self._lock = threading.Lock()
+
+    @contextmanager
+    def timing(self, stage: str) -> Iterator[Sitting]:
+        """Time the body as one sitting of ``stage``; the file is rewritten every ``every_s`` seconds
+        and at the end, and the sitting is dropped if the body discards it."""
+        sitting = Sitting()
+        entry = {"started": datetime.now(timezone.utc).isoformat(timespec="seconds"), "seconds": 0.0, "code": self.code}
+        start = time.perf_counter()
+        done = threading.Event()
+
+        def tick() -> None:
+            while not done.wait(self.every_s):
+                self._write(stage, entry, time.perf_counter() - start, keep=True)
+
+        ticker = threading.Thread(target=tick, name=f"clock {stage}", daemon=True)
+        ticker.start()
+        try:
+            yield sitting
+        finally:
+            done.set()
+            ticker.join()
+            self._write(stage, entry, time.perf_counter() - start, keep=not sitting.discarded)
+
+    def _write(self, stage: str, entry: dict[str, Any], seconds: float, keep: bool) -> None:
+        with self._lock:
+            entry["seconds"] = round(seconds, 1)
+            sittings = self.stages.setdefault(stage, [])
+            if keep and not any(s is entry for s in sittings):
+                sittings.append(entry)
+            elif not keep:
+                sittings[:] = [s for s in sittings if s is not entry]
+            write_json_atomic(self.path, {"stages": self.stages}, indent=2)
+
+    def seconds(self, stage: str) -> float:
+        """The stage's wall seconds over every sitting so far (0 when none worked on it)."""
+        return round(sum(s["seconds"] for s in self.stages.get(stage, [])), 1)
+
+    def sittings(self, stage: str) -> int:
+        """How many sittings worked on the stage."""
+        return len(self.stages.get(stage, []))
+
+    def started(self, stage: str) -> float | None:
+        """When the stage's first timed sitting began (POSIX seconds), or None."""
+        sittings = self.stages.get(stage, [])
+        return datetime.fromisoformat(sittings[0]["started"]).timestamp() if sittings else None
+
+
+def generation_seconds(root: Path, scenes: list[str], clock: StageClock, stage: str) -> tuple[float, str]:
+    """A generate stage's wall seconds and note: the clock's sittings, plus the scenes finished
+    before the clock first timed this stage (a run begun before the clock existed), from the
+    time each scene's ``scene.json`` records spread over the scene processes that ran at once.
+
+    Args:
+        root: The dataset root.
+        scenes: The stage's scene folders.
+        clock: The run's clock.
+        stage: The stage's name on the clock.
+
+    Returns:
+        ``(seconds, note)``; the note says which part was on the clock and which was not.
+    """
+    from davis_ag.formats.layout import SCENE_METADATA
+    from davis_ag.generate.run_progress import default_workers
+
+    began = clock.started(stage)
+    views = 0
+    earlier: list[float] = []
+    for scene in scenes:
+        path = root / scene / SCENE_METADATA
+        try:
+            metadata = json.loads(path.read_text())
+        except (OSError, ValueError):
+            continue
+        views += len(metadata.get("views", []))
+        timing = metadata.get("timing_s", {})
+        if began is None or path.stat().st_mtime < began:
+            earlier.append(timing.get("grow", 0.0) + timing.get("draw_and_label", 0.0))
+    workers = max(1, min(default_workers(), len(scenes)))
+    seconds = clock.seconds(stage) + sum(earlier) / workers
+    note = f"{len(scenes)} scene(s), {views:,} views; {clock.sittings(stage)} sitting(s) on the clock"
+    if earlier:
+        note += (
+            f", {len(earlier)} scene(s) made before it: their scene.json times "
+            f"({sum(earlier) / 3600:.2f} h) over {workers} scene processes"
+        )
+    return seconds, note
+
+
+def read_clock(path: Path) -> dict[str, list[dict[str, Any]]]:
+    """The sittings per stage of a clock file; none for a missing or unreadable one (a run from
+    before the clock, or a file a crash cut short: its stages are then timed from here on)."""
+    try:
+        stages = json.loads(Path(path).read_text()).get("stages", {})
+    except (OSError, ValueError, AttributeError):
+        return {}
+    return {k: v for k, v in stages.items() if isinstance(v, list)} if isinstance(stages, dict) else {}
