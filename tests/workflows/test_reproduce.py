@@ -145,6 +145,7 @@ def test_a_whole_run_times_every_stage_on_its_clock_and_a_rerun_adds_no_sitting(
         CONFIGS["small"],
         name="tiny",
         size=(160, 90),
+        sp_scenes=2,  # one to train on, one to test on
         sp_timesteps=256,
         n_envs=2,
         episodes=4,
