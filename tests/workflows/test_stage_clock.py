@@ -60,6 +60,9 @@ def test_a_sitting_with_nothing_to_do_is_left_out_and_other_stages_are_kept(tmp_
     stages = read_clock(path)
     assert [s["code"] for s in stages["sp-strawberry: train A2C"]] == ["a"]
     assert [s["code"] for s in stages["sp-strawberry: evaluate"]] == ["b"]
+    with second.timing("mp-vine: generate") as sitting:
+        sitting.discard()
+    assert "mp-vine: generate" not in read_clock(path)
     assert second.seconds("mp-vine: generate") == 0 and second.started("mp-vine: generate") is None
 
 

@@ -87,6 +87,8 @@ class StageClock:
                 sittings.append(entry)
             elif not keep:
                 sittings[:] = [s for s in sittings if s is not entry]
+            if not sittings:  # a stage no sitting worked on is not listed
+                del self.stages[stage]
             write_json_atomic(self.path, {"stages": self.stages}, indent=2)
 
     def seconds(self, stage: str) -> float:
