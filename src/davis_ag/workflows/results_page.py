@@ -561,12 +561,12 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
     lines += learning_curve_section(out, Path(path))
     lines += ["## Notes", ""] + [f"- {note}" for note in _notes(config, state, out)] + [""]
     lines += _how_made(state, out)
-    lines += ["## Wall time per stage", "", "| Stage | Seconds | Code | Note |", "|---|---|---|---|"]
+    lines += ["## Wall time per stage", "", "| Stage | Seconds | Hours | Code | Note |", "|---|---|---|---|---|"]
     total = 0.0
     for stage, seconds, code, note in stage_rows(state, out):
         total += seconds
-        lines.append(f"| {stage} | {seconds:.0f} | {code} | {note} |")
-    lines += [f"| total | {total:.0f} | | |", ""]
+        lines.append(f"| {stage} | {seconds:.0f} | {seconds / 3600:.2f} | {code} | {note} |")
+    lines += [f"| total | {total:.0f} | {total / 3600:.2f} | | |", ""]
     written = write_text_atomic(path, "\n".join(lines) + "\n")
     # A page in a project's docs/ also updates the README's block beside it, so the README's
     # numbers are the run's, never copied by hand.
