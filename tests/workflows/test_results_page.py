@@ -367,7 +367,12 @@ def test_a_run_with_ppo_shows_its_row_gap_settings_and_stage(tmp_path: Path, sp_
     assert f"PPO minus `Best fixed action`: {'+' if gap['gap'] >= 0 else '-'}{_c(abs(gap['gap']))}" in text
     assert f"PPO is ahead on {ahead} of 1." in text and "A2C is ahead on" in text
     assert "PPO: trained with n_steps=16, n_epochs=4, batch_size=32, learning_rate=lin_2.5e-4" in text
-    assert "PPO beside it (SB3's PPO defaults" in text
+    assert "PPO beside it (RL Baselines3 Zoo's Atari settings" in text
+    train_starts = state["results"]["sp"]["train_split"]["starts"]
+    assert (
+        f"Split `test` (1 scene(s), {both['protocol']['starts']:,} eligible starts; the train split: "
+        f"{train_starts:,} eligible starts), tau = 3" in text
+    )
     assert "where the snapshot was chosen: A2C's kept snapshot (70 steps)" in text
     assert "where the snapshot was chosen: PPO's kept snapshot (64 steps)" in text
     how = text.split("## How this run was made", 1)[1]

@@ -263,8 +263,11 @@ def _notes(config: Any, state: dict[str, Any], out: Path | None) -> list[str]:
                 "draw `done` with probability 1/3 at each step (common random numbers)."
             )
     notes.append(
-        "Stage times are wall times; a resumed run keeps each scene's own time. Other "
-        "work may share the machine, so rates (e.g. A2C steps/s) can vary between stages."
+        "Stage times are wall times summed over every sitting that worked on the stage (the run's "
+        "clock, written each minute, so a sitting ended by a kill counts, with the work it redoes); "
+        "scenes made before a run had the clock count their own times over the scene processes "
+        "that ran at once. Other work may share the machine, so rates (e.g. A2C steps/s) can vary "
+        "between stages."
     )
     notes.append(
         "Oracle is not in the paper: it plays the best reachable final OER within tau "
@@ -503,7 +506,7 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
         f"network of section V-B, {config.n_envs} environments; its settings under each scenario) for {config.sp_timesteps:,} (SP) and "
         f"{config.mp_timesteps:,} (MP) environment steps"
         + (
-            "; PPO beside it (SB3's PPO defaults, the same network, steps, seed, train split and keep-best-train rule)"
+            "; PPO beside it (RL Baselines3 Zoo's Atari settings, the same network, steps, seed, train split and keep-best-train rule)"
             if "PPO" in learners_run(state, out)
             else ""
         )
@@ -523,8 +526,11 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
             lines += ["Not run (yet): the run stopped before this benchmark.", ""]
             continue
         protocol, policies = result["protocol"], result["policies"]
+        starts = f", {protocol['starts']:,} eligible starts" if "starts" in protocol else ""
+        if "starts" in result.get("train_split", {}):
+            starts += f"; the train split: {result['train_split']['starts']:,} eligible starts"
         lines += [
-            f"Split `{protocol['split']}` ({len(protocol.get('scenes', []))} scene(s)), "
+            f"Split `{protocol['split']}` ({len(protocol.get('scenes', []))} scene(s){starts}), "
             f"tau = {protocol['tau']}; ours: mean ± std over {protocol['sessions']} "
             f"sessions of {protocol['episodes']} episodes.",
             "",
