@@ -52,13 +52,14 @@ class ReproduceConfig:
     learners: tuple[str, ...] = ("a2c", "ppo")
 
 
-#: ``small``: 43 min of stages measured on a 2-core CPU machine without GPU (docs/results.md);
+#: ``small``: under an hour of stages on a 2-core CPU machine without GPU;
 #: a 3 x 2 m MP grid and 10 % / 5 % of the paper's A2C steps: not comparable with Table 4.
 #: ``medium``: the paper's grids (Table 2: 3 x 3 m SP, 7 x 3 m MP) and protocol (300K A2C steps,
 #: 3 sessions of 200 episodes) on 10 SP strawberry and 10 MP vine scenes at 640x360 (the policy
 #: sees 224x224 either way; the 70/30 split leaves 3 test scenes of each), a few hours on such a
 #: machine, resumable across sittings.
-#: ``paper-scale``: Table 3's scene counts at 1280x720 and 300K A2C steps (days on such a machine).
+#: ``paper-scale``: Table 3's scene counts at 1280x720 and 300K steps of each learner, many sittings
+#: on such a machine (its results page gives the hours of every stage).
 #: Scene counts of Table 3 (SP strawberry, MP vine), what a configuration is measured against.
 PAPER_SCENES = (PAPER_TABLE3["sp", "strawberry"][0], PAPER_TABLE3["mp", "vine"][0])
 CONFIGS: dict[str, ReproduceConfig] = {
