@@ -4,7 +4,6 @@ in one process and in another (Helios seeds a new Context from the clock)."""
 from __future__ import annotations
 
 import hashlib
-import importlib.util
 import subprocess
 import sys
 
@@ -89,4 +88,3 @@ def test_a_grown_tomato_and_vine_are_the_same_in_one_process_and_in_another() ->
         expected.append(digest(first))
     call = "[m.digest(m.grown_plant(crop, 0)[0]) for crop in ('tomato', 'vine')]"
     assert digests_in_another_process(call) == expected
-
