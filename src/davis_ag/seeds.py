@@ -5,6 +5,8 @@ Streams are NumPy ``SeedSequence`` keys, so two streams never share draws howeve
 - a scene: ``[dataset seed, scenario's index, crop's index, scene index]`` gives the scene's own
   seed (:func:`davis_ag.generate.one_scene.scene_seed`), which scene.json records; the plants, the
   Helios seeds, the sun and the slip draw from ``default_rng(scene seed)`` in a fixed order;
+  a PlantArchitecture model's load seeds Helios from a child of that generator (``spawn``),
+  which leaves those draws as they were;
 - a scene's random appearance: ``[scene seed, APPEARANCE_STREAM]``;
 - a group's train/test split: ``[split seed, scenario's index, crop's index, SPLIT_STREAM]``;
 - our renderer's per-view noise: ``[lighting's noise seed, view index]``;

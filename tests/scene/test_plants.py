@@ -123,8 +123,8 @@ def grow(crop: CropSpec, seed: int, position: tuple[float, float]) -> tuple[obje
 
     from davis_ag.scene.architecture_plants import grow_architecture_plant, load_architecture_model
 
-    model = load_architecture_model(Context(), crop)
     rng = np.random.default_rng(seed)
+    model = load_architecture_model(Context(), crop, rng)
     target = sample_phenotype(crop, rng)
     plant = grow_architecture_plant(model, 0, position, target, helios_seed(rng))
     return model.context, model.plant_architecture, plant
@@ -209,7 +209,7 @@ def test_distinct_helios_seeds_give_distinct_plants() -> None:
     from davis_ag.scene.architecture_plants import load_architecture_model
 
     crop = CROPS["strawberry"]
-    model = load_architecture_model(Context(), crop)
+    model = load_architecture_model(Context(), crop, np.random.default_rng(0))
     context, plant_architecture = model.context, model.plant_architecture
 
     def build(seed: int) -> np.ndarray:

@@ -4,9 +4,21 @@ Context, and its plants grown towards their phenotypes.
 Strawberry and tomato come from pyhelios3d's plant library (:func:`grow_library_plant`), the
 goblet vine is composed from its grapevine shoot types (:mod:`davis_ag.scene.goblet_vine`);
 :func:`grow_architecture_plant` picks the one for the model's crop.
+
+Loading a model draws from the Context's generator, which Helios seeds from the clock
+(``Context::Context``), and one of those draws lasts: the library assigns each shoot type its
+``LeafPrototype`` (``LeafPrototype::operator=`` samples the non-constant parameters), later copies
+keep the sampled value (``LeafPrototype::duplicate``) and the leaf builder reads it without drawing
+again (``GenericLeafPrototype``). The tomato's and the grapevine's ``longitudinal_curvature``
+(uniform) is drawn so, once per model, and bends every leaf of every plant; redefining the shoot
+types, even after seeding, does not draw it again (pyhelios3d 0.1.38, measured). So the Context is
+seeded before the model is loaded (:func:`load_architecture_model`): without it no tomato or vine
+could be grown twice alike. The strawberry's prototype has no random parameter.
 """
 
 from __future__ import annotations
+
+import numpy as np
 
 from davis_ag.scene.goblet_vine import grow_goblet_vine, load_vine_model
 from davis_ag.scene.plants import (
@@ -15,6 +27,7 @@ from davis_ag.scene.plants import (
     Phenotype,
     blades_per_leaf,
     grow_to_target,
+    helios_seed,
     lift_to_ground,
     prepare_build,
     quiet_stdout,
@@ -32,18 +45,24 @@ DEFAULT_SIZES = {"strawberry": (0.037, 0.139), "tomato": (0.016, 0.205)}
 LEAF_UNIT = {"strawberry": 1}
 
 
-def load_architecture_model(context, crop: CropSpec) -> ArchitectureModel:
-    """Load a crop's shoot types into a new PlantArchitecture of ``context``.
+def load_architecture_model(context, crop: CropSpec, rng: np.random.Generator) -> ArchitectureModel:
+    """Load a crop's shoot types into a new PlantArchitecture of ``context``, seeded first.
 
     Args:
         context: The scene's Helios Context.
         crop: The crop: the library model ``crop.helios_model``, or the goblet vine's shoots.
+        rng: The scene's generator. The load's Helios seed comes from a child of it
+            (``rng.spawn``), so what ``rng`` draws next (the plants' phenotypes and seeds) is
+            the same as if the model had not been loaded.
 
     Returns:
         The loaded model, with every shoot type's parameters as loaded.
     """
     from pyhelios import PlantArchitecture
 
+    # Helios seeds a new Context from the clock, and the load keeps some of its draws for
+    # good (the module docstring): seed it before anything is drawn.
+    context.seedRandomGenerator(helios_seed(rng.spawn(1)[0]))
     plant_architecture = PlantArchitecture(context)
     plant_architecture.disableMessages()
     with quiet_stdout():

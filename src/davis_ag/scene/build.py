@@ -186,7 +186,7 @@ def _grow_architecture_plants(
     """PlantArchitecture plants grown towards their phenotypes (``--plants architecture``)."""
     from davis_ag.scene.architecture_plants import grow_architecture_plant, load_architecture_model
 
-    model = load_architecture_model(context, crop)
+    model = load_architecture_model(context, crop, rng)
     plants = []
     for index, position in enumerate(plant_positions(scenario, crop)):
         target = sample_phenotype(crop, rng)
