@@ -59,3 +59,18 @@ def test_the_training_rates_reach_performance_md_and_ppos_line_in_benchmark_md(t
     line = benchmark.read_text()
     assert "SB3's defaults train at 10.0 steps/s" in line and "the zoo's settings at 25.0 (2.5 times as fast)" in line
     assert line.startswith("# B\n") and line.endswith("end\n")
+
+
+@pytest.mark.slow
+def test_every_path_of_the_bench_runs_on_a_small_scene(tmp_path: Path) -> None:
+    """``make bench`` at a test's size: ours, pyhelios's documented path (its JPEG, boxes and
+    masks written), the floor and ours without class images, each timed on the same views."""
+    from davis_ag.scene.camera import Camera
+    from davis_ag.workflows.bench import bench_crop
+
+    result = bench_crop("strawberry", tmp_path, repeats=1, camera=Camera(160, 90), view_count=3)
+    assert result["views_timed"] == 2 and result["repeats"] == 1
+    assert set(result["seconds_per_view"]) == {"ours", "documented", "floor", "no_classes"}
+    assert all(seconds > 0 for seconds in result["seconds_per_view"].values())
+    written = {p.name for p in (tmp_path / "strawberry-documented").iterdir()}
+    assert {"0001.jpeg", "0003.jpeg"} <= written and any(name.endswith(".json") for name in written)

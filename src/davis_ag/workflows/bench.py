@@ -38,6 +38,7 @@ from pathlib import Path
 from typing import Callable
 
 from davis_ag.errors import UserError
+from davis_ag.formats.layout import view_name, view_stem
 from davis_ag.generate.one_scene import SceneRequest, draw_scene, grow_scene
 from davis_ag.generate.run_progress import count_views
 from davis_ag.scene.camera import Camera
@@ -94,16 +95,34 @@ def time_ours(request: SceneRequest, model, grid, views: list, root: Path) -> tu
     return (end - marks["first"]) / (len(views) - 1), marks["first"] - start
 
 
-def bench_crop(crop: str, scratch: Path, repeats: int, documented: bool = True, antialiasing: str = "fxaa") -> dict:
-    """Grow one scene and time ours, the documented path and the floor on the same views."""
+def bench_crop(
+    crop: str,
+    scratch: Path,
+    repeats: int,
+    documented: bool = True,
+    antialiasing: str = "fxaa",
+    camera: Camera = CAMERA,
+    view_count: int | None = None,
+) -> dict:
+    """Grow one scene and time ours, the documented path and the floor on the same views.
+
+    Args:
+        crop: The crop (its :data:`GRIDS` scene).
+        scratch: A folder for what the paths write.
+        repeats: Interleaved repetitions.
+        documented: Time pyhelios's documented path too.
+        antialiasing: Our renderer's.
+        camera: The image size (the bench's: 1280x720; tests: smaller).
+        view_count: Views timed (default :data:`VIEWS` of the crop), the first of each repetition untimed.
+    """
     from davis_ag.render.helios import HeliosRenderer
     from davis_ag.render.opengl import OpenGLRenderer
 
-    request = SceneRequest(GRIDS[crop], CROPS[crop], 0, SEED, CAMERA, antialiasing=antialiasing)
+    request = SceneRequest(GRIDS[crop], CROPS[crop], 0, SEED, camera, antialiasing=antialiasing)
     started = time.perf_counter()
     model, grid = grow_scene(request)
     grow_s = time.perf_counter() - started
-    views = list(grid.viewpoints[: VIEWS[crop]])
+    views = list(grid.viewpoints[: view_count or VIEWS[crop]])
     for fruit in model.fruits:  # the documented route labels fruit with object data (a cluster: its berries)
         for object_id in {model.context.getPrimitiveParentObjectID(int(u)) for u in fruit.uuids}:
             model.context.setObjectDataInt(object_id, "fruit_id", fruit.id)
@@ -116,16 +135,17 @@ def bench_crop(crop: str, scratch: Path, repeats: int, documented: bool = True, 
     try:
 
         def documented_view(view) -> None:
+            name = view_name(view.number)
             helios.set_view(view)
-            jpeg = str(images / view.image_name)
+            jpeg = str(images / name)
             helios._vis.printWindow(jpeg)
             helios._vis.writeImageBoundingBoxes(
-                object_data_labels="fruit_id", object_class_ids=0, image_file=view.image_name, image_path=str(images)
+                object_data_labels="fruit_id", object_class_ids=0, image_file=name, image_path=str(images)
             )
             helios._vis.writeImageSegmentationMasks(
                 object_data_labels="fruit_id",
                 object_class_ids=0,
-                json_filename=str(images / f"{view.image_name[:-5]}.json"),
+                json_filename=str(images / f"{view_stem(name)}.json"),
                 image_file=jpeg,
             )
 
