@@ -39,3 +39,22 @@ def test_bench_flags_parse_and_bad_ones_are_one_line(capsys: pytest.CaptureFixtu
     with pytest.raises(SystemExit) as stopped:
         cli.build_parser().parse_args(["bench", "--crops", "pear"])
     assert stopped.value.code == 2 and "pear" in capsys.readouterr().err
+
+
+def test_plants_are_measured_for_the_generator_asked_and_the_other_crops_keep_their_rows(tmp_path: Path) -> None:
+    """``plants --generators architecture`` grows PlantArchitecture plants into their own file;
+    the crops not grown keep their saved rows, and the canopy file is left alone."""
+    import json
+
+    docs = tmp_path / "docs"
+    shutil.copytree(DOCS, docs, ignore=shutil.ignore_patterns("images", "transfer"))
+    canopy_before = (docs / "data" / "scenes-plants.json").read_text()
+    saved = json.loads((docs / "data" / "scenes-plants-architecture.json").read_text())
+    argv = ["scene-stats", "plants", "--crops", "strawberry", "--count", "1", "--generators", "architecture"]
+    assert cli.main([*argv, "--docs", str(docs)]) == 0
+    fresh = json.loads((docs / "data" / "scenes-plants-architecture.json").read_text())
+    assert [p["index"] for p in fresh["crops"]["strawberry"]] == [0]  # grown anew, one plant
+    assert fresh["crops"]["strawberry"][0]["build_s"] is not None  # PlantArchitecture's builds are timed
+    assert fresh["crops"]["vine"] == saved["crops"]["vine"] and fresh["crops"]["tomato"] == saved["crops"]["tomato"]
+    assert (docs / "data" / "scenes-plants.json").read_text() == canopy_before
+    assert "| strawberry | architecture | " in (docs / "plants.md").read_text()

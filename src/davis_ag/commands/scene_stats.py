@@ -45,7 +45,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--generators",
         type=arguments.name_list(("canopy", "architecture")),
         default=None,
-        help="refused: the plant generators compared (default both)",
+        help="refused: the plant generators compared (default both); plants: the generators grown (default canopy)",
     )
     parser.add_argument(
         "--step",

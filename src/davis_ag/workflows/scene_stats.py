@@ -46,8 +46,9 @@ def measure_views() -> dict:
     return rows
 
 
-def measure_plants(count: int, crops: list[str]) -> dict:
-    """Grow ``count`` single plants of each of ``crops``; their fruit counts and phenotypes."""
+def measure_plants(count: int, crops: list[str], generator: str = "canopy") -> dict:
+    """Grow ``count`` single plants of each of ``crops`` with the plant ``generator`` (``canopy``,
+    ``architecture``) as ``generate`` grows them; their fruit counts and phenotypes."""
     from davis_ag.generate.one_scene import SceneRequest
     from davis_ag.scene.build import build_scene
 
@@ -58,7 +59,7 @@ def measure_plants(count: int, crops: list[str]) -> dict:
         for index in range(count):
             started = time.perf_counter()
             seed = SceneRequest(scenario, crop, index, 0).seed
-            model = build_scene(scenario, crop, np.random.default_rng(seed))
+            model = build_scene(scenario, crop, np.random.default_rng(seed), plants=generator)
             plant = model.plants[0]
             plants.append(
                 {

@@ -61,8 +61,8 @@ def views_table(docs: Path) -> list[str]:
     return lines
 
 
-#: Plant measurements per generator: the default's, kept fresh by ``plants N``, and the
-#: PlantArchitecture plants' as last measured (2026-11-22, before the Canopy Generator plants).
+#: Plant measurements per generator: the default's (``plants N``) and the PlantArchitecture
+#: plants' (``plants N --generators architecture``).
 PLANT_FILES = {"canopy": "scenes-plants.json", "architecture": "scenes-plants-architecture.json"}
 
 
@@ -282,7 +282,7 @@ def write_measurement(
         count: Plants per crop, or scenes.
         size: Image size of the generated scenes (``refused``, ``findings``).
         crops: Crops whose plants are grown (``plants``; the others keep their saved rows).
-        generators: Plant generators compared (``refused``).
+        generators: Plant generators compared (``refused``) or grown (``plants``; default canopy).
         step: Grid step, m (``findings``; 0.25 is the paper's).
     """
     from davis_ag.workflows import scene_stats
@@ -296,12 +296,13 @@ def write_measurement(
         write_json_atomic(data / "scenes-views.json", scene_stats.measure_views(), indent=1)
     elif what == "plants":
         # Crops measured earlier are kept: the vine takes long, so crops can be measured apart.
-        path = data / "scenes-plants.json"
-        fresh = scene_stats.measure_plants(count, crops or list(CROPS))
-        before = json.loads(path.read_text()) if path.exists() else {"crops": {}}
-        merged = {**before, **fresh, "crops": {**before["crops"], **fresh["crops"]}, "machine": machine}
-        merged["crops"] = {name: merged["crops"][name] for name in CROPS if name in merged["crops"]}
-        write_json_atomic(path, merged, indent=1)
+        for generator in generators or ["canopy"]:
+            path = data / PLANT_FILES[generator]
+            fresh = scene_stats.measure_plants(count, crops or list(CROPS), generator)
+            before = json.loads(path.read_text()) if path.exists() else {"crops": {}}
+            merged = {**before, **fresh, "crops": {**before["crops"], **fresh["crops"]}, "machine": machine}
+            merged["crops"] = {name: merged["crops"][name] for name in CROPS if name in merged["crops"]}
+            write_json_atomic(path, merged, indent=1)
     elif what == "refused":
         write_json_atomic(
             data / "scenes-refused.json",
