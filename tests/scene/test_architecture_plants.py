@@ -78,13 +78,9 @@ def test_the_same_seed_loads_and_builds_the_same_tomato_in_one_process_and_in_an
 
 
 @pytest.mark.slow
-def test_a_grown_tomato_and_vine_are_the_same_in_one_process_and_in_another() -> None:
-    # The whole rebuild loop (several builds, deleted and redone in one PlantArchitecture) included.
-    expected = []
-    for crop in ("tomato", "vine"):
-        (first, summary), (second, summary_again) = grown_plant(crop, 0), grown_plant(crop, 0)
-        assert summary == summary_again and summary["builds"] >= 1
-        assert len(first) == len(second) and all(np.array_equal(a, b) for a, b in zip(first, second))
-        expected.append(digest(first))
-    call = "[m.digest(m.grown_plant(crop, 0)[0]) for crop in ('tomato', 'vine')]"
-    assert digests_in_another_process(call) == expected
+def test_a_grown_vine_is_the_same_in_one_process_and_in_another() -> None:
+    # The whole rebuild loop (several builds, deleted and redone in one PlantArchitecture) included;
+    # the vine, since it grows in half the tomato's time (the tomato's first build is the test above).
+    first, summary = grown_plant("vine", 0)
+    assert summary["builds"] >= 1 and len(first) > 1000
+    assert digests_in_another_process("[m.digest(m.grown_plant('vine', 0)[0])]") == [digest(first)]
