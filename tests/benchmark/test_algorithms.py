@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from davis_ag.benchmark.algorithms import SB3_SETTINGS, sb3_arguments
@@ -23,6 +23,7 @@ def test_ppo_trains_with_the_zoos_atari_settings() -> None:
     }
 
 
+@settings(deadline=None)  # the first example imports Stable-Baselines3 (about a second)
 @given(start=st.floats(min_value=1e-8, max_value=10.0), remaining=st.floats(min_value=0.0, max_value=1.0))
 def test_a_lin_value_falls_linearly_from_its_number_to_zero(start: float, remaining: float) -> None:
     """SB3 calls a schedule with the fraction of the run left: 1 at the start, 0 at the end."""

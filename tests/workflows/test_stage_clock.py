@@ -63,6 +63,9 @@ def test_a_sitting_with_nothing_to_do_is_left_out_and_other_stages_are_kept(tmp_
     with second.timing("mp-vine: generate") as sitting:
         sitting.discard()
     assert "mp-vine: generate" not in read_clock(path)
+    # A clock with no stage left is a clock, not a damaged file.
+    path.write_text('{"stages": {}}')
+    assert StageClock(path, "c").stages == {} and not (tmp_path / "clock.json.unreadable").exists()
     assert second.seconds("mp-vine: generate") == 0 and second.started("mp-vine: generate") is None
 
 

@@ -13,8 +13,8 @@ ALGORITHMS: tuple[str, ...] = ("a2c", "ppo", "dqn")
 #: settings for Atari (``hyperparams/ppo.yml``, the zoo's set for a ``CnnPolicy`` on images with
 #: our 8 environments), not SB3's defaults, which are made for small vector observations: with
 #: 8 environments SB3's 2,048-step rollouts leave 300K steps 18 policy updates (the zoo's
-#: 128-step rollouts, 292), and its 10 epochs of 64-sample batches cost about 2.5 times the
-#: zoo's 4 epochs of 256 per step on this network (docs/benchmark.md). ``lin_X``: X falling
+#: 128-step rollouts, 292), and its 10 epochs of 64-sample batches cost more per step than the
+#: zoo's 4 epochs of 256 (``make bench``'s training table, docs/performance.md). ``lin_X``: X falling
 #: linearly to 0 over the run (:func:`sb3_arguments`). DQN: SB3's replay
 #: buffer holds 1M transitions, which at 224x224x4 bytes per observation (twice: the next one
 #: too) is 400 GB; 10,000 keep it near 2 GB (one copy, ``optimize_memory_usage``, which needs

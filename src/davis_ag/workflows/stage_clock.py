@@ -49,12 +49,13 @@ class StageClock:
         self.path = Path(path)
         self.code = code
         self.every_s = every_s
-        self.stages: dict[str, list[dict[str, Any]]] = read_clock(self.path)
-        if self.path.is_file() and not self.stages and self.path.read_bytes().strip():
+        stages = _read(self.path)
+        if stages is None:
             # Unreadable: kept aside, never overwritten, and the stages timed from here on.
             kept = self.path.with_name(self.path.name + ".unreadable")
             self.path.replace(kept)
             print(f"note: {self.path} could not be read; kept as {kept}, stages timed from now on", flush=True)
+        self.stages: dict[str, list[dict[str, Any]]] = stages or {}
         self._lock = threading.Lock()
 
     @contextmanager
@@ -148,9 +149,18 @@ def generation_seconds(root: Path, scenes: list[str], clock: StageClock, stage: 
 
 def read_clock(path: Path) -> dict[str, list[dict[str, Any]]]:
     """The sittings per stage of a clock file; none for a missing or unreadable one (a run from
-    before the clock, or a file a crash cut short: its stages are then timed from here on)."""
-    try:
-        stages = json.loads(Path(path).read_text()).get("stages", {})
-    except (OSError, ValueError, AttributeError):
+    before the clock, or a file damaged by hand: its stages are then timed from here on)."""
+    return _read(Path(path)) or {}
+
+
+def _read(path: Path) -> dict[str, list[dict[str, Any]]] | None:
+    """The clock file's stages; {} when there is no file, None when it cannot be read as a clock."""
+    if not path.is_file():
         return {}
-    return {k: v for k, v in stages.items() if isinstance(v, list)} if isinstance(stages, dict) else {}
+    try:
+        stages = json.loads(path.read_text()).get("stages", {})
+    except (OSError, ValueError, AttributeError):
+        return None
+    if not isinstance(stages, dict):
+        return None
+    return {k: v for k, v in stages.items() if isinstance(v, list)}
