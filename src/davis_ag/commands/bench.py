@@ -62,7 +62,7 @@ def run(args: argparse.Namespace) -> int:
     """Measure, print and write the report (and the doc's sections)."""
     from davis_ag.atomic_files import write_marked_section
     from davis_ag.workflows.bench import run as run_bench
-    from davis_ag.workflows.bench import run_continuous, run_training
+    from davis_ag.workflows.bench import run_only
     from davis_ag.workflows.bench_training import write_training
     from davis_ag.workflows.bench_report import table, write_continuous
 
@@ -80,7 +80,7 @@ def run(args: argparse.Namespace) -> int:
             "markers; give docs/performance.md or leave --doc out"
         )
     if args.only in ("continuous", "training"):
-        (run_continuous if args.only == "continuous" else run_training)(args.out, args.doc)
+        run_only(args.only, args.out, args.doc)
         print(f"written {args.out}" + (f" and {args.doc}" if args.doc else ""))
         return 0
     report = run_bench(args.out, args.crops, args.repeats, args.antialiasing)

@@ -275,31 +275,22 @@ def continuous_env_speed(scratch: Path, steps: int = 600) -> dict:
     }
 
 
-def run_continuous(out: Path, doc: Path | None) -> dict:
-    """Only the TVMContinuous-v0 measurement (``--only continuous``): JSON, the doc's section and
-    docs/views-on-demand.md's line."""
+def run_only(what: str, out: Path, doc: Path | None) -> dict:
+    """One measurement alone (``--only continuous``: TVMContinuous-v0's rate, about a minute;
+    ``--only training``: the learners' training rates, about 8 minutes): JSON, the doc's section
+    and the line another page shows of it."""
+    key, measure, table_of, write = {
+        "continuous": ("continuous_env", continuous_env_speed, continuous_table, write_continuous),
+        "training": ("training", training_speed, training_table, write_training),
+    }[what]
     start = os.getloadavg()[0]
     with tempfile.TemporaryDirectory(prefix="davis-ag-bench-") as scratch:
-        result = continuous_env_speed(Path(scratch))
+        result = measure(Path(scratch))
     load = (start, os.getloadavg()[0])
-    print(continuous_table(result, load))
+    print(table_of(result, load))
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps({"continuous_env": result}, indent=1) + "\n")
-    write_continuous(result, load, doc)
-    return result
-
-
-def run_training(out: Path, doc: Path | None) -> dict:
-    """Only the learners' training rates (``--only training``, about 8 minutes): JSON, the doc's
-    section and docs/benchmark.md's PPO line."""
-    start = os.getloadavg()[0]
-    with tempfile.TemporaryDirectory(prefix="davis-ag-bench-") as scratch:
-        result = training_speed(Path(scratch))
-    load = (start, os.getloadavg()[0])
-    print(training_table(result, load))
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps({"training": result}, indent=1) + "\n")
-    write_training(result, load, doc)
+    out.write_text(json.dumps({key: result}, indent=1) + "\n")
+    write(result, load, doc)
     return result
 
 
