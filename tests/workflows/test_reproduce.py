@@ -130,11 +130,13 @@ SP_ONLY = (("sp", "strawberry"),)
 
 @pytest.mark.slow
 def test_a_whole_run_times_every_stage_on_its_clock_and_a_rerun_adds_no_sitting(
-    tmp_path: Path, one_thread: None
+    tmp_path: Path, one_thread: None, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """``reproduce`` end to end at the smallest size (SP strawberry, A2C with the paper's network;
-    PPO's stage is the same code, trained in the test above): every stage that worked is on the clock and in the page's stage table; a second
-    sitting over the finished run reuses everything and adds no sitting to any stage."""
+    PPO's stage is the same code, trained in the test above): every stage that worked is on the
+    clock and in the page's stage table; a second sitting over the finished run reuses everything,
+    its validation included, and adds no sitting to any stage; a file changed since is validated
+    again."""
     import json
     from dataclasses import replace
 
@@ -161,5 +163,13 @@ def test_a_whole_run_times_every_stage_on_its_clock_and_a_rerun_adds_no_sitting(
     for stage in worked:
         assert state["stages"][stage]["seconds"] == pytest.approx(clock[stage][0]["seconds"], abs=0.2)
         assert f"| {stage} | {clock[stage][0]['seconds']:.0f} |" in page.read_text()
+    capsys.readouterr()
     assert reproduce(config, out, page, SP_ONLY) == 0
     assert read_clock(out / CLOCK_FILE) == clock
+    rerun = capsys.readouterr().out
+    assert "(validated before; its files and the validator are unchanged)" in rerun
+    assert json.loads((out / "state.json").read_text())["stages"] == state["stages"]
+    view = next((out / "dataset" / "Single-Strawberry" / "001" / "images").glob("*.jpeg"))
+    view.write_bytes(view.read_bytes()[: view.stat().st_size // 2])  # cut short since
+    assert reproduce(config, out, page, SP_ONLY) == 1
+    assert "validated before" not in capsys.readouterr().out

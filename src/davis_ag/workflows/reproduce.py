@@ -238,7 +238,6 @@ def reproduce(
     from davis_ag.atomic_files import prove_writable_file, prove_writable_folder, write_or_rescue
     from davis_ag.benchmark.evaluation import format_table, write_json
     from davis_ag.figures.result_charts import plot_results
-    from davis_ag.data.validate import validate_dataset
     from davis_ag.generate.one_scene import SceneRequest
     from davis_ag.scene.camera import Camera
     from davis_ag.scene.specs import crop_spec, scenario_spec
@@ -266,8 +265,8 @@ def reproduce(
     state.setdefault("results", {})
     clock = StageClock(out / CLOCK_FILE, code_version())
 
-    def record(stage: str, seconds: float, note: str = "", code: str | None = None) -> None:
-        state["stages"][stage] = {"seconds": round(seconds, 1), "note": note, "code": code or code_version()}
+    def record(stage: str, seconds: float, note: str = "", code: str | None = None, **extra: str) -> None:
+        state["stages"][stage] = {"seconds": round(seconds, 1), "note": note, "code": code or code_version(), **extra}
         write_json_atomic(state_path, state, indent=2)
 
     camera = Camera(*config.size)
@@ -286,14 +285,8 @@ def reproduce(
             if all(g["skipped"] for g in generated):
                 sitting.discard()
         record(f"{key}: generate", *generation_seconds(root, [r.folder for r in requests], clock, f"{key}: generate"))
-        start = time.perf_counter()
         group = root / requests[0].folder.split("/")[0]
-        report = validate_dataset(group)
-        print(report.summary(), flush=True)
-        record(f"{key}: validate", time.perf_counter() - start, report.summary())
-        if not report.ok:
-            for problem in report.problems[:20]:
-                print(problem, flush=True)
+        if not validate_once(group, state, f"{key}: validate", record):
             return 1
         split = evaluation_split(root, scenario_name, crop_name)
         timesteps = config.sp_timesteps if scenario_name == "sp" else config.mp_timesteps
@@ -339,6 +332,34 @@ def reproduce(
         write_results_md(results_md, config, state, out)
         print(f"wrote {results_md}", flush=True)
     return 0
+
+
+def validate_once(group: Path, state: dict[str, Any], stage: str, record: Any) -> bool:
+    """Validate ``group`` unless the last sitting validated the same files with the same code
+    (:func:`davis_ag.data.validation_stamp.validation_stamp`): a sound report is reused, so a
+    resumed paper-scale run does not re-read 9 GB of views for half an hour at every sitting.
+
+    Returns:
+        Whether the data is sound (the problems are printed where it is not).
+    """
+    from davis_ag.data.validate import validate_dataset
+    from davis_ag.data.validation_stamp import validation_stamp
+
+    stamp = validation_stamp(group)
+    earlier = state["stages"].get(stage, {})
+    if earlier.get("stamp") == stamp:
+        print(f"{earlier['note']} (validated before; its files and the validator are unchanged)", flush=True)
+        return True
+    start = time.perf_counter()
+    report = validate_dataset(group)
+    print(report.summary(), flush=True)
+    if not report.ok:
+        record(stage, time.perf_counter() - start, report.summary())
+        for problem in report.problems[:20]:
+            print(problem, flush=True)
+        return False
+    record(stage, time.perf_counter() - start, report.summary(), stamp=stamp)
+    return True
 
 
 def _reusable_results(path: Path, models: list[Path], split: str, config: ReproduceConfig) -> dict[str, Any] | None:

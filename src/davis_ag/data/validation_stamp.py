@@ -1,0 +1,60 @@
+"""A stamp of what validating a dataset folder would read: the validator's code, the root files it
+checks (their bytes) and every scene file's name, size and modification time, as one SHA-256.
+
+A long run that resumes (``davis-ag reproduce``) validates its data at every sitting; at the
+paper's scale that reads 9 GB of SP strawberry views for half an hour. Two equal stamps mean the
+same rules would read files that were not rewritten since, so the run keeps the earlier report.
+Sizes and times, not contents, because hashing the views would cost as much as validating them;
+what a stamp cannot see is a file rewritten in place with its size and time restored, which no
+writer of ours does (``davis-ag validate`` always reads everything).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+from pathlib import Path
+
+from davis_ag.data.reader import open_dataset
+from davis_ag.formats.layout import DATASET_FILE, SPLITS_FILE
+
+#: The packages whose code decides what a validation finds: a change to any of them is a new stamp.
+VALIDATOR_PACKAGES = ("data", "formats")
+
+
+def validator_digest() -> bytes:
+    """SHA-256 of the source of :data:`VALIDATOR_PACKAGES`, file by file in name order."""
+    package = Path(__file__).resolve().parent.parent
+    digest = hashlib.sha256()
+    for name in VALIDATOR_PACKAGES:
+        for source in sorted((package / name).glob("*.py")):
+            digest.update(f"{name}/{source.name}\0".encode())
+            digest.update(source.read_bytes())
+    return digest.digest()
+
+
+def validation_stamp(path: str | os.PathLike[str]) -> str:
+    """The stamp of validating ``path`` (a dataset root, a group folder or a scene folder).
+
+    Args:
+        path: What :func:`davis_ag.data.validate.validate_dataset` would be given.
+
+    Returns:
+        A hex SHA-256; equal for equal code, root files and scene files (names, sizes, times).
+
+    Raises:
+        UserError: when the path is not a DAVIS-Ag dataset (as :func:`open_dataset`).
+    """
+    dataset = open_dataset(path)
+    digest = hashlib.sha256(validator_digest())
+    for name in (SPLITS_FILE, DATASET_FILE):  # small, and rewritten with the same bytes by each generate
+        file = dataset.root / name
+        digest.update(f"{name}\0".encode() + (file.read_bytes() if file.is_file() else b"-"))
+    for scene in dataset.scenes:
+        for folder, subfolders, files in os.walk(scene.path):
+            subfolders[:] = sorted(d for d in subfolders if not d.startswith("."))
+            for name in sorted(files):
+                stat = os.stat(os.path.join(folder, name))
+                relative = os.path.relpath(os.path.join(folder, name), dataset.root)
+                digest.update(f"{relative}\0{stat.st_size}\0{stat.st_mtime_ns}\n".encode())
+    return digest.hexdigest()

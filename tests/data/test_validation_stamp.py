@@ -1,0 +1,82 @@
+"""The validation stamp: the same files give the same stamp; any change validation would see gives
+another, so a resumed run never keeps a report of data that has changed since."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+from pathlib import Path
+
+import pytest
+from layout_factory import write_tiny_dataset
+
+from davis_ag.data.validation_stamp import validation_stamp
+
+GROUP = "Single-Strawberry"
+
+
+@pytest.fixture(scope="module")
+def pristine(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    root = tmp_path_factory.mktemp("pristine")
+    write_tiny_dataset(root, "sp", "strawberry", scenes=2)
+    return root
+
+
+@pytest.fixture
+def dataset(pristine: Path, tmp_path: Path) -> Path:
+    return Path(shutil.copytree(pristine, tmp_path / "ds"))
+
+
+def test_an_unchanged_dataset_keeps_its_stamp_wherever_it_is_read_from(
+    dataset: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    first = validation_stamp(dataset / GROUP)
+    monkeypatch.chdir(dataset)
+    assert validation_stamp(GROUP) == first
+    (dataset / ".davis_ag_cache").mkdir()  # the observation cache is not validated
+    (dataset / ".davis_ag_cache" / "x.npy").write_bytes(b"1")
+    assert validation_stamp(GROUP) == first
+
+
+def one_view(dataset: Path) -> Path:
+    return next((dataset / GROUP / "000" / "images").glob("*.jpeg"))
+
+
+def rewrite_with_another_time(path: Path) -> None:
+    path.write_bytes(path.read_bytes())
+    stat = path.stat()
+    os.utime(path, ns=(stat.st_atime_ns, stat.st_mtime_ns + 1_000_000_000))
+
+
+def drop_a_split_entry(dataset: Path) -> None:
+    splits = json.loads((dataset / "splits.json").read_text())
+    splits["train"] = splits["train"][1:]
+    (dataset / "splits.json").write_text(json.dumps(splits))
+
+
+@pytest.mark.parametrize(
+    "change",
+    [
+        pytest.param(lambda d: one_view(d).write_bytes(one_view(d).read_bytes()[:-10]), id="a view cut short"),
+        pytest.param(
+            lambda d: rewrite_with_another_time(d / GROUP / "001" / "annotations.json"), id="a file rewritten"
+        ),
+        pytest.param(lambda d: one_view(d).unlink(), id="a view removed"),
+        pytest.param(lambda d: (d / GROUP / "000" / "images" / "extra.jpeg").write_bytes(b"x"), id="a file added"),
+        pytest.param(lambda d: shutil.rmtree(d / GROUP / "001"), id="a scene removed"),
+        pytest.param(drop_a_split_entry, id="the split edited"),
+    ],
+)
+def test_any_change_validation_would_see_gives_another_stamp(dataset: Path, change) -> None:  # type: ignore[no-untyped-def]
+    before = validation_stamp(dataset / GROUP)
+    change(dataset)
+    assert validation_stamp(dataset / GROUP) != before
+
+
+def test_another_validator_gives_another_stamp(dataset: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from davis_ag.data import validation_stamp as module
+
+    before = validation_stamp(dataset / GROUP)
+    monkeypatch.setattr(module, "VALIDATOR_PACKAGES", ("data",))
+    assert validation_stamp(dataset / GROUP) != before
