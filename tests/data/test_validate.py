@@ -203,3 +203,20 @@ def test_relative_paths_print_relative(
     monkeypatch.chdir(dataset)
     code, lines, _ = run(capsys, ".")
     assert code == 1 and lines[0].startswith(str(SCENE / "images" / "0007.jpeg") + ": missing")
+
+
+def test_a_pool_of_processes_reports_what_one_process_does(
+    dataset: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--workers``: damage in two scenes is reported the same, line for line and in the same
+    order, by one process and by a pool (forced on this small dataset)."""
+    from davis_ag.data import validate
+
+    edit_annotations(dataset / SCENE / "annotations.json", lambda d: d["0002.jpeg"].update(forward="9999.jpeg"))
+    mask = next((dataset / "Single-Strawberry" / "001" / "images").glob("*_seg.png"))
+    mask.write_bytes(mask.read_bytes()[:40])
+    one = run(capsys, str(dataset), "--workers", "1")
+    monkeypatch.setattr(validate, "POOL_FROM_BYTES", 0)
+    pooled = run(capsys, str(dataset), "--workers", "2")
+    assert one[0] == pooled[0] == 1
+    assert one[1] == pooled[1] and any("cannot decode" in line for line in one[1])

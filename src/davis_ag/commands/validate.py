@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 from davis_ag.commands import arguments
@@ -27,6 +28,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--quick", action="store_true", help="skip pixel checks (image and mask sizes, boxes against masks)"
     )
     parser.add_argument(
+        "--workers",
+        type=arguments.bounded(1, 1024),
+        default=os.cpu_count() or 1,
+        help=f"processes checking scenes at once on a large dataset (default: one per core, "
+        f"{os.cpu_count() or 1} here); the report is the same for any number",
+    )
+    parser.add_argument(
         "--box-tolerance",
         type=arguments.whole,
         default=None,
@@ -49,6 +57,7 @@ def run(args: argparse.Namespace) -> int:
         box_tolerance=args.box_tolerance,
         on_problem=lambda p: tqdm.write(str(p), file=sys.stdout),
         progress=True,
+        workers=args.workers,
     )
     print(report.summary())
     return 0 if report.ok else 1

@@ -10,13 +10,13 @@ from davis_ag.data.annotation_schema import NO_FRUIT
 from davis_ag.scene.organs import FRUIT, ORGAN_NAMES
 
 
-def class_problems(class_path: Path, mask_path: Path | None) -> list[str]:
+def class_problems(class_path: Path, mask: np.ndarray | None) -> list[str]:
     """Check a class image: 8-bit, one channel, known class values, the mask's size, and every
     fruit pixel of the instance mask labelled ``fruit`` (both come from the same id pass).
 
     Args:
         class_path: ``images/NNNN_class.png``.
-        mask_path: The view's ``_seg.png``, when present.
+        mask: The view's instance mask (``_seg.png``, decoded), when present and readable.
 
     Returns:
         One reason per problem.
@@ -37,12 +37,7 @@ def class_problems(class_path: Path, mask_path: Path | None) -> list[str]:
             f"holds class values {unknown.tolist()[:5]}, not in the table 0..{len(ORGAN_NAMES) - 1} "
             f"({', '.join(ORGAN_NAMES)})"
         )
-    if mask_path is None:
-        return problems
-    try:
-        with Image.open(mask_path) as im:
-            mask = np.asarray(im)
-    except Exception:  # the mask's own check reports it
+    if mask is None:  # absent or unreadable: the mask's own check reports it
         return problems
     if mask.shape != classes.shape:
         return problems + [f"is {classes.shape[1]}x{classes.shape[0]} but its mask is {mask.shape[1]}x{mask.shape[0]}"]

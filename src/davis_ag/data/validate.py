@@ -5,19 +5,23 @@ so one run lists everything a re-download or regeneration has to fix. What the r
 tolerates in the original download (names without ".jpeg", float boxes, missing pose or
 pointer keys, unknown keys) is not a problem; a missing image or mask is.
 
-Box against mask: our writer makes each box exactly the inclusive pixel extent of its fruit's
-mask, so scenes with a scene.json (ours) are held to that. The original README does not say
-whether its width is ``xmax - xmin`` or ``xmax - xmin + 1``, so other scenes get one pixel of
-slack on each edge unless told otherwise.
+Box against mask (:mod:`davis_ag.data.pixel_checks`): our writer makes each box exactly the
+inclusive pixel extent of its fruit's mask, so scenes with a scene.json (ours) are held to that.
+The original README does not say whether its width is ``xmax - xmin`` or ``xmax - xmin + 1``, so
+other scenes get one pixel of slack on each edge unless told otherwise.
 """
 
 from __future__ import annotations
 
 import json
+import multiprocessing
 import os
+import signal
 import sys
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from concurrent.futures import ProcessPoolExecutor
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -25,23 +29,29 @@ from typing import Any
 from pydantic import BaseModel, ValidationError
 
 from davis_ag.data.class_checks import class_problems
+from davis_ag.data.pixel_checks import (
+    boxes_inside,
+    camera_size,
+    depth_problems,
+    image_problems,
+    mask_problems,
+    read_mask,
+)
 from davis_ag.formats.scene_file import SceneFile, scene_file_from
 from davis_ag.data.reader import (
     ANNOTATIONS,
     NO_FRUIT,
     SCENE_METADATA,
     SPLITS,
-    Box,
     Dataset,
     Scene,
     ViewRecord,
-    boxes_from_mask,
     normalise_view_name,
     open_dataset,
     parse_entry,
 )
 from davis_ag.data.safe_read import check_inside
-from davis_ag.formats.layout import DATASET_FILE, IMAGES, read_depth_millimetres, view_file, view_of_file
+from davis_ag.formats.layout import DATASET_FILE, IMAGES, view_file, view_of_file
 from davis_ag.formats.models import AnnotationEntry, DatasetFile, SplitsFile, one_line
 from davis_ag.errors import UserError
 
@@ -204,22 +214,12 @@ def validate_scene(
         if metadata is not None and metadata.depth and not depth.is_file():
             flag(depth, f"missing: scene.json records depth images but {record.name} has none")
         if quick:
-            size = _camera_size(metadata)
+            size = camera_size(metadata)
             if size:
-                for problem in _boxes_inside(record, size):
+                for problem in boxes_inside(record, size):
                     flag(ann_path, problem)
         elif has_image:
-            for path, problem in _pixel_problems(
-                record, ann_path, image, mask if has_mask else None, metadata, tolerance
-            ):
-                flag(path, problem)
-            if depth.is_file():
-                for problem in depth_problems(record, depth, mask if has_mask else None, metadata):
-                    flag(depth, problem)
-            classes = view_file(scene.path, record.name, "classes")
-            if classes.is_file() and not _outside(classes, scene.root):
-                for problem in class_problems(classes, mask if has_mask else None):
-                    flag(classes, problem)
+            _check_pixels(scene, record, ann_path, mask if has_mask else None, metadata, tolerance, flag)
 
     if images.is_dir():
         for path in sorted(images.iterdir()):
@@ -227,6 +227,41 @@ def validate_scene(
             if view is not None and view[0] not in names:
                 flag(path, "has no entry in annotations.json")
     return report
+
+
+def _check_pixels(
+    scene: Scene,
+    record: ViewRecord,
+    ann_path: Path,
+    mask_path: Path | None,
+    metadata: SceneFile | None,
+    tolerance: int,
+    flag: Callable[[Path, str], None],
+) -> None:
+    """Decode a view's image, mask, depth and class images, each once, and flag what is wrong."""
+    image = scene.path / IMAGES / record.name
+    size, problems = image_problems(image, metadata)
+    for problem in problems:
+        flag(image, problem)
+    if size is not None:
+        for problem in boxes_inside(record, size):
+            flag(ann_path, problem)
+    mask = None
+    if mask_path is not None:
+        mask, unreadable = read_mask(mask_path)
+        if unreadable:
+            flag(mask_path, unreadable)
+        elif size is not None and mask is not None:
+            for problem in mask_problems(record, mask, size, tolerance):
+                flag(mask_path, problem)
+    depth = view_file(scene.path, record.name, "depth")
+    if depth.is_file():
+        for problem in depth_problems(record, depth, mask, metadata):
+            flag(depth, problem)
+    classes = view_file(scene.path, record.name, "classes")
+    if classes.is_file() and not _outside(classes, scene.root):
+        for problem in class_problems(classes, mask):
+            flag(classes, problem)
 
 
 def _outside(path: Path, root: Path | None) -> str | None:
@@ -260,148 +295,6 @@ def _box_schema_problems(record: ViewRecord) -> list[str]:
             problems.append(f"{where}: fruit {box.fruit_id} has two boxes in this view")
         seen.add(box.fruit_id)
     return problems
-
-
-def _camera_size(metadata: SceneFile | None) -> tuple[int, int] | None:
-    return metadata.image_size() if metadata is not None else None
-
-
-def _boxes_inside(record: ViewRecord, size: tuple[int, int]) -> list[str]:
-    width, height = size
-    return [
-        f"{record.name}: box {b.to_list()[:5]} reaches past the {width}x{height} image"
-        for b in record.boxes
-        if b.xmax >= width or b.ymax >= height
-    ]
-
-
-def _pixel_problems(
-    record: ViewRecord, ann_path: Path, image: Path, mask_path: Path | None, metadata: SceneFile | None, tolerance: int
-) -> list[tuple[Path, str]]:
-    import numpy as np
-    from PIL import Image
-
-    problems: list[tuple[Path, str]] = []
-    try:
-        with Image.open(image) as im:
-            size, mode = im.size, im.mode
-            # Decoding at 1/8 scale still reads every byte, so truncation shows, at a fraction of the cost.
-            im.draft("RGB", (max(1, size[0] // 8), max(1, size[1] // 8)))
-            im.load()
-    except Exception as error:  # Pillow raises many types for a damaged file
-        return [(image, f"cannot decode ({error})")]
-    if mode != "RGB":
-        problems.append((image, f"must be RGB, got mode {mode}"))
-    expected = _camera_size(metadata)
-    if expected and size != expected:
-        problems.append((image, f"is {size[0]}x{size[1]} but scene.json's camera says {expected[0]}x{expected[1]}"))
-    problems += [(ann_path, p) for p in _boxes_inside(record, size)]
-    if mask_path is None:
-        return problems
-    try:
-        with Image.open(mask_path) as im:
-            mask_mode = im.mode
-            mask = np.asarray(im)
-    except Exception as error:
-        return problems + [(mask_path, f"cannot decode ({error})")]
-    if mask_mode not in ("L", "P") or mask.dtype != np.uint8 or mask.ndim != 2:
-        return problems + [(mask_path, f"must be a uint8 single-channel PNG, got mode {mask_mode}")]
-    if mask.shape[::-1] != size:
-        return problems + [(mask_path, f"is {mask.shape[1]}x{mask.shape[0]} but its image is {size[0]}x{size[1]}")]
-    extents = boxes_from_mask(mask)
-    boxes = {b.fruit_id: b for b in record.boxes}
-    for fid in sorted(set(extents) - set(boxes)):
-        problems.append((mask_path, f"holds fruit {fid}, which has no box in {record.name}"))
-    for fid, box in boxes.items():
-        if fid not in extents:
-            problems.append((mask_path, f"has no pixels of fruit {fid}, which has a box in {record.name}"))
-        elif not _close(box, extents[fid], tolerance):
-            m = extents[fid]
-            problems.append(
-                (
-                    mask_path,
-                    f"{record.name}: box of fruit {fid} is {box.to_list()[:4]} but its mask "
-                    f"pixels span {[m.xmin, m.ymin, m.width, m.height]} (x, y, width, height)",
-                )
-            )
-    return problems
-
-
-#: Depth images: surfaces nearer than this cannot be seen (the renderers' near plane), mm.
-DEPTH_NEAR_MM = 50
-#: A fruit's depth in the image may differ from its centre's by its half size plus this, m.
-DEPTH_SLACK_M = 0.02
-
-
-def depth_problems(
-    record: ViewRecord, depth_path: Path, mask_path: Path | None, metadata: SceneFile | None
-) -> list[str]:
-    """Check a depth image: 16-bit, the image's size, a plausible range, and agreement with the
-    3-D centres of the fruit scene.json records (where a fruit is boxed in the view).
-
-    Args:
-        record: The view's annotation.
-        depth_path: ``images/NNNN_depth.png``.
-        mask_path: Its instance mask, when present.
-        metadata: scene.json, when present.
-
-    Returns:
-        One reason per problem.
-    """
-    import numpy as np
-    from PIL import Image
-
-    try:
-        depth = read_depth_millimetres(depth_path)
-    except UserError as error:  # the reason, without the path the report already names
-        return [str(error).removeprefix(f"{depth_path}: ").removesuffix("; regenerate the scene")]
-    problems = []
-    size = _camera_size(metadata)
-    if size and depth.shape[::-1] != size:
-        problems.append(f"is {depth.shape[1]}x{depth.shape[0]} but scene.json's camera says {size[0]}x{size[1]}")
-        return problems
-    hit = depth > 0
-    if not hit.any():
-        problems.append("holds no surface at all (every pixel 0)")
-    elif int(depth[hit].min()) < DEPTH_NEAR_MM:
-        problems.append(f"holds a surface {int(depth[hit].min())} mm from the camera, nearer than any renderer draws")
-    if mask_path is None or metadata is None or record.pose is None:
-        return problems
-    fruits = {f.id: f for f in metadata.fruits if f.center is not None}
-    try:
-        with Image.open(mask_path) as im:
-            mask = np.asarray(im)
-    except Exception:  # reported by the mask check
-        return problems
-    if mask.shape != depth.shape:
-        return problems
-    x, y, z, yaw, pitch = (float(v) for v in record.pose[:5])
-    forward = np.array(
-        [
-            np.cos(np.radians(pitch)) * np.cos(np.radians(yaw)),
-            np.cos(np.radians(pitch)) * np.sin(np.radians(yaw)),
-            np.sin(np.radians(pitch)),
-        ]
-    )
-    for box in record.boxes:
-        fruit = fruits.get(box.fruit_id)
-        pixels = (mask == box.fruit_id) & hit
-        if fruit is None or not pixels.any():
-            continue
-        expected = float(np.dot(np.subtract(fruit.center, (x, y, z)), forward))  # type: ignore[arg-type]
-        seen = float(np.median(depth[pixels])) / 1000.0
-        allowed = 0.5 * float(np.linalg.norm(fruit.size or (0.0, 0.0, 0.0))) + DEPTH_SLACK_M
-        if abs(seen - expected) > allowed:
-            problems.append(
-                f"fruit {box.fruit_id} lies at {seen:.3f} m in the depth image but its centre is "
-                f"{expected:.3f} m from the camera (scene.json), more than {allowed:.3f} m apart"
-            )
-    return problems
-
-
-def _close(box: Box, extent: Box, tolerance: int) -> bool:
-    edges = zip((box.xmin, box.ymin, box.xmax, box.ymax), (extent.xmin, extent.ymin, extent.xmax, extent.ymax))
-    return all(abs(a - b) <= tolerance for a, b in edges)
 
 
 def _check_splits(dataset: Dataset, whole: bool) -> list[Problem]:
@@ -465,12 +358,18 @@ def _check_counts(dataset: Dataset, counts: dict[str, int]) -> list[Problem]:
     return problems
 
 
+#: A pool of processes pays for its start (about a second each) from this many bytes of
+#: annotations.json on (about 700 views, 20 s of checks in one process at 1280x720).
+POOL_FROM_BYTES = 500_000
+
+
 def validate_dataset(
     path: str | Path,
     quick: bool = False,
     box_tolerance: int | None = None,
     on_problem: Callable[[Problem], None] | None = None,
     progress: bool = False,
+    workers: int = 1,
 ) -> Report:
     """Check every scene under a dataset root, group folder or scene folder.
 
@@ -478,8 +377,12 @@ def validate_dataset(
         path: What to check.
         quick: Skip pixel checks.
         box_tolerance: See :func:`validate_scene`.
-        on_problem: Called with each problem as it is found.
+        on_problem: Called with each problem as it is found (with ``workers``, as each scene's
+            check ends; in scene order either way).
         progress: Show a tqdm bar on stderr (when it is a terminal and there are several scenes).
+        workers: Processes checking scenes at once (decoding is the cost; one per core scales
+            it), used where the dataset is large enough to repay their start
+            (:data:`POOL_FROM_BYTES`). The report is the same for any number.
 
     Returns:
         The :class:`Report`.
@@ -501,18 +404,63 @@ def validate_dataset(
     whole = Path(path).expanduser().absolute() == dataset.root
     for problem in _check_splits(dataset, whole) + (_check_dataset_file(dataset) if whole else []):
         emit(problem)
+    scenes = dataset.scenes
     bar = tqdm(
-        dataset.scenes,
+        total=len(scenes),
         desc="validate",
         unit="scene",
         file=sys.stderr,
-        disable=None if progress and len(dataset.scenes) > 1 else True,
+        disable=None if progress and len(scenes) > 1 else True,
     )
-    for scene in bar:
-        before = report.views
-        validate_scene(scene, quick, box_tolerance, report, on_problem)
-        if report.views > before:  # an unreadable annotations.json is reported already
-            counts[scene.id] = report.views - before
+    with _scene_reports(scenes, quick, box_tolerance, workers) as reports:
+        for scene, part in zip(scenes, reports):
+            report.scenes += part.scenes
+            report.views += part.views
+            report.boxes += part.boxes
+            for problem in part.problems:
+                emit(problem)
+            if part.views:  # an unreadable annotations.json is reported already
+                counts[scene.id] = part.views
+            bar.update()
+    bar.close()
     for problem in _check_counts(dataset, counts):
         emit(problem)
     return report
+
+
+@contextmanager
+def _scene_reports(
+    scenes: list[Scene], quick: bool, box_tolerance: int | None, workers: int
+) -> Iterator[Iterator[Report]]:
+    """Each scene's report, in scene order: from a pool of ``workers`` processes where the
+    scenes are many enough, else checked one after the other here."""
+    if workers < 2 or len(scenes) < 2 or _annotation_bytes(scenes) < POOL_FROM_BYTES:
+        yield (validate_scene(scene, quick, box_tolerance) for scene in scenes)
+        return
+    # spawn: the caller may hold threads and GL contexts (reproduce), which fork would copy.
+    context = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(min(workers, len(scenes)), mp_context=context, initializer=_ignore_ctrl_c) as pool:
+        tasks = [(scene.path, scene.group, scene.root, quick, box_tolerance) for scene in scenes]
+        yield pool.map(_validate_scene_at, tasks)
+
+
+def _ignore_ctrl_c() -> None:
+    # Ctrl-C reaches the whole process group: the parent stops the run, a worker would only
+    # print a traceback.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _validate_scene_at(task: tuple[Path, str, Path | None, bool, int | None]) -> Report:
+    """:func:`validate_scene` in a pool's process: the scene is rebuilt from its folder there."""
+    path, group, root, quick, box_tolerance = task
+    return validate_scene(Scene(path, group, root), quick, box_tolerance)
+
+
+def _annotation_bytes(scenes: list[Scene]) -> int:
+    total = 0
+    for scene in scenes:
+        try:
+            total += (scene.path / ANNOTATIONS).stat().st_size
+        except OSError:  # validate_scene reports it
+            pass
+    return total

@@ -12,6 +12,7 @@ a crashed scene's partial folder is cleared, and the environment's observation c
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Any
 
@@ -200,7 +201,9 @@ def run_demo(
         timer.notes["generate"] = "all scenes reused"
     print("[2/5] validating", flush=True)
     with timer.stage("validate"):
-        report = validate_dataset(root, on_problem=lambda p: tqdm.write(str(p)), progress=True)
+        report = validate_dataset(
+            root, on_problem=lambda p: tqdm.write(str(p)), progress=True, workers=os.cpu_count() or 1
+        )
     print(report.summary(), flush=True)
     if not report.ok:
         print(f"the dataset in {root} is not sound: see the problems above", flush=True)

@@ -10,6 +10,7 @@ run cut short still leaves what it measured.
 from __future__ import annotations
 
 import json
+import os
 import time
 from dataclasses import asdict, dataclass, replace
 from functools import partial
@@ -351,7 +352,7 @@ def validate_once(group: Path, state: dict[str, Any], stage: str, record: Any) -
         print(f"{earlier['note']} (validated before; its files and the validator are unchanged)", flush=True)
         return True
     start = time.perf_counter()
-    report = validate_dataset(group)
+    report = validate_dataset(group, workers=os.cpu_count() or 1)
     print(report.summary(), flush=True)
     if not report.ok:
         record(stage, time.perf_counter() - start, report.summary())
