@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import re
 import signal
 import sys
@@ -114,6 +115,11 @@ def main(argv: list[str] | None = None) -> int:
     except UserError as error:
         print(f"davis-ag {args.command}: error: {error}", file=sys.stderr)
         return 2
+    except BrokenPipeError as error:
+        if _stdout_closed():  # the reader of our output went away (``| head``): stop as Unix tools do
+            return 128 + signal.SIGPIPE
+        print(f"davis-ag {args.command}: error: {error}", file=sys.stderr)
+        return 1
     except OSError as error:  # the machine, not the code: a full disk, a folder gone, a lost mount
         where = f"{error.filename}: " if error.filename else ""
         print(
@@ -134,6 +140,23 @@ def main(argv: list[str] | None = None) -> int:
     finally:
         for number, handler in previous.items():
             signal.signal(number, handler)
+
+
+def _stdout_closed() -> bool:
+    """Whether standard output is a pipe whose reader has gone (poll reports an error on it); if
+    so, point it at the null device, so the interpreter's last flush at exit stays quiet."""
+    import select
+
+    try:
+        fd = sys.stdout.fileno()
+        poller = select.poll()
+        poller.register(fd, select.POLLOUT)
+        closed = any(events & select.POLLERR for _, events in poller.poll(0))
+    except (AttributeError, OSError, ValueError):  # no poll (Windows), or stdout not a file
+        return False
+    if closed:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), fd)
+    return closed
 
 
 def _stop_on_signals() -> dict[int, Any]:

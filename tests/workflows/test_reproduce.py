@@ -141,6 +141,7 @@ def test_a_whole_run_times_every_stage_on_its_clock_and_a_rerun_adds_no_sitting(
     from dataclasses import replace
 
     from davis_ag.workflows.reproduce import CONFIGS, reproduce
+    from davis_ag.workflows.reproduce_status import run_status
     from davis_ag.workflows.stage_clock import CLOCK_FILE, read_clock
 
     config = replace(
@@ -163,6 +164,10 @@ def test_a_whole_run_times_every_stage_on_its_clock_and_a_rerun_adds_no_sitting(
     for stage in worked:
         assert state["stages"][stage]["seconds"] == pytest.approx(clock[stage][0]["seconds"], abs=0.2)
         assert f"| {stage} | {clock[stage][0]['seconds']:.0f} |" in page.read_text()
+    sp_stages = [s for s in run_status(out)[1] if s.stage.startswith("sp-")]
+    assert all(s.done for s in sp_stages) and [s.stage for s in sp_stages] == [
+        f"sp-strawberry: {stage}" for stage in ("generate", "validate", "train A2C", "evaluate")
+    ]
     capsys.readouterr()
     assert reproduce(config, out, page, SP_ONLY) == 0
     assert read_clock(out / CLOCK_FILE) == clock

@@ -14,13 +14,8 @@ from dataclasses import replace
 
 from davis_ag.commands import arguments
 from davis_ag.errors import UserError
-from davis_ag.workflows.reproduce import (
-    CONFIGS,
-    SCENARIO_CROPS,
-    ReproduceConfig,
-    load_state,
-    reproduce,
-)
+from davis_ag.workflows.reproduce import CONFIGS, SCENARIO_CROPS, load_state, reproduce
+from davis_ag.workflows.reproduce_status import format_status, run_config
 from davis_ag.workflows.results_page import write_results_md
 
 HELP = "reproduce Table 4: generate, train A2C and PPO, benchmark, write results.md"
@@ -57,6 +52,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--rewrite-results", action="store_true", help="only rewrite --results from DIR/state.json; run nothing"
     )
+    parser.add_argument(
+        "--status",
+        action="store_true",
+        help="only print where the run in DIR stands, stage by stage (safe while it runs); run nothing",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -68,18 +68,15 @@ def run(args: argparse.Namespace) -> int:
         if getattr(args, k) is not None
     }
     config = replace(config, **overrides)
+    if args.status:
+        print(format_status(args.out))
+        return 0
     arguments.prove_writable_file(args.results, "--results")
     if args.rewrite_results:
         state = load_state(args.out / "state.json")
         if not state.get("config"):
             raise UserError(f"{args.out / 'state.json'}: no finished run to write results from")
-        saved = state["config"]
-        saved.update(
-            size=tuple(saved["size"]),
-            mp_extent=tuple(saved["mp_extent"]) if saved.get("mp_extent") else None,
-            learners=tuple(saved.get("learners", ("a2c",))),  # a run from before PPO trained A2C alone
-        )
-        write_results_md(args.results, ReproduceConfig(**saved), state, args.out)
+        write_results_md(args.results, run_config(state, args.out / "state.json"), state, args.out)
         print(f"wrote {args.results}")
         return 0
     arguments.prove_writable_folder(args.out)

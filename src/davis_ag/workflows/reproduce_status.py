@@ -1,0 +1,153 @@
+"""``davis-ag reproduce --status``: where a long run stands, read from its files, touching nothing.
+
+A ``paper-scale`` run takes many sittings; its log says what the last one did. The status says
+what each stage of the whole run has done (scenes made, steps trained, evaluations written), how
+long it has worked on the stage's clock, and, for a stage under way, about how long is left at
+the rate of its last sitting. Reading it while the run goes on is safe: every file it reads is
+written atomically.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from davis_ag.errors import UserError
+from davis_ag.workflows.reproduce import SCENARIO_CROPS, ReproduceConfig, load_state
+
+
+@dataclass(frozen=True)
+class StageStatus:
+    """One stage of a run as its files show it.
+
+    Attributes:
+        stage: The stage's name, as in the run's clock and results page (``sp-strawberry: train A2C``).
+        done: Whether it has finished.
+        progress: What it has done, in words (``62 of 86 scenes``, ``not started``).
+        seconds: Its wall time so far on the run's clock (or its record), None when it has none.
+        left_s: About how long is left at its last sitting's rate, where it is under way.
+    """
+
+    stage: str
+    done: bool
+    progress: str
+    seconds: float | None = None
+    left_s: float | None = None
+
+
+def run_config(state: dict[str, Any], path: Path) -> ReproduceConfig:
+    """The configuration a run's ``state.json`` records.
+
+    Raises:
+        UserError: when ``state.json`` records none (no run started in that folder).
+    """
+    saved = dict(state.get("config") or {})
+    if not saved:
+        raise UserError(f"{path}: no reproduce run started there (no configuration in its state.json)")
+    saved.update(
+        size=tuple(saved["size"]),
+        mp_extent=tuple(saved["mp_extent"]) if saved.get("mp_extent") else None,
+        learners=tuple(saved.get("learners", ("a2c",))),  # a run from before PPO trained A2C alone
+    )
+    return ReproduceConfig(**saved)
+
+
+def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
+    """Every stage of the run in ``out``, in the order the run takes them.
+
+    Args:
+        out: The run's work folder (``--out``).
+
+    Returns:
+        The run's configuration and one :class:`StageStatus` per stage.
+
+    Raises:
+        UserError: when ``out`` holds no run.
+    """
+    from davis_ag.generate.dataset_files import complete_scenes
+    from davis_ag.workflows.stage_clock import CLOCK_FILE, read_clock
+
+    state = load_state(out / "state.json")
+    config = run_config(state, out / "state.json")
+    recorded: dict[str, dict[str, Any]] = state.get("stages", {})
+    clock = read_clock(out / CLOCK_FILE)
+
+    def seconds(stage: str) -> float | None:
+        if stage in recorded and stage.endswith((": generate", ": validate")):
+            return float(recorded[stage]["seconds"])  # scenes made before the clock are counted there
+        sittings = clock.get(stage)
+        return sum(s["seconds"] for s in sittings) if sittings else None
+
+    made = set(complete_scenes(out / "dataset"))
+    stages: list[StageStatus] = []
+    for scenario, crop in SCENARIO_CROPS:
+        key = f"{scenario}-{crop}"
+        wanted = config.sp_scenes if scenario == "sp" else config.mp_scenes
+        folders = state.get("scene_folders", {}).get(key, [])
+        count = sum(folder in made for folder in folders)
+        stage = f"{key}: generate"
+        progress = f"{count} of {wanted} scenes" if folders else "not started"
+        stages.append(StageStatus(stage, bool(folders) and count == wanted, progress, seconds(stage)))
+        stage = f"{key}: validate"
+        note = recorded.get(stage, {}).get("note")
+        stages.append(
+            StageStatus(stage, bool(note and note.endswith(": sound")), note or "not started", seconds(stage))
+        )
+        timesteps = config.sp_timesteps if scenario == "sp" else config.mp_timesteps
+        for algo in config.learners:
+            stage = f"{key}: train {algo.upper()}"
+            stages.append(_training_status(out, key, algo, timesteps, stage, seconds(stage)))
+        stage = f"{key}: evaluate"
+        written = (out / "results" / f"{key}.json").is_file()
+        progress = f"{config.sessions} x {config.episodes} episodes written" if written else "not started"
+        stages.append(StageStatus(stage, written, progress, seconds(stage)))
+    return config, stages
+
+
+def _training_status(out: Path, key: str, algo: str, timesteps: int, stage: str, seconds: float | None) -> StageStatus:
+    """A learner's stage from its saved model, or the checkpoint of a run under way."""
+    from davis_ag.benchmark.training import checkpoint_paths
+    from davis_ag.workflows.results_policies import load_json_object, model_path, training_record
+
+    model = model_path(out, key, algo)
+    if model.is_file():
+        selection = training_record(out, key, algo).get("selection", {})
+        return StageStatus(stage, True, f"{timesteps:,} steps trained{_best(selection.get('scores'))}", seconds)
+    record = load_json_object(checkpoint_paths(model)[1])
+    done = int(record.get("timesteps_done", 0))
+    if not done:
+        return StageStatus(stage, False, "not started" if seconds is None else "under way, no checkpoint yet", seconds)
+    left = None
+    if sittings := record.get("sittings"):
+        last = sittings[-1]
+        steps, spent = last["to_step"] - last["from_step"], last["seconds"]
+        if steps > 0 and spent > 0:
+            left = (timesteps - done) * spent / steps
+    progress = f"{done:,} of {timesteps:,} steps at its last checkpoint ({100 * done / timesteps:.0f} %)"
+    return StageStatus(stage, False, progress + _best(record.get("selection")), seconds, left)
+
+
+def _best(scores: Any) -> str:
+    """``; best train-split OER_tau .459 at 90,000 steps`` from a run's snapshot scores, or ``""``."""
+    if not isinstance(scores, list) or not scores:
+        return ""
+    best = max(scores, key=lambda s: s["oer_tau"])
+    return f"; best train-split OER_tau {best['oer_tau']:.3f} at {best['step']:,} steps"
+
+
+def format_status(out: Path) -> str:
+    """The run's status as a Markdown table under one line naming the run."""
+    config, stages = run_status(out)
+    lines = [
+        f"`{config.name}` run in {out}: {config.sp_scenes} SP strawberry and {config.mp_scenes} MP vine "
+        f"scenes at {config.size[0]}x{config.size[1]}, learners {', '.join(a.upper() for a in config.learners)}",
+        "",
+        "| stage | done | what its files show | hours on the clock | hours left (at its last sitting's rate) |",
+        "|---|---|---|---|---|",
+    ]
+    for s in stages:
+        hours = f"{s.seconds / 3600:.2f}" if s.seconds is not None else "-"
+        left = f"{s.left_s / 3600:.1f}" if s.left_s is not None else "-"
+        lines.append(f"| {s.stage} | {'yes' if s.done else 'no'} | {s.progress} | {hours} | {left} |")
+    return "\n".join(lines)

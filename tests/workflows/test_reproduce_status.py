@@ -1,0 +1,99 @@
+"""``davis-ag reproduce --status``: where a run stands, stage by stage, from its files alone.
+
+The run's folder is laid out here as ``reproduce`` and ``train`` leave it part way (the end of a
+whole run is checked in ``test_reproduce.py``), so that every kind of stage shows."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from dataclasses import asdict, replace
+from pathlib import Path
+
+import pytest
+
+from davis_ag import cli
+from davis_ag.workflows.reproduce import CONFIGS
+from davis_ag.workflows.reproduce_status import run_status
+
+CONFIG = replace(CONFIGS["small"], sp_scenes=3, sp_timesteps=30_000)
+
+
+def a_run_part_way(out: Path) -> Path:
+    """SP: 2 of 3 scenes made, A2C at 20,000 of 30,000 steps after a sitting of 400 s for 10,000."""
+    folders = [f"Single-Strawberry/{i:03d}" for i in range(3)]
+    for folder in folders[:2]:
+        (out / "dataset" / folder).mkdir(parents=True)
+        (out / "dataset" / folder / "annotations.json").write_text("{}")
+    (out / "dataset" / "Single-Strawberry" / ".002.partial").mkdir()  # under way: not a scene
+    state = {
+        "config": asdict(CONFIG),
+        "scene_folders": {"sp-strawberry": folders},
+        "stages": {"sp-strawberry: generate": {"seconds": 7200.0, "note": "", "code": "x"}},
+    }
+    (out / "state.json").write_text(json.dumps(state))
+    sittings = [{"started": "t", "seconds": 600.0, "code": "x"}, {"started": "t", "seconds": 300.0, "code": "x"}]
+    clock = {"stages": {"sp-strawberry: train A2C": sittings}}
+    (out / "clock.json").write_text(json.dumps(clock))
+    (out / "models").mkdir()
+    checkpoint = {
+        "timesteps_done": 20_000,
+        "sittings": [
+            {"code": "x", "from_step": 0, "to_step": 10_000, "seconds": 900.0},
+            {"code": "x", "from_step": 10_000, "to_step": 20_000, "seconds": 400.0},
+        ],
+        "selection": [{"step": 10_000, "oer_tau": 0.41}, {"step": 20_000, "oer_tau": 0.452}],
+    }
+    (out / "models" / "a2c_sp-strawberry.checkpoint.json").write_text(json.dumps(checkpoint))
+    return out
+
+
+def test_each_stage_says_what_its_files_show(tmp_path: Path) -> None:
+    config, stages = run_status(a_run_part_way(tmp_path))
+    assert config == CONFIG
+    by_name = {s.stage: s for s in stages}
+    assert list(by_name)[:5] == [
+        "sp-strawberry: generate",
+        "sp-strawberry: validate",
+        "sp-strawberry: train A2C",
+        "sp-strawberry: train PPO",
+        "sp-strawberry: evaluate",
+    ]
+    made = by_name["sp-strawberry: generate"]
+    assert (made.done, made.progress, made.seconds) == (False, "2 of 3 scenes", 7200.0)
+    a2c = by_name["sp-strawberry: train A2C"]
+    assert not a2c.done and a2c.seconds == 900.0  # both sittings on the clock
+    assert a2c.progress.startswith("20,000 of 30,000 steps at its last checkpoint (67 %)")
+    assert a2c.progress.endswith("best train-split OER_tau 0.452 at 20,000 steps")
+    assert a2c.left_s == pytest.approx(10_000 * 400.0 / 10_000)  # the last sitting's rate
+    assert all(s.progress == "not started" and s.seconds is None for s in stages if s.stage.startswith("mp-"))
+
+
+def test_the_status_prints_and_a_folder_without_a_run_gets_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = a_run_part_way(tmp_path / "run")
+    assert cli.main(["reproduce", "--out", str(out), "--status"]) == 0
+    printed = capsys.readouterr().out
+    assert "| sp-strawberry: train A2C | no | 20,000 of 30,000 steps" in printed and "| 0.25 | 0.1 |" in printed
+    assert not (tmp_path / "docs").exists()  # --status writes nothing, the results page included
+    assert cli.main(["reproduce", "--out", str(tmp_path / "none"), "--status"]) == 2
+    assert "no reproduce run started there" in capsys.readouterr().err
+
+
+def test_a_reader_that_goes_away_stops_the_output_without_an_error(tmp_path: Path) -> None:
+    """``davis-ag reproduce --status | head -1``: the exit a pipe's writer gets, nothing on stderr."""
+    out = a_run_part_way(tmp_path / "run")
+    read, write = os.pipe()
+    os.close(read)
+    done = subprocess.run(
+        [sys.executable, "-m", "davis_ag.cli", "reproduce", "--out", str(out), "--status"],
+        stdout=write,
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=tmp_path,
+    )
+    os.close(write)
+    assert (done.returncode, done.stderr) == (141, "")
