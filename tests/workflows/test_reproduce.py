@@ -142,6 +142,7 @@ def test_a_whole_run_times_every_stage_on_its_clock_and_a_rerun_adds_no_sitting(
 
     from davis_ag.workflows.reproduce import CONFIGS, reproduce
     from davis_ag.workflows.reproduce_status import run_status
+    from davis_ag.workflows.results_page import machine_summary
     from davis_ag.workflows.stage_clock import CLOCK_FILE, read_clock
 
     config = replace(
@@ -163,7 +164,10 @@ def test_a_whole_run_times_every_stage_on_its_clock_and_a_rerun_adds_no_sitting(
     state = json.loads((out / "state.json").read_text())
     for stage in worked:
         assert state["stages"][stage]["seconds"] == pytest.approx(clock[stage][0]["seconds"], abs=0.2)
-        assert f"| {stage} | {clock[stage][0]['seconds']:.0f} |" in page.read_text()
+        seconds = clock[stage][0]["seconds"]
+        # Issue 32: the page says where each stage ran.
+        assert clock[stage][0]["machine"] == machine_summary()
+        assert f"| {stage} | {seconds:.0f} | {seconds / 3600:.2f} | {machine_summary()} |" in page.read_text()
     sp_stages = [s for s in run_status(out)[1] if s.stage.startswith("sp-")]
     assert all(s.done for s in sp_stages) and [s.stage for s in sp_stages] == [
         f"sp-strawberry: {stage}" for stage in ("generate", "validate", "train A2C", "evaluate")

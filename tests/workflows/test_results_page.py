@@ -101,12 +101,12 @@ def test_a_run_resumed_across_code_changes_says_so(tmp_path: Path) -> None:
     assert "under-trained" not in text  # 300K steps: the paper's count
     assert "do not edit by hand" in text and "How this run was made" in text
     # The stage table takes each stage's code from what did the work: the scenes, the sittings.
-    assert "| sp-strawberry: generate | 12 | 0.00 | 0.1.0+aaaa (1 scene); 0.1.0+bbbb (1 scene) | 2 scenes |" in text
+    assert "| sp-strawberry: generate | 12 | 0.00 | - | 0.1.0+aaaa (1 scene); 0.1.0+bbbb (1 scene) | 2 scenes |" in text
     assert (
-        "| sp-strawberry: train A2C | 7200 | 2.00 | 0.1.0+aaaa, 0.1.0+bbbb | 300,000 steps in 2 sitting(s), "
+        "| sp-strawberry: train A2C | 7200 | 2.00 | - | 0.1.0+aaaa, 0.1.0+bbbb | 300,000 steps in 2 sitting(s), "
         "41.7 steps/s over the sittings' wall time |"
     ) in text
-    assert "71.4" not in text and "| total | 7212 | 2.00 | | |" in text
+    assert "71.4" not in text and "| total | 7212 | 2.00 | | | |" in text
 
 
 def test_how_the_run_was_made_names_the_plants_and_the_a2c_settings(tmp_path: Path) -> None:

@@ -112,3 +112,16 @@ def test_scenes_made_before_the_clock_count_their_own_times_over_the_scene_proce
         time.sleep(0.1)
     seconds, note = generation_seconds(root, folders, clock, "sp-strawberry: generate")
     assert seconds == pytest.approx(150.1, abs=0.05) and "1 sitting(s) on the clock" in note
+
+
+def test_each_sitting_says_where_it_ran_and_older_ones_are_counted_apart(tmp_path: Path) -> None:
+    from davis_ag.workflows.stage_clock import machines
+
+    path = tmp_path / "clock.json"
+    path.write_text(json.dumps({"stages": {"train": [{"started": "2026-11-24T23:59:50+00:00", "seconds": 9.0}]}}))
+    for machine in ("2 CPU cores, no GPU", "16 CPU cores, NVIDIA H200", "2 CPU cores, no GPU"):
+        with StageClock(path, "a", machine=machine).timing("train"):
+            pass
+    sittings = read_clock(path)["train"]
+    assert machines(sittings) == "2 CPU cores, no GPU; 16 CPU cores, NVIDIA H200; 1 sitting(s) unrecorded"
+    assert machines([]) == "-"

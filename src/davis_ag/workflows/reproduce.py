@@ -244,7 +244,7 @@ def reproduce(
     from davis_ag.scene.specs import crop_spec, scenario_spec
     from davis_ag.provenance import code_version
     from davis_ag.workflows.demo import evaluation_split, generate_scenes, run_baselines
-    from davis_ag.workflows.results_page import write_results_md
+    from davis_ag.workflows.results_page import machine_summary, write_results_md
     from davis_ag.workflows.reproduce_learners import train_learner
     from davis_ag.workflows.stage_clock import CLOCK_FILE, StageClock, generation_seconds
     from davis_ag.workflows.results_policies import model_path
@@ -264,7 +264,7 @@ def reproduce(
     state["config"] = asdict(config)
     state.setdefault("stages", {})
     state.setdefault("results", {})
-    clock = StageClock(out / CLOCK_FILE, code_version())
+    clock = StageClock(out / CLOCK_FILE, code_version(), machine=machine_summary())
 
     def record(stage: str, seconds: float, note: str = "", code: str | None = None, **extra: str) -> None:
         state["stages"][stage] = {"seconds": round(seconds, 1), "note": note, "code": code or code_version(), **extra}

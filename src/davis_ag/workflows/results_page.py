@@ -87,6 +87,14 @@ def machine_description() -> str:
     )
 
 
+def machine_summary() -> str:
+    """This machine in a few words, for each sitting of a run's clock: cores and accelerator."""
+    import torch
+
+    gpu = torch.cuda.get_device_name(0) if torch.cuda.is_available() else "no GPU"
+    return f"{os.cpu_count()} CPU cores, {gpu}"
+
+
 def ordering_failures(
     order: tuple[str, ...], policies: dict[str, dict[str, Any]], metric: str = "oer_tau"
 ) -> list[str] | None:
@@ -481,6 +489,7 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
         ``path``.
     """
     from davis_ag.atomic_files import write_marked_section, write_text_atomic
+    from davis_ag.workflows.stage_clock import CLOCK_FILE, machines, read_clock
     from davis_ag.scene.specs import crop_spec, scenario_spec
     from davis_ag.scene.view_grid import views_per_scene
 
@@ -567,12 +576,19 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
     lines += learning_curve_section(out, Path(path))
     lines += ["## Notes", ""] + [f"- {note}" for note in _notes(config, state, out)] + [""]
     lines += _how_made(state, out)
-    lines += ["## Wall time per stage", "", "| Stage | Seconds | Hours | Code | Note |", "|---|---|---|---|---|"]
+    lines += [
+        "## Wall time per stage",
+        "",
+        "| Stage | Seconds | Hours | Ran on (the clock's sittings) | Code | Note |",
+        "|---|---|---|---|---|---|",
+    ]
     total = 0.0
+    clock = read_clock(out / CLOCK_FILE) if out is not None else {}
     for stage, seconds, code, note in stage_rows(state, out):
         total += seconds
-        lines.append(f"| {stage} | {seconds:.0f} | {seconds / 3600:.2f} | {code} | {note} |")
-    lines += [f"| total | {total:.0f} | {total / 3600:.2f} | | |", ""]
+        where = machines(clock.get(stage, []))
+        lines.append(f"| {stage} | {seconds:.0f} | {seconds / 3600:.2f} | {where} | {code} | {note} |")
+    lines += [f"| total | {total:.0f} | {total / 3600:.2f} | | | |", ""]
     written = write_text_atomic(path, "\n".join(lines) + "\n")
     # A page in a project's docs/ also updates the README's block beside it, so the README's
     # numbers are the run's, never copied by hand.

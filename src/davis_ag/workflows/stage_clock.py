@@ -40,15 +40,18 @@ class Sitting:
 class StageClock:
     """Per stage, the wall seconds of every sitting that worked on it, kept in one JSON file."""
 
-    def __init__(self, path: Path, code: str, every_s: float = WRITE_EVERY_S) -> None:
+    def __init__(self, path: Path, code: str, every_s: float = WRITE_EVERY_S, machine: str | None = None) -> None:
         """Args:
         path: The clock's file (``OUT/clock.json``); its earlier sittings are kept.
         code: The code version this sitting runs, recorded with each of its sittings.
         every_s: Seconds between writes while a stage runs.
+        machine: Where this sitting runs (``2 CPU cores, no GPU``), recorded with each of its
+            sittings, so a run whose stages ran on several machines says which ran where.
         """
         self.path = Path(path)
         self.code = code
         self.every_s = every_s
+        self.machine = machine
         stages = _read(self.path)
         if stages is None:
             # Unreadable: kept aside, never overwritten, and the stages timed from here on.
@@ -64,6 +67,8 @@ class StageClock:
         and at the end, and the sitting is dropped if the body discards it."""
         sitting = Sitting()
         entry = {"started": datetime.now(timezone.utc).isoformat(timespec="seconds"), "seconds": 0.0, "code": self.code}
+        if self.machine:
+            entry["machine"] = self.machine
         start = time.perf_counter()
         done = threading.Event()
 
@@ -104,6 +109,16 @@ class StageClock:
         """When the stage's first timed sitting began (POSIX seconds), or None."""
         sittings = self.stages.get(stage, [])
         return datetime.fromisoformat(sittings[0]["started"]).timestamp() if sittings else None
+
+
+def machines(sittings: list[dict[str, Any]]) -> str:
+    """Where a stage's sittings ran, each machine once in order (``2 CPU cores, no GPU``), with
+    the sittings from before the clock recorded machines counted apart; ``-`` without sittings."""
+    named = list(dict.fromkeys(s["machine"] for s in sittings if s.get("machine")))
+    unnamed = sum(1 for s in sittings if not s.get("machine"))
+    if unnamed:
+        named.append(f"{unnamed} sitting(s) unrecorded")
+    return "; ".join(named) or "-"
 
 
 def generation_seconds(root: Path, scenes: list[str], clock: StageClock, stage: str) -> tuple[float, str]:
