@@ -159,7 +159,7 @@ def test_a_whole_run_times_every_stage_on_its_clock_and_a_rerun_adds_no_sitting(
     out, page = tmp_path / "run", tmp_path / "results.md"
     assert reproduce(config, out, page, SP_ONLY) == 0
     clock = read_clock(out / CLOCK_FILE)
-    worked = [f"sp-strawberry: {stage}" for stage in ("generate", "train A2C", "evaluate")]
+    worked = [f"sp-strawberry: {stage}" for stage in ("generate", "validate", "train A2C", "evaluate")]
     assert sorted(clock) == sorted(worked) and all(len(clock[s]) == 1 for s in worked)
     state = json.loads((out / "state.json").read_text())
     for stage in worked:
