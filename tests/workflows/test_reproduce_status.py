@@ -15,6 +15,7 @@ from pathlib import Path
 import pytest
 
 from davis_ag import cli
+from davis_ag.generate.run_progress import default_workers
 from davis_ag.workflows.reproduce import CONFIGS
 from davis_ag.workflows.reproduce_status import run_status
 
@@ -28,6 +29,12 @@ def a_run_part_way(out: Path) -> Path:
         (out / "dataset" / folder).mkdir(parents=True)
         (out / "dataset" / folder / "annotations.json").write_text("{}")
     (out / "dataset" / "Single-Strawberry" / ".002.partial").mkdir()  # under way: not a scene
+    timings = [
+        {"grow": 10.0, "draw_and_label": 590.0},
+        {"grow": 1.0, "draw_and_label": 20.0, "views_from_an_earlier_run": 9},
+    ]
+    for folder, timing in zip(folders, timings):  # the second was resumed: its time is partial
+        (out / "dataset" / folder / "scene.json").write_text(json.dumps({"timing_s": timing}))
     state = {
         "config": asdict(CONFIG),
         "scene_folders": {"sp-strawberry": folders},
@@ -63,6 +70,7 @@ def test_each_stage_says_what_its_files_show(tmp_path: Path) -> None:
     ]
     made = by_name["sp-strawberry: generate"]
     assert (made.done, made.progress, made.seconds) == (False, "2 of 3 scenes", 7200.0)
+    assert made.left_s == pytest.approx(600.0 / default_workers())  # one scene left, at the whole scene's time
     a2c = by_name["sp-strawberry: train A2C"]
     assert not a2c.done and a2c.seconds == 900.0  # both sittings on the clock
     assert a2c.progress.startswith("20,000 of 30,000 steps at its last checkpoint (67 %)")

@@ -2,9 +2,9 @@
 
 A ``paper-scale`` run takes many sittings; its log says what the last one did. The status says
 what each stage of the whole run has done (scenes made, steps trained, evaluations written), how
-long it has worked on the stage's clock, and, for a stage under way, about how long is left at
-the rate of its last sitting. Reading it while the run goes on is safe: every file it reads is
-written atomically.
+long it has worked on the stage's clock, and, for a stage under way, about how long is left (a
+learner at the rate of its last sitting, a generate stage at the mean time of its scenes so
+far). Reading it while the run goes on is safe: every file it reads is written atomically.
 """
 
 from __future__ import annotations
@@ -26,7 +26,8 @@ class StageStatus:
         done: Whether it has finished.
         progress: What it has done, in words (``62 of 86 scenes``, ``not started``).
         seconds: Its wall time so far on the run's clock (or its record), None when it has none.
-        left_s: About how long is left at its last sitting's rate, where it is under way.
+        left_s: About how long is left, where it is under way: a learner's at its last sitting's
+            rate, a generate stage's at the mean time of its scenes made so far.
     """
 
     stage: str
@@ -88,7 +89,8 @@ def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
         count = sum(folder in made for folder in folders)
         stage = f"{key}: generate"
         progress = f"{count} of {wanted} scenes" if folders else "not started"
-        stages.append(StageStatus(stage, bool(folders) and count == wanted, progress, seconds(stage)))
+        left = _generation_left(out / "dataset", [f for f in folders if f in made], wanted - count)
+        stages.append(StageStatus(stage, bool(folders) and count == wanted, progress, seconds(stage), left))
         stage = f"{key}: validate"
         note = recorded.get(stage, {}).get("note")
         stages.append(
@@ -103,6 +105,27 @@ def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
         progress = f"{config.sessions} x {config.episodes} episodes written" if written else "not started"
         stages.append(StageStatus(stage, written, progress, seconds(stage)))
     return config, stages
+
+
+def _generation_left(root: Path, made: list[str], remaining: int) -> float | None:
+    """About how long the ``remaining`` scenes of a group take: the mean time of its scenes made
+    in one go (``scene.json``'s ``timing_s``) over the scene processes this machine runs at once."""
+    import json
+
+    from davis_ag.formats.layout import SCENE_METADATA
+    from davis_ag.generate.run_progress import default_workers
+
+    if remaining <= 0:
+        return None
+    times = []
+    for folder in made:
+        try:
+            timing = json.loads((root / folder / SCENE_METADATA).read_text()).get("timing_s", {})
+        except (OSError, ValueError):
+            continue
+        if timing and not timing.get("views_from_an_earlier_run"):  # a resumed scene's time is partial
+            times.append(float(timing.get("grow", 0)) + float(timing.get("draw_and_label", 0)))
+    return remaining * sum(times) / len(times) / default_workers() if times else None
 
 
 def _training_status(out: Path, key: str, algo: str, timesteps: int, stage: str, seconds: float | None) -> StageStatus:
@@ -143,7 +166,7 @@ def format_status(out: Path) -> str:
         f"`{config.name}` run in {out}: {config.sp_scenes} SP strawberry and {config.mp_scenes} MP vine "
         f"scenes at {config.size[0]}x{config.size[1]}, learners {', '.join(a.upper() for a in config.learners)}",
         "",
-        "| stage | done | what its files show | hours on the clock | hours left (at its last sitting's rate) |",
+        "| stage | done | what its files show | hours on the clock | about hours left |",
         "|---|---|---|---|---|",
     ]
     for s in stages:
