@@ -363,3 +363,29 @@ def test_ppo_and_dqn_train_resume_and_keep_the_best(
     assert model.num_timesteps == kept["kept_step"]
     if algo == "ppo":  # the zoo's lin_ schedules survive the checkpoint: 2.5e-4 falling to 0
         assert model.lr_schedule(1.0) == pytest.approx(2.5e-4) and model.lr_schedule(0.0) == 0.0
+
+
+class _SavesInTwoWrites:
+    """A model whose save is cut by a stop (Ctrl-C) between its two writes, as a signal may cut
+    torch's zip writer."""
+
+    def save(self, handle) -> None:  # type: ignore[no-untyped-def]
+        import signal
+
+        from davis_ag.errors import stop
+
+        handle.write(b"first half,")
+        stop(signal.SIGINT)
+        handle.write(b" second half")
+
+
+def test_a_stop_while_a_model_saves_waits_for_the_whole_file(tmp_path: Path) -> None:
+    """Ctrl-C during a checkpoint's save: the stop comes once the file is whole, never as torch's
+    error from a half-written zip (a CI run caught ``train`` exiting 1 with that traceback)."""
+    from davis_ag.benchmark.training import save_model
+    from davis_ag.errors import Stopped
+
+    path = tmp_path / "a2c.checkpoint.zip"
+    with pytest.raises(Stopped):
+        save_model(_SavesInTwoWrites(), path)
+    assert path.read_bytes() == b"first half, second half"

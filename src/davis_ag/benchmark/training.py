@@ -34,7 +34,7 @@ from davis_ag.benchmark.networks import ARCHITECTURES
 from davis_ag.benchmark.progress import TrainingProgress
 from davis_ag.benchmark.selection import KeepBestOnTrain, check_keep, snapshot_path
 from davis_ag.benchmark.tvm import as_dataset
-from davis_ag.errors import MachineError, UserError
+from davis_ag.errors import MachineError, UserError, stops_held
 from davis_ag.formats.models import check_seed
 from davis_ag.provenance import code_version
 
@@ -98,8 +98,10 @@ def training_record_path(out_path: str | os.PathLike[str]) -> Path:
 
 
 def save_model(model: Any, path: Path) -> None:
-    """Save an SB3 model atomically (a kill mid-save leaves the previous file)."""
-    with atomic_output(path, "wb") as handle:
+    """Save an SB3 model atomically (a kill mid-save leaves the previous file). A stop asked for
+    while it saves (Ctrl-C, SIGTERM) takes effect once the file is in place: cut inside torch's
+    zip writer, it would surface as torch's RuntimeError instead of a stop."""
+    with stops_held(), atomic_output(path, "wb") as handle:
         model.save(handle)
 
 
@@ -190,21 +192,25 @@ class _Checkpoint(BaseCallback):
     def _on_step(self) -> bool:
         if self.model.num_timesteps - self._last >= self.every:
             self._last = self.model.num_timesteps
-            save_model(self.model, self.model_file)
-            scores = self.selection.scores if self.selection else []
-            write_json_atomic(
-                self.settings_file,
-                {
-                    **self.settings,
-                    "timesteps_done": self._last,
-                    "sittings": self.sittings.upto(self._last),
-                    "curve": self.curve.points,
-                    "selection": scores,
-                },
-            )
-            if self.selection:  # the checkpoint now names the best snapshot: older ones can go
-                self.selection.prune()
+            with stops_held():  # the model and its settings file, both or neither, before a stop
+                self._save()
         return True
+
+    def _save(self) -> None:
+        save_model(self.model, self.model_file)
+        scores = self.selection.scores if self.selection else []
+        write_json_atomic(
+            self.settings_file,
+            {
+                **self.settings,
+                "timesteps_done": self._last,
+                "sittings": self.sittings.upto(self._last),
+                "curve": self.curve.points,
+                "selection": scores,
+            },
+        )
+        if self.selection:  # the checkpoint now names the best snapshot: older ones can go
+            self.selection.prune()
 
 
 def train_a2c(dataset: Any, scenario: str, **kwargs: Any) -> Path:
