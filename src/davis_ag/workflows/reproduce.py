@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import json
 import os
-import time
 from dataclasses import asdict, dataclass, replace
 from functools import partial
 from pathlib import Path
@@ -287,9 +286,7 @@ def reproduce(
                 sitting.discard()
         record(f"{key}: generate", *generation_seconds(root, [r.folder for r in requests], clock, f"{key}: generate"))
         group = root / requests[0].folder.split("/")[0]
-        with clock.timing(f"{key}: validate") as sitting:
-            sound = validate_once(group, state, f"{key}: validate", record, sitting)
-        if not sound:
+        if not validate_once(group, state, f"{key}: validate", clock, record):
             return 1
         split = evaluation_split(root, scenario_name, crop_name)
         timesteps = config.sp_timesteps if scenario_name == "sp" else config.mp_timesteps
@@ -337,11 +334,11 @@ def reproduce(
     return 0
 
 
-def validate_once(group: Path, state: dict[str, Any], stage: str, record: Any, sitting: Any) -> bool:
-    """Validate ``group`` unless the last sitting validated the same files with the same code
-    (:func:`davis_ag.data.validation_stamp.validation_stamp`): a sound report is reused, so a
-    resumed paper-scale run does not re-read 9 GB of views for half an hour at every sitting.
-    A reused report discards the clock's ``sitting`` (it did no work).
+def validate_once(group: Path, state: dict[str, Any], stage: str, clock: Any, record: Any) -> bool:
+    """Validate ``group`` on the run's ``clock`` unless the last sitting validated the same files
+    with the same code (:func:`davis_ag.data.validation_stamp.validation_stamp`): a sound report
+    is reused, so a resumed paper-scale run does not re-read 9 GB of views for half an hour at
+    every sitting.
 
     Returns:
         Whether the data is sound (the problems are printed where it is not).
@@ -353,18 +350,14 @@ def validate_once(group: Path, state: dict[str, Any], stage: str, record: Any, s
     earlier = state["stages"].get(stage, {})
     if earlier.get("stamp") == stamp:
         print(f"{earlier['note']} (validated before; its files and the validator are unchanged)", flush=True)
-        sitting.discard()
         return True
-    start = time.perf_counter()
-    report = validate_dataset(group, workers=os.cpu_count() or 1)
+    with clock.timing(stage):
+        report = validate_dataset(group, workers=os.cpu_count() or 1)
     print(report.summary(), flush=True)
-    if not report.ok:
-        record(stage, time.perf_counter() - start, report.summary())
-        for problem in report.problems[:20]:
-            print(problem, flush=True)
-        return False
-    record(stage, time.perf_counter() - start, report.summary(), stamp=stamp)
-    return True
+    record(stage, clock.seconds(stage), report.summary(), **({"stamp": stamp} if report.ok else {}))
+    for problem in report.problems[:20]:
+        print(problem, flush=True)
+    return report.ok
 
 
 def _reusable_results(path: Path, models: list[Path], split: str, config: ReproduceConfig) -> dict[str, Any] | None:
