@@ -61,6 +61,37 @@ def test_the_training_rates_reach_performance_md_and_ppos_line_in_benchmark_md(t
     assert line.startswith("# B\n") and line.endswith("end\n")
 
 
+def test_rates_on_a_gpu_stand_beside_the_cpus_and_ppos_line_keeps_the_cpus(tmp_path: Path) -> None:
+    """``davis-ag bench --only training --device cuda`` on a GPU machine: each learner on the CPU,
+    then on the GPU, against the CPU's A2C; the page's PPO sentence stays the CPU's."""
+    from davis_ag.workflows.bench_training import LEARNERS, ppo_line, training_table
+
+    rates = {"cpu": (50.0, 25.0, 10.0), "cuda": (400.0, 300.0, 150.0)}
+    learners = {
+        f"{row} on {device}": {
+            "algo": algo,
+            "device": device,
+            "steps_per_second": rate,
+            "over_reference": rate / 50.0,
+            "hours_300k": round(300_000 / rate / 3600, 1),
+        }
+        for device in ("cpu", "cuda")
+        for (row, algo, _), rate in zip(LEARNERS, rates[device])
+    }
+    result = {"steps": 2048, "seed": 0, "devices": ["cpu", "cuda"], "learners": learners}
+    table = training_table(result, (1.0, 1.0))
+    assert "on each device in turn (cpu, cuda;" in table and "| against A2C (ours) on cpu |" in table
+    assert "| PPO (the zoo's Atari settings, ours) on cuda | **300.0** | 6.00x | 0.3 |" in table
+    assert "SB3's defaults train at 10.0 steps/s" in ppo_line(result)
+
+
+def test_a_gpu_is_asked_for_the_training_rates_only(capsys: pytest.CaptureFixture[str]) -> None:
+    from davis_ag import cli
+
+    assert cli.main(["bench", "--device", "cuda", "--out", "unused.json"]) == 2
+    assert "--device cuda is for --only training" in capsys.readouterr().err
+
+
 @pytest.mark.slow
 def test_every_path_of_the_bench_runs_on_a_small_scene(tmp_path: Path) -> None:
     """``make bench`` at a test's size: ours, pyhelios's documented path (its JPEG, boxes and

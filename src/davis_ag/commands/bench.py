@@ -47,6 +47,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="continuous: only TVMContinuous-v0's steps/s (about a minute); training: only the "
         "learners' training steps/s (about 8 minutes)",
     )
+    parser.add_argument(
+        "--device",
+        choices=("cpu", "cuda"),
+        default="cpu",
+        help="with --only training: cuda times every learner on the CPU and then on the GPU, in one "
+        "process, for what the GPU gains (default cpu)",
+    )
 
 
 def _is_report(path: Path) -> bool:
@@ -79,8 +86,10 @@ def run(args: argparse.Namespace) -> int:
             f"--doc {args.doc}: not a Markdown page with <!-- bench:start --> and <!-- bench:end --> "
             "markers; give docs/performance.md or leave --doc out"
         )
+    if args.device != "cpu" and args.only != "training":
+        raise UserError(f"--device {args.device} is for --only training: add --only training, or leave --device out")
     if args.only in ("continuous", "training"):
-        run_only(args.only, args.out, args.doc)
+        run_only(args.only, args.out, args.doc, ("cpu",) if args.device == "cpu" else ("cpu", args.device))
         print(f"written {args.out}" + (f" and {args.doc}" if args.doc else ""))
         return 0
     report = run_bench(args.out, args.crops, args.repeats, args.antialiasing)

@@ -275,17 +275,17 @@ def continuous_env_speed(scratch: Path, steps: int = 600) -> dict:
     }
 
 
-def run_only(what: str, out: Path, doc: Path | None) -> dict:
+def run_only(what: str, out: Path, doc: Path | None, devices: tuple[str, ...] = ("cpu",)) -> dict:
     """One measurement alone (``--only continuous``: TVMContinuous-v0's rate, about a minute;
-    ``--only training``: the learners' training rates, about 8 minutes): JSON, the doc's section
-    and the line another page shows of it."""
+    ``--only training``: the learners' training rates, about 8 minutes, on each of ``devices``):
+    JSON, the doc's section and the line another page shows of it."""
     key, measure, table_of, write = {
         "continuous": ("continuous_env", continuous_env_speed, continuous_table, write_continuous),
         "training": ("training", training_speed, training_table, write_training),
     }[what]
     start = os.getloadavg()[0]
     with tempfile.TemporaryDirectory(prefix="davis-ag-bench-") as scratch:
-        result = measure(Path(scratch))
+        result = training_speed(Path(scratch), devices=devices) if what == "training" else measure(Path(scratch))
     load = (start, os.getloadavg()[0])
     print(table_of(result, load))
     out.parent.mkdir(parents=True, exist_ok=True)

@@ -56,49 +56,68 @@ def training_scenes(root: Path) -> Path:
     return root
 
 
-def training_speed(scratch: Path, steps: int = STEPS) -> dict[str, Any]:
-    """Steps per second of each of :data:`LEARNERS`, trained ``steps`` steps on the paper's network
-    (CPU, 8 environments, the observation cache built before the first is timed).
+def training_speed(scratch: Path, steps: int = STEPS, devices: tuple[str, ...] = ("cpu",)) -> dict[str, Any]:
+    """Steps per second of each of :data:`LEARNERS` on each torch device, trained ``steps`` steps
+    on the paper's network (8 environments, the observation cache built before the first is
+    timed); the first device's A2C is the reference of the ratios.
+
+    Args:
+        scratch: A folder for the scenes and models.
+        steps: Steps each learner is timed for.
+        devices: Torch devices, the CPU first (``("cpu", "cuda")`` on a GPU machine: what the GPU
+            gains, measured in the same process).
 
     Returns:
-        ``{"steps": n, "learners": {row: {"steps_per_second", "over_reference", "hours_300k"}}}``.
+        ``{"steps": n, "devices": [...], "learners": {row: {"algo", "device", "steps_per_second",
+        "over_reference", "hours_300k"}}}``; a row is named by its learner, and by its device too
+        where several are timed.
     """
-    from davis_ag.benchmark.training import train_agent
+    from davis_ag.benchmark.training import check_device, train_agent
 
+    for device in devices:
+        check_device(device)  # before minutes of measuring
     root = training_scenes(scratch / "training")
-    common = dict(seed=SEED, n_envs=8, arch="paper", device="cpu", checkpoint_every=0, keep="last", progress=False)
-    train_agent(root, "sp", total_timesteps=8, out_path=scratch / "warm.zip", **common)  # builds the cache
+    common = dict(seed=SEED, n_envs=8, arch="paper", checkpoint_every=0, keep="last", progress=False)
     rows: dict[str, Any] = {}
-    for number, (row, algo, settings) in enumerate(LEARNERS):
-        started = time.perf_counter()
-        train_agent(
-            root,
-            "sp",
-            total_timesteps=steps,
-            out_path=scratch / f"{number}.zip",
-            algo=algo,
-            settings=settings,
-            **common,
-        )
-        rate = steps / (time.perf_counter() - started)
-        reference = rows[LEARNERS[0][0]]["steps_per_second"] if rows else rate
-        rows[row] = {
-            "steps_per_second": round(rate, 1),
-            "over_reference": round(rate / reference, 2),
-            "hours_300k": round(RUN_STEPS / rate / 3600, 1),
-        }
-    return {"steps": steps, "seed": SEED, "learners": rows}
+    for device in devices:
+        # Builds the cache (first device) and warms the device up before anything is timed.
+        train_agent(root, "sp", total_timesteps=8, out_path=scratch / f"warm-{device}.zip", device=device, **common)
+        for number, (row, algo, settings) in enumerate(LEARNERS):
+            started = time.perf_counter()
+            train_agent(
+                root,
+                "sp",
+                total_timesteps=steps,
+                out_path=scratch / f"{device}-{number}.zip",
+                algo=algo,
+                settings=settings,
+                device=device,
+                **common,
+            )
+            rate = steps / (time.perf_counter() - started)
+            reference = next(iter(rows.values()))["steps_per_second"] if rows else rate
+            rows[row if len(devices) == 1 else f"{row} on {device}"] = {
+                "algo": algo,
+                "device": device,
+                "steps_per_second": round(rate, 1),
+                "over_reference": round(rate / reference, 2),
+                "hours_300k": round(RUN_STEPS / rate / 3600, 1),
+            }
+    return {"steps": steps, "seed": SEED, "devices": list(devices), "learners": rows}
 
 
 def training_table(result: dict[str, Any], load: tuple[float, float]) -> str:
     """The training rates as Markdown."""
+    devices = result.get("devices", ["cpu"])
+    where = "the CPU" if devices == ["cpu"] else f"each device in turn ({', '.join(devices)}; {_accelerator()})"
     lines = [
-        f"The paper's network on the CPU, 8 environments, {result['steps']:,} steps of each learner on three "
+        f"The paper's network on {where}, 8 environments, {result['steps']:,} steps of each learner on three "
         f"single-plant strawberry scenes (seed {result['seed']}), one after the other in one process; load "
         f"average {load[0]:.2f} at the start, {load[1]:.2f} at the end, {os.cpu_count()} CPUs. SB3's PPO "
         "defaults with 256-step rollouts (what a step costs does not depend on the rollout's length).",
         "",
-        f"| learner | steps/s | against {LEARNERS[0][0]} | hours for {RUN_STEPS // 1000}K steps at this rate |",
+        f"| learner | steps/s | against {next(iter(result['learners']))} | hours for {RUN_STEPS // 1000}K steps "
+        "at this rate |",
         "|---|---|---|---|",
     ]
     for row, r in result["learners"].items():
@@ -106,9 +125,16 @@ def training_table(result: dict[str, Any], load: tuple[float, float]) -> str:
     return "\n".join(lines)
 
 
+def _accelerator() -> str:
+    import torch
+
+    return torch.cuda.get_device_name(0) if torch.cuda.is_available() else "no GPU"
+
+
 def ppo_line(result: dict[str, Any]) -> str:
-    """PPO's two settings in one sentence, for docs/benchmark.md."""
-    zoo, sb3 = (result["learners"][row] for row, algo, _ in LEARNERS if algo == "ppo")
+    """PPO's two settings in one sentence, for docs/benchmark.md (on the first device, the CPU)."""
+    first = result.get("devices", ["cpu"])[0]
+    zoo, sb3 = (r for row, r in result["learners"].items() if row.startswith("PPO") and r.get("device", first) == first)
     return (
         f"PPO's two settings, measured by `make bench` ([performance.md](performance.md)): SB3's defaults "
         f"train at {sb3['steps_per_second']} steps/s on the paper's network on this machine, the zoo's "
