@@ -72,6 +72,14 @@ def machine_description() -> str:
     """CPU model, core count and accelerator of this machine, with Python's and torch's versions."""
     import torch
 
+    return f"{machine_summary()}; Python {platform.python_version()}, torch {torch.__version__}, {platform.system()} {platform.release()}"
+
+
+def machine_summary() -> str:
+    """This machine in a few words, for each sitting of a run's clock: cores, CPU model, accelerator
+    (``2 CPU cores (Intel(R) Xeon(R) Processor), no GPU``)."""
+    import torch
+
     cpu = platform.processor() or platform.machine()
     try:
         for line in Path("/proc/cpuinfo").read_text().splitlines():
@@ -81,18 +89,7 @@ def machine_description() -> str:
     except OSError:
         pass
     gpu = torch.cuda.get_device_name(0) if torch.cuda.is_available() else "no GPU"
-    return (
-        f"{os.cpu_count()} CPU cores ({cpu}), {gpu}; Python {platform.python_version()}, "
-        f"torch {torch.__version__}, {platform.system()} {platform.release()}"
-    )
-
-
-def machine_summary() -> str:
-    """This machine in a few words, for each sitting of a run's clock: cores and accelerator."""
-    import torch
-
-    gpu = torch.cuda.get_device_name(0) if torch.cuda.is_available() else "no GPU"
-    return f"{os.cpu_count()} CPU cores, {gpu}"
+    return f"{os.cpu_count()} CPU cores ({cpu}), {gpu}"
 
 
 def ordering_failures(

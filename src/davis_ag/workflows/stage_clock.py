@@ -45,7 +45,7 @@ class StageClock:
         path: The clock's file (``OUT/clock.json``); its earlier sittings are kept.
         code: The code version this sitting runs, recorded with each of its sittings.
         every_s: Seconds between writes while a stage runs.
-        machine: Where this sitting runs (``2 CPU cores, no GPU``), recorded with each of its
+        machine: Where this sitting runs (``2 CPU cores (AMD EPYC), no GPU``), recorded with each of its
             sittings, so a run whose stages ran on several machines says which ran where.
         """
         self.path = Path(path)
@@ -112,7 +112,7 @@ class StageClock:
 
 
 def machines(sittings: list[dict[str, Any]]) -> str:
-    """Where a stage's sittings ran, each machine once in order (``2 CPU cores, no GPU``), with
+    """Where a stage's sittings ran, each machine once in order (``2 CPU cores (AMD EPYC), no GPU``), with
     the sittings from before the clock recorded machines counted apart; ``-`` without sittings."""
     named = list(dict.fromkeys(s["machine"] for s in sittings if s.get("machine")))
     unnamed = sum(1 for s in sittings if not s.get("machine"))
