@@ -38,7 +38,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         choices=list(CONFIGS),
         default="small",
         help="small (43 min measured on 2 CPU cores, default; not comparable with Table 4), "
-        "medium (the paper's grids and 300K A2C steps, hours) or paper-scale (days)",
+        "medium (the paper's grids and 300K A2C steps, hours) or paper-scale (Table 3's 130 scenes "
+        "at 1280x720, over many sittings: --status says where a run stands)",
     )
     parser.add_argument(
         "--sp-scenes", type=arguments.bounded(1, 1000), default=None, help="override the SP scene count"
