@@ -337,8 +337,7 @@ def reproduce(
 def validate_once(group: Path, state: dict[str, Any], stage: str, clock: Any, record: Any) -> bool:
     """Validate ``group`` on the run's ``clock`` unless the last sitting validated the same files
     with the same code (:func:`davis_ag.data.validation_stamp.validation_stamp`): a sound report
-    is reused, so a resumed paper-scale run does not re-read 9 GB of views for half an hour at
-    every sitting.
+    is reused, so a resumed paper-scale run does not re-read 9 GB of views at every sitting.
 
     Returns:
         Whether the data is sound (the problems are printed where it is not).
