@@ -23,11 +23,14 @@ VALIDATOR_PACKAGES = ("data", "formats")
 
 
 def validator_digest() -> bytes:
-    """SHA-256 of the source of :data:`VALIDATOR_PACKAGES`, file by file in name order."""
+    """SHA-256 of the source of :data:`VALIDATOR_PACKAGES` (this module aside), file by file in
+    name order."""
     package = Path(__file__).resolve().parent.parent
     digest = hashlib.sha256()
     for name in VALIDATOR_PACKAGES:
         for source in sorted((package / name).glob("*.py")):
+            if source.name == Path(__file__).name:  # the stamp's own rule decides nothing validation finds
+                continue
             digest.update(f"{name}/{source.name}\0".encode())
             digest.update(source.read_bytes())
     return digest.digest()
