@@ -210,13 +210,13 @@ def test_a_pool_of_processes_reports_what_one_process_does(
 ) -> None:
     """``--workers``: damage in two scenes is reported the same, line for line and in the same
     order, by one process and by a pool (forced on this small dataset)."""
-    from davis_ag.data import validate
+    from davis_ag.data import validate_pool
 
     edit_annotations(dataset / SCENE / "annotations.json", lambda d: d["0002.jpeg"].update(forward="9999.jpeg"))
     mask = next((dataset / "Single-Strawberry" / "001" / "images").glob("*_seg.png"))
     mask.write_bytes(mask.read_bytes()[:40])
     one = run(capsys, str(dataset), "--workers", "1")
-    monkeypatch.setattr(validate, "POOL_FROM_BYTES", 0)
+    monkeypatch.setattr(validate_pool, "POOL_FROM_BYTES", 0)
     pooled = run(capsys, str(dataset), "--workers", "2")
     assert one[0] == pooled[0] == 1
     assert one[1] == pooled[1] and any("cannot decode" in line for line in one[1])

@@ -14,14 +14,10 @@ other scenes get one pixel of slack on each edge unless told otherwise.
 from __future__ import annotations
 
 import json
-import multiprocessing
 import os
-import signal
 import sys
 from collections import Counter
-from collections.abc import Callable, Iterator
-from concurrent.futures import ProcessPoolExecutor
-from contextlib import contextmanager
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -51,6 +47,7 @@ from davis_ag.data.reader import (
     parse_entry,
 )
 from davis_ag.data.safe_read import check_inside
+from davis_ag.data.validate_pool import in_scene_order
 from davis_ag.formats.layout import DATASET_FILE, IMAGES, view_file, view_of_file
 from davis_ag.formats.models import AnnotationEntry, DatasetFile, SplitsFile, one_line
 from davis_ag.errors import UserError
@@ -358,11 +355,6 @@ def _check_counts(dataset: Dataset, counts: dict[str, int]) -> list[Problem]:
     return problems
 
 
-#: A pool of processes pays for its start (about a second each) from this many bytes of
-#: annotations.json on (about 700 views, 20 s of checks in one process at 1280x720).
-POOL_FROM_BYTES = 500_000
-
-
 def validate_dataset(
     path: str | Path,
     quick: bool = False,
@@ -382,7 +374,7 @@ def validate_dataset(
         progress: Show a tqdm bar on stderr (when it is a terminal and there are several scenes).
         workers: Processes checking scenes at once (decoding is the cost; one per core scales
             it), used where the dataset is large enough to repay their start
-            (:data:`POOL_FROM_BYTES`). The report is the same for any number.
+            (:mod:`davis_ag.data.validate_pool`). The report is the same for any number.
 
     Returns:
         The :class:`Report`.
@@ -412,7 +404,8 @@ def validate_dataset(
         file=sys.stderr,
         disable=None if progress and len(scenes) > 1 else True,
     )
-    with _scene_reports(scenes, quick, box_tolerance, workers) as reports:
+    tasks = [(scene.path, scene.group, scene.root, quick, box_tolerance) for scene in scenes]
+    with in_scene_order(_validate_scene_at, tasks, scenes, workers) as reports:
         for scene, part in zip(scenes, reports):
             report.scenes += part.scenes
             report.views += part.views
@@ -428,39 +421,7 @@ def validate_dataset(
     return report
 
 
-@contextmanager
-def _scene_reports(
-    scenes: list[Scene], quick: bool, box_tolerance: int | None, workers: int
-) -> Iterator[Iterator[Report]]:
-    """Each scene's report, in scene order: from a pool of ``workers`` processes where the
-    scenes are many enough, else checked one after the other here."""
-    if workers < 2 or len(scenes) < 2 or _annotation_bytes(scenes) < POOL_FROM_BYTES:
-        yield (validate_scene(scene, quick, box_tolerance) for scene in scenes)
-        return
-    # spawn: the caller may hold threads and GL contexts (reproduce), which fork would copy.
-    context = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(min(workers, len(scenes)), mp_context=context, initializer=_ignore_ctrl_c) as pool:
-        tasks = [(scene.path, scene.group, scene.root, quick, box_tolerance) for scene in scenes]
-        yield pool.map(_validate_scene_at, tasks)
-
-
-def _ignore_ctrl_c() -> None:
-    # Ctrl-C reaches the whole process group: the parent stops the run, a worker would only
-    # print a traceback.
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-
-
 def _validate_scene_at(task: tuple[Path, str, Path | None, bool, int | None]) -> Report:
-    """:func:`validate_scene` in a pool's process: the scene is rebuilt from its folder there."""
+    """:func:`validate_scene` of one scene rebuilt from its folder (in a pool's process, or here)."""
     path, group, root, quick, box_tolerance = task
     return validate_scene(Scene(path, group, root), quick, box_tolerance)
-
-
-def _annotation_bytes(scenes: list[Scene]) -> int:
-    total = 0
-    for scene in scenes:
-        try:
-            total += (scene.path / ANNOTATIONS).stat().st_size
-        except OSError:  # validate_scene reports it
-            pass
-    return total
