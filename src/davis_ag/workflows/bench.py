@@ -34,8 +34,9 @@ import platform
 import statistics
 import tempfile
 import time
+from functools import partial
 from pathlib import Path
-from typing import Callable
+from typing import Any, Callable
 
 from davis_ag.errors import UserError
 from davis_ag.formats.layout import view_name, view_stem
@@ -279,13 +280,14 @@ def run_only(what: str, out: Path, doc: Path | None, devices: tuple[str, ...] = 
     """One measurement alone (``--only continuous``: TVMContinuous-v0's rate, about a minute;
     ``--only training``: the learners' training rates, about 8 minutes, on each of ``devices``):
     JSON, the doc's section and the line another page shows of it."""
-    key, measure, table_of, write = {
+    measurements: dict[str, tuple[str, Any, Any, Any]] = {
         "continuous": ("continuous_env", continuous_env_speed, continuous_table, write_continuous),
-        "training": ("training", training_speed, training_table, write_training),
-    }[what]
+        "training": ("training", partial(training_speed, devices=devices), training_table, write_training),
+    }
+    key, measure, table_of, write = measurements[what]
     start = os.getloadavg()[0]
     with tempfile.TemporaryDirectory(prefix="davis-ag-bench-") as scratch:
-        result = training_speed(Path(scratch), devices=devices) if what == "training" else measure(Path(scratch))
+        result = measure(Path(scratch))
     load = (start, os.getloadavg()[0])
     print(table_of(result, load))
     out.parent.mkdir(parents=True, exist_ok=True)

@@ -108,8 +108,10 @@ def training_speed(scratch: Path, steps: int = STEPS, devices: tuple[str, ...] =
 
 def training_table(result: dict[str, Any], load: tuple[float, float]) -> str:
     """The training rates as Markdown."""
+    from davis_ag.workflows.results_page import machine_summary
+
     devices = result.get("devices", ["cpu"])
-    where = "the CPU" if devices == ["cpu"] else f"each device in turn ({', '.join(devices)}; {_accelerator()})"
+    where = "the CPU" if devices == ["cpu"] else f"each device in turn ({', '.join(devices)}; {machine_summary()})"
     lines = [
         f"The paper's network on {where}, 8 environments, {result['steps']:,} steps of each learner on three "
         f"single-plant strawberry scenes (seed {result['seed']}), one after the other in one process; load "
@@ -123,12 +125,6 @@ def training_table(result: dict[str, Any], load: tuple[float, float]) -> str:
     for row, r in result["learners"].items():
         lines.append(f"| {row} | **{r['steps_per_second']}** | {r['over_reference']:.2f}x | {r['hours_300k']} |")
     return "\n".join(lines)
-
-
-def _accelerator() -> str:
-    import torch
-
-    return torch.cuda.get_device_name(0) if torch.cuda.is_available() else "no GPU"
 
 
 def ppo_line(result: dict[str, Any]) -> str:

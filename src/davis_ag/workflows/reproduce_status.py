@@ -114,6 +114,7 @@ def _generation_left(root: Path, made: list[str], remaining: int) -> float | Non
 
     from davis_ag.formats.layout import SCENE_METADATA
     from davis_ag.generate.run_progress import default_workers
+    from davis_ag.workflows.stage_clock import scene_seconds
 
     if remaining <= 0:
         return None
@@ -124,7 +125,7 @@ def _generation_left(root: Path, made: list[str], remaining: int) -> float | Non
         except (OSError, ValueError):
             continue
         if timing and not timing.get("views_from_an_earlier_run"):  # a resumed scene's time is partial
-            times.append(float(timing.get("grow", 0)) + float(timing.get("draw_and_label", 0)))
+            times.append(scene_seconds(timing))
     return remaining * sum(times) / len(times) / default_workers() if times else None
 
 

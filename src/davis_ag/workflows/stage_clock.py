@@ -121,6 +121,11 @@ def machines(sittings: list[dict[str, Any]]) -> str:
     return "; ".join(named) or "-"
 
 
+def scene_seconds(timing: dict[str, Any]) -> float:
+    """A scene's own time from its ``scene.json`` ``timing_s``: growing, then drawing and labelling."""
+    return float(timing.get("grow", 0.0)) + float(timing.get("draw_and_label", 0.0))
+
+
 def generation_seconds(root: Path, scenes: list[str], clock: StageClock, stage: str) -> tuple[float, str]:
     """A generate stage's wall seconds and note: the clock's sittings, plus the scenes finished
     before the clock first timed this stage (a run begun before the clock existed), from the
@@ -148,9 +153,8 @@ def generation_seconds(root: Path, scenes: list[str], clock: StageClock, stage: 
         except (OSError, ValueError):
             continue
         views += len(metadata.get("views", []))
-        timing = metadata.get("timing_s", {})
         if began is None or path.stat().st_mtime < began:
-            earlier.append(timing.get("grow", 0.0) + timing.get("draw_and_label", 0.0))
+            earlier.append(scene_seconds(metadata.get("timing_s", {})))
     workers = max(1, min(default_workers(), len(scenes)))
     seconds = clock.seconds(stage) + sum(earlier) / workers
     note = f"{len(scenes)} scene(s), {views:,} views; {clock.sittings(stage)} sitting(s) on the clock"
