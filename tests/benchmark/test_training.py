@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -21,8 +22,11 @@ TINY_RUN = dict(n_envs=2, arch="pooled", device="cpu", checkpoint_every=20)
 
 
 def test_a_killed_run_resumes_from_its_checkpoint(
-    tmp_path: Path, one_thread: None, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, one_thread: None, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
+    system_tmp = tmp_path / "system-tmp"
+    system_tmp.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(system_tmp))
     root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2)
     out = tmp_path / "models" / "a2c"
     kwargs = dict(total_timesteps=240, seed=1, out_path=out, n_envs=2, arch="pooled", device="cpu", checkpoint_every=40)
@@ -49,6 +53,7 @@ def test_a_killed_run_resumes_from_its_checkpoint(
     assert record["timesteps"] == 240 and record["seconds"] == pytest.approx(
         sum(s["seconds"] for s in sittings), abs=0.2
     )
+    assert list(system_tmp.glob("SB3-*")) == []  # SB3 leaves no empty /tmp/SB3-<time> folder behind
 
 
 def test_a_checkpoint_of_another_dataset_is_not_resumed(

@@ -4,6 +4,7 @@ brief PPO run and `davis-ag evaluate --env continuous`."""
 from __future__ import annotations
 
 import json
+import tempfile
 from pathlib import Path
 
 import gymnasium
@@ -159,8 +160,15 @@ def test_policies_play_the_same_starts(env: TVMContinuousEnv, tmp_path: Path) ->
 
 
 def test_ppo_trains_briefly_and_plays(
-    live_scene_dir: Path, env: TVMContinuousEnv, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    live_scene_dir: Path,
+    env: TVMContinuousEnv,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
 ) -> None:
+    system_tmp = tmp_path / "system-tmp"
+    system_tmp.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(system_tmp))
     path, records = train_continuous(
         live_scene_dir,
         "sp",
@@ -174,6 +182,7 @@ def test_ppo_trains_briefly_and_plays(
     )
     assert path.suffix == ".zip" and path.is_file()
     assert "PPO: 48/48 steps" in capsys.readouterr().out
+    assert list(system_tmp.glob("SB3-*")) == []  # SB3 leaves no empty /tmp/SB3-<time> folder behind
     assert len(records) >= 48 // env.tau - 1 and all(r["reward"] >= 0 for r in records)
     assert plot_training_curve(records, tmp_path / "curve.png", "PPO", window=4).stat().st_size > 0
     agent = ModelPolicy(path)

@@ -130,3 +130,20 @@ def resolve_sb3_settings(algo: str, settings: str | dict[str, Any]) -> dict[str,
     if wrong:
         raise UserError(f"{algo.upper()} setting {wrong[0]!r} cannot be changed here")
     return {**SB3_SETTINGS[algo], **settings}
+
+
+def console_logger(verbose: int) -> Any:
+    """The logger a model learns with: SB3's table on stdout when ``verbose``, else nothing.
+
+    Set on every model before ``learn``: without one, SB3 makes a fresh empty ``/tmp/SB3-<time>``
+    folder on every ``learn`` call and never removes it (a thousand a day under the test suite).
+
+    Args:
+        verbose: SB3 verbosity; 0 writes nothing.
+
+    Returns:
+        A ``stable_baselines3.common.logger.Logger`` for ``model.set_logger``.
+    """
+    from stable_baselines3.common.logger import Logger, make_output_format
+
+    return Logger(folder=None, output_formats=[make_output_format("stdout", "")] if verbose else [])

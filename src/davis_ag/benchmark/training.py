@@ -28,7 +28,13 @@ from davis_ag.atomic_files import (
     write_or_rescue,
 )
 from davis_ag.benchmark import TVMEnv
-from davis_ag.benchmark.algorithms import ALGORITHMS, resolve_sb3_settings, resolve_settings, sb3_arguments
+from davis_ag.benchmark.algorithms import (
+    ALGORITHMS,
+    console_logger,
+    resolve_sb3_settings,
+    resolve_settings,
+    sb3_arguments,
+)
 from davis_ag.benchmark.checkpoints import check_checkpoint, load_checkpoint
 from davis_ag.benchmark.networks import ARCHITECTURES
 from davis_ag.benchmark.progress import TrainingProgress
@@ -342,6 +348,7 @@ def train_agent(
             **arguments,
         )
         done, earlier, points = 0, [], []
+    model.set_logger(console_logger(verbose))
     sittings = _Sittings(earlier, done)
     curve = LearningCurve(CURVE_EVERY, points)
     selection = None

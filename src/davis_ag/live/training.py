@@ -17,6 +17,7 @@ import gymnasium as gym
 import numpy as np
 
 from davis_ag.atomic_files import prove_writable_file, write_or_rescue
+from davis_ag.benchmark.algorithms import console_logger
 from davis_ag.benchmark.networks import ARCHITECTURES
 from davis_ag.benchmark.training import model_path, save_model
 from davis_ag.errors import UserError
@@ -137,6 +138,7 @@ def train_continuous(
             verbose=verbose,
             policy_kwargs=dict(ARCHITECTURES[arch]),
         )
+        model.set_logger(console_logger(verbose))
         model.learn(
             total_timesteps=total_timesteps,
             callback=_progress_printer(log, total_timesteps, progress_every) if progress_every else None,
