@@ -1,8 +1,11 @@
-"""Which code made an output: the package version and, in a git checkout, the commit."""
+"""Which code, and which machine, made an output: the package version and, in a git checkout, the
+commit; the machine's cores, CPU model and accelerator."""
 
 from __future__ import annotations
 
 import functools
+import os
+import platform
 import subprocess
 from pathlib import Path
 
@@ -39,3 +42,27 @@ def code_version() -> str:
     """``0.1.0`` or ``0.1.0+<commit>[-dirty]``: what to record beside an output."""
     revision = source_revision()
     return f"{__version__}+{revision}" if revision else __version__
+
+
+def machine_description() -> str:
+    """CPU model, core count and accelerator of this machine, with Python's and torch's versions."""
+    import torch
+
+    return f"{machine_summary()}; Python {platform.python_version()}, torch {torch.__version__}, {platform.system()} {platform.release()}"
+
+
+def machine_summary() -> str:
+    """This machine in a few words, for each sitting of a run's clock: cores, CPU model, accelerator
+    (``2 CPU cores (Intel(R) Xeon(R) Processor), no GPU``)."""
+    import torch
+
+    cpu = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    gpu = torch.cuda.get_device_name(0) if torch.cuda.is_available() else "no GPU"
+    return f"{os.cpu_count()} CPU cores ({cpu}), {gpu}"

@@ -142,7 +142,7 @@ def test_a_whole_run_times_every_stage_on_its_clock_and_a_rerun_adds_no_sitting(
 
     from davis_ag.workflows.reproduce import CONFIGS, reproduce
     from davis_ag.workflows.reproduce_status import run_status
-    from davis_ag.workflows.results_page import machine_summary
+    from davis_ag.provenance import machine_summary
     from davis_ag.workflows.stage_clock import CLOCK_FILE, read_clock
 
     config = replace(

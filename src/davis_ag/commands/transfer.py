@@ -90,7 +90,7 @@ def run(args: argparse.Namespace) -> int:
     print(table5_markdown(results))
     print(f"wrote {args.out / 'transfer.json'} ({results['wall_s']['total']:.0f} s)")
     if args.results:
-        from davis_ag.workflows.results_page import machine_description
+        from davis_ag.provenance import machine_description
 
         print(f"wrote {write_results_md(results, args.results, machine_description())}")
     return 0

@@ -108,7 +108,7 @@ def training_speed(scratch: Path, steps: int = STEPS, devices: tuple[str, ...] =
 
 def training_table(result: dict[str, Any], load: tuple[float, float]) -> str:
     """The training rates as Markdown."""
-    from davis_ag.workflows.results_page import machine_summary
+    from davis_ag.provenance import machine_summary
 
     devices = result.get("devices", ["cpu"])
     where = "the CPU" if devices == ["cpu"] else f"each device in turn ({', '.join(devices)}; {machine_summary()})"

@@ -241,9 +241,9 @@ def reproduce(
     from davis_ag.generate.one_scene import SceneRequest
     from davis_ag.scene.camera import Camera
     from davis_ag.scene.specs import crop_spec, scenario_spec
-    from davis_ag.provenance import code_version
+    from davis_ag.provenance import code_version, machine_summary
     from davis_ag.workflows.demo import evaluation_split, generate_scenes, run_baselines
-    from davis_ag.workflows.results_page import machine_summary, write_results_md
+    from davis_ag.workflows.results_page import write_results_md
     from davis_ag.workflows.reproduce_learners import train_learner
     from davis_ag.workflows.stage_clock import CLOCK_FILE, StageClock, generation_seconds
     from davis_ag.workflows.results_policies import model_path
