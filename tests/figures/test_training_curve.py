@@ -47,3 +47,28 @@ def test_a_record_that_kept_its_best_snapshot_draws_the_scores(tmp_path: Path) -
     alone = plot_learning_curve({"sp-strawberry": {"curve": curve}}, tmp_path / "alone", formats=("png",))
     with Image.open(plotted.paths[0]) as two, Image.open(alone.paths[0]) as one:
         assert two.height > 1.4 * one.height  # a second panel under the curve
+
+
+def test_a_trivial_policys_train_score_is_drawn_across_the_snapshots(tmp_path: Path) -> None:
+    """The best fixed action's train-split score crosses the snapshot panel, so a learner below it
+    reads as one that did not learn."""
+    from PIL import Image
+
+    curve = [{"step": 1000 * (k + 1), "episodes": 300, "reward": 0.02, "length": 3.0} for k in range(30)]
+    scores = [{"step": 10_000, "oer_tau": 0.40}, {"step": 20_000, "oer_tau": 0.48}, {"step": 30_000, "oer_tau": 0.44}]
+    record = {"curve": curve, "selection": {"scores": scores, "kept_step": 20_000}, "algorithm": "PPO"}
+    plain = plot_learning_curve({"sp-strawberry": record}, tmp_path / "plain", formats=("png",))
+    marked = plot_learning_curve(
+        {"sp-strawberry": record},
+        tmp_path / "marked",
+        formats=("png",),
+        references={"sp-strawberry: best fixed action (always backward), exact": 0.45},
+    )
+    with Image.open(plain.paths[0]) as a, Image.open(marked.paths[0]) as b:
+        lower_a = np.asarray(a.convert("L"))[a.height // 2 :]
+        lower_b = np.asarray(b.convert("L"))[b.height // 2 :]
+        assert a.size == b.size
+        # A dashed line spans the panel: many more dark pixels in the lower half.
+        assert (lower_b < 100).sum() > (lower_a < 100).sum() + 200
+        upper_a, upper_b = np.asarray(a.convert("L"))[: a.height // 2], np.asarray(b.convert("L"))[: b.height // 2]
+        assert (upper_a == upper_b).all()  # the reward curve is untouched

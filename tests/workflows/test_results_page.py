@@ -153,7 +153,7 @@ def test_how_the_run_was_made_names_the_plants_and_the_a2c_settings(tmp_path: Pa
 def test_the_kept_snapshot_is_set_beside_the_best_fixed_action_on_train(tmp_path: Path) -> None:
     # Issue 22: a learner that beats one move on its own scenes but not on test is told apart from
     # one that learned nothing; the numbers come from the training record and the evaluation's JSON.
-    from davis_ag.workflows.results_policies import train_split_line
+    from davis_ag.workflows.results_policies import train_split_line, train_split_references
 
     (tmp_path / "models").mkdir()
     record = {
@@ -179,6 +179,10 @@ def test_the_kept_snapshot_is_set_beside_the_best_fixed_action_on_train(tmp_path
     # Without the yardstick (an evaluation from before it) or a scored run, no line.
     assert train_split_line("sp", {}, tmp_path) is None
     assert train_split_line("mp", result, tmp_path) is None
+    # The same yardstick is drawn across the learning curve's snapshot panel.
+    assert train_split_references({"sp": result, "mp": {}}) == {
+        "sp-strawberry: best fixed action (always backward), exact": 0.6
+    }
 
 
 def test_the_readme_block_beside_docs_is_rewritten_from_the_run(tmp_path: Path) -> None:

@@ -29,6 +29,7 @@ def plot_learning_curve(
     out: str | Path,
     formats: tuple[str, ...] = FORMATS,
     window: int = ROLLING_POINTS,
+    references: dict[str, float] | None = None,
 ) -> Plotted:
     """Fig. 4a: mean episodic reward per 1K training steps, with a rolling average, per model.
 
@@ -37,6 +38,9 @@ def plot_learning_curve(
         out: Output path without suffix.
         formats: File formats to write.
         window: Points in the rolling average.
+        references: What a trivial policy scores on the train split, drawn across the snapshot
+            panel as dashed lines so a learner below them reads as one that did not learn
+            (e.g. ``{"sp-strawberry: best fixed action (always backward), exact": 0.434}``).
 
     Records that kept their best train-split snapshot (``selection``) get a second panel: each
     snapshot's train-split OER_tau against its step, the kept one ringed.
@@ -57,7 +61,7 @@ def plot_learning_curve(
     selections = {
         label: records[label]["selection"] for label in curves if (records[label].get("selection") or {}).get("scores")
     }
-    figure = new_figure(6.0, 5.6 if selections else 3.6)
+    figure = new_figure(6.0, 6.2 if selections else 3.6)
     axes = figure.add_subplot(2, 1, 1) if selections else figure.add_subplot(1, 1, 1)
     data: dict[str, dict[str, Any]] = {}
     for k, (label, curve) in enumerate(curves.items()):
@@ -70,7 +74,9 @@ def plot_learning_curve(
         data[label] = {"steps": steps.astype(int).tolist(), "reward": reward.tolist(), "smoothed": smoothed.tolist()}
     axes.set_xlabel("training steps (thousands)")
     axes.set_ylabel("episodic reward")
-    axes.set_title(f"A2C learning curve: mean reward per 1K steps (faint), rolling mean of {window} (bold)", fontsize=8)
+    learners = sorted({str(records[label].get("algorithm", "A2C")) for label in curves})
+    name = f"{learners[0]} learning curve" if len(learners) == 1 else "learning curves"
+    axes.set_title(f"{name}: mean reward per 1K steps (faint), rolling mean of {window} (bold)", fontsize=8)
     axes.legend(fontsize=8)
     if selections:
         lower = figure.add_subplot(2, 1, 2, sharex=axes)
@@ -93,9 +99,14 @@ def plot_learning_curve(
                     linestyle="none",
                 )
             data[label].update(scored_steps=steps.astype(int).tolist(), scored_oer_tau=oer.tolist(), kept_step=kept)
+        for k, (text, value) in enumerate((references or {}).items()):
+            lower.axhline(value, color="black", linestyle=("--", ":", "-.")[k % 3], linewidth=1, label=text)
+        played = {(sel.get("episodes", 200), sel.get("play", "sampled")) for sel in selections.values()}
+        how = "{} {} episodes".format(*next(iter(played))) if len(played) == 1 else "each learner's episodes"
         lower.set_xlabel("training steps (thousands)")
         lower.set_ylabel("train-split OER_tau")
-        lower.set_title("each snapshot on the train split (200 sampled episodes); ringed: the one kept", fontsize=8)
-        lower.legend(fontsize=8)
+        lower.set_title(f"each snapshot on the train split ({how}); ringed: the one kept", fontsize=8)
+        # Under the panel: inside it, the legend would hide the snapshots it names.
+        lower.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.28), ncol=2, frameon=False)
     figure.tight_layout()
     return Plotted(save_formats(figure, out, formats), data)

@@ -410,7 +410,7 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
             lines += ["", text + "."]
         lines.append("")
         lines += policy_sections(scenario, result, out, Path(path))
-    lines += learning_curve_section(out, Path(path))
+    lines += learning_curve_section(out, Path(path), state.get("results", {}))
     lines += ["## Notes", ""] + [f"- {note}" for note in _notes(config, state, out)] + [""]
     lines += how_made(state, out)
     lines += [

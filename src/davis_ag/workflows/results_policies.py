@@ -247,8 +247,22 @@ def action_figure(scenario: str, out: Path | None, page: Path) -> str | None:
     return f"![actions per policy and A2C's choices, {GROUPS[scenario]}](images/{target.name}.png)"
 
 
-def learning_curve_section(out: Path | None, page: Path) -> list[str]:
-    """Fig. 4a from the run's training records, drawn into ``images/`` beside the page."""
+def train_split_references(results: dict[str, Any]) -> dict[str, float]:
+    """The best fixed action's exact train-split OER_tau per group, labelled for the learning
+    curve's snapshot panel, from each scenario's evaluation (``result["train_split"]``)."""
+    references = {}
+    for scenario, result in results.items():
+        fixed = (result.get("train_split") or {}).get("fixed_actions")
+        if fixed and scenario in GROUPS:
+            action = best_fixed_action(fixed)
+            references[f"{GROUPS[scenario]}: best fixed action (always {action}), exact"] = fixed[action]["oer_tau"]
+    return references
+
+
+def learning_curve_section(out: Path | None, page: Path, results: dict[str, Any] | None = None) -> list[str]:
+    """Fig. 4a from the run's training records, drawn into ``images/`` beside the page, with the
+    best fixed action's train-split score across the snapshots where ``results`` (the run's
+    evaluations by scenario) hold it."""
     from davis_ag.errors import UserError
     from davis_ag.figures.training_curve import plot_learning_curve
 
@@ -266,7 +280,9 @@ def learning_curve_section(out: Path | None, page: Path) -> list[str]:
         return []
     target = page.parent / "images" / "results-learning-curve"
     try:
-        plotted = plot_learning_curve(records, target, formats=("png",))
+        plotted = plot_learning_curve(
+            records, target, formats=("png",), references=train_split_references(results or {})
+        )
     except UserError:
         return [
             f"## {title}",
@@ -278,7 +294,13 @@ def learning_curve_section(out: Path | None, page: Path) -> list[str]:
         f"## {title}",
         "",
         "Mean episodic reward per 1,000 training steps on the train split (Fig. 4a), read from "
-        "each model's training record:",
+        "each model's training record"
+        + (
+            "; below it, each snapshot's train-split OER_tau against the best fixed action's there "
+            "(dashed), which a learner must pass to have learned more than one move:"
+            if train_split_references(results or {})
+            else ":"
+        ),
         "",
         f"![{title}](images/{target.name}.png)",
         "",
