@@ -38,6 +38,7 @@ from davis_ag.seeds import derived_seed
 from davis_ag.render.egl_context import create_context, egl_current, egl_restore
 from davis_ag.render.projection import camera_matrices, gl_matrix, helios_shadow_box, light_matrix, matmul32
 from davis_ag.render.scene_geometry import SceneGeometry, read_scene_geometry
+from davis_ag.render.silhouettes import DrawnSilhouettes
 from davis_ag.render.textures import decode_srgb, default_sky_texture, load_texture, texture_layers
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.lighting import Lighting
@@ -59,6 +60,17 @@ SHADOW_BIAS = 1e-4
 #: texture coordinates stretch one soil image over a whole 12 m tile (Helios shows its texels as
 #: 2 cm blocks); the default look lays the image at this size instead, with mipmaps.
 GROUND_REPEAT = 0.5
+#: The scene's vertex buffer as moderngl reads it: the format, then the attribute names.
+VERTEX_FORMAT = (
+    "3f 2f 3f 4f 1u 1i 1i",
+    "in_position",
+    "in_uv",
+    "in_normal",
+    "in_colour",
+    "in_id",
+    "in_texture",
+    "in_mode",
+)
 
 
 def linear_albedo(colours: np.ndarray) -> np.ndarray:
@@ -173,17 +185,22 @@ class OpenGLRenderer:
         vertex["texture"] = np.repeat(np.maximum(geometry.texture[order], 0), 3)
         vertex["mode"] = np.repeat(geometry.mode[order], 3)
         self._vbo = ctx.buffer(vertex.tobytes())
-        self._triangle_uuids = geometry.uuids[order]
-        self._silhouette_groups: dict[int, tuple | None] = {}
-        self._positions = np.ascontiguousarray(vertex["position"]).reshape(-1, 3, 3)
-        layout = "3f 2f 3f 4f 1u 1i 1i"
-        names = ["in_position", "in_uv", "in_normal", "in_colour", "in_id", "in_texture", "in_mode"]
-        self._scene = ctx.vertex_array(self._programs["scene"], [(self._vbo, layout, *names)], skip_errors=True)
-        self._ids = ctx.vertex_array(self._programs["ids"], [(self._vbo, layout, *names)], skip_errors=True)
+        self._scene = ctx.vertex_array(self._programs["scene"], [(self._vbo, *VERTEX_FORMAT)], skip_errors=True)
+        self._ids = ctx.vertex_array(self._programs["ids"], [(self._vbo, *VERTEX_FORMAT)], skip_errors=True)
         if "no_depth" in self._programs:
             self._no_depth = ctx.vertex_array(
-                self._programs["no_depth"], [(self._vbo, layout, *names)], skip_errors=True
+                self._programs["no_depth"], [(self._vbo, *VERTEX_FORMAT)], skip_errors=True
             )
+        self._silhouettes = DrawnSilhouettes(
+            ctx,
+            self._programs["ids"],
+            self._vbo,
+            VERTEX_FORMAT,
+            geometry.uuids[order],
+            np.ascontiguousarray(vertex["position"]).reshape(-1, 3, 3),
+            self.camera,
+            self._prepare_view,
+        )
         shadow_layout = "3f 2f 12x 16x 4x 1i 1i"
         self._shadow = ctx.vertex_array(
             self._programs["shadow"],
@@ -338,14 +355,18 @@ class OpenGLRenderer:
             gl_matrix(np.linalg.inv(projection.astype(np.float64) @ rotation)),
         )
 
+    def _prepare_view(self, view: Viewpoint) -> None:
+        """Set the programs' uniforms for ``view`` and bind the textures."""
+        self._view_uniforms(view)
+        self._bind_textures()
+
     def draw(self, view: Viewpoint, depth: bool = True) -> None:
         """Draw a view into the renderer's buffers (read them with :meth:`read`); without
         ``depth``, antialiasing ``none`` leaves the depth image out (FXAA needs it)."""
         import moderngl
 
         ctx = self.ctx
-        self._view_uniforms(view)
-        self._bind_textures()
+        self._prepare_view(view)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<="
         ctx.polygon_offset = (1.0, 1.0)
@@ -408,97 +429,20 @@ class OpenGLRenderer:
 
     def silhouette_pixels(self, view: Viewpoint, key: int, uuids: np.ndarray) -> int:
         """Pixels whose centre some primitive of ``uuids`` covers with nothing else drawn: the area
-        an object (a fruit) would have in the view if nothing hid it. One 1x raster of only its
-        triangles, the same rule the id image follows, cleared, drawn and read back inside the
-        rectangle its vertices project to (a whole-frame clear and read-back cost ten times the
-        raster of a small fruit).
+        an object (a fruit) would have in the view if nothing hid it
+        (:meth:`davis_ag.render.silhouettes.DrawnSilhouettes.pixels`).
 
         Args:
             view: The pose.
             key: A name for the group (a fruit id): its triangles are looked up once per renderer.
             uuids: The group's primitive UUIDs.
         """
-        import moderngl
-
         previous = egl_current()
         try:
             with self.ctx:
-                group = self._silhouette_groups.get(key)
-                if group is None:
-                    group = self._silhouette_group(uuids)
-                    self._silhouette_groups[key] = group
-                if group is None:
-                    return 0
-                vao, corners = group
-                rect = self._screen_rect(view, corners)
-                if rect is None:
-                    return 0
-                if not hasattr(self, "_silhouette_fbo"):
-                    size = (self.camera.width, self.camera.height)
-                    self._silhouette_fbo = self.ctx.framebuffer([self.ctx.renderbuffer(size, 1, dtype="u4")])
-                self._view_uniforms(view)
-                self._bind_textures()
-                fbo = self._silhouette_fbo
-                fbo.scissor = rect
-                fbo.use()
-                fbo.clear(0.0, 0.0, 0.0, 0.0, viewport=rect)
-                self.ctx.disable(moderngl.DEPTH_TEST)
-                vao.render(moderngl.TRIANGLES)
-                self.ctx.enable(moderngl.DEPTH_TEST)
-                ids = np.frombuffer(fbo.read(viewport=rect, components=1, dtype="u4"), dtype=np.uint32)
-                fbo.scissor = None
-                return int(np.count_nonzero(ids))
+                return self._silhouettes.pixels(view, key, uuids)
         finally:
             egl_restore(previous)
-
-    def _silhouette_group(self, uuids: np.ndarray) -> tuple | None:
-        """A vertex array of the triangles of ``uuids`` and their corners, or None if none is drawn."""
-        triangles = np.nonzero(np.isin(self._triangle_uuids, np.asarray(uuids, dtype=np.uint32)))[0]
-        if not len(triangles):
-            return None
-        indices = (triangles[:, None] * 3 + np.arange(3)).astype(np.uint32)
-        vao = self.ctx.vertex_array(
-            self._programs["ids"],
-            [
-                (
-                    self._vbo,
-                    "3f 2f 3f 4f 1u 1i 1i",
-                    "in_position",
-                    "in_uv",
-                    "in_normal",
-                    "in_colour",
-                    "in_id",
-                    "in_texture",
-                    "in_mode",
-                )
-            ],
-            index_buffer=self.ctx.buffer(indices.tobytes()),
-            index_element_size=4,
-            skip_errors=True,
-        )
-        # The eight corners of the triangles' bounding box: their projection bounds the fruit's.
-        points = self._positions[triangles].reshape(-1, 3)
-        lo, hi = points.min(axis=0).astype(np.float64), points.max(axis=0).astype(np.float64)
-        corners = np.array([[x, y, z, 1.0] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
-        return vao, corners
-
-    def _screen_rect(self, view: Viewpoint, corners: np.ndarray) -> tuple[int, int, int, int] | None:
-        """The framebuffer rectangle (x, y, width, height; y up) that holds every pixel centre a
-        shape inside the box of ``corners`` can cover; the whole frame where a corner lies behind
-        the eye (the near plane clips there); None where it misses the frame."""
-        width, height = self.camera.width, self.camera.height
-        view_matrix, projection = camera_matrices(self.camera, view)
-        clip = corners @ (projection.astype(np.float64) @ view_matrix.astype(np.float64)).T
-        if (clip[:, 3] <= 1e-6).any():
-            return (0, 0, width, height)
-        x = (clip[:, 0] / clip[:, 3] * 0.5 + 0.5) * width
-        y = (clip[:, 1] / clip[:, 3] * 0.5 + 0.5) * height
-        # One pixel of margin on each side absorbs the float32 rounding of the GPU's transform.
-        x0, x1 = max(int(np.floor(x.min())) - 1, 0), min(int(np.ceil(x.max())) + 1, width)
-        y0, y1 = max(int(np.floor(y.min())) - 1, 0), min(int(np.ceil(y.max())) + 1, height)
-        if x0 >= x1 or y0 >= y1:
-            return None
-        return (x0, y0, x1 - x0, y1 - y0)
 
     def close(self) -> None:
         """Release the GL context and everything in it."""

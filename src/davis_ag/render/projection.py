@@ -130,3 +130,35 @@ def helios_shadow_box(camera: Camera, eye: np.ndarray, target: np.ndarray, sun) 
 def gl_matrix(matrix: np.ndarray) -> bytes:
     """A matrix as GLSL reads it (column-major float32)."""
     return np.asarray(matrix, dtype=np.float32).T.tobytes()
+
+
+def box_corners(points: np.ndarray) -> np.ndarray:
+    """The eight corners of the axis-aligned box around ``points`` (N, 3), homogeneous (8, 4)."""
+    points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    return np.array([[x, y, z, 1.0] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+
+
+def screen_rect(camera: Camera, view: Viewpoint, corners: np.ndarray) -> tuple[int, int, int, int] | None:
+    """The framebuffer rectangle (x, y, width, height; y up, as OpenGL's) that holds every pixel
+    centre a shape inside the box of ``corners`` can cover; the whole frame where a corner lies
+    behind the eye (the near plane clips there); None where the box misses the frame.
+
+    Args:
+        camera: Image size and field of view.
+        view: The pose.
+        corners: Homogeneous corners (8, 4), e.g. from :func:`box_corners`.
+    """
+    width, height = camera.width, camera.height
+    view_matrix, projection = camera_matrices(camera, view)
+    clip = corners @ (projection.astype(np.float64) @ view_matrix.astype(np.float64)).T
+    if (clip[:, 3] <= 1e-6).any():
+        return (0, 0, width, height)
+    x = (clip[:, 0] / clip[:, 3] * 0.5 + 0.5) * width
+    y = (clip[:, 1] / clip[:, 3] * 0.5 + 0.5) * height
+    # One pixel of margin on each side absorbs the float32 rounding of the GPU's transform.
+    x0, x1 = max(int(np.floor(x.min())) - 1, 0), min(int(np.ceil(x.max())) + 1, width)
+    y0, y1 = max(int(np.floor(y.min())) - 1, 0), min(int(np.ceil(y.max())) + 1, height)
+    if x0 >= x1 or y0 >= y1:
+        return None
+    return (x0, y0, x1 - x0, y1 - y0)
