@@ -19,7 +19,8 @@ from davis_ag.benchmark.policies import ModelPolicy
 from davis_ag.live.policies import Greedy, RandomAxes, build_policies
 from davis_ag.figures.result_charts import plot_training_curve
 from davis_ag.live.training import train_continuous
-from davis_ag.live.tvm_continuous import TVMContinuousEnv, steps_per_second
+from davis_ag.live.tvm_continuous import TVMContinuousEnv
+from davis_ag.workflows.bench import steps_per_second
 from davis_ag.scene.specs import SLIP_SIGMA
 
 

@@ -38,6 +38,8 @@ from functools import partial
 from pathlib import Path
 from typing import Any, Callable
 
+import numpy as np
+
 from davis_ag.errors import UserError
 from davis_ag.formats.layout import view_name, view_stem
 from davis_ag.generate.one_scene import SceneRequest, draw_scene, grow_scene
@@ -238,12 +240,56 @@ def continuous_scene(root: Path) -> Path:
     return scene_dir
 
 
+def steps_per_second(env: Any, n: int = 500, seed: int = 0) -> dict[str, float]:
+    """Measure environment steps per second with uniformly random actions, resets included (as in
+    training); actions are drawn before the clock starts.
+
+    Args:
+        env: A TVMContinuous-v0 environment (wrapped or not).
+        n: Steps to time.
+        seed: Seeds the first reset and the action draw.
+
+    Returns:
+        ``steps_per_second`` (wall clock), ``cpu_ms_per_step`` (CPU time of every thread of the
+        process, so less sensitive to other jobs on the machine), ``steps``, ``resets``,
+        ``refused`` (share of refused moves), ``draws_per_step`` (views drawn per timed step,
+        resets' included) and ``draws_per_reset`` (the random start's tries that were drawn).
+    """
+    actions = np.random.default_rng(seed).uniform(-1, 1, size=(n, env.action_space.shape[0])).astype(np.float32)
+    env.reset(seed=seed)
+    counted = env.unwrapped
+    resets = refused = reset_draws = 0
+    first_draw = counted.draws
+    cpu = os.times()
+    start = time.perf_counter()
+    for action in actions:
+        _, _, terminated, truncated, info = env.step(action)
+        refused += bool(info["refused"])
+        if terminated or truncated:
+            before = counted.draws
+            env.reset()
+            reset_draws += counted.draws - before
+            resets += 1
+    seconds = time.perf_counter() - start
+    used = os.times()
+    cpu_s = (used.user - cpu.user) + (used.system - cpu.system)  # every thread, Mesa's included
+    return {
+        "steps_per_second": n / seconds,
+        "cpu_ms_per_step": 1000 * cpu_s / n,
+        "steps": n,
+        "resets": resets,
+        "refused": refused / n,
+        "draws_per_step": (counted.draws - first_draw) / n,
+        "draws_per_reset": reset_draws / max(resets, 1),
+    }
+
+
 def continuous_env_speed(scratch: Path, steps: int = 600) -> dict:
     """Steps per second of TVMContinuous-v0 at 224x224 on a single-plant strawberry scene (the
     crop's full grid area; one view drawn, the geometry cached from the growth, so nothing
     regrows), random actions, resets included; and the time one 224x224 render takes."""
     from davis_ag.live.scene import merge_ground
-    from davis_ag.live.tvm_continuous import TVMContinuousEnv, steps_per_second
+    from davis_ag.live.tvm_continuous import TVMContinuousEnv
 
     scene_dir = continuous_scene(scratch)
     started = time.perf_counter()
