@@ -29,7 +29,9 @@ def test_a_killed_run_resumes_from_its_checkpoint(
     monkeypatch.setattr(tempfile, "tempdir", str(system_tmp))
     root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2)
     out = tmp_path / "models" / "a2c"
-    kwargs = dict(total_timesteps=240, seed=1, out_path=out, n_envs=2, arch="pooled", device="cpu", checkpoint_every=40)
+    kwargs = dict(
+        total_timesteps=240, seed=1, out_path=out, n_envs=2, arch="pooled", device="cpu", checkpoint_every=40, verbose=1
+    )
     with pytest.raises(KeyboardInterrupt):
         train_a2c(root, "sp", callback=KillAfter(130), **kwargs)
     model_file, settings_file = checkpoint_paths(out)

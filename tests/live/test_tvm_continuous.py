@@ -180,9 +180,11 @@ def test_ppo_trains_briefly_and_plays(
         n_steps=24,
         batch_size=12,
         progress_every=24,
+        verbose=1,
     )
     assert path.suffix == ".zip" and path.is_file()
-    assert "PPO: 48/48 steps" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert "PPO: 48/48 steps" in printed and "| rollout/" in printed  # SB3's table, as --verbose 1 asks
     assert list(system_tmp.glob("SB3-*")) == []  # SB3 leaves no empty /tmp/SB3-<time> folder behind
     assert len(records) >= 48 // env.tau - 1 and all(r["reward"] >= 0 for r in records)
     assert plot_training_curve(records, tmp_path / "curve.png", "PPO", window=4).stat().st_size > 0

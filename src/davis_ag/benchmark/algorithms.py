@@ -144,6 +144,8 @@ def console_logger(verbose: int) -> Any:
     Returns:
         A ``stable_baselines3.common.logger.Logger`` for ``model.set_logger``.
     """
-    from stable_baselines3.common.logger import Logger, make_output_format
+    import sys
 
-    return Logger(folder=None, output_formats=[make_output_format("stdout", "")] if verbose else [])
+    from stable_baselines3.common.logger import HumanOutputFormat, Logger
+
+    return Logger(folder=None, output_formats=[HumanOutputFormat(sys.stdout)] if verbose else [])
