@@ -14,7 +14,8 @@ from dataclasses import replace
 
 from davis_ag.commands import arguments
 from davis_ag.errors import UserError
-from davis_ag.workflows.reproduce import CONFIGS, SCENARIO_CROPS, load_state, reproduce
+from davis_ag.workflows.reproduce import CONFIGS, load_state, reproduce
+from davis_ag.workflows.run_groups import SCENARIO_CROPS
 from davis_ag.workflows.reproduce_status import format_status, run_config
 from davis_ag.workflows.results_page import write_results_md
 

@@ -18,6 +18,7 @@ from typing import Any
 
 from davis_ag.atomic_files import write_json_atomic
 from davis_ag.scene.specs import PAPER_IMAGE_SIZE, PAPER_TABLE3
+from davis_ag.workflows.run_groups import SCENARIO_CROPS, group_key
 
 
 @dataclass(frozen=True)
@@ -129,10 +130,6 @@ def configurations_table() -> str:
             f"| {verdict} |"
         )
     return "\n".join(rows)
-
-
-#: The scenario and crop pairs of Table 4.
-SCENARIO_CROPS: tuple[tuple[str, str], ...] = (("sp", "strawberry"), ("mp", "vine"))
 
 
 def load_state(path: Path) -> dict[str, Any]:
@@ -276,7 +273,7 @@ def reproduce(
         if scenario_name == "mp" and config.mp_extent:
             scenario = replace(scenario, extent=tuple(config.mp_extent))
         n = config.sp_scenes if scenario_name == "sp" else config.mp_scenes
-        key = f"{scenario_name}-{crop_name}"
+        key = group_key(scenario_name, crop_name)
         requests = [SceneRequest(scenario, crop, i, config.seed, camera) for i in range(n)]
         state.setdefault("scene_folders", {})[key] = [r.folder for r in requests]
         print(f"== {key}: {n} scene(s) at {config.size[0]}x{config.size[1]}", flush=True)

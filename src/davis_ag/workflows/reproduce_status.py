@@ -14,7 +14,8 @@ from pathlib import Path
 from typing import Any
 
 from davis_ag.errors import UserError
-from davis_ag.workflows.reproduce import SCENARIO_CROPS, ReproduceConfig, load_state
+from davis_ag.workflows.reproduce import ReproduceConfig, load_state
+from davis_ag.workflows.run_groups import SCENARIO_CROPS, group_key
 
 
 @dataclass(frozen=True)
@@ -83,7 +84,7 @@ def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
     made = set(complete_scenes(out / "dataset"))
     stages: list[StageStatus] = []
     for scenario, crop in SCENARIO_CROPS:
-        key = f"{scenario}-{crop}"
+        key = group_key(scenario, crop)
         wanted = config.sp_scenes if scenario == "sp" else config.mp_scenes
         folders = state.get("scene_folders", {}).get(key, [])
         count = sum(folder in made for folder in folders)

@@ -25,7 +25,8 @@ from davis_ag.workflows.results_policies import (
     signed,
     training_record,
 )
-from davis_ag.workflows.results_provenance import GROUPS, how_made, stage_rows
+from davis_ag.workflows.run_groups import GROUPS
+from davis_ag.workflows.results_provenance import how_made, stage_rows
 
 #: Table 4 of the paper: scenario -> metric -> policy -> value.
 PAPER_TABLE4: dict[str, dict[str, dict[str, float]]] = {

@@ -17,12 +17,12 @@ from typing import Any
 
 from davis_ag.benchmark.exact import BEST_FIXED, best_fixed_action
 from davis_ag.benchmark.paired import CONFIDENCE, RESAMPLES, paired_key
+from davis_ag.workflows.run_groups import GROUPS
 
 #: The learners a run may train, as their rows are named (the paper's A2C first).
 LEARNERS = ("A2C", "PPO")
 #: Row order of the policies on the page.
 POLICY_ORDER = ("A2C", "A2C (deterministic)", "PPO", "LRD", "UDD", "Rand", BEST_FIXED, "Oracle")
-GROUPS = {"sp": "sp-strawberry", "mp": "mp-vine"}
 #: What each learner trains with besides the settings its record names (the SB3 defaults).
 SB3_DEFAULTS_TEXT = {
     "A2C": "learning rate 7e-4, n_steps 5, gamma .99, vf_coef .5, max_grad_norm .5, RMSprop",

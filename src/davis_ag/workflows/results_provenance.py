@@ -11,10 +11,8 @@ from typing import Any
 
 from davis_ag.formats.layout import SCENE_METADATA
 from davis_ag.formats.scene_file import CameraRecord, RendererRecord, read_scene_file_or_empty
+from davis_ag.workflows.run_groups import GROUPS
 from davis_ag.workflows.results_policies import LEARNERS, training_record
-
-#: The run's scene groups by scenario.
-GROUPS = {"sp": "sp-strawberry", "mp": "mp-vine"}
 
 
 def _counted(counter: Counter) -> str:

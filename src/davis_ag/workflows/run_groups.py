@@ -1,0 +1,16 @@
+"""The scenario and crop of each part of a ``davis-ag reproduce`` run, and the name each part goes
+by: in the stages, ``state.json``, the models, the results files and the results page."""
+
+from __future__ import annotations
+
+#: Table 4's two benchmarks: single-plant strawberry and multi-plant vine.
+SCENARIO_CROPS: tuple[tuple[str, str], ...] = (("sp", "strawberry"), ("mp", "vine"))
+
+
+def group_key(scenario: str, crop: str) -> str:
+    """The name of a scenario's scenes and all made from them (``sp-strawberry``)."""
+    return f"{scenario}-{crop}"
+
+
+#: The run's group of each scenario (``{"sp": "sp-strawberry", "mp": "mp-vine"}``).
+GROUPS: dict[str, str] = {scenario: group_key(scenario, crop) for scenario, crop in SCENARIO_CROPS}
