@@ -40,6 +40,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from davis_ag.benchmark.cache import OBS_SIZE
 from davis_ag.errors import UserError
 from davis_ag.formats.layout import view_name, view_stem
 from davis_ag.generate.one_scene import SceneRequest, draw_scene, grow_scene
@@ -298,10 +299,12 @@ def continuous_env_speed(scratch: Path, steps: int = 600) -> dict:
     setup_s = time.perf_counter() - started
     try:
         view = env.scene.aimed_pose(1.0, -1.0, 0.4)
-        env.scene.render(view, 224, 224, antialiasing="none", fractions=False, fast_ground=True, depth=False)
+        env.scene.render(view, OBS_SIZE, OBS_SIZE, antialiasing="none", fractions=False, fast_ground=True, depth=False)
         begun = time.perf_counter()
         for _ in range(50):  # as the environment draws
-            env.scene.render(view, 224, 224, antialiasing="none", fractions=False, fast_ground=True, depth=False)
+            env.scene.render(
+                view, OBS_SIZE, OBS_SIZE, antialiasing="none", fractions=False, fast_ground=True, depth=False
+            )
         render_ms = (time.perf_counter() - begun) / 50 * 1000
         rate = steps_per_second(env, steps, seed=SEED)
     finally:

@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from davis_ag.atomic_files import write_json_atomic
+from davis_ag.benchmark.cache import OBS_SIZE
 from davis_ag.scene.specs import PAPER_IMAGE_SIZE, PAPER_TABLE3
 from davis_ag.workflows.run_groups import SCENARIO_CROPS, group_key
 
@@ -86,7 +87,7 @@ CONFIGS: dict[str, ReproduceConfig] = {
 #: own mean is used instead.
 BYTES_PER_VIEW_720P = 0.46e6
 #: Bytes one view takes in the observation cache (224 x 224 x 4 uint8, :mod:`davis_ag.benchmark.cache`).
-CACHE_BYTES_PER_VIEW = 224 * 224 * 4
+CACHE_BYTES_PER_VIEW = OBS_SIZE * OBS_SIZE * 4
 #: Room left free beyond the estimate, for models, results and the estimate's error.
 DISK_MARGIN = 1.1
 
