@@ -105,3 +105,21 @@ def test_a_reader_that_goes_away_stops_the_output_without_an_error(tmp_path: Pat
     )
     os.close(write)
     assert (done.returncode, done.stderr) == (141, "")
+
+
+def test_a_learner_not_started_is_timed_at_its_rate_on_the_other_group(tmp_path: Path) -> None:
+    """Once SP's A2C has trained, MP's is timed at its rate; what has no rate yet is named, not guessed."""
+    from davis_ag.workflows.reproduce_status import format_status
+
+    out = a_run_part_way(tmp_path)
+    record = {"timesteps": 30_000, "seconds": 600.0, "steps_per_second": 50.0}
+    (out / "models" / "a2c_sp-strawberry.training.json").write_text(json.dumps(record))
+    by_name = {s.stage: s for s in run_status(out)[1]}
+    mp_a2c = by_name["mp-vine: train A2C"]
+    assert mp_a2c.progress == "not started; timed at sp-strawberry's 50.0 steps/s"
+    assert mp_a2c.left_s == pytest.approx(CONFIG.mp_timesteps / 50.0)
+    assert by_name["mp-vine: train PPO"].left_s is None  # SP's PPO has no record yet
+    last = format_status(out).splitlines()[-1]
+    timed = by_name["sp-strawberry: generate"].left_s + 400.0 + CONFIG.mp_timesteps / 50.0
+    assert last.startswith(f"About {timed / 3600:.1f} hours left in the stages timed above, and ")
+    assert "mp-vine: generate" in last and "mp-vine: train PPO" in last and "train A2C" not in last

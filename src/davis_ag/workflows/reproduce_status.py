@@ -2,9 +2,10 @@
 
 A ``paper-scale`` run takes many sittings; its log says what the last one did. The status says
 what each stage of the whole run has done (scenes made, steps trained, evaluations written), how
-long it has worked on the stage's clock, and, for a stage under way, about how long is left (a
+long it has worked on the stage's clock, and about how long is left: for a stage under way (a
 learner at the rate of its last sitting, a generate stage at the mean time of its scenes so
-far). Reading it while the run goes on is safe: every file it reads is written atomically.
+far), and for a learner not started, at the rate the same learner trained at on the run's other
+group; the stages with no rate yet are named, not guessed. Reading it while the run goes on is safe: every file it reads is written atomically.
 """
 
 from __future__ import annotations
@@ -101,6 +102,8 @@ def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
         for algo in config.learners:
             stage = f"{key}: train {algo.upper()}"
             stages.append(_training_status(out, key, algo, timesteps, stage, seconds(stage)))
+            if stages[-1].progress == "not started":
+                stages[-1] = _estimated_from_elsewhere(out, key, algo, timesteps, stages[-1])
         stage = f"{key}: evaluate"
         written = (out / "results" / f"{key}.json").is_file()
         progress = f"{config.sessions} x {config.episodes} episodes written" if written else "not started"
@@ -153,6 +156,22 @@ def _training_status(out: Path, key: str, algo: str, timesteps: int, stage: str,
     return StageStatus(stage, False, progress + _best(record.get("selection")), seconds, left)
 
 
+def _estimated_from_elsewhere(out: Path, key: str, algo: str, timesteps: int, status: StageStatus) -> StageStatus:
+    """A learner not started, timed at the rate the same learner trained at on another group of
+    the run (the same network and observations; the scenes differ), where one has finished."""
+    from dataclasses import replace
+
+    from davis_ag.workflows.results_policies import training_record
+
+    for other in (group_key(s, c) for s, c in SCENARIO_CROPS):
+        rate = training_record(out, other, algo).get("steps_per_second") if other != key else None
+        if rate:
+            return replace(
+                status, progress=f"not started; timed at {other}'s {rate:.1f} steps/s", left_s=timesteps / rate
+            )
+    return status
+
+
 def _best(scores: Any) -> str:
     """``; best train-split OER_tau .459 at 90,000 steps`` from a run's snapshot scores, or ``""``."""
     if not isinstance(scores, list) or not scores:
@@ -175,4 +194,11 @@ def format_status(out: Path) -> str:
         hours = f"{s.seconds / 3600:.2f}" if s.seconds is not None else "-"
         left = f"{s.left_s / 3600:.1f}" if s.left_s is not None else "-"
         lines.append(f"| {s.stage} | {'yes' if s.done else 'no'} | {s.progress} | {hours} | {left} |")
+    timed = [s for s in stages if not s.done and s.left_s is not None]
+    untimed = [s.stage for s in stages if not s.done and s.left_s is None]
+    if timed or untimed:
+        lines += ["", f"About {sum(s.left_s or 0.0 for s in timed) / 3600:.1f} hours left in the stages timed above"]
+        if untimed:
+            lines[-1] += f", and {len(untimed)} not timed yet (no rate measured for them): {', '.join(untimed)}"
+        lines[-1] += "."
     return "\n".join(lines)
