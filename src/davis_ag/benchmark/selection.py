@@ -1,6 +1,6 @@
 """Which snapshot a training run keeps: the last one, or the best one on the train split.
 
-Why: A2C with SB3's learning rate (7e-4, RMSprop) on the paper's 72M-parameter network moves a
+Why: A2C with SB3's learning rate (7e-4, RMSprop) on the paper's 36M-parameter network moves a
 long way in a few updates. On SP strawberry (2026-11-24 ``medium`` run) the 300K-step snapshot put
 probability .998 on "backward" at every train start, while the episodes of the last rollouts
 earned .05-.06 reward and, trained on from that snapshot, the policy was varied again within ten

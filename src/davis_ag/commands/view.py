@@ -1,6 +1,6 @@
 """``davis-ag view DIR``: a local web page to drive through a scene with the keyboard, using the
-paper's actions (arrows or W/S/A/D, R/F up and down, Q/E rotate), boxes, masks and depth toggled
-with B, M and Z, the current position shown on the map (click it to jump).
+paper's actions (arrows or W/S/A/D, R/F up and down, Q/E rotate), boxes, masks, depth and organ
+classes toggled with B, M, Z and O, the current position shown on the map (click it to jump).
 
 The server listens on 127.0.0.1 only and serves nothing outside the dataset's scene folders.
 Stop it with Ctrl-C.
