@@ -188,3 +188,62 @@ def test_a_claim_refuses_before_creating_anything(data: Path, tmp_path: Path) ->
             pass
     assert (tmp_path / "old.json").read_text() == "mine"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["DATA", "old.json"]
+
+
+def test_every_command_that_writes_keeps_the_rule(
+    data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """stats, plot, compare, reproduce and transfer wrote over splits.json, a scene's
+    annotations.json, their own inputs or a run's state.json without a word."""
+    before = digest(data)
+    splits, annotations = data / "splits.json", data / "Single-Strawberry" / "000" / "annotations.json"
+    for argv, flag, target in [
+        (["stats", "--no-oer", str(data), "--out", str(splits)], "--out", splits),
+        (["stats", "--no-oer", str(data), "--out", str(annotations)], "--out", annotations),
+        (["plot", "visibility", str(data), "--out", str(data / "splits")], "--out", data / "splits.png"),
+        (
+            ["transfer", "--real", str(tmp_path / "r.yaml"), "--pretrain", str(data), "--out", str(data / "tf")],
+            "--out",
+            data / "tf",
+        ),
+    ]:
+        line = one_line(capsys, *argv)
+        assert f"{flag} {target} lies in" in line and "only davis-ag generate writes there" in line, line
+    assert digest(data) == before
+
+    stats = tmp_path / "stats.json"
+    assert run(capsys, "stats", "--no-oer", str(data), "--out", str(stats))[0] == 0
+    assert "--out" in one_line(capsys, "stats", "--no-oer", str(data), "--out", str(stats))
+    assert run(capsys, "stats", "--no-oer", str(data), "--out", str(stats), "--force")[0] == 0
+
+    results = tmp_path / "r.json"
+    evaluate = ["evaluate", "--dataset", str(data), "--scenario", "sp", "--episodes", "2", "--sessions", "1"]
+    assert run(capsys, *evaluate, "--policies", "LRD", "--out", str(results))[0] == 0
+    kept = results.read_bytes()
+    assert "is one of the results files compared" in one_line(capsys, "compare", str(results), "--out", str(results))
+    page = tmp_path / "board.md"
+    assert run(capsys, "compare", str(results), "--out", str(page))[0] == 0
+    assert "already exists: give --force" in one_line(capsys, "compare", str(results), "--out", str(page))
+    assert results.read_bytes() == kept
+
+    run_dir = tmp_path / "run"
+    run_dir.mkdir()
+    (run_dir / "state.json").write_text('{"config": {}}')
+    line = one_line(
+        capsys, "reproduce", "--out", str(run_dir), "--rewrite-results", "--results", str(run_dir / "state.json")
+    )
+    assert "would replace the run's own records" in line and (run_dir / "state.json").read_text() == '{"config": {}}'
+    line = one_line(capsys, "reproduce", "--out", str(run_dir), "--results", str(splits))
+    assert "--results" in line and "only davis-ag generate writes there" in line
+
+
+@pytest.mark.parametrize("text", ["[1, 2]", "{not json", '{"config": "small"}', '{"config": {"a": 1}}'])
+def test_a_damaged_state_file_is_named_not_taken_for_no_run(
+    text: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A run that read a damaged state.json as "no run yet" would start its records afresh over it."""
+    (tmp_path / "state.json").write_text(text)
+    for extra in (["--status"], ["--rewrite-results", "--results", str(tmp_path.parent / "page.md")]):
+        line = one_line(capsys, "reproduce", "--out", str(tmp_path), *extra)
+        assert f"{tmp_path / 'state.json'}:" in line and ("damaged" in line or "not a reproduce state" in line), line
+    assert (tmp_path / "state.json").read_text() == text

@@ -28,17 +28,23 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="PAGE.md",
         help="also write the leaderboard as a Markdown page",
     )
+    parser.add_argument("--force", action="store_true", help="replace an existing --out")
 
 
 def run(args: argparse.Namespace) -> int:
     """Rank, print and write the page."""
+    from contextlib import nullcontext
+
     from davis_ag.atomic_files import write_text_atomic
     from davis_ag.benchmark.leaderboard import format_leaderboard, leaderboard
+    from davis_ag.errors import UserError
+    from davis_ag.formats.outputs import claim_output
 
-    if args.out:
-        arguments.prove_writable_file(args.out)
-    page = format_leaderboard(leaderboard(args.results))
-    print(page, end="")
-    if args.out:
-        print(f"wrote {write_text_atomic(args.out, page)}")
+    if args.out and args.out.absolute() in {p.absolute() for p in args.results}:
+        raise UserError(f"--out {args.out} is one of the results files compared: choose another path for the page")
+    with claim_output(args.out, force=args.force) if args.out else nullcontext():  # the output rule
+        page = format_leaderboard(leaderboard(args.results))
+        print(page, end="")
+        if args.out:
+            print(f"wrote {write_text_atomic(args.out, page)}")
     return 0

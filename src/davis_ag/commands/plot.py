@@ -59,6 +59,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="output path without suffix: PATH.png, PATH.svg, PATH.json",
     )
     parser.add_argument("--formats", default="png,svg", help="figure formats (default png,svg)")
+    parser.add_argument("--force", action="store_true", help="replace existing figure and numbers files")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -69,8 +70,21 @@ def run(args: argparse.Namespace) -> int:
     bad = [f for f in formats if f not in ("png", "svg", "pdf")]
     if bad or not formats:
         raise UserError(f"--formats {args.formats!r}: choose from png, svg, pdf (comma-separated)")
+    from davis_ag.formats.outputs import claim_output
+
     actions = [a.strip() for a in args.actions.split(",") if a.strip()]
-    plotted = make_plot(
+    base = args.out.with_suffix("") if args.out.suffix.lower().lstrip(".") in ("png", "svg", "pdf") else args.out
+    files = [base.with_name(f"{base.name}.{suffix}") for suffix in (*formats, "json")]
+    with claim_output(files[0], force=args.force, also=[(f, "--out") for f in files[1:]]):  # the output rule
+        plotted = _draw(args, formats, actions)
+    for path in plotted.paths:
+        print(f"wrote {path}")
+    return 0
+
+
+def _draw(args: argparse.Namespace, formats: tuple[str, ...], actions: list[str]):
+    """The figure the arguments ask for."""
+    return make_plot(
         PlotRequest(
             args.kind,
             args.out,
@@ -85,6 +99,3 @@ def run(args: argparse.Namespace) -> int:
             formats=formats,
         )
     )
-    for path in plotted.paths:
-        print(f"wrote {path}")
-    return 0

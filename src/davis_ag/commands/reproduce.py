@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 from dataclasses import replace
+from pathlib import Path
 
 from davis_ag.commands import arguments
 from davis_ag.errors import UserError
@@ -61,6 +62,28 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def check_results_path(results: Path, out: Path) -> None:
+    """Refuse a ``--results`` page that would replace a run's records or a dataset's files.
+
+    The page is rewritten at every sitting, so an existing one is replaced without ``--force``;
+    but never over the run's ``state.json`` or clock, into its models or results folders, or into
+    a dataset.
+
+    Raises:
+        UserError: naming what the page would replace.
+    """
+    from davis_ag.formats.outputs import check_outside_datasets
+    from davis_ag.workflows.stage_clock import CLOCK_FILE
+
+    page, work = check_outside_datasets(results, "--results"), out.expanduser().absolute()
+    records = [work / "state.json", work / CLOCK_FILE, work / "models", work / "results", work / "dataset"]
+    if any(page == record or record in page.parents for record in records):
+        raise UserError(
+            f"--results {page} would replace the run's own records in {work}: "
+            "choose another path (e.g. docs/results.md)"
+        )
+
+
 def run(args: argparse.Namespace) -> int:
     """Run every stage of the chosen configuration and write the results file."""
     config = CONFIGS[args.config]
@@ -73,6 +96,7 @@ def run(args: argparse.Namespace) -> int:
     if args.status:
         print(format_status(args.out))
         return 0
+    check_results_path(args.results, args.out)
     arguments.prove_writable_file(args.results, "--results")
     if args.rewrite_results:
         state = load_state(args.out / "state.json")

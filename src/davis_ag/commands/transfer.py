@@ -70,6 +70,14 @@ def run(args: argparse.Namespace) -> int:
     from davis_ag.detection.yolo_training import Budget
     from davis_ag.workflows.transfer import TransferConfig, run_transfer, table5_markdown, write_results_md
 
+    from davis_ag.formats.outputs import check_outside_datasets
+
+    # Before any export or training: the work folder and the report never land in a dataset.
+    check_outside_datasets(args.out)
+    arguments.prove_writable_folder(args.out)
+    if args.results:
+        check_outside_datasets(args.results, "--results")
+        arguments.prove_writable_file(args.results, "--results")
     if args.imgsz < 32 or args.imgsz % 32:
         raise UserError(f"--imgsz must be a multiple of 32 (YOLO's stride), at least 32; got {args.imgsz}")
     budget = Budget(args.epochs, args.imgsz, args.batch, args.device, args.workers)

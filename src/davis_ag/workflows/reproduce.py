@@ -134,10 +134,26 @@ def configurations_table() -> str:
 
 
 def load_state(path: Path) -> dict[str, Any]:
-    try:
-        return json.loads(path.read_text())
-    except (OSError, ValueError):
+    """A run's ``state.json``: ``{}`` where there is none yet.
+
+    Raises:
+        UserError: for a file that is there but not a JSON object: a run that took it for no
+            run would start its records afresh over it.
+    """
+    from davis_ag.errors import UserError
+
+    if not path.exists():
         return {}
+    try:
+        state = json.loads(path.read_text())
+    except (OSError, ValueError) as error:
+        state = error
+    if not isinstance(state, dict):
+        raise UserError(
+            f"{path}: not a reproduce state file (damaged or not JSON): move it aside to start the "
+            "run's records afresh (scenes and models already made are reused)"
+        )
+    return state
 
 
 def disk_needed(
@@ -364,7 +380,12 @@ def _reusable_results(path: Path, models: list[Path], split: str, config: Reprod
     are seeded, so the rows it had come out as they were, and the page is never half one
     evaluation, half another.
     """
-    results = load_state(path)
+    try:
+        results = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+    if not isinstance(results, dict):
+        return None
     protocol = results.get("protocol", {})
     try:
         fresh = all(path.stat().st_mtime >= model.stat().st_mtime for model in models)

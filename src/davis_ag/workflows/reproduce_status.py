@@ -45,15 +45,22 @@ def run_config(state: dict[str, Any], path: Path) -> ReproduceConfig:
     Raises:
         UserError: when ``state.json`` records none (no run started in that folder).
     """
-    saved = dict(state.get("config") or {})
+    saved = state.get("config")
     if not saved:
         raise UserError(f"{path}: no reproduce run started there (no configuration in its state.json)")
-    saved.update(
-        size=tuple(saved["size"]),
-        mp_extent=tuple(saved["mp_extent"]) if saved.get("mp_extent") else None,
-        learners=tuple(saved.get("learners", ("a2c",))),  # a run from before PPO trained A2C alone
-    )
-    return ReproduceConfig(**saved)
+    try:
+        saved = dict(saved)
+        saved.update(
+            size=tuple(saved["size"]),
+            mp_extent=tuple(saved["mp_extent"]) if saved.get("mp_extent") else None,
+            learners=tuple(saved.get("learners", ("a2c",))),  # a run from before PPO trained A2C alone
+        )
+        return ReproduceConfig(**saved)
+    except (TypeError, KeyError, ValueError) as error:
+        raise UserError(
+            f"{path}: its configuration is damaged ({type(error).__name__}: {error}): move the file aside "
+            "to start the run's records afresh"
+        ) from None
 
 
 def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
