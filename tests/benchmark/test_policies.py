@@ -134,3 +134,28 @@ def test_a_policy_that_fails_is_one_line_naming_where(sp_root: Path) -> None:
         UserError, match=r"policy broken: act failed with KeyError: 'missing' \(at .*test_policies.py:\d+\)"
     ):
         evaluate_policies(TVMEnv(sp_root, "sp", "all"), [_named(broken, "broken")], episodes=1, sessions=1)
+
+
+@pytest.mark.parametrize(
+    "source, message",
+    [
+        ("def act(observation, info)\n    return 0\n", r"broken\.py, line 1: "),
+        ("raise RuntimeError('no GPU here')\n", r"importing .*broken\.py raised RuntimeError: no GPU here"),
+        ("import sys\nsys.exit(3)\n", r"importing .*broken\.py raised SystemExit: 3"),
+        ("import a_package_nobody_installed\n", r"needs module 'a_package_nobody_installed', not installed"),
+        ("x = 1\x00\n", r"broken\.py"),
+    ],
+)
+def test_a_policy_file_that_fails_to_import_is_one_line(source: str, message: str, tmp_path: Path) -> None:
+    """A syntax error, an exception or sys.exit at import came out as a traceback (or a silent exit)."""
+    broken = tmp_path / "broken.py"
+    broken.write_text(source)
+    with pytest.raises(UserError, match=message) as error:
+        policy_from_spec(f"{broken}:act")
+    assert "\n" not in str(error.value)
+
+
+@pytest.mark.parametrize("spec, message", [("", "empty"), (":", "empty"), ("{folder}", "a folder, not a model file")])
+def test_an_empty_spec_or_a_folder_says_so(spec: str, message: str, tmp_path: Path) -> None:
+    with pytest.raises(UserError, match=message):
+        policy_from_spec(spec.format(folder=tmp_path))

@@ -27,6 +27,8 @@ import json
 import os
 import sys
 import zipfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Callable, Protocol, runtime_checkable
 
@@ -185,6 +187,8 @@ def model_algorithm(path: Path) -> str:
     Raises:
         UserError: when the file is missing or not a Stable-Baselines3 model.
     """
+    if path.is_dir():
+        raise UserError(f"{path}: a folder, not a model file; give the .zip `davis-ag train` saved")
     if not path.is_file():
         raise UserError(f"{path}: no such model file; train one with `davis-ag train`")
     try:
@@ -303,14 +307,36 @@ def _import_target(target: str, spec: str) -> Any:
             raise UserError(f"--policy {spec}: {path} is not a Python file")
         module = importlib.util.module_from_spec(loader_spec)
         sys.modules[name] = module
-        loader_spec.loader.exec_module(module)
+        with _import_errors(spec, str(path), keep_missing=False):
+            loader_spec.loader.exec_module(module)
         return module
     try:
-        return importlib.import_module(target)
+        with _import_errors(spec, target):
+            return importlib.import_module(target)
     except ModuleNotFoundError as error:
         raise UserError(
             f"--policy {spec}: no module {error.name!r} (is it on PYTHONPATH? a file needs "
             "its path, e.g. ./my_policy.py:act)"
+        ) from None
+
+
+@contextmanager
+def _import_errors(spec: str, where: str, keep_missing: bool = True) -> Iterator[None]:
+    """A user's policy file that fails to import (a syntax error, an exception or ``sys.exit`` at
+    import) is named in one line with where it failed, not a traceback from inside the loader.
+    ``keep_missing`` lets a missing module through, for the caller's own message."""
+    try:
+        yield
+    except ModuleNotFoundError as error:
+        if keep_missing:
+            raise
+        raise UserError(f"--policy {spec}: importing {where} needs module {error.name!r}, not installed here") from None
+    except SyntaxError as error:
+        raise UserError(f"--policy {spec}: {error.filename or where}, line {error.lineno}: {error.msg}") from None
+    except (Exception, SystemExit) as error:
+        raise UserError(
+            f"--policy {spec}: importing {where} raised {type(error).__name__}: {error} "
+            f"(run `python {where}` to see where)"
         ) from None
 
 
@@ -326,6 +352,8 @@ def policy_from_spec(spec: str, name: str | None = None, deterministic: bool = D
         UserError: for a missing file, module or attribute, or something that is not a policy.
     """
     text = str(spec).strip()
+    if not text.strip(":"):
+        raise UserError(f"--policy {spec!r}: empty; give MODEL.zip, module:attr or path/to/file.py:attr")
     target, colon, attr = text.rpartition(":")
     if not colon or not target or not attr or attr.endswith((".zip", ".py")) or os.sep in attr:
         if text.endswith(".py"):
