@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
+from typing import Any
 
 import pytest
 from layout_factory import write_tiny_dataset
@@ -10,6 +12,7 @@ from layout_factory import write_tiny_dataset
 from davis_ag import cli
 from davis_ag.benchmark import evaluate
 from davis_ag.benchmark.leaderboard import format_leaderboard, leaderboard
+from davis_ag.errors import UserError
 
 
 def _always(move: str):
@@ -50,3 +53,29 @@ def test_compare_refuses_another_dataset_or_split(
         assert cli.main(["compare", str(ours), str(other)]) == 2
         err = capsys.readouterr().err.strip()
         assert what in err and "cannot be ranked together" in err and "\n" not in err
+
+
+@pytest.mark.parametrize(
+    "damage, where",
+    [
+        (lambda d: d.update(policies={}), "policies"),
+        (lambda d: d.update(format="something else"), "format"),
+        (lambda d: d["protocol"].update(version=99), "protocol.version"),
+        (lambda d: d["protocol"].update(episodes=-3), "protocol.episodes"),
+        (lambda d: d["protocol"].update(scenario="banana"), "protocol.scenario"),
+        (lambda d: next(iter(d["policies"].values()))["oer_tau"].update(mean=float("nan")), "oer_tau.mean"),
+    ],
+)
+def test_a_file_that_is_not_sound_results_is_refused_in_one_line(
+    damage: Any, where: str, sp_root: Path, tmp_path: Path
+) -> None:
+    """compare ranked a file with no policies (an IndexError), another format, a future protocol
+    version, negative episodes, an unknown scenario and NaN means."""
+    sound = evaluate([], sp_root, "sp", sessions=1, episodes=2).write(tmp_path / "sound.json")
+    data = json.loads(sound.read_text())
+    damage(data)
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(data))
+    with pytest.raises(UserError, match=f"not davis-ag evaluation results \\(.*{where}") as error:
+        leaderboard([bad])
+    assert "\n" not in str(error.value)

@@ -16,7 +16,7 @@ import hashlib
 import json
 import os
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
@@ -36,6 +36,8 @@ class _Model(BaseModel):
 class Metric(_Model):
     """One metric of one policy: mean and population std over sessions (Table 4's ``±``), the
     standard error of the mean over all episodes, and each session's mean."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)  # a NaN mean ranks nowhere
 
     mean: float
     std: float
@@ -119,14 +121,14 @@ class Protocol(_Model):
     eligible starts, sessions x episodes, the base seed (episode ``e`` of session ``s`` resets
     with ``SeedSequence([seed, s])``'s ``e``-th state, the policy with ``SeedSequence([seed, s, 1])``'s)."""
 
-    version: int = 0
+    version: int = Field(0, ge=0, le=PROTOCOL_VERSION)
     environment: str = "davis_ag/TVM-v0"
-    scenario: str
+    scenario: Literal["sp", "mp"]
     crop: str | None = None
     split: str
-    tau: int
-    episodes: int
-    sessions: int
+    tau: int = Field(ge=1)
+    episodes: int = Field(ge=1)
+    sessions: int = Field(ge=1)
     seed: int
     scenes: list[str]
     dataset: str
@@ -139,11 +141,11 @@ class Protocol(_Model):
 class EvaluationResults(_Model):
     """An evaluation: its protocol, the dataset's identity, the code, one row per policy."""
 
-    format: str = FORMAT
+    format: Literal["davis-ag evaluation results"] = FORMAT
     protocol: Protocol
     dataset: DatasetIdentity | None = None
     code: str | None = None
-    policies: dict[str, PolicyResult]
+    policies: dict[str, PolicyResult] = Field(min_length=1)
     fixed_actions: dict[str, dict[str, float]] | None = None
     train_split: dict[str, Any] | None = None
 
