@@ -220,3 +220,24 @@ def test_a_pool_of_processes_reports_what_one_process_does(
     pooled = run(capsys, str(dataset), "--workers", "2")
     assert one[0] == pooled[0] == 1
     assert one[1] == pooled[1] and any("cannot decode" in line for line in one[1])
+
+
+@pytest.mark.parametrize("loss", ["deleted", "a folder"])
+def test_a_scene_that_lost_its_labels_is_not_passed_over(
+    loss: str, dataset: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The reader skips a folder without annotations.json, so validate said "sound" (exit 0) with a
+    scene gone; with splits.json it only said the split names a scene that is not there."""
+    path = dataset / SCENE / "annotations.json"
+    path.unlink()
+    if loss == "a folder":
+        path.mkdir()
+    (dataset / "splits.json").unlink()
+    code, lines, _ = run(capsys, str(dataset))
+    what = "missing" if loss == "deleted" else "a folder"
+    assert code == 1 and f"{path}: {what}: this scene has images but no labels" in lines[0]
+    # The whole group lost: a group folder with no scene the reader found is still looked at.
+    for scene in (dataset / "Multi-Tomato").iterdir():
+        (scene / "annotations.json").unlink()
+    code, lines, _ = run(capsys, str(dataset))
+    assert code == 1 and any("Multi-Tomato/000/annotations.json: missing" in line for line in lines)

@@ -312,6 +312,32 @@ def _check_splits(dataset: Dataset, whole: bool) -> list[Problem]:
     return problems
 
 
+def _unlabelled_scenes(dataset: Dataset, whole: bool) -> list[Problem]:
+    """Scene folders beside the dataset's scenes that have images or a scene.json but no readable
+    annotations.json: the reader passes over them, so without this a scene whose labels were lost
+    would leave the dataset "sound" and a scene short."""
+    problems = []
+    groups = {scene.path.parent for scene in dataset.scenes}
+    if whole:  # a group whose every scene lost its labels holds no scene the reader found
+        groups |= {p for p in dataset.root.iterdir() if p.is_dir() and not p.name.startswith(".")}
+    for group in sorted(groups):
+        try:
+            folders = sorted(p for p in group.iterdir() if p.is_dir() and not p.name.startswith("."))
+        except OSError:
+            continue
+        for folder in folders:
+            labels = folder / ANNOTATIONS
+            if labels.is_file() or not ((folder / IMAGES).is_dir() or (folder / SCENE_METADATA).exists()):
+                continue
+            what = "a folder" if labels.is_dir() else "unreadable" if os.path.lexists(labels) else "missing"
+            problems.append(
+                Problem(
+                    labels, f"{what}: this scene has images but no labels; make it again (davis-ag generate resumes)"
+                )
+            )
+    return problems
+
+
 def _read_root_file(dataset: Dataset, name: str, model: type[BaseModel]) -> tuple[Any, list[Problem]]:
     """A JSON file at the dataset's root read through its model: ``(model or None, problems)``;
     ``(None, [])`` where the file is absent."""
@@ -394,7 +420,11 @@ def validate_dataset(
             on_problem(problem)
 
     whole = Path(path).expanduser().absolute() == dataset.root
-    for problem in _check_splits(dataset, whole) + (_check_dataset_file(dataset) if whole else []):
+    for problem in (
+        _check_splits(dataset, whole)
+        + (_check_dataset_file(dataset) if whole else [])
+        + _unlabelled_scenes(dataset, whole)
+    ):
         emit(problem)
     scenes = dataset.scenes
     bar = tqdm(
