@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -37,3 +39,38 @@ def test_a_lin_value_falls_linearly_from_its_number_to_zero(start: float, remain
 def test_a_lin_value_that_is_no_number_or_no_schedule_is_refused_in_one_line(settings: dict[str, str]) -> None:
     with pytest.raises(UserError, match="lin_X .X a number. is for learning_rate, clip_range, clip_range_vf only"):
         sb3_arguments(settings)
+
+
+@pytest.mark.parametrize(
+    "algo, values, message",
+    [
+        ("ppo", {"n_steps": "abc"}, "n_steps='abc': must be a number"),
+        ("ppo", {"n_steps": -5}, "n_steps=-5: must be a whole number, at least 1"),
+        ("ppo", {"batch_size": 2.5}, "batch_size=2.5: must be a whole number"),
+        ("a2c", {"gamma": "yes"}, "gamma='yes': must be a number"),
+        ("a2c", {"normalize_advantage": 1}, "normalize_advantage=1: must be true or false"),
+        ("a2c", {"ent_coef": -0.1}, "ent_coef=-0.1: must not be negative"),
+        ("dqn", {"learning_starts": float("nan")}, "learning_starts=nan: must be a number"),
+    ],
+)
+def test_a_setting_sb3_would_crash_on_is_refused_before_training(algo: str, values: dict, message: str) -> None:
+    """--set n_steps=abc or n_steps=-5 reached SB3 and crashed inside learn, after the
+    environments were built; now one line names the setting."""
+    from davis_ag.benchmark.algorithms import resolve_sb3_settings, resolve_settings
+
+    with pytest.raises(UserError, match=re.escape(message)):
+        resolve_settings(values) if algo == "a2c" else resolve_sb3_settings(algo, values)
+
+
+def test_every_preset_and_sound_values_pass() -> None:
+    from davis_ag.benchmark.algorithms import (
+        SB3_SETTINGS,
+        SETTINGS_PRESETS,
+        check_setting_values,
+    )
+
+    for algo, chosen in SB3_SETTINGS.items():
+        check_setting_values(algo, chosen)
+    for chosen in SETTINGS_PRESETS.values():
+        check_setting_values("a2c", chosen)
+    check_setting_values("ppo", {"n_steps": 64, "batch_size": 64, "gamma": 1, "learning_rate": "lin_3e-4"})

@@ -92,6 +92,48 @@ TUNABLE = (
 )
 
 
+#: Settings that count something and must be at least 1 (``learning_starts`` may be 0;
+#: ``sde_sample_freq`` is -1 by default, so sign rules come from this list, not from the type).
+COUNTS = ("n_steps", "batch_size", "n_epochs", "buffer_size", "gradient_steps", "target_update_interval", "train_freq")
+
+
+def check_setting_values(algo: str, settings: dict[str, Any]) -> None:
+    """Refuse a setting whose value SB3 would take and then crash on, minutes later inside
+    ``learn``: a value of another kind than SB3's default (``n_steps=abc``, ``gamma=yes``), a
+    count below 1, a negative rate or coefficient, or a number that is not finite.
+
+    Args:
+        algo: ``a2c``, ``ppo`` or ``dqn``.
+        settings: The settings given (``--set`` or a dict), before SB3's defaults fill the rest.
+
+    Raises:
+        UserError: naming the setting, its value and what it must be.
+    """
+    import inspect
+    import math
+
+    import stable_baselines3
+
+    defaults = {
+        k: v.default for k, v in inspect.signature(getattr(stable_baselines3, algo.upper())).parameters.items()
+    }
+    for key, value in settings.items():
+        default = defaults.get(key)
+        if isinstance(value, str) and value.startswith("lin_") or default is None or isinstance(value, dict):
+            continue  # schedules are checked by sb3_arguments; None defaults take many kinds
+        shown = f"{algo.upper()} setting {key}={value!r}"
+        if isinstance(default, bool):
+            if not isinstance(value, bool):
+                raise UserError(f"{shown}: must be true or false")
+        elif isinstance(default, (int, float)):
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise UserError(f"{shown}: must be a number")
+            if isinstance(default, int) and key in COUNTS and (not float(value).is_integer() or value < 1):
+                raise UserError(f"{shown}: must be a whole number, at least 1")
+            if key not in COUNTS + ("sde_sample_freq",) and value < 0:
+                raise UserError(f"{shown}: must not be negative")
+
+
 def resolve_settings(settings: str | dict[str, Any]) -> dict[str, Any]:
     """The SB3 A2C arguments a setting set names (see :data:`SETTINGS_PRESETS`).
 
@@ -105,6 +147,7 @@ def resolve_settings(settings: str | dict[str, Any]) -> dict[str, Any]:
     wrong = [k for k in settings if k not in TUNABLE]
     if wrong:
         raise UserError(f"A2C setting {wrong[0]!r} cannot be changed here: use {', '.join(TUNABLE)}")
+    check_setting_values("a2c", settings)
     return {**SB3_DEFAULT_SETTINGS, **settings}
 
 
@@ -129,6 +172,7 @@ def resolve_sb3_settings(algo: str, settings: str | dict[str, Any]) -> dict[str,
     wrong = [k for k in settings if k not in known or k in ("policy", "env", "seed", "device", "verbose")]
     if wrong:
         raise UserError(f"{algo.upper()} setting {wrong[0]!r} cannot be changed here")
+    check_setting_values(algo, settings)
     return {**SB3_SETTINGS[algo], **settings}
 
 
