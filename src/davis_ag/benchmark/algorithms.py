@@ -114,9 +114,7 @@ def check_setting_values(algo: str, settings: dict[str, Any]) -> None:
 
     import stable_baselines3
 
-    defaults = {
-        k: v.default for k, v in inspect.signature(getattr(stable_baselines3, algo.upper())).parameters.items()
-    }
+    defaults = {k: v.default for k, v in inspect.signature(getattr(stable_baselines3, algo.upper())).parameters.items()}
     for key, value in settings.items():
         default = defaults.get(key)
         if isinstance(value, str) and value.startswith("lin_") or default is None or isinstance(value, dict):
