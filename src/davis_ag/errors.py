@@ -62,3 +62,12 @@ def stops_held() -> Iterator[None]:
         if not _held["depth"] and pending is not None:
             _held["pending"] = None
             raise Stopped(pending)
+
+
+def yaml_problem(error: Exception) -> str:
+    """A YAML parser's error in a few words, with its line and column: PyYAML's own text spans
+    several lines (the context, the faulty line, a caret)."""
+    mark = getattr(error, "problem_mark", None)
+    where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+    problem = getattr(error, "problem", None) or "not valid YAML"
+    return f"not valid YAML{where}: {problem}"

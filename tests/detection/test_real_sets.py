@@ -56,3 +56,8 @@ def test_bad_real_sets_are_one_line(tmp_path: Path) -> None:
     for path, message in ((tmp_path, "not a labelled set"), (tmp_path / "x.json", "needs images")):
         with pytest.raises(UserError, match=message):
             load_pool(path)
+    # A data YAML PyYAML cannot parse: its several-line error comes as one line with the place.
+    (tmp_path / "bad.yaml").write_text("names: [fruit\ntrain: images\n")
+    with pytest.raises(UserError, match=r"bad\.yaml: not valid YAML at line \d+, column \d+") as error:
+        load_pool(tmp_path / "bad.yaml")
+    assert "\n" not in str(error.value)

@@ -84,7 +84,7 @@ def select_scenes(dataset: Any, scenario: str, split: str, crop: str | None = No
     chosen = sorted((s for s in scenes if s.id in keep), key=lambda s: s.id)
     if not chosen:
         raise UserError(
-            f"the {split} split has none of the {len(scenes)} {where}: use "
-            "--split all (split='all') or a dataset with more scenes"
+            f"the {split} split has none of the {len(scenes)} {where}: give a "
+            "dataset with more scenes, or evaluate on all of them (evaluate --split all, split='all')"
         )
     return chosen

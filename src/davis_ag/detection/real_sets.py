@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from davis_ag.atomic_files import write_text_atomic
-from davis_ag.errors import UserError
+from davis_ag.errors import UserError, yaml_problem
 
 #: Section VI-B's split sizes (Table 5).
 PAPER_TRAIN, PAPER_TEST = 654, 159
@@ -65,8 +65,10 @@ def _from_yaml(path: Path) -> Pool:
 
     try:
         data = yaml.safe_load(path.read_text())
-    except (OSError, yaml.YAMLError) as error:
-        raise UserError(f"{path}: cannot read the data YAML ({error}); give an ultralytics data YAML") from None
+    except OSError as error:
+        raise UserError(f"{path}: cannot read the data YAML ({error.strerror or error})") from None
+    except yaml.YAMLError as error:
+        raise UserError(f"{path}: {yaml_problem(error)}; give an ultralytics data YAML") from None
     if not isinstance(data, dict) or "names" not in data:
         raise UserError(f"{path}: an ultralytics data YAML needs 'names' and train/val/test entries")
     base = Path(data.get("path") or path.parent)

@@ -42,7 +42,7 @@ from typing import Any
 
 from pydantic import ValidationError
 
-from davis_ag.errors import UserError
+from davis_ag.errors import UserError, yaml_problem
 from davis_ag.formats.models import (
     MAX_SCENES,
     MAX_VIEWS_PER_SCENE,
@@ -267,10 +267,7 @@ def parse_dataset_config(text: str, source: str, default_name: str = "dataset") 
     try:
         data = yaml.safe_load(text)
     except yaml.YAMLError as error:
-        mark = getattr(error, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        problem = getattr(error, "problem", None) or "not valid YAML"
-        raise UserError(f"{source}: not valid YAML{where}: {problem}") from None
+        raise UserError(f"{source}: {yaml_problem(error)}") from None
     if not isinstance(data, dict):
         raise UserError(f"{source}: must be a mapping with at least a 'groups' list")
     try:
