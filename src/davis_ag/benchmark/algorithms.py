@@ -92,8 +92,8 @@ TUNABLE = (
 )
 
 
-#: Settings that count something and must be at least 1 (``learning_starts`` may be 0;
-#: ``sde_sample_freq`` is -1 by default, so sign rules come from this list, not from the type).
+#: Settings that count something: whole numbers, at least 1. Every other number must not be
+#: negative, but ``sde_sample_freq`` (-1 by default: never resample).
 COUNTS = ("n_steps", "batch_size", "n_epochs", "buffer_size", "gradient_steps", "target_update_interval", "train_freq")
 
 
@@ -126,7 +126,7 @@ def check_setting_values(algo: str, settings: dict[str, Any]) -> None:
         elif isinstance(default, (int, float)):
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
                 raise UserError(f"{shown}: must be a number")
-            if isinstance(default, int) and key in COUNTS and (not float(value).is_integer() or value < 1):
+            if key in COUNTS and (not isinstance(value, int) or value < 1):
                 raise UserError(f"{shown}: must be a whole number, at least 1")
             if key not in COUNTS + ("sde_sample_freq",) and value < 0:
                 raise UserError(f"{shown}: must not be negative")
