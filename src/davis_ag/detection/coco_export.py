@@ -150,17 +150,19 @@ def write_coco_split(
         images_path, annotations_path = Path(tmp) / "images", Path(tmp) / "annotations"
         with open(images_path, "w") as images, open(annotations_path, "w") as annotations:
             first_image = first_annotation = True
-            bar = tqdm(total=count_views(scenes), desc=f"coco {split}", unit="view", disable=not progress)
-            for item in iter_split_views(scenes):
-                image_id = counts["images"] + 1
-                first_image = _write_array_items(images, [_image_entry(item, image_id, root)], first_image)
-                entries = _annotation_entries(item, image_id, counts["annotations"] + 1)
-                if organs:
-                    entries += organ_annotations(item, image_id, counts["annotations"] + 1 + len(entries))
-                first_annotation = _write_array_items(annotations, entries, first_annotation)
-                tally(counts, item, "annotations", len(entries))
-                bar.update()
-            bar.close()
+            # A bar on a terminal only (not in logs), closed before an error's line is printed.
+            with tqdm(
+                total=count_views(scenes), desc=f"coco {split}", unit="view", disable=None if progress else True
+            ) as bar:
+                for item in iter_split_views(scenes):
+                    image_id = counts["images"] + 1
+                    first_image = _write_array_items(images, [_image_entry(item, image_id, root)], first_image)
+                    entries = _annotation_entries(item, image_id, counts["annotations"] + 1)
+                    if organs:
+                        entries += organ_annotations(item, image_id, counts["annotations"] + 1 + len(entries))
+                    first_annotation = _write_array_items(annotations, entries, first_annotation)
+                    tally(counts, item, "annotations", len(entries))
+                    bar.update()
         with atomic_output(target, "w") as out:
             head = json.dumps(header, indent=1)
             out.write(head[:-2] + ',\n "images": [\n')  # reopen the header object: its last "\n}"

@@ -128,17 +128,17 @@ def write_yolo_split(
     images.mkdir(parents=True, exist_ok=True)
     labels.mkdir(parents=True, exist_ok=True)
     counts = {"images": 0, "instances": 0, "clipped": 0, "dropped": 0}
-    bar = tqdm(total=count_views(scenes), desc=f"yolo {split}", unit="view", disable=not progress)
-    for item in iter_split_views(scenes, with_masks=task == "segment"):
-        name = flat_name(f"{item.view.scene.id}/{item.view.name}")
-        lines = label_lines(item, task)
-        if organs:
-            lines += organ_lines(item)
-        write_text_atomic(labels / f"{name}.txt", "".join(f"{line}\n" for line in lines))
-        place_image(item.view.image_path, images / f"{name}{IMAGE_SUFFIX}")
-        tally(counts, item, "instances", len(lines))
-        bar.update()
-    bar.close()
+    # A bar on a terminal only (not in logs), closed before an error's line is printed.
+    with tqdm(total=count_views(scenes), desc=f"yolo {split}", unit="view", disable=None if progress else True) as bar:
+        for item in iter_split_views(scenes, with_masks=task == "segment"):
+            name = flat_name(f"{item.view.scene.id}/{item.view.name}")
+            lines = label_lines(item, task)
+            if organs:
+                lines += organ_lines(item)
+            write_text_atomic(labels / f"{name}.txt", "".join(f"{line}\n" for line in lines))
+            place_image(item.view.image_path, images / f"{name}{IMAGE_SUFFIX}")
+            tally(counts, item, "instances", len(lines))
+            bar.update()
     return counts
 
 
