@@ -38,13 +38,13 @@ def test_progress_of_a_resumed_run_starts_at_its_checkpoint(tmp_path: Path, one_
 
 def test_the_configurations_table_in_the_docs_is_the_codes() -> None:
     # docs/benchmark.md's table of `reproduce --config` sizes follows CONFIGS, never a hand copy.
-    from davis_ag.workflows.reproduce import CONFIGS, CONFIGS_MARKER, configurations_table
+    from davis_ag.workflows.reproduce_configs import CONFIGS, CONFIGS_MARKER, configurations_table
 
     page = (Path(__file__).resolve().parents[2] / "docs" / "benchmark.md").read_text()
     section = page.split(f"<!-- {CONFIGS_MARKER}:start -->\n", 1)[1].split(f"\n<!-- {CONFIGS_MARKER}:end -->", 1)[0]
     assert section == configurations_table(), (
         'docs/benchmark.md is behind CONFIGS; rewrite it: python -c "from davis_ag.atomic_files import '
-        "write_marked_section as w; from davis_ag.workflows import reproduce as r; "
+        "write_marked_section as w; from davis_ag.workflows import reproduce_configs as r; "
         "w('docs/benchmark.md', r.CONFIGS_MARKER, r.configurations_table())\""
     )
     # Issue 22: medium's MP split keeps at least 3 test scenes (70/30 of 10 or more).
@@ -68,7 +68,8 @@ def test_a_run_the_disk_cannot_hold_is_refused_before_anything_is_written(tmp_pa
     from dataclasses import replace
 
     from davis_ag.errors import UserError
-    from davis_ag.workflows.reproduce import CONFIGS, disk_needed, reproduce
+    from davis_ag.workflows.reproduce import reproduce
+    from davis_ag.workflows.reproduce_configs import CONFIGS, disk_needed
 
     paper = CONFIGS["paper-scale"]
     # Table 3's 86 SP strawberry and 44 MP vine scenes (285 and 1,800 views, Table 2) at 1280x720.
@@ -95,7 +96,7 @@ def test_ppo_trains_beside_a2c_resumes_a_killed_run_and_reuses_a_finished_one(
 
     from davis_ag.benchmark.training import training_record_path
     from davis_ag.benchmark.algorithms import A2C_SETTINGS, SB3_SETTINGS
-    from davis_ag.workflows.reproduce import CONFIGS
+    from davis_ag.workflows.reproduce_configs import CONFIGS
     from davis_ag.workflows.reproduce_learners import KEEP, learner_stamp, train_learner
     from davis_ag.workflows.results_policies import model_path
 
@@ -140,7 +141,8 @@ def test_a_whole_run_times_every_stage_on_its_clock_and_a_rerun_adds_no_sitting(
     import json
     from dataclasses import replace
 
-    from davis_ag.workflows.reproduce import CONFIGS, reproduce
+    from davis_ag.workflows.reproduce import reproduce
+    from davis_ag.workflows.reproduce_configs import CONFIGS
     from davis_ag.workflows.reproduce_status import run_status
     from davis_ag.provenance import machine_summary
     from davis_ag.workflows.stage_clock import CLOCK_FILE, read_clock

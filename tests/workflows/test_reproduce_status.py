@@ -16,7 +16,7 @@ import pytest
 
 from davis_ag import cli
 from davis_ag.generate.run_progress import default_workers
-from davis_ag.workflows.reproduce import CONFIGS
+from davis_ag.workflows.reproduce_configs import CONFIGS
 from davis_ag.workflows.reproduce_status import run_status
 
 CONFIG = replace(CONFIGS["small"], sp_scenes=3, sp_timesteps=30_000)

@@ -6,42 +6,10 @@ import json
 from pathlib import Path
 
 import numpy as np
-import pytest
 
-from davis_ag.workflows.reproduce import CONFIGS
-from davis_ag.workflows.results_page import (
-    PAPER_ORDERINGS,
-    PAPER_TABLE4,
-    PAPER_TABLE4_STD,
-    ordering_failures,
-    ordering_holds,
-    write_results_md,
-)
-
-
-def paper_stats(scenario: str) -> dict:
-    return {
-        name: {"oer_tau": {"mean": mean, "std": PAPER_TABLE4_STD[scenario]["oer_tau"][name]}}
-        for name, mean in PAPER_TABLE4[scenario]["oer_tau"].items()
-    }
-
-
-@pytest.mark.parametrize("scenario", ["sp", "mp"])
-def test_table_4_meets_the_orderings_section_vi_reads_from_it(scenario: str) -> None:
-    # Table 4: SP .520 (A2C) > .438 ± .101 (Rand) ~ .433 ± .007 (LRD) > .371 (UDD);
-    # MP .369 > .340 (Rand) > .316 ± .008 (LRD) ~ .313 ± .006 (UDD).
-    assert ordering_holds(PAPER_ORDERINGS[scenario], paper_stats(scenario)) is True
-
-
-def test_an_ordering_fails_where_a_step_is_reversed_or_apart() -> None:
-    stats = paper_stats("sp")
-    stats["A2C"]["oer_tau"]["mean"] = 0.40  # below Rand
-    assert ordering_holds(PAPER_ORDERINGS["sp"], stats) is False
-    stats = paper_stats("mp")
-    stats["UDD"]["oer_tau"]["mean"] = 0.2  # LRD ~ UDD no longer: .116 apart, stds .014
-    assert ordering_holds(PAPER_ORDERINGS["mp"], stats) is False
-    del stats["A2C"]
-    assert ordering_holds(PAPER_ORDERINGS["mp"], stats) is None
+from davis_ag.workflows.paper_table4 import PAPER_ORDERINGS, ordering_failures
+from davis_ag.workflows.reproduce_configs import CONFIGS
+from davis_ag.workflows.results_page import write_results_md
 
 
 def write_scene(root: Path, folder: str, version: str, plants: str | None = None) -> None:
@@ -183,61 +151,6 @@ def test_the_kept_snapshot_is_set_beside_the_best_fixed_action_on_train(tmp_path
     assert train_split_references({"sp": result, "mp": {}}) == {
         "sp-strawberry: best fixed action (always backward), exact": 0.6
     }
-
-
-def test_the_readme_block_beside_docs_is_rewritten_from_the_run(tmp_path: Path) -> None:
-    # A results page in a project's docs/ writes the README's block too: no number copied by hand.
-    (tmp_path / "docs").mkdir()
-    readme = tmp_path / "README.md"
-    readme.write_text("# p\n\nbefore\n<!-- results-table4:start -->\nstale .999\n<!-- results-table4:end -->\nafter\n")
-    stat = {"mean": 0.5, "std": 0.01}
-    policies = {
-        name: {"oer_tau": dict(stat, mean=m), "reward": stat, "length": stat}
-        for name, m in (("A2C", 0.6), ("Rand", 0.45), ("LRD", 0.44), ("UDD", 0.3))
-    }
-    state = {
-        "results": {
-            "sp": {
-                "protocol": {
-                    "split": "test",
-                    "tau": 3,
-                    "sessions": 3,
-                    "episodes": 200,
-                    "scenes": ["Single-Strawberry/003", "Single-Strawberry/007"],
-                },
-                "policies": policies,
-                "a2c_vs_best_fixed": {
-                    "gap": 0.027,
-                    "low": 0.01,
-                    "high": 0.04,
-                    "episodes": 600,
-                    "per_scene": [{"scene": "Single-Strawberry/003", "gap": -0.2, "episodes": 22, "starts": 1}],
-                },
-            }
-        }
-    }
-    page = write_results_md(tmp_path / "docs" / "results.md", CONFIGS["medium"], state, tmp_path).read_text()
-    assert (
-        "A2C minus `Best fixed action`: +.027, 95% bootstrap interval over episodes +.010 to +.040 (10,000 "
-        "resamples), above zero. Per test scene: Single-Strawberry/003 -.200 (22 episodes, 1 start); A2C is "
-        "ahead on 0 of 1."
-    ) in page
-    text = readme.read_text()
-    assert "stale" not in text and text.startswith("# p\n\nbefore\n") and text.endswith("after\n")
-    assert "PPO" not in text and "PPO" not in page  # a run without PPO (medium's), whatever CONFIGS now lists
-    assert "| SP strawberry, ours (2 test scenes) | .600 ± .010 | .440 ± .010 | .300 ± .010 | .450 ± .010 | – |" in text
-    assert "| SP strawberry, paper (Table 4) | .520 ± .004 | .433 ± .007 | .371 ± .008 | .438 ± .101 | - |" in text
-    assert "| MP vine, ours | not run |" in text and "| MP vine, paper (Table 4) | .369 ± .009 |" in text
-    assert "SP strawberry: A2C > Rand ~ LRD > UDD **holds**." in text
-    assert (
-        "A2C minus `Best fixed action` on the same episodes (95% bootstrap interval over the test episodes): "
-        "SP strawberry +.027 (+.010 to +.040)."
-    ) in text
-    # A page written elsewhere (a work folder beside the README) leaves the README alone.
-    other = tmp_path / "work"
-    other.mkdir()
-    write_results_md(other / "results.md", CONFIGS["medium"], {"results": {}}, other)
-    assert readme.read_text() == text
 
 
 def test_a_broken_ordering_names_the_steps_that_break() -> None:
@@ -385,7 +298,8 @@ def test_a_run_with_ppo_shows_its_row_gap_settings_and_stage(tmp_path: Path, sp_
     assert "| sp-strawberry: train PPO |" in text and "| sp-strawberry: train A2C |" in text
     readme = (tmp_path / "README.md").read_text()
     assert "| | A2C | PPO (ours only) | LRD |" in readme and "paper (Table 4) | .520 ± .004 | - | .433" in readme
-    assert "PPO minus `Best fixed action` on the same episodes" in readme
+    assert "Each learner minus `Best fixed action` on the same test episodes" in readme
+    assert "\n- A2C: SP strawberry " in readme and "\n- PPO: SP strawberry " in readme
 
 
 def _c(value: float) -> str:

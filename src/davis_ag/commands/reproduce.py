@@ -15,7 +15,8 @@ from pathlib import Path
 
 from davis_ag.commands import arguments
 from davis_ag.errors import UserError
-from davis_ag.workflows.reproduce import CONFIGS, load_state, reproduce
+from davis_ag.workflows.reproduce import load_state, reproduce
+from davis_ag.workflows.reproduce_configs import CONFIGS
 from davis_ag.workflows.run_groups import SCENARIO_CROPS
 from davis_ag.workflows.reproduce_status import format_status, run_config
 from davis_ag.workflows.results_page import write_results_md

@@ -11,126 +11,14 @@ from __future__ import annotations
 
 import json
 import os
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, replace
 from functools import partial
 from pathlib import Path
 from typing import Any
 
 from davis_ag.atomic_files import write_json_atomic
-from davis_ag.benchmark.cache import OBS_SIZE
-from davis_ag.scene.specs import PAPER_IMAGE_SIZE, PAPER_TABLE3
+from davis_ag.workflows.reproduce_configs import ReproduceConfig, check_disk
 from davis_ag.workflows.run_groups import SCENARIO_CROPS, group_key
-
-
-@dataclass(frozen=True)
-class ReproduceConfig:
-    """One reproduction's size.
-
-    Attributes:
-        name: ``small``, ``medium`` or ``paper-scale``.
-        size: Image width and height.
-        sp_scenes, mp_scenes: SP strawberry and MP vine scenes.
-        mp_extent: MP grid extent (x, y) in metres; ``None`` keeps Table 2's 7 x 3 m.
-        sp_timesteps, mp_timesteps: Environment steps per scenario of each learner.
-        n_envs: Parallel environments of each learner.
-        episodes, sessions: Evaluation protocol (200 x 3 in the paper).
-        seed: Dataset, training and evaluation seed.
-        learners: The algorithms trained (:data:`davis_ag.benchmark.algorithms.ALGORITHMS`), each
-            with the same steps, seed, network, train split and keep rule: the paper's ``a2c``
-            and, beside it, ``ppo`` with RL Baselines3 Zoo's Atari settings.
-    """
-
-    name: str
-    size: tuple[int, int]
-    sp_scenes: int
-    mp_scenes: int
-    mp_extent: tuple[float, float] | None
-    sp_timesteps: int
-    mp_timesteps: int
-    n_envs: int = 8
-    episodes: int = 200
-    sessions: int = 3
-    seed: int = 0
-    learners: tuple[str, ...] = ("a2c", "ppo")
-
-
-#: ``small``: under an hour of stages on a 2-core CPU machine without GPU;
-#: a 3 x 2 m MP grid and 10 % / 5 % of the paper's A2C steps: not comparable with Table 4.
-#: ``medium``: the paper's grids (Table 2: 3 x 3 m SP, 7 x 3 m MP) and protocol (300K A2C steps,
-#: 3 sessions of 200 episodes) on 10 SP strawberry and 10 MP vine scenes at 640x360 (the policy
-#: sees 224x224 either way; the 70/30 split leaves 3 test scenes of each), a few hours on such a
-#: machine, resumable across sittings.
-#: ``paper-scale``: Table 3's scene counts at 1280x720 and 300K steps of each learner, many sittings
-#: on such a machine (its results page gives the hours of every stage).
-#: Scene counts of Table 3 (SP strawberry, MP vine), what a configuration is measured against.
-PAPER_SCENES = (PAPER_TABLE3["sp", "strawberry"][0], PAPER_TABLE3["mp", "vine"][0])
-CONFIGS: dict[str, ReproduceConfig] = {
-    "small": ReproduceConfig(
-        "small", (640, 360), sp_scenes=3, mp_scenes=2, mp_extent=(3.0, 2.0), sp_timesteps=30_000, mp_timesteps=15_000
-    ),
-    "medium": ReproduceConfig(
-        "medium", (640, 360), sp_scenes=10, mp_scenes=10, mp_extent=None, sp_timesteps=300_000, mp_timesteps=300_000
-    ),
-    "paper-scale": ReproduceConfig(
-        "paper-scale",
-        PAPER_IMAGE_SIZE,
-        sp_scenes=PAPER_SCENES[0],
-        mp_scenes=PAPER_SCENES[1],
-        mp_extent=None,
-        sp_timesteps=300_000,
-        mp_timesteps=300_000,
-    ),
-}
-
-#: Bytes one 1280x720 view writes (JPEG 0.36 MB, depth 0.07 MB, masks and classes), measured on
-#: canopy-plant scenes; other sizes scale it by their pixel count, and once scenes exist their
-#: own mean is used instead.
-BYTES_PER_VIEW_720P = 0.46e6
-#: Bytes one view takes in the observation cache (224 x 224 x 4 uint8, :mod:`davis_ag.benchmark.cache`).
-CACHE_BYTES_PER_VIEW = OBS_SIZE * OBS_SIZE * 4
-#: Room left free beyond the estimate, for models, results and the estimate's error.
-DISK_MARGIN = 1.1
-
-#: Marker of docs/benchmark.md's table of the configurations (:func:`configurations_table`).
-CONFIGS_MARKER = "reproduce-configs"
-
-
-def configurations_table() -> str:
-    """docs/benchmark.md's table of :data:`CONFIGS`, written from them so the page follows the code.
-
-    Returns:
-        A Markdown table: scenes, grid, image size, learners, their steps and disk space of each
-        configuration.
-    """
-    rows = [
-        "| configuration | SP strawberry | MP vine | images | learners | steps each (SP / MP) "
-        "| disk (views and caches) | beside Table 4 |",
-        "|---|---|---|---|---|---|---|---|",
-    ]
-    for config in CONFIGS.values():
-        grid = (
-            f"{config.mp_extent[0]:g} x {config.mp_extent[1]:g} m grid"
-            if config.mp_extent
-            else "the paper's 7 x 3 m grid"
-        )
-        scenes = (config.sp_scenes, config.mp_scenes)
-        if scenes == PAPER_SCENES and config.size == (1280, 720):
-            verdict = "Table 3's scenes and images"
-        elif config.mp_extent is None and (config.sp_timesteps, config.mp_timesteps) == (300_000, 300_000):
-            verdict = (
-                f"grids, protocol and training as the paper's; {sum(scenes)} scenes instead of "
-                f"{sum(PAPER_SCENES)}, {config.size[0]}x{config.size[1]} images"
-            )
-        else:
-            verdict = "not comparable: a smoke test of every stage"
-        rows.append(
-            f"| `{config.name}` | {config.sp_scenes} scenes | {config.mp_scenes} scenes, {grid} | "
-            f"{config.size[0]}x{config.size[1]} | {', '.join(a.upper() for a in config.learners)} "
-            f"| {config.sp_timesteps // 1000}K / "
-            f"{config.mp_timesteps // 1000}K | {disk_needed(config) / 1e9:.1f} GB "
-            f"| {verdict} |"
-        )
-    return "\n".join(rows)
 
 
 def load_state(path: Path) -> dict[str, Any]:
@@ -154,82 +42,6 @@ def load_state(path: Path) -> dict[str, Any]:
             "run's records afresh (scenes and models already made are reused)"
         )
     return state
-
-
-def disk_needed(
-    config: ReproduceConfig,
-    root: Path | None = None,
-    pairs: list[tuple[str, str]] | tuple[tuple[str, str], ...] = SCENARIO_CROPS,
-) -> int:
-    """Bytes the run still has to write under its dataset ``root``: the scenes not yet complete
-    and the observation caches not yet built.
-
-    Args:
-        config: The size of the run.
-        root: The dataset root (``OUT/dataset``); what is complete there is not counted. None
-            for a run not started.
-        pairs: ``(scenario, crop)`` pairs to run.
-
-    Returns:
-        An estimate in bytes, the measured per-view size of finished scenes where there are some.
-    """
-    from davis_ag.benchmark.cache import CACHE_FOLDER
-    from davis_ag.generate.dataset_files import complete_scenes
-    from davis_ag.scene.specs import crop_spec, group_name, scenario_spec
-    from davis_ag.scene.view_grid import views_per_scene
-
-    root = root or Path("/nonexistent")
-    done = set(complete_scenes(root))
-    written = [p for scene in done for p in (root / scene).rglob("*") if p.is_file()]
-    done_views = sum(1 for p in written if p.suffix == ".jpeg")
-    width, height = config.size
-    per_view = (
-        sum(p.stat().st_size for p in written) / done_views
-        if done_views
-        else BYTES_PER_VIEW_720P * width * height / (1280 * 720)
-    )
-    needed = 0.0
-    for scenario_name, crop_name in pairs:
-        crop = crop_spec(crop_name)
-        scenario = scenario_spec(scenario_name, crop)
-        if scenario_name == "mp" and config.mp_extent:
-            scenario = replace(scenario, extent=tuple(config.mp_extent))
-        views = views_per_scene(scenario, crop)
-        n = config.sp_scenes if scenario_name == "sp" else config.mp_scenes
-        group = group_name(scenario, crop)
-        cache_folders = [f"{group}/{p.name}" for p in (root / CACHE_FOLDER / group).glob("*")]
-        made = sum(_among_first(folder, group, n) for folder in done)
-        cached = sum(_among_first(folder, group, n) for folder in cache_folders)
-        needed += views * (per_view * (n - made) + CACHE_BYTES_PER_VIEW * (n - cached))
-    return int(needed)
-
-
-def _among_first(folder: str, group: str, n: int) -> bool:
-    """Whether a scene folder is one of a run's ``n`` scenes of ``group`` (``GROUP/000`` to ``n - 1``)."""
-    name, _, index = folder.partition("/")
-    return name == group and index.isdigit() and int(index) < n
-
-
-def check_disk(
-    config: ReproduceConfig, out: Path, pairs: list[tuple[str, str]] | tuple[tuple[str, str], ...] = SCENARIO_CROPS
-) -> None:
-    """Refuse, before anything is written, a run whose files the disk under ``out`` cannot hold.
-
-    Raises:
-        UserError: when the free space is below :func:`disk_needed` with a 10 % margin.
-    """
-    import shutil
-
-    from davis_ag.errors import UserError
-
-    needed = disk_needed(config, out / "dataset", pairs) * DISK_MARGIN
-    probe = out if out.exists() else next(p for p in out.parents if p.exists())
-    free = shutil.disk_usage(probe).free
-    if free < needed:
-        raise UserError(
-            f"reproduce --config {config.name} needs about {needed / 1e9:.1f} GB more under {out} "
-            f"and the disk has {free / 1e9:.1f} GB free: free space, or pass --out on a larger disk"
-        )
 
 
 def reproduce(

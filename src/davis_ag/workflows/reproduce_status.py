@@ -15,7 +15,8 @@ from pathlib import Path
 from typing import Any
 
 from davis_ag.errors import UserError
-from davis_ag.workflows.reproduce import ReproduceConfig, load_state
+from davis_ag.workflows.reproduce import load_state
+from davis_ag.workflows.reproduce_configs import ReproduceConfig
 from davis_ag.workflows.run_groups import SCENARIO_CROPS, group_key
 
 

@@ -12,97 +12,28 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from davis_ag.benchmark.exact import BEST_FIXED
-from davis_ag.benchmark.paired import CONFIDENCE, paired_key
 from davis_ag.provenance import machine_description
 from davis_ag.scene.specs import PAPER_TABLE3
+from davis_ag.workflows.paper_table4 import (
+    PAPER_ORDERINGS,
+    PAPER_TABLE4,
+    PAPER_TABLE4_STD,
+    PAPER_TIMESTEPS,
+    TITLES,
+    ordering_failures,
+    ordering_holds,
+)
 from davis_ag.workflows.results_policies import (
     LEARNERS,
     cell,
+    learners_run,
     learning_curve_section,
     ordered,
     policy_sections,
-    signed,
     training_record,
 )
 from davis_ag.workflows.run_groups import GROUPS
 from davis_ag.workflows.results_provenance import how_made, stage_rows
-
-#: Table 4 of the paper: scenario -> metric -> policy -> value.
-PAPER_TABLE4: dict[str, dict[str, dict[str, float]]] = {
-    "sp": {
-        "oer_tau": {"A2C": 0.520, "LRD": 0.433, "UDD": 0.371, "Rand": 0.438},
-        "reward": {"A2C": 0.052, "LRD": 0.026, "UDD": 0.008, "Rand": 0.027},
-        "length": {"A2C": 2.987, "LRD": 2.157, "UDD": 2.137, "Rand": 2.652},
-    },
-    "mp": {
-        "oer_tau": {"A2C": 0.369, "LRD": 0.316, "UDD": 0.313, "Rand": 0.340},
-        "reward": {"A2C": 0.020, "LRD": 0.006, "UDD": 0.004, "Rand": 0.012},
-        "length": {"A2C": 5.000, "LRD": 2.558, "UDD": 2.683, "Rand": 4.163},
-    },
-}
-#: Table 4's standard deviations (over its three sets of 200 episodes), in the same layout.
-PAPER_TABLE4_STD: dict[str, dict[str, dict[str, float]]] = {
-    "sp": {
-        "oer_tau": {"A2C": 0.004, "LRD": 0.007, "UDD": 0.008, "Rand": 0.101},
-        "reward": {"A2C": 0.001, "LRD": 0.002, "UDD": 0.002, "Rand": 0.002},
-        "length": {"A2C": 0.008, "LRD": 0.043, "UDD": 0.036, "Rand": 0.056},
-    },
-    "mp": {
-        "oer_tau": {"A2C": 0.009, "LRD": 0.008, "UDD": 0.006, "Rand": 0.002},
-        "reward": {"A2C": 0.003, "LRD": 0.002, "UDD": 0.001, "Rand": 0.002},
-        "length": {"A2C": 0.000, "LRD": 0.097, "UDD": 0.118, "Rand": 0.058},
-    },
-}
-#: The orderings of OER_tau that section VI reads from Table 4: each step is ``>`` (better) or
-#: ``~`` (about equal), left to right.
-PAPER_ORDERINGS: dict[str, tuple[str, ...]] = {
-    "sp": ("A2C", ">", "Rand", "~", "LRD", ">", "UDD"),
-    "mp": ("A2C", ">", "Rand", ">", "LRD", "~", "UDD"),
-}
-#: The 300K environment steps of A2C training in section VI.
-PAPER_TIMESTEPS = 300_000
-TITLES = {"sp": "SP strawberry", "mp": "MP vine"}
-
-
-def ordering_failures(
-    order: tuple[str, ...], policies: dict[str, dict[str, Any]], metric: str = "oer_tau"
-) -> list[str] | None:
-    """The steps of an ordering such as ``A2C > Rand ~ LRD > UDD`` that measured means and stds break.
-
-    ``a > b`` holds when a's mean exceeds b's; ``a ~ b`` when the means differ by no more than the
-    two standard deviations (over sessions) added.
-
-    Returns:
-        One sentence per broken step (empty when the ordering holds); None when a policy in the
-        ordering was not measured.
-    """
-    try:
-        stats = {name: policies[name][metric] for name in order[::2]}
-    except KeyError:
-        return None
-    failures = []
-    for left, relation, right in zip(order[0::2], order[1::2], order[2::2]):
-        a, b = stats[left], stats[right]
-        if relation == ">" and not a["mean"] > b["mean"]:
-            failures.append(f"{left} > {right} fails: {cell(a['mean'])} is not above {cell(b['mean'])}")
-        gap, spread = abs(a["mean"] - b["mean"]), a["std"] + b["std"]
-        if relation == "~" and gap > spread:
-            failures.append(
-                f"{left} ~ {right} fails: {cell(a['mean'])} and {cell(b['mean'])} are "
-                f"{cell(gap)} apart, more than their stds added ({cell(spread)})"
-            )
-    return failures
-
-
-def ordering_holds(order: tuple[str, ...], policies: dict[str, dict[str, Any]], metric: str = "oer_tau") -> bool | None:
-    """Whether an ordering holds for measured means and stds (:func:`ordering_failures`).
-
-    Returns:
-        True or False; None when a policy in the ordering was not measured.
-    """
-    failures = ordering_failures(order, policies, metric)
-    return None if failures is None else not failures
 
 
 def _a2c_play(state: dict[str, Any]) -> str:
@@ -121,17 +52,6 @@ def _a2c_play(state: dict[str, Any]) -> str:
         if plays <= {"deterministic"}
         else "sampled and deterministic"
     )
-
-
-def learners_run(state: dict[str, Any], out: Path | None = None) -> list[str]:
-    """The learners (:data:`LEARNERS`) this run evaluated or trained, from its records only (a run
-    from before PPO names A2C alone, whatever the configuration now lists)."""
-    rows = {name for result in state.get("results", {}).values() for name in result.get("policies", {})}
-    return [
-        learner
-        for learner in LEARNERS
-        if learner in rows or any(training_record(out, key, learner) for key in GROUPS.values())
-    ]
 
 
 def _notes(config: Any, state: dict[str, Any], out: Path | None) -> list[str]:
@@ -222,97 +142,6 @@ def _comparison(scenario: str, policies: dict[str, dict[str, Any]]) -> str:
     )
 
 
-#: The README's block that holds the run's OER_tau beside Table 4's (see :func:`readme_block`).
-README_MARKER = "results-table4"
-
-
-def readme_block(config: Any, state: dict[str, Any]) -> str:
-    """The README's short Table 4: OER_tau, ours beside the paper's, and whether the orderings hold.
-
-    Args:
-        config: The run's :class:`~davis_ag.workflows.reproduce.ReproduceConfig`.
-        state: The run's ``state.json`` (its ``results``).
-
-    Returns:
-        Markdown: a line on the run, a table, a line per ordering.
-    """
-    results = state.get("results", {})
-    learners = [n for n in LEARNERS if n == "A2C" or n in learners_run(state)]
-    head = (
-        f"`{config.name}` run (docs/results.md): {config.sp_scenes} SP strawberry and {config.mp_scenes} "
-        f"MP vine scenes at {config.size[0]}x{config.size[1]}, {' and '.join(learners)} "
-        f"{config.sp_timesteps:,} (SP) and "
-        f"{config.mp_timesteps:,} (MP) steps; OER_tau, mean ± std over {config.sessions} sessions of "
-        f"{config.episodes} episodes on the split each row names. Table 4's rows are the paper's."
-    )
-    extra = [n for n in learners if n != "A2C"]  # learners the paper did not train: ours only
-    columns = ["A2C", *extra, "LRD", "UDD", "Rand", "Oracle", BEST_FIXED]
-    lines = [
-        head,
-        "",
-        "| | A2C | "
-        + "".join(f"{n} (ours only) | " for n in extra)
-        + "LRD | UDD | Rand | Oracle (ours only) | Best fixed action (ours only) |",
-        "|---" * (len(columns) + 1) + "|",
-    ]
-    verdicts = []
-    for scenario in ("sp", "mp"):
-        result = results.get(scenario)
-        if result:
-            policies = result["policies"]
-            scenes, split = len(result["protocol"].get("scenes", [])), result["protocol"]["split"]
-            cells = [
-                f"{cell(policies[n]['oer_tau']['mean'])} ± {cell(policies[n]['oer_tau']['std'])}"
-                if n in policies
-                else "–"
-                for n in columns
-            ]
-            lines.append(
-                f"| {TITLES[scenario]}, ours ({scenes} {split} scene{'s' if scenes != 1 else ''}) | "
-                + " | ".join(cells)
-                + " |"
-            )
-            failures = ordering_failures(PAPER_ORDERINGS[scenario], policies)
-            verdict = (
-                "not checked"
-                if failures is None
-                else "**holds**"
-                if not failures
-                else "**does not hold** (" + "; ".join(failures) + ")"
-            )
-            verdicts.append(f"{TITLES[scenario]}: {' '.join(PAPER_ORDERINGS[scenario])} {verdict}.")
-        else:
-            lines.append(f"| {TITLES[scenario]}, ours | not run |" + " |" * (len(columns) - 1))
-        paper = PAPER_TABLE4[scenario]["oer_tau"]
-        lines.append(
-            f"| {TITLES[scenario]}, paper (Table 4) | "
-            + " | ".join(
-                f"{cell(paper[n])} ± {cell(PAPER_TABLE4_STD[scenario]['oer_tau'][n])}" if n in paper else "-"
-                for n in columns[:-2]
-            )
-            + " | - | - |"
-        )
-    if verdicts:
-        lines += [
-            "",
-            "The paper's orderings in this run (`~`: means within their two standard deviations "
-            "added): " + " ".join(verdicts),
-        ]
-    for learner in learners:
-        gaps = [
-            f"{TITLES[s]} {signed(p['gap'])} ({signed(p['low'])} to {signed(p['high'])})"
-            for s in ("sp", "mp")
-            if (p := results.get(s, {}).get(paired_key(learner)))
-        ]
-        if gaps:
-            lines += [
-                "",
-                f"{learner} minus `{BEST_FIXED}` on the same episodes ({CONFIDENCE:.0%} bootstrap interval over "
-                "the test episodes): " + ", ".join(gaps) + ".",
-            ]
-    return "\n".join(lines)
-
-
 def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path | None = None) -> Path:
     """Write the Markdown results: our Table 4 beside the paper's, how the run was made, the timings.
 
@@ -326,7 +155,8 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
     Returns:
         ``path``.
     """
-    from davis_ag.atomic_files import write_marked_section, write_text_atomic
+    from davis_ag.atomic_files import write_text_atomic
+    from davis_ag.workflows.results_blocks import write_blocks_beside
     from davis_ag.workflows.stage_clock import CLOCK_FILE, machines, read_clock
     from davis_ag.scene.specs import crop_spec, scenario_spec
     from davis_ag.scene.view_grid import views_per_scene
@@ -420,18 +250,16 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
         "| Stage | Seconds | Hours | Ran on (the clock's sittings) | Code | Note |",
         "|---|---|---|---|---|---|",
     ]
-    total = 0.0
     clock = read_clock(out / CLOCK_FILE) if out is not None else {}
+    stages = []  # (stage, seconds, sittings), for the blocks beside the page
     for stage, seconds, code, note in stage_rows(state, out):
-        total += seconds
+        stages.append((stage, seconds, clock.get(stage, [])))
         where = machines(clock.get(stage, []))
         lines.append(f"| {stage} | {seconds:.0f} | {seconds / 3600:.2f} | {where} | {code} | {note} |")
+    total = sum(seconds for _, seconds, _ in stages)
     lines += [f"| total | {total:.0f} | {total / 3600:.2f} | | | |", ""]
     written = write_text_atomic(path, "\n".join(lines) + "\n")
-    # A page in a project's docs/ also updates the README's block beside it, so the README's
-    # numbers are the run's, never copied by hand.
-    folder = Path(path).absolute().parent
-    readme = folder.parent / "README.md"
-    if folder.name == "docs" and readme.is_file() and f"<!-- {README_MARKER}:start -->" in readme.read_text():
-        write_marked_section(readme, README_MARKER, readme_block(config, state))
+    # A page in a project's docs/ also rewrites its blocks in the README and docs/benchmark.md,
+    # so their numbers are the run's, never copied by hand.
+    write_blocks_beside(Path(path), config, state, out, stages)
     return written

@@ -60,6 +60,17 @@ def training_record(out: Path | None, group: str, learner: str = "A2C") -> dict[
     return load_json_object(training_record_path(model_path(out, group, learner))) if out else {}
 
 
+def learners_run(state: dict[str, Any], out: Path | None = None) -> list[str]:
+    """The learners (:data:`LEARNERS`) this run evaluated or trained, from its records only (a run
+    from before PPO names A2C alone, whatever the configuration now lists)."""
+    rows = {name for result in state.get("results", {}).values() for name in result.get("policies", {})}
+    return [
+        learner
+        for learner in LEARNERS
+        if learner in rows or any(training_record(out, key, learner) for key in GROUPS.values())
+    ]
+
+
 def learners_in(policies: dict[str, Any]) -> list[str]:
     """The learners (:data:`LEARNERS`) an evaluation has a row of, in page order."""
     return [name for name in LEARNERS if name in policies]
@@ -202,12 +213,21 @@ def a2c_line(scenario: str, policies: dict[str, Any], out: Path | None, learner:
     return text
 
 
-def train_split_line(scenario: str, result: dict[str, Any], out: Path | None, learner: str = "A2C") -> str | None:
-    """A learner's (A2C's) kept snapshot against the best fixed action on the train split, where it
-    was chosen.
+def train_split_gap(
+    scenario: str, result: dict[str, Any], out: Path | None, learner: str = "A2C"
+) -> dict[str, Any] | None:
+    """A learner's kept snapshot against the best fixed action on the train split, where it was chosen.
 
-    Beside the test verdict this separates a policy that did not learn (no better than one move
-    on the scenes it trained on) from one that does not carry over to unseen scenes.
+    Args:
+        scenario: ``sp`` or ``mp``.
+        result: The scenario's evaluation (its ``train_split``).
+        out: The run's folder, for the learner's training record.
+        learner: ``A2C`` or ``PPO``.
+
+    Returns:
+        ``kept`` (the kept snapshot's sampled OER_tau), ``best`` (the best fixed action's exact
+        OER_tau), ``action``, ``starts``, the record's ``selection`` and its snapshot ``scores``
+        by step; None when the run has no train-split record for it.
     """
     train = result.get("train_split")
     record = training_record(out, GROUPS[scenario], learner)
@@ -217,14 +237,35 @@ def train_split_line(scenario: str, result: dict[str, Any], out: Path | None, le
         return None
     fixed = train["fixed_actions"]
     action = best_fixed_action(fixed)
-    kept, best = scores[selection["kept_step"]], fixed[action]["oer_tau"]
+    return {
+        "kept": scores[selection["kept_step"]],
+        "best": fixed[action]["oer_tau"],
+        "action": action,
+        "starts": train["starts"],
+        "selection": selection,
+        "scores": scores,
+    }
+
+
+def train_split_line(scenario: str, result: dict[str, Any], out: Path | None, learner: str = "A2C") -> str | None:
+    """A learner's (A2C's) kept snapshot against the best fixed action on the train split, where it
+    was chosen.
+
+    Beside the test verdict this separates a policy that did not learn (no better than one move
+    on the scenes it trained on) from one that does not carry over to unseen scenes.
+    """
+    found = train_split_gap(scenario, result, out, learner)
+    if found is None:
+        return None
+    selection, scores = found["selection"], found["scores"]
+    gap = found["kept"] - found["best"]
     last_step = max(scores)
-    gap = kept - best
     return (
-        f"On the train split ({train['starts']:,} eligible starts), where the snapshot was chosen: {learner}'s "
-        f"kept snapshot ({selection['kept_step']:,} steps) scores OER_tau {cell(kept)} "
+        f"On the train split ({found['starts']:,} eligible starts), where the snapshot was chosen: {learner}'s "
+        f"kept snapshot ({selection['kept_step']:,} steps) scores OER_tau {cell(found['kept'])} "
         f"({selection['episodes']} {selection['play']} episodes), the best fixed action there "
-        f"(always `{action}`) {cell(best)} exactly, {cell(abs(gap))} {'above' if gap >= 0 else 'below'} it; "
+        f"(always `{found['action']}`) {cell(found['best'])} exactly, {cell(abs(gap))} "
+        f"{'above' if gap >= 0 else 'below'} it; "
         f"the last snapshot ({last_step:,} steps) {cell(scores[last_step])}. "
         "Above it on train but not on test: a policy that does not carry over to unseen scenes; "
         "not above it on train: a policy that did not learn."

@@ -1,0 +1,88 @@
+"""Table 4 of the paper and the orderings section VI reads from it: the numbers every results
+page and README block sets ours beside, owned here alone.
+
+Every value is the paper's (Table 4, section VI); tests pin them against the paper, never
+against our runs.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from davis_ag.workflows.results_policies import cell
+
+#: Table 4 of the paper: scenario -> metric -> policy -> value.
+PAPER_TABLE4: dict[str, dict[str, dict[str, float]]] = {
+    "sp": {
+        "oer_tau": {"A2C": 0.520, "LRD": 0.433, "UDD": 0.371, "Rand": 0.438},
+        "reward": {"A2C": 0.052, "LRD": 0.026, "UDD": 0.008, "Rand": 0.027},
+        "length": {"A2C": 2.987, "LRD": 2.157, "UDD": 2.137, "Rand": 2.652},
+    },
+    "mp": {
+        "oer_tau": {"A2C": 0.369, "LRD": 0.316, "UDD": 0.313, "Rand": 0.340},
+        "reward": {"A2C": 0.020, "LRD": 0.006, "UDD": 0.004, "Rand": 0.012},
+        "length": {"A2C": 5.000, "LRD": 2.558, "UDD": 2.683, "Rand": 4.163},
+    },
+}
+#: Table 4's standard deviations (over its three sets of 200 episodes), in the same layout.
+PAPER_TABLE4_STD: dict[str, dict[str, dict[str, float]]] = {
+    "sp": {
+        "oer_tau": {"A2C": 0.004, "LRD": 0.007, "UDD": 0.008, "Rand": 0.101},
+        "reward": {"A2C": 0.001, "LRD": 0.002, "UDD": 0.002, "Rand": 0.002},
+        "length": {"A2C": 0.008, "LRD": 0.043, "UDD": 0.036, "Rand": 0.056},
+    },
+    "mp": {
+        "oer_tau": {"A2C": 0.009, "LRD": 0.008, "UDD": 0.006, "Rand": 0.002},
+        "reward": {"A2C": 0.003, "LRD": 0.002, "UDD": 0.001, "Rand": 0.002},
+        "length": {"A2C": 0.000, "LRD": 0.097, "UDD": 0.118, "Rand": 0.058},
+    },
+}
+#: The orderings of OER_tau that section VI reads from Table 4: each step is ``>`` (better) or
+#: ``~`` (about equal), left to right.
+PAPER_ORDERINGS: dict[str, tuple[str, ...]] = {
+    "sp": ("A2C", ">", "Rand", "~", "LRD", ">", "UDD"),
+    "mp": ("A2C", ">", "Rand", ">", "LRD", "~", "UDD"),
+}
+#: The 300K environment steps of A2C training in section VI.
+PAPER_TIMESTEPS = 300_000
+TITLES = {"sp": "SP strawberry", "mp": "MP vine"}
+
+
+def ordering_failures(
+    order: tuple[str, ...], policies: dict[str, dict[str, Any]], metric: str = "oer_tau"
+) -> list[str] | None:
+    """The steps of an ordering such as ``A2C > Rand ~ LRD > UDD`` that measured means and stds break.
+
+    ``a > b`` holds when a's mean exceeds b's; ``a ~ b`` when the means differ by no more than the
+    two standard deviations (over sessions) added.
+
+    Returns:
+        One sentence per broken step (empty when the ordering holds); None when a policy in the
+        ordering was not measured.
+    """
+    try:
+        stats = {name: policies[name][metric] for name in order[::2]}
+    except KeyError:
+        return None
+    failures = []
+    for left, relation, right in zip(order[0::2], order[1::2], order[2::2]):
+        a, b = stats[left], stats[right]
+        if relation == ">" and not a["mean"] > b["mean"]:
+            failures.append(f"{left} > {right} fails: {cell(a['mean'])} is not above {cell(b['mean'])}")
+        gap, spread = abs(a["mean"] - b["mean"]), a["std"] + b["std"]
+        if relation == "~" and gap > spread:
+            failures.append(
+                f"{left} ~ {right} fails: {cell(a['mean'])} and {cell(b['mean'])} are "
+                f"{cell(gap)} apart, more than their stds added ({cell(spread)})"
+            )
+    return failures
+
+
+def ordering_holds(order: tuple[str, ...], policies: dict[str, dict[str, Any]], metric: str = "oer_tau") -> bool | None:
+    """Whether an ordering holds for measured means and stds (:func:`ordering_failures`).
+
+    Returns:
+        True or False; None when a policy in the ordering was not measured.
+    """
+    failures = ordering_failures(order, policies, metric)
+    return None if failures is None else not failures
