@@ -9,37 +9,28 @@ from davis_ag.workflows.reproduce_configs import CONFIGS
 from davis_ag.workflows.results_page import write_results_md
 
 
+def sp_result(oer: dict[str, float], gap: dict, **extra: object) -> dict:
+    """An SP strawberry evaluation as state.json keeps it: each policy's OER_tau, A2C's paired gap."""
+    policies = {
+        name: {
+            "oer_tau": {"mean": m, "std": 0.01},
+            "reward": {"mean": 0.5, "std": 0.01},
+            "length": {"mean": 0.5, "std": 0.01},
+        }
+        for name, m in oer.items()
+    }
+    protocol = {"split": "test", "tau": 3, "sessions": 3, "episodes": 200, "scenes": ["Single-Strawberry/003", "b"]}
+    return {"protocol": protocol, "policies": policies, "a2c_vs_best_fixed": dict(gap, episodes=600), **extra}
+
+
 def test_the_readme_block_beside_docs_is_rewritten_from_the_run(tmp_path: Path) -> None:
     # A results page in a project's docs/ writes the README's block too: no number copied by hand.
     (tmp_path / "docs").mkdir()
     readme = tmp_path / "README.md"
     readme.write_text("# p\n\nbefore\n<!-- results-table4:start -->\nstale .999\n<!-- results-table4:end -->\nafter\n")
-    stat = {"mean": 0.5, "std": 0.01}
-    policies = {
-        name: {"oer_tau": dict(stat, mean=m), "reward": stat, "length": stat}
-        for name, m in (("A2C", 0.6), ("Rand", 0.45), ("LRD", 0.44), ("UDD", 0.3))
-    }
-    state = {
-        "results": {
-            "sp": {
-                "protocol": {
-                    "split": "test",
-                    "tau": 3,
-                    "sessions": 3,
-                    "episodes": 200,
-                    "scenes": ["Single-Strawberry/003", "Single-Strawberry/007"],
-                },
-                "policies": policies,
-                "a2c_vs_best_fixed": {
-                    "gap": 0.027,
-                    "low": 0.01,
-                    "high": 0.04,
-                    "episodes": 600,
-                    "per_scene": [{"scene": "Single-Strawberry/003", "gap": -0.2, "episodes": 22, "starts": 1}],
-                },
-            }
-        }
-    }
+    per_scene = [{"scene": "Single-Strawberry/003", "gap": -0.2, "episodes": 22, "starts": 1}]
+    gap = {"gap": 0.027, "low": 0.01, "high": 0.04, "per_scene": per_scene}
+    state = {"results": {"sp": sp_result({"A2C": 0.6, "Rand": 0.45, "LRD": 0.44, "UDD": 0.3}, gap)}}
     page = write_results_md(tmp_path / "docs" / "results.md", CONFIGS["medium"], state, tmp_path).read_text()
     assert (
         "A2C minus `Best fixed action`: +.027, 95% bootstrap interval over episodes +.010 to +.040 (10,000 "
@@ -73,29 +64,17 @@ def test_the_blocks_beside_docs_give_the_train_gap_and_the_measured_hours(tmp_pa
     selection = {"kept_step": 90_000, "episodes": 200, "play": "sampled"}
     selection["scores"] = [{"step": 90_000, "oer_tau": 0.459}, {"step": 300_000, "oer_tau": 0.442}]
     (tmp_path / "models" / "a2c_sp-strawberry.training.json").write_text(json.dumps({"selection": selection}))
-    stat = {"mean": 0.45, "std": 0.01}
-    policies = {n: {"oer_tau": stat, "reward": stat, "length": stat} for n in ("A2C", "Rand", "LRD", "UDD")}
     fixed = {"up": {"oer_tau": 0.42, "reward": 0.0, "length": 3.0}}
     per_scene = [
         {"scene": f"Single-Strawberry/{i:03d}", "gap": g, "episodes": 1, "starts": 1}
         for i, g in ((3, 0.1), (4, -0.1), (9, 0.2))
     ]
+    gap = {"gap": 0.03, "low": 0.02, "high": 0.039, "per_scene": per_scene}
+    result = sp_result(dict.fromkeys(("A2C", "Rand", "LRD", "UDD"), 0.45), gap)
+    result["protocol"]["starts"] = 507
+    result["train_split"] = {"split": "train", "starts": 1280, "fixed_actions": fixed}
     state = {
-        "results": {
-            "sp": {
-                "protocol": {
-                    "split": "test",
-                    "tau": 3,
-                    "sessions": 3,
-                    "episodes": 200,
-                    "starts": 507,
-                    "scenes": ["a", "b"],
-                },
-                "policies": policies,
-                "a2c_vs_best_fixed": {"gap": 0.03, "low": 0.02, "high": 0.039, "episodes": 600, "per_scene": per_scene},
-                "train_split": {"split": "train", "starts": 1280, "fixed_actions": fixed},
-            }
-        },
+        "results": {"sp": result},
         "stages": {
             "sp-strawberry: generate": {"seconds": 8460.0, "note": "86 scene(s)"},
             "sp-strawberry: evaluate": {"seconds": 36.0, "note": "split test"},
