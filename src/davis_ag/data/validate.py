@@ -13,18 +13,14 @@ other scenes get one pixel of slack on each edge unless told otherwise.
 
 from __future__ import annotations
 
-import json
-import os
 import sys
-from collections import Counter
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
-from pydantic import BaseModel, ValidationError
+from pydantic import ValidationError
 
 from davis_ag.data.class_checks import class_problems
+from davis_ag.data.dataset_checks import check_counts, check_dataset_file, check_splits, unlabelled_scenes
 from davis_ag.data.pixel_checks import (
     boxes_inside,
     camera_size,
@@ -38,74 +34,16 @@ from davis_ag.data.reader import (
     ANNOTATIONS,
     NO_FRUIT,
     SCENE_METADATA,
-    SPLITS,
-    Dataset,
     Scene,
     ViewRecord,
     normalise_view_name,
     open_dataset,
     parse_entry,
 )
-from davis_ag.data.safe_read import check_inside
+from davis_ag.data.problems import Problem, Report, outside_reason, read_json_file
 from davis_ag.data.validate_pool import in_scene_order
-from davis_ag.formats.layout import DATASET_FILE, IMAGES, view_file, view_of_file
-from davis_ag.formats.models import AnnotationEntry, DatasetFile, SplitsFile, one_line
-from davis_ag.errors import UserError
-
-
-@dataclass(frozen=True)
-class Problem:
-    """One thing wrong, and the file it is in."""
-
-    path: Path
-    reason: str
-
-    def __str__(self) -> str:
-        return f"{_display(self.path)}: {self.reason}"
-
-
-def _display(path: Path) -> str:
-    # Relative to the working directory when inside it: shorter and what the user typed.
-    try:
-        return os.path.relpath(path) if Path(path).is_relative_to(Path.cwd()) else str(path)
-    except (ValueError, OSError):  # another drive on Windows, or a deleted working directory
-        return str(path)
-
-
-@dataclass
-class Report:
-    """What a validation run looked at and found."""
-
-    scenes: int = 0
-    views: int = 0
-    boxes: int = 0
-    problems: list[Problem] = field(default_factory=list)
-
-    @property
-    def ok(self) -> bool:
-        """True when no problem was found."""
-        return not self.problems
-
-    def summary(self) -> str:
-        """One line: the counts and the verdict."""
-        verdict = "sound" if self.ok else _plural(len(self.problems), "problem")
-        counts = ", ".join(
-            _plural(n, what) for n, what in ((self.scenes, "scene"), (self.views, "view"), (self.boxes, "box"))
-        )
-        return f"checked {counts}: {verdict}"
-
-
-def _plural(n: int, word: str) -> str:
-    return f"{n} {word}" + ("" if n == 1 else "es" if word.endswith("x") else "s")
-
-
-def _read_json(path: Path) -> tuple[object, str | None]:
-    try:
-        return json.loads(path.read_text(encoding="utf-8")), None
-    except json.JSONDecodeError as error:
-        return None, f"not valid JSON (line {error.lineno} column {error.colno}: {error.msg})"
-    except (OSError, UnicodeDecodeError) as error:
-        return None, f"cannot read ({error})"
+from davis_ag.formats.layout import IMAGES, view_file, view_of_file
+from davis_ag.formats.models import AnnotationEntry, one_line
 
 
 def validate_scene(
@@ -138,11 +76,11 @@ def validate_scene(
             on_problem(problem)
 
     ann_path = scene.path / ANNOTATIONS
-    outside = _outside(ann_path, scene.root)
+    outside = outside_reason(ann_path, scene.root)
     if outside:
         flag(ann_path, outside)
         return report
-    raw, error = _read_json(ann_path)
+    raw, error = read_json_file(ann_path)
     if error is None and (not isinstance(raw, dict) or not raw):
         error = "must be a non-empty JSON object keyed by image name"
     if error is not None or not isinstance(raw, dict):
@@ -153,8 +91,8 @@ def validate_scene(
     if (scene.path / SCENE_METADATA).is_file():
         raw_metadata, error = (
             (None, outside)
-            if (outside := _outside(scene.path / SCENE_METADATA, scene.root))
-            else _read_json(scene.path / SCENE_METADATA)
+            if (outside := outside_reason(scene.path / SCENE_METADATA, scene.root))
+            else read_json_file(scene.path / SCENE_METADATA)
         )
         if error is None:
             try:
@@ -198,11 +136,11 @@ def validate_scene(
         image, mask = images / record.name, view_file(scene.path, record.name, "mask")
         has_image, has_mask = image.is_file(), mask.is_file()
         for path, present in ((image, has_image), (mask, has_mask)):
-            if present and (outside := _outside(path, scene.root)):
+            if present and (outside := outside_reason(path, scene.root)):
                 flag(path, outside)
         # A link out of the dataset is never decoded.
-        has_image = has_image and not _outside(image, scene.root)
-        has_mask = has_mask and not _outside(mask, scene.root)
+        has_image = has_image and not outside_reason(image, scene.root)
+        has_mask = has_mask and not outside_reason(mask, scene.root)
         if not image.is_file():
             flag(image, f"missing: annotations.json has an entry {record.name} for it")
         if not mask.is_file():
@@ -256,18 +194,9 @@ def _check_pixels(
         for problem in depth_problems(record, depth, mask, metadata):
             flag(depth, problem)
     classes = view_file(scene.path, record.name, "classes")
-    if classes.is_file() and not _outside(classes, scene.root):
+    if classes.is_file() and not outside_reason(classes, scene.root):
         for problem in class_problems(classes, mask):
             flag(classes, problem)
-
-
-def _outside(path: Path, root: Path | None) -> str | None:
-    """Why ``path`` must not be read (it resolves outside the dataset), or None."""
-    try:
-        check_inside(path, root)
-    except UserError as error:
-        return str(error).split(": ", 1)[1]
-    return None
 
 
 def _name_or_key(key: str) -> str:
@@ -291,93 +220,6 @@ def _box_schema_problems(record: ViewRecord) -> list[str]:
         if box.fruit_id in seen:
             problems.append(f"{where}: fruit {box.fruit_id} has two boxes in this view")
         seen.add(box.fruit_id)
-    return problems
-
-
-def _check_splits(dataset: Dataset, whole: bool) -> list[Problem]:
-    path = dataset.root / SPLITS
-    splits, problems = _read_root_file(dataset, SPLITS, SplitsFile)
-    if splits is None:
-        return problems
-    known = {scene.id for scene in dataset.scenes}
-    # Only scenes under the opened path are known; a group or scene opened alone sees a subset.
-    problems = [
-        Problem(path, f"{name} lists {i}, which is not a scene here")
-        for name, ids in (("train", splits.train), ("test", splits.test))
-        for i in ids
-        if whole and i not in known
-    ]
-    if both := splits.in_both():
-        problems.append(Problem(path, f"{len(both)} scene(s) in both train and test, e.g. {both[0]}"))
-    return problems
-
-
-def _unlabelled_scenes(dataset: Dataset, whole: bool) -> list[Problem]:
-    """Scene folders beside the dataset's scenes that have images or a scene.json but no readable
-    annotations.json: the reader passes over them, so without this a scene whose labels were lost
-    would leave the dataset "sound" and a scene short."""
-    problems = []
-    groups = {scene.path.parent for scene in dataset.scenes}
-    if whole:  # a group whose every scene lost its labels holds no scene the reader found
-        groups |= {p for p in dataset.root.iterdir() if p.is_dir() and not p.name.startswith(".")}
-    for group in sorted(groups):
-        try:
-            folders = sorted(p for p in group.iterdir() if p.is_dir() and not p.name.startswith("."))
-        except OSError:
-            continue
-        for folder in folders:
-            labels = folder / ANNOTATIONS
-            if labels.is_file() or not ((folder / IMAGES).is_dir() or (folder / SCENE_METADATA).exists()):
-                continue
-            what = "a folder" if labels.is_dir() else "unreadable" if os.path.lexists(labels) else "missing"
-            problems.append(
-                Problem(
-                    labels, f"{what}: this scene has images but no labels; make it again (davis-ag generate resumes)"
-                )
-            )
-    return problems
-
-
-def _read_root_file(dataset: Dataset, name: str, model: type[BaseModel]) -> tuple[Any, list[Problem]]:
-    """A JSON file at the dataset's root read through its model: ``(model or None, problems)``;
-    ``(None, [])`` where the file is absent."""
-    path = dataset.root / name
-    if not path.is_file():
-        return None, []
-    outside = _outside(path, dataset.root)
-    data, error = (None, outside) if outside else _read_json(path)
-    if error:
-        return None, [Problem(path, error)]
-    try:
-        return model.model_validate(data), []
-    except ValidationError as invalid:
-        return None, [Problem(path, one_line(invalid))]
-
-
-def _check_dataset_file(dataset: Dataset) -> list[Problem]:
-    """dataset.json (ours), where the root has one: the settings its scenes share."""
-    return _read_root_file(dataset, DATASET_FILE, DatasetFile)[1]
-
-
-def _check_counts(dataset: Dataset, counts: dict[str, int]) -> list[Problem]:
-    """Scenes of a group share one grid, so a scene with another view count lost or gained images."""
-    problems = []
-    by_group: dict[str, list[Scene]] = {}
-    for scene in dataset.scenes:
-        if scene.id in counts:
-            by_group.setdefault(scene.group, []).append(scene)
-    for group, scenes in by_group.items():
-        common, votes = Counter(counts[s.id] for s in scenes).most_common(1)[0]
-        if votes * 2 <= len(scenes):
-            continue
-        problems += [
-            Problem(
-                s.path / ANNOTATIONS,
-                f"has {counts[s.id]} views but {votes} of the {len(scenes)} scenes of {group} have {common}",
-            )
-            for s in scenes
-            if counts[s.id] != common
-        ]
     return problems
 
 
@@ -421,9 +263,9 @@ def validate_dataset(
 
     whole = Path(path).expanduser().absolute() == dataset.root
     for problem in (
-        _check_splits(dataset, whole)
-        + (_check_dataset_file(dataset) if whole else [])
-        + _unlabelled_scenes(dataset, whole)
+        check_splits(dataset, whole)
+        + (check_dataset_file(dataset) if whole else [])
+        + unlabelled_scenes(dataset, whole)
     ):
         emit(problem)
     scenes = dataset.scenes
@@ -446,7 +288,7 @@ def validate_dataset(
                 counts[scene.id] = part.views
             bar.update()
     bar.close()
-    for problem in _check_counts(dataset, counts):
+    for problem in check_counts(dataset, counts):
         emit(problem)
     return report
 
