@@ -16,12 +16,11 @@ from typing import Any, Callable
 
 import numpy as np
 
-from davis_ag.formats.layout import ROOT_FILES, SCENE_METADATA, published_pointers, view_name
+from davis_ag.formats.layout import published_pointers, view_name
 from davis_ag.formats.models import AnnotationEntry
-from davis_ag.formats.scene_file import SCENE_FORMAT, SceneFile, read_scene_file
+from davis_ag.formats.scene_file import SCENE_FORMAT, SceneFile
 from davis_ag.provenance import code_version
 from davis_ag.seeds import derived_seed
-from davis_ag.atomic_files import PROBE_PREFIX, prove_writable_folder
 from davis_ag.errors import UserError
 from davis_ag.generate.scene_writer import SceneWriter
 from davis_ag.labels.fruit_labels import fruit_lookup, label_view, visible_fractions
@@ -141,22 +140,6 @@ def scene_seed(dataset_seed: int, scenario: ScenarioSpec, crop: CropSpec, index:
     """Derive a scene's seed from the dataset seed; independent streams for every scene."""
     keys = [dataset_seed, list(SCENARIOS).index(scenario.name), list(CROPS).index(crop.name), index]
     return derived_seed(*keys)
-
-
-def read_scene_seed(scene_dir: Path) -> int | None:
-    """The seed a finished scene was made with, or None when it carries no scene.json of ours."""
-    try:
-        return read_scene_file(scene_dir / SCENE_METADATA).seed
-    except UserError:
-        return None
-
-
-def read_scene_size(scene_dir: Path) -> tuple[int, int] | None:
-    """The image size a finished scene was drawn at, or None when its scene.json does not say."""
-    try:
-        return read_scene_file(scene_dir / SCENE_METADATA).image_size()
-    except UserError:
-        return None
 
 
 def generate_scene(
@@ -386,59 +369,3 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict, timing: di
         visible_fraction=visible,
         **({"timing_s": timing} if timing is not None else {}),
     )
-
-
-# ---------------------------------------------------------------------------------------------
-# Output folder checks
-
-
-def check_output_root(root: Path) -> None:
-    """Refuse an output folder we could damage or cannot write.
-
-    Raises:
-        UserError: when ``root`` is a file, holds something that is not a DAVIS-Ag dataset, or
-            cannot be written.
-    """
-    from davis_ag.scene.specs import parse_group_name
-
-    if root.exists() and not root.is_dir():
-        raise UserError(f"{root} is a file, not a folder: choose another --out")
-    if root.is_dir():
-        strangers = [
-            p.name
-            for p in root.iterdir()
-            if p.name not in ROOT_FILES
-            and not p.name.startswith(PROBE_PREFIX)
-            and not (p.is_dir() and parse_group_name(p.name))
-        ]
-        if strangers:
-            raise UserError(
-                f"{root} holds other things ({', '.join(sorted(strangers)[:3])}): "
-                "choose an empty or DAVIS-Ag folder for --out"
-            )
-    prove_writable_folder(root)
-
-
-def check_scene_slot(root: Path, request: SceneRequest) -> bool:
-    """Whether a scene is already complete (True: skip it); clear stale partial folders.
-
-    Raises:
-        UserError: when a finished scene was made with a different seed or image size: it is
-            never replaced.
-    """
-    scene_dir = root / request.folder
-    if scene_dir.exists():
-        seed = read_scene_seed(scene_dir)
-        if seed != request.seed:
-            raise UserError(
-                f"{scene_dir} already holds a scene made with other settings (seed {seed}, "
-                f"not {request.seed}): use another --out or --seed, or move it away"
-            )
-        size = read_scene_size(scene_dir)
-        if size is not None and size != (request.camera.width, request.camera.height):
-            raise UserError(
-                f"{scene_dir} was drawn at {size[0]}x{size[1]}, not {request.camera.width}x"
-                f"{request.camera.height}: use the same --size or another --out"
-            )
-        return True
-    return False

@@ -3,7 +3,7 @@
 A run is safe to kill at any moment and to start again with the same command:
 
 - scenes are written atomically (:mod:`davis_ag.generate.scene_writer`), so a scene folder is whole or absent;
-  finished scenes are skipped (:func:`davis_ag.generate.one_scene.check_scene_slot`) and what a killed run
+  finished scenes are skipped (:func:`davis_ag.generate.output_checks.check_scene_slot`) and what a killed run
   left of a scene (its hidden ``.NNN.partial`` folder) is resumed: the views it wrote are kept and
   only the rest are drawn, unless the request or the code changed, when it is cleared and redone;
 - every scene is fully determined by its seed, so a resumed or redone scene equals the one an
@@ -38,12 +38,8 @@ from davis_ag.generate.dataset_files import (
     reconcile_settings,
     write_splits,
 )
-from davis_ag.generate.one_scene import (
-    SceneRequest,
-    check_output_root,
-    check_scene_slot,
-    generate_scene,
-)
+from davis_ag.generate.one_scene import SceneRequest, generate_scene
+from davis_ag.generate.output_checks import check_output_root, check_scene_slot
 from davis_ag.generate.run_progress import (  # noqa: F401
     DEFAULT_MAX_RETRIES,
     Progress,

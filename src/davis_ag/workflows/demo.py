@@ -6,7 +6,7 @@ a Table 4 style table and write an HTML report (:mod:`davis_ag.figures.report`) 
 with the paper's figures drawn for the small dataset; it ends by saying where they are and how to
 open the viewer (``davis-ag view``).
 
-Every stage is resumable: finished scenes are skipped (:func:`davis_ag.generate.one_scene.check_scene_slot`),
+Every stage is resumable: finished scenes are skipped (:func:`davis_ag.generate.output_checks.check_scene_slot`),
 a crashed scene's partial folder is cleared, and the environment's observation cache is reused.
 """
 
