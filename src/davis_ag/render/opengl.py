@@ -39,45 +39,23 @@ from davis_ag.render.egl_context import create_context, egl_current, egl_restore
 from davis_ag.render.projection import camera_matrices, gl_matrix, helios_shadow_box, light_matrix, matmul32
 from davis_ag.render.scene_geometry import SceneGeometry, read_scene_geometry
 from davis_ag.render.silhouettes import DrawnSilhouettes
-from davis_ag.render.textures import decode_srgb, default_sky_texture, load_texture, texture_layers
+from davis_ag.render.textures import default_sky_texture, load_texture, texture_layers
+from davis_ag.render.vertices import GROUND_REPEAT, SHADOW_FORMAT, VERTEX_FORMAT, interleaved_vertices
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.lighting import Lighting
 from davis_ag.scene.view_grid import Viewpoint
 
 LOOKS = ("default", "helios")
 #: Helios's shading constants (its Visualizer's defaults): Phong weights and shininess, the
-#: ambient sky and ground colours, the boost of vertex colours, exposure, the sun's tint.
+#: ambient sky and ground colours, exposure (the boost of vertex colours: :mod:`davis_ag.render.vertices`).
 MATERIAL = (1.0, 0.8, 0.2, 32.0)
 SKY_AMBIENT = (0.5, 0.6, 0.75)
 GROUND_AMBIENT = (0.35, 0.30, 0.22)
-COLOUR_BOOST = 1.5
 EXPOSURE = 1.0
 #: Side of the one shadow map, texels.
 SHADOW_MAP_SIZE = 4096
 #: Depth offset of the shadow test, in the map's [0, 1] depth (besides a polygon offset).
 SHADOW_BIAS = 1e-4
-#: Default look: one copy of a ground texture covers this many metres of soil. The Context's own
-#: texture coordinates stretch one soil image over a whole 12 m tile (Helios shows its texels as
-#: 2 cm blocks); the default look lays the image at this size instead, with mipmaps.
-GROUND_REPEAT = 0.5
-#: The scene's vertex buffer as moderngl reads it: the format, then the attribute names.
-VERTEX_FORMAT = (
-    "3f 2f 3f 4f 1u 1i 1i",
-    "in_position",
-    "in_uv",
-    "in_normal",
-    "in_colour",
-    "in_id",
-    "in_texture",
-    "in_mode",
-)
-
-
-def linear_albedo(colours: np.ndarray) -> np.ndarray:
-    """Helios's vertex colours as its shader uses them: boosted, clipped, decoded to linear light."""
-    out = np.array(colours, dtype=np.float64)
-    out[:, :3] = decode_srgb(np.clip(out[:, :3] * COLOUR_BOOST, 0.0, 1.0))
-    return out.astype(np.float32)
 
 
 def _shader(name: str) -> str:
@@ -157,33 +135,7 @@ class OpenGLRenderer:
             self._set(program, "shadow_map", 1)
             self._set(program, "sky", 2)
         self._upload_textures(geometry)
-        # Helios draws triangles, then patches, each in UUID order; later draws win depth ties
-        # (GL_LEQUAL), so keep that order.
-        order = np.lexsort((geometry.uuids, geometry.patch))
-        n = geometry.triangle_count
-        vertex = np.zeros(
-            n * 3,
-            dtype=[
-                ("position", "f4", 3),
-                ("uv", "f4", 2),
-                ("normal", "f4", 3),
-                ("colour", "f4", 4),
-                ("id", "u4"),
-                ("texture", "i4"),
-                ("mode", "i4"),
-            ],
-        )
-        vertex["position"] = geometry.positions[order].reshape(-1, 3)
-        uvs = geometry.uvs[order]
-        if not helios:  # the soil's image laid at a fixed size on the ground, not stretched over the tile
-            ground = ~geometry.caster[order] & (geometry.texture[order] >= 0)
-            uvs = np.where(ground[:, None, None], geometry.positions[order][:, :, :2] / GROUND_REPEAT, uvs)
-        vertex["uv"] = uvs.reshape(-1, 2)
-        vertex["normal"] = geometry.normals[order].reshape(-1, 3)
-        vertex["colour"] = np.repeat(linear_albedo(geometry.colours[order]), 3, axis=0)
-        vertex["id"] = np.repeat(geometry.uuids[order].astype(np.uint64) + 1, 3).astype(np.uint32)
-        vertex["texture"] = np.repeat(np.maximum(geometry.texture[order], 0), 3)
-        vertex["mode"] = np.repeat(geometry.mode[order], 3)
+        vertex, order = interleaved_vertices(geometry, ground_repeat=None if helios else GROUND_REPEAT)
         self._vbo = ctx.buffer(vertex.tobytes())
         self._scene = ctx.vertex_array(self._programs["scene"], [(self._vbo, *VERTEX_FORMAT)], skip_errors=True)
         self._ids = ctx.vertex_array(self._programs["ids"], [(self._vbo, *VERTEX_FORMAT)], skip_errors=True)
@@ -201,10 +153,9 @@ class OpenGLRenderer:
             self.camera,
             self._prepare_view,
         )
-        shadow_layout = "3f 2f 12x 16x 4x 1i 1i"
         self._shadow = ctx.vertex_array(
             self._programs["shadow"],
-            [(self._vbo, shadow_layout, "in_position", "in_uv", "in_texture", "in_mode")],
+            [(self._vbo, *SHADOW_FORMAT)],
             skip_errors=True,
         )
         self._sky = ctx.vertex_array(self._programs["sky"], [])
@@ -220,7 +171,7 @@ class OpenGLRenderer:
         self._caster_vbo = ctx.buffer(caster_vertex.tobytes())
         caster_vao = ctx.vertex_array(
             self._programs["shadow"],
-            [(self._caster_vbo, shadow_layout, "in_position", "in_uv", "in_texture", "in_mode")],
+            [(self._caster_vbo, *SHADOW_FORMAT)],
             skip_errors=True,
         )
         shadow_fbo = ctx.framebuffer(depth_attachment=self._shadow_map)
