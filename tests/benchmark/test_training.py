@@ -389,7 +389,7 @@ class _SavesInTwoWrites:
 def test_a_stop_while_a_model_saves_waits_for_the_whole_file(tmp_path: Path) -> None:
     """Ctrl-C during a checkpoint's save: the stop comes once the file is whole, never as torch's
     error from a half-written zip (a CI run caught ``train`` exiting 1 with that traceback)."""
-    from davis_ag.benchmark.training import save_model
+    from davis_ag.benchmark.checkpoints import save_model
     from davis_ag.errors import Stopped
 
     path = tmp_path / "a2c.checkpoint.zip"

@@ -1,8 +1,9 @@
-"""A training run's checkpoint beside its output: whether a run may resume it, and loading it.
+"""A training run's checkpoint beside its output: writing it every so many steps, whether a run may
+resume it, and loading it.
 
 A checkpoint is SB3's zip of the model (with its optimiser state and step count) beside a JSON
 record of the run's settings, steps done, sittings, learning curve and snapshot scores
-(:mod:`davis_ag.benchmark.training` writes both). By the output rule (docs/errors.md) the same
+(:class:`CheckpointEvery` writes both, :func:`save_model` the zip atomically). By the output rule (docs/errors.md) the same
 run's checkpoint is resumed; one of another run, or a damaged one, is discarded only with
 ``--force``, and otherwise refused in one line offering both ways on.
 """
@@ -10,11 +11,18 @@ run's checkpoint is resumed; one of another run, or a damaged one, is discarded 
 from __future__ import annotations
 
 import json
+import time
 from pathlib import Path
 from typing import Any
 
+from stable_baselines3.common.callbacks import BaseCallback
+
+from davis_ag.atomic_files import atomic_output, write_json_atomic
 from davis_ag.benchmark.algorithms import SB3_DEFAULT_SETTINGS
-from davis_ag.errors import UserError
+from davis_ag.benchmark.progress import LearningCurve
+from davis_ag.benchmark.selection import KeepBestOnTrain
+from davis_ag.errors import UserError, stops_held
+from davis_ag.provenance import code_version
 
 
 def resumable(settings_file: Path, model_file: Path, settings: dict[str, Any]) -> tuple[int, list, list, list] | None:
@@ -112,3 +120,75 @@ def load_checkpoint(algorithm: Any, model_file: Path, env: Any, device: str) -> 
             "cannot be resumed: run again with --force to discard it and start over, or stop "
             "here to keep it"
         ) from None
+
+
+def save_model(model: Any, path: Path) -> None:
+    """Save an SB3 model atomically (a kill mid-save leaves the previous file). A stop asked for
+    while it saves (Ctrl-C, SIGTERM) takes effect once the file is in place: cut inside torch's
+    zip writer, it would surface as torch's RuntimeError instead of a stop."""
+    with stops_held(), atomic_output(path, "wb") as handle:
+        model.save(handle)
+
+
+class Sittings:
+    """The sittings of one training run: for each, the code that ran, the steps and the seconds.
+    A run resumed from a checkpoint keeps the sittings before it, so its record says how it was
+    made (and whether the code changed between sittings)."""
+
+    def __init__(self, earlier: list[dict[str, Any]], first_step: int) -> None:
+        self.earlier, self.first_step, self.start = earlier, first_step, time.perf_counter()
+
+    def upto(self, step: int) -> list[dict[str, Any]]:
+        """Every sitting, this one up to ``step``."""
+        now = {
+            "code": code_version(),
+            "from_step": self.first_step,
+            "to_step": step,
+            "seconds": round(time.perf_counter() - self.start, 1),
+        }
+        return [*self.earlier, now]
+
+
+class CheckpointEvery(BaseCallback):
+    """Saves the model, the run's settings and its sittings every ``every`` environment steps."""
+
+    def __init__(
+        self,
+        every: int,
+        model_file: Path,
+        settings_file: Path,
+        settings: dict[str, Any],
+        sittings: Sittings,
+        curve: LearningCurve,
+        selection: KeepBestOnTrain | None,
+    ) -> None:
+        super().__init__()
+        self.every, self.model_file, self.settings_file, self.settings = every, model_file, settings_file, settings
+        self.sittings, self.curve, self.selection = sittings, curve, selection
+        self._last = 0
+
+    def _on_training_start(self) -> None:
+        self._last = self.model.num_timesteps
+
+    def _on_step(self) -> bool:
+        if self.model.num_timesteps - self._last >= self.every:
+            self._last = self.model.num_timesteps
+            with stops_held():  # the model and its settings file, both or neither, before a stop
+                self._save()
+        return True
+
+    def _save(self) -> None:
+        save_model(self.model, self.model_file)
+        scores = self.selection.scores if self.selection else []
+        write_json_atomic(
+            self.settings_file,
+            {
+                **self.settings,
+                "timesteps_done": self._last,
+                "sittings": self.sittings.upto(self._last),
+                "curve": self.curve.points,
+                "selection": scores,
+            },
+        )
+        if self.selection:  # the checkpoint now names the best snapshot: older ones can go
+            self.selection.prune()

@@ -1,9 +1,11 @@
-"""Training's progress: a bar on a terminal, a line a minute in a log (tqdm formats both)."""
+"""Training's progress: a bar on a terminal, a line a minute in a log (tqdm formats both), and the
+learning curve the training record keeps (Fig. 4a)."""
 
 from __future__ import annotations
 
 import sys
 import time
+from typing import Any
 
 from stable_baselines3.common.callbacks import BaseCallback
 
@@ -79,3 +81,47 @@ class TrainingProgress(BaseCallback):
     def _on_training_end(self) -> None:
         if self.bar is not None:
             self.bar.close()
+
+
+class LearningCurve(BaseCallback):
+    """Episode rewards while training, averaged over bins of ``every`` environment steps (Fig. 4a).
+
+    Reads the ``episode`` entry SB3's ``Monitor`` puts in an ending step's info. Each point is
+    ``{"step", "episodes", "reward", "length"}``: the bin's last step, the episodes that ended in
+    it and their mean reward and length. Points before a resumed run's checkpoint are passed in.
+    """
+
+    def __init__(self, every: int, points: list[dict[str, Any]] | None = None) -> None:
+        super().__init__()
+        self.every = every
+        self.points: list[dict[str, Any]] = list(points or [])
+        self._rewards: list[float] = []
+        self._lengths: list[int] = []
+        self._edge = 0
+
+    def _on_training_start(self) -> None:
+        self._edge = (self.model.num_timesteps // self.every + 1) * self.every
+
+    def _on_step(self) -> bool:
+        for info in self.locals.get("infos", []):
+            episode = info.get("episode")
+            if episode:
+                self._rewards.append(float(episode["r"]))
+                self._lengths.append(int(episode["l"]))
+        if self.model.num_timesteps >= self._edge:
+            self.flush(self._edge)
+            self._edge += self.every
+        return True
+
+    def flush(self, step: int) -> None:
+        """Close the current bin at ``step`` (a bin without episodes adds no point)."""
+        if self._rewards:
+            self.points.append(
+                {
+                    "step": int(step),
+                    "episodes": len(self._rewards),
+                    "reward": round(float(sum(self._rewards) / len(self._rewards)), 6),
+                    "length": round(sum(self._lengths) / len(self._lengths), 4),
+                }
+            )
+        self._rewards, self._lengths = [], []

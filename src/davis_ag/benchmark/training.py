@@ -14,15 +14,12 @@ to an uninterrupted one.
 from __future__ import annotations
 
 import os
-import time
 from pathlib import Path
 from typing import Any
 
 import torch
-from stable_baselines3.common.callbacks import BaseCallback
 
 from davis_ag.atomic_files import (
-    atomic_output,
     prove_writable_file,
     write_json_atomic,
     write_or_rescue,
@@ -35,14 +32,13 @@ from davis_ag.benchmark.algorithms import (
     resolve_settings,
     sb3_arguments,
 )
-from davis_ag.benchmark.checkpoints import check_checkpoint, load_checkpoint
+from davis_ag.benchmark.checkpoints import CheckpointEvery, Sittings, check_checkpoint, load_checkpoint, save_model
 from davis_ag.benchmark.networks import ARCHITECTURES
-from davis_ag.benchmark.progress import TrainingProgress
+from davis_ag.benchmark.progress import LearningCurve, TrainingProgress
 from davis_ag.benchmark.selection import KeepBestOnTrain, check_keep, snapshot_path
 from davis_ag.benchmark.tvm import as_dataset
-from davis_ag.errors import MachineError, UserError, stops_held
+from davis_ag.errors import MachineError, UserError
 from davis_ag.formats.models import check_seed
-from davis_ag.provenance import code_version
 
 #: Steps between checkpoints by default: about a minute of training on a 2-core CPU.
 CHECKPOINT_EVERY = 10_000
@@ -103,122 +99,6 @@ def training_record_path(out_path: str | os.PathLike[str]) -> Path:
     return stem.with_name(stem.name + ".training.json")
 
 
-def save_model(model: Any, path: Path) -> None:
-    """Save an SB3 model atomically (a kill mid-save leaves the previous file). A stop asked for
-    while it saves (Ctrl-C, SIGTERM) takes effect once the file is in place: cut inside torch's
-    zip writer, it would surface as torch's RuntimeError instead of a stop."""
-    with stops_held(), atomic_output(path, "wb") as handle:
-        model.save(handle)
-
-
-class _Sittings:
-    """The sittings of one training run: for each, the code that ran, the steps and the seconds.
-    A run resumed from a checkpoint keeps the sittings before it, so its record says how it was
-    made (and whether the code changed between sittings)."""
-
-    def __init__(self, earlier: list[dict[str, Any]], first_step: int) -> None:
-        self.earlier, self.first_step, self.start = earlier, first_step, time.perf_counter()
-
-    def upto(self, step: int) -> list[dict[str, Any]]:
-        """Every sitting, this one up to ``step``."""
-        now = {
-            "code": code_version(),
-            "from_step": self.first_step,
-            "to_step": step,
-            "seconds": round(time.perf_counter() - self.start, 1),
-        }
-        return [*self.earlier, now]
-
-
-class LearningCurve(BaseCallback):
-    """Episode rewards while training, averaged over bins of ``every`` environment steps (Fig. 4a).
-
-    Reads the ``episode`` entry SB3's ``Monitor`` puts in an ending step's info. Each point is
-    ``{"step", "episodes", "reward", "length"}``: the bin's last step, the episodes that ended in
-    it and their mean reward and length. Points before a resumed run's checkpoint are passed in.
-    """
-
-    def __init__(self, every: int = CURVE_EVERY, points: list[dict[str, Any]] | None = None) -> None:
-        super().__init__()
-        self.every = every
-        self.points: list[dict[str, Any]] = list(points or [])
-        self._rewards: list[float] = []
-        self._lengths: list[int] = []
-        self._edge = 0
-
-    def _on_training_start(self) -> None:
-        self._edge = (self.model.num_timesteps // self.every + 1) * self.every
-
-    def _on_step(self) -> bool:
-        for info in self.locals.get("infos", []):
-            episode = info.get("episode")
-            if episode:
-                self._rewards.append(float(episode["r"]))
-                self._lengths.append(int(episode["l"]))
-        if self.model.num_timesteps >= self._edge:
-            self.flush(self._edge)
-            self._edge += self.every
-        return True
-
-    def flush(self, step: int) -> None:
-        """Close the current bin at ``step`` (a bin without episodes adds no point)."""
-        if self._rewards:
-            self.points.append(
-                {
-                    "step": int(step),
-                    "episodes": len(self._rewards),
-                    "reward": round(float(sum(self._rewards) / len(self._rewards)), 6),
-                    "length": round(sum(self._lengths) / len(self._lengths), 4),
-                }
-            )
-        self._rewards, self._lengths = [], []
-
-
-class _Checkpoint(BaseCallback):
-    """Saves the model, the run's settings and its sittings every ``every`` environment steps."""
-
-    def __init__(
-        self,
-        every: int,
-        model_file: Path,
-        settings_file: Path,
-        settings: dict[str, Any],
-        sittings: _Sittings,
-        curve: LearningCurve,
-        selection: KeepBestOnTrain | None,
-    ) -> None:
-        super().__init__()
-        self.every, self.model_file, self.settings_file, self.settings = every, model_file, settings_file, settings
-        self.sittings, self.curve, self.selection = sittings, curve, selection
-        self._last = 0
-
-    def _on_training_start(self) -> None:
-        self._last = self.model.num_timesteps
-
-    def _on_step(self) -> bool:
-        if self.model.num_timesteps - self._last >= self.every:
-            self._last = self.model.num_timesteps
-            with stops_held():  # the model and its settings file, both or neither, before a stop
-                self._save()
-        return True
-
-    def _save(self) -> None:
-        save_model(self.model, self.model_file)
-        scores = self.selection.scores if self.selection else []
-        write_json_atomic(
-            self.settings_file,
-            {
-                **self.settings,
-                "timesteps_done": self._last,
-                "sittings": self.sittings.upto(self._last),
-                "curve": self.curve.points,
-                "selection": scores,
-            },
-        )
-        if self.selection:  # the checkpoint now names the best snapshot: older ones can go
-            self.selection.prune()
-
-
 def train_a2c(dataset: Any, scenario: str, **kwargs: Any) -> Path:
     """:func:`train_agent` with ``algo="a2c"``: the paper's agent."""
     return train_agent(dataset, scenario, algo="a2c", **kwargs)
@@ -261,7 +141,7 @@ def train_agent(
     environment steps over all environments. By default the saved model is the snapshot that
     scored best on the train split (``keep``, :mod:`davis_ag.benchmark.selection`), not the
     last. The training record (:func:`training_record_path`) keeps the settings, the learning
-    curve (:class:`LearningCurve`) and the snapshots' train-split scores.
+    curve (:class:`~davis_ag.benchmark.progress.LearningCurve`) and the snapshots' train-split scores.
 
     Args:
         dataset: Dataset root or opened dataset.
@@ -349,7 +229,7 @@ def train_agent(
         )
         done, earlier, points = 0, [], []
     model.set_logger(console_logger(verbose))
-    sittings = _Sittings(earlier, done)
+    sittings = Sittings(earlier, done)
     curve = LearningCurve(CURVE_EVERY, points)
     selection = None
     if keep == "best-train":
@@ -360,7 +240,9 @@ def train_agent(
     shown = TrainingProgress(total_timesteps, f"{algo.upper()} {scenario}", selection) if progress else None
     callbacks = [c for c in (callback, curve, selection, shown) if c is not None]
     if checkpoint_every:
-        callbacks.append(_Checkpoint(checkpoint_every, model_file, settings_file, settings, sittings, curve, selection))
+        callbacks.append(
+            CheckpointEvery(checkpoint_every, model_file, settings_file, settings, sittings, curve, selection)
+        )
     try:
         if total_timesteps > done:
             model.learn(
