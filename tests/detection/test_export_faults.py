@@ -94,6 +94,20 @@ def test_a_renamed_scene_folder_is_refused_not_dropped(
     assert "Single-Strawberry/000" in err and "Single-Strawberry/000 (copy)" in err and "rename" in err
 
 
+@pytest.mark.parametrize("fmt", ["coco", "yolo"])
+def test_a_scene_that_lost_its_labels_is_refused_not_dropped(
+    fmt: str, data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A scene whose annotations.json became a link to itself left the export, exit 0."""
+    labels = data / "Single-Strawberry" / "001" / "annotations.json"
+    labels.unlink()
+    labels.symlink_to("annotations.json")
+    code, _, err = export(capsys, fmt, str(data), str(tmp_path / "out"))
+    assert code == 2 and len(err.splitlines()) == 1
+    assert "Single-Strawberry/001: a" in err and "without a readable annotations.json" in err
+    assert not (tmp_path / "out").exists()  # refused before anything is created
+
+
 def test_a_killed_export_leaves_nothing_the_next_run_keeps(
     pristine: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

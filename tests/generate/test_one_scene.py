@@ -453,3 +453,22 @@ def test_random_appearance_changes_the_pictures_not_the_labels(
         else:
             differ += np.abs(ours - paper).mean() > 2
     assert differ == VIEWS
+
+
+def test_a_scene_that_lost_its_labels_is_neither_skipped_nor_drawn_over(
+    generated: tuple[Path, Path, dict], tmp_path: Path
+) -> None:
+    # A resumed run took a finished folder for a complete scene by its seed alone, so a scene whose
+    # annotations.json was lost stayed lost; drawing over it could destroy what is left.
+    from davis_ag.errors import UserError
+    from davis_ag.generate.output_checks import check_scene_slot
+
+    _, scene_dir, _ = generated
+    root = tmp_path / "ds"
+    shutil.copytree(scene_dir, root / REQUEST.folder)
+    assert check_scene_slot(root, REQUEST) is True  # whole: skipped
+    (root / REQUEST.folder / "annotations.json").unlink()
+    before = snapshot(root)
+    with pytest.raises(UserError, match="has lost its annotations.json .* move the folder out of the dataset"):
+        check_scene_slot(root, REQUEST)
+    assert snapshot(root) == before

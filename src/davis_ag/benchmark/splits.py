@@ -13,6 +13,7 @@ from __future__ import annotations
 from typing import Any
 
 from davis_ag.errors import UserError
+from davis_ag.formats.layout import ANNOTATIONS
 from davis_ag.formats.splits import recorded_seed, split_scenes
 from davis_ag.scene.specs import crop_spec, parse_group_name, scenario_spec
 
@@ -51,8 +52,28 @@ def dataset_splits(dataset: Any) -> dict[str, list[str]]:
     """
     splits = getattr(dataset, "splits", None)
     if splits is not None:
-        return {"train": [str(i) for i in splits.train], "test": [str(i) for i in splits.test]}
+        lists = {"train": [str(i) for i in splits.train], "test": [str(i) for i in splits.test]}
+        _refuse_unlabelled(dataset, lists)
+        return lists
     return split_scenes((s.id for s in dataset.scenes), recorded_seed(dataset.root))
+
+
+def _refuse_unlabelled(dataset: Any, lists: dict[str, list[str]]) -> None:
+    """Refuse a split naming a scene under the opened folder whose folder is there without
+    readable labels: the reader passes over such a folder, so the scene would silently leave its
+    split (and a benchmark or an export be made on fewer scenes than it says)."""
+    readable = {s.id for s in dataset.scenes}
+    opened = getattr(dataset, "opened", None) or dataset.root
+    for split, ids in lists.items():
+        for scene_id in ids:
+            folder = dataset.root / scene_id
+            inside = folder == opened or opened in folder.parents
+            if inside and scene_id not in readable and folder.is_dir() and not (folder / ANNOTATIONS).is_file():
+                raise UserError(
+                    f"{folder}: a {split} scene of splits.json without a readable {ANNOTATIONS}, so it would "
+                    f"silently leave its split; move the folder out of the dataset and run davis-ag generate "
+                    "again to make it anew (davis-ag validate lists every such scene)"
+                )
 
 
 def select_scenes(dataset: Any, scenario: str, split: str, crop: str | None = None) -> list[Any]:

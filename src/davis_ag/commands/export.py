@@ -114,9 +114,12 @@ def check_out(out: Path, fmt: str) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Export ``args.dir`` to ``args.out``; prints the counts per split."""
+    from davis_ag.benchmark.splits import dataset_splits
     from davis_ag.data.reader import open_dataset
 
-    open_dataset(args.dir)  # a bad DIR is reported before anything is created
+    dataset = open_dataset(args.dir)  # a bad DIR, or a split that lost a scene, before anything is created
+    if args.format != "pointcloud":
+        dataset_splits(dataset)
     check_out(args.out, args.format)
     unfinished = (args.out / UNFINISHED).exists()  # a stopped export: the same command carries on
     with claim_output(args.out, force=args.force or unfinished, folder=True, temporaries=LEFT_BY_A_KILL):

@@ -55,7 +55,9 @@ def unlabelled_scenes(dataset: Dataset, whole: bool) -> list[Problem]:
             what = "a folder" if labels.is_dir() else "unreadable" if os.path.lexists(labels) else "missing"
             problems.append(
                 Problem(
-                    labels, f"{what}: this scene has images but no labels; make it again (davis-ag generate resumes)"
+                    labels,
+                    f"{what}: this scene has images but no labels; move the folder out of the dataset and run "
+                    "davis-ag generate again to make it anew",
                 )
             )
     return problems

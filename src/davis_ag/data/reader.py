@@ -354,10 +354,12 @@ class Dataset:
         root: The dataset root (the folder holding group folders), also when a group or scene
             folder was opened.
         scenes: The scenes under the opened path, sorted by id.
+        opened: The folder opened: the root, a group folder or a scene folder (None: the root).
     """
 
     root: Path
     scenes: list[Scene]
+    opened: Path | None = None
 
     def scene(self, scene_id: str) -> Scene:
         """Look a scene up by id, e.g. ``"Single-Strawberry/000"``.
@@ -435,4 +437,4 @@ def open_dataset(path: str | Path) -> Dataset:
             "or a scene folder"
         )
     scenes.sort(key=lambda s: s.id)
-    return Dataset(root, scenes)
+    return Dataset(root, scenes, path)

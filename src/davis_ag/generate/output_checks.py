@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 
 from davis_ag.atomic_files import PROBE_PREFIX, prove_writable_folder
 from davis_ag.errors import UserError
-from davis_ag.formats.layout import ROOT_FILES, SCENE_METADATA
+from davis_ag.formats.layout import ANNOTATIONS, ROOT_FILES, SCENE_METADATA
 from davis_ag.formats.scene_file import read_scene_file
 
 if TYPE_CHECKING:
@@ -60,11 +60,15 @@ def check_output_root(root: Path) -> None:
 
 
 def check_scene_slot(root: Path, request: SceneRequest) -> bool:
-    """Whether a scene is already complete (True: skip it); clear stale partial folders.
+    """Whether a scene is already complete (True: skip it).
+
+    A scene's folder appears only once the scene is whole (it is written under a hidden partial
+    name first), so a folder without its labels lost them afterwards: it is neither skipped as
+    complete nor drawn over.
 
     Raises:
-        UserError: when a finished scene was made with a different seed or image size: it is
-            never replaced.
+        UserError: when a finished scene was made with a different seed or image size, or has
+            lost its labels: it is never replaced.
     """
     scene_dir = root / request.folder
     if scene_dir.exists():
@@ -79,6 +83,11 @@ def check_scene_slot(root: Path, request: SceneRequest) -> bool:
             raise UserError(
                 f"{scene_dir} was drawn at {size[0]}x{size[1]}, not {request.camera.width}x"
                 f"{request.camera.height}: use the same --size or another --out"
+            )
+        if not (scene_dir / ANNOTATIONS).is_file():
+            raise UserError(
+                f"{scene_dir} has lost its {ANNOTATIONS} (missing or unreadable), so it is not complete: "
+                "move the folder out of the dataset and run again to make the scene anew"
             )
         return True
     return False
