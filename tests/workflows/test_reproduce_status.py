@@ -123,3 +123,26 @@ def test_a_learner_not_started_is_timed_at_its_rate_on_the_other_group(tmp_path:
     timed = by_name["sp-strawberry: generate"].left_s + 400.0 + CONFIG.mp_timesteps / 50.0
     assert last.startswith(f"About {timed / 3600:.1f} hours left in the stages timed above, and ")
     assert "mp-vine: generate" in last and "mp-vine: train PPO" in last and "train A2C" not in last
+
+
+def test_a_generate_stage_shows_its_views_before_its_first_scene_ends(tmp_path: Path) -> None:
+    # A paper-scale MP vine scene takes about half an hour: the stage showed "not started" and no
+    # time left for its first scenes. The journals of the scenes under way give both.
+    from davis_ag.scene.view_grid import views_per_scene
+
+    out = a_run_part_way(tmp_path)
+    for index, views in ((0, 200), (1, 100)):
+        partial = out / "dataset" / "Multi-Vine" / f".{index:03d}.partial"
+        partial.mkdir(parents=True)
+        (partial / "views.jsonl").write_text('{"name": "x"}\n' * views)
+    clock = json.loads((out / "clock.json").read_text())
+    clock["stages"]["mp-vine: generate"] = [{"started": "t", "seconds": 600.0, "code": "x"}]
+    (out / "clock.json").write_text(json.dumps(clock))
+    stage = {s.stage: s for s in run_status(out)[1]}["mp-vine: generate"]
+    assert (stage.done, stage.progress, stage.seconds) == (
+        False,
+        "0 of 2 scenes; 2 more under way (300 views drawn)",
+        600.0,
+    )
+    views = views_per_scene(*CONFIG.specs("mp", "vine"))
+    assert stage.left_s == pytest.approx((2 * views - 300) * 600.0 / 300)

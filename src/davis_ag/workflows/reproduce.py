@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import json
 import os
-from dataclasses import asdict, replace
+from dataclasses import asdict
 from functools import partial
 from pathlib import Path
 from typing import Any
@@ -66,7 +66,6 @@ def reproduce(
     from davis_ag.figures.result_charts import plot_results
     from davis_ag.generate.one_scene import SceneRequest
     from davis_ag.scene.camera import Camera
-    from davis_ag.scene.specs import crop_spec, scenario_spec
     from davis_ag.provenance import code_version, machine_summary
     from davis_ag.workflows.demo import evaluation_split, generate_scenes, run_baselines
     from davis_ag.workflows.results_page import write_results_md
@@ -97,11 +96,8 @@ def reproduce(
 
     camera = Camera(*config.size)
     for scenario_name, crop_name in pairs:
-        crop = crop_spec(crop_name)
-        scenario = scenario_spec(scenario_name, crop)
-        if scenario_name == "mp" and config.mp_extent:
-            scenario = replace(scenario, extent=tuple(config.mp_extent))
-        n = config.sp_scenes if scenario_name == "sp" else config.mp_scenes
+        scenario, crop = config.specs(scenario_name, crop_name)
+        n = config.scenes(scenario_name)
         key = group_key(scenario_name, crop_name)
         requests = [SceneRequest(scenario, crop, i, config.seed, camera) for i in range(n)]
         state.setdefault("scene_folders", {})[key] = [r.folder for r in requests]

@@ -9,7 +9,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from davis_ag.benchmark.cache import OBS_SIZE
-from davis_ag.scene.specs import PAPER_IMAGE_SIZE, PAPER_TABLE3
+from davis_ag.scene.specs import PAPER_IMAGE_SIZE, PAPER_TABLE3, CropSpec, ScenarioSpec, crop_spec, scenario_spec
 from davis_ag.workflows.run_groups import SCENARIO_CROPS
 
 
@@ -43,6 +43,18 @@ class ReproduceConfig:
     sessions: int = 3
     seed: int = 0
     learners: tuple[str, ...] = ("a2c", "ppo")
+
+    def scenes(self, scenario_name: str) -> int:
+        """How many scenes the run makes of a scenario (``sp`` or ``mp``)."""
+        return self.sp_scenes if scenario_name == "sp" else self.mp_scenes
+
+    def specs(self, scenario_name: str, crop_name: str) -> tuple[ScenarioSpec, CropSpec]:
+        """The scenario and crop of one group of the run, the MP grid cut to :attr:`mp_extent`."""
+        crop = crop_spec(crop_name)
+        scenario = scenario_spec(scenario_name, crop)
+        if scenario_name == "mp" and self.mp_extent:
+            scenario = replace(scenario, extent=tuple(self.mp_extent))
+        return scenario, crop
 
 
 #: ``small``: under an hour of stages on a 2-core CPU machine without GPU;
@@ -151,7 +163,7 @@ def disk_needed(
     """
     from davis_ag.benchmark.cache import CACHE_FOLDER
     from davis_ag.generate.dataset_files import complete_scenes
-    from davis_ag.scene.specs import crop_spec, group_name, scenario_spec
+    from davis_ag.scene.specs import group_name
     from davis_ag.scene.view_grid import views_per_scene
 
     root = root or Path("/nonexistent")
@@ -166,12 +178,9 @@ def disk_needed(
     )
     needed = 0.0
     for scenario_name, crop_name in pairs:
-        crop = crop_spec(crop_name)
-        scenario = scenario_spec(scenario_name, crop)
-        if scenario_name == "mp" and config.mp_extent:
-            scenario = replace(scenario, extent=tuple(config.mp_extent))
+        scenario, crop = config.specs(scenario_name, crop_name)
         views = views_per_scene(scenario, crop)
-        n = config.sp_scenes if scenario_name == "sp" else config.mp_scenes
+        n = config.scenes(scenario_name)
         group = group_name(scenario, crop)
         cache_folders = [f"{group}/{p.name}" for p in (root / CACHE_FOLDER / group).glob("*")]
         made = sum(_among_first(folder, group, n) for folder in done)

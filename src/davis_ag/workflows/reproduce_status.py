@@ -4,7 +4,7 @@ A ``paper-scale`` run takes many sittings; its log says what the last one did. T
 what each stage of the whole run has done (scenes made, steps trained, evaluations written), how
 long it has worked on the stage's clock, and about how long is left: for a stage under way (a
 learner at the rate of its last sitting, a generate stage at the mean time of its scenes so
-far), and for a learner not started, at the rate the same learner trained at on the run's other
+far, or at the rate of the views drawn before its first scene ends), and for a learner not started, at the rate the same learner trained at on the run's other
 group; the stages with no rate yet are named, not guessed. Reading it while the run goes on is safe: every file it reads is written atomically.
 """
 
@@ -30,7 +30,8 @@ class StageStatus:
         progress: What it has done, in words (``62 of 86 scenes``, ``not started``).
         seconds: Its wall time so far on the run's clock (or its record), None when it has none.
         left_s: About how long is left, where it is under way: a learner's at its last sitting's
-            rate, a generate stage's at the mean time of its scenes made so far.
+            rate, a generate stage's at the mean time of its scenes made so far (before the first
+            ends, at the rate of the views drawn on the stage's clock).
     """
 
     stage: str
@@ -94,13 +95,8 @@ def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
     stages: list[StageStatus] = []
     for scenario, crop in SCENARIO_CROPS:
         key = group_key(scenario, crop)
-        wanted = config.sp_scenes if scenario == "sp" else config.mp_scenes
-        folders = state.get("scene_folders", {}).get(key, [])
-        count = sum(folder in made for folder in folders)
         stage = f"{key}: generate"
-        progress = f"{count} of {wanted} scenes" if folders else "not started"
-        left = _generation_left(out / "dataset", [f for f in folders if f in made], wanted - count)
-        stages.append(StageStatus(stage, bool(folders) and count == wanted, progress, seconds(stage), left))
+        stages.append(_generation_status(out / "dataset", config, scenario, crop, state, made, seconds(stage)))
         stage = f"{key}: validate"
         note = recorded.get(stage, {}).get("note")
         stages.append(
@@ -117,6 +113,47 @@ def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
         progress = f"{config.sessions} x {config.episodes} episodes written" if written else "not started"
         stages.append(StageStatus(stage, written, progress, seconds(stage)))
     return config, stages
+
+
+def _generation_status(
+    root: Path,
+    config: ReproduceConfig,
+    scenario: str,
+    crop: str,
+    state: dict[str, Any],
+    made: set[str],
+    seconds: float | None,
+) -> StageStatus:
+    """A generate stage from its scene folders: the scenes made, and the views drawn so far in
+    those under way (their hidden partial folders' journals), so a stage of long scenes shows
+    progress before its first scene ends.
+    """
+    from davis_ag.generate.scene_writer import JOURNAL, partial_dir
+    from davis_ag.scene.specs import group_name
+    from davis_ag.scene.view_grid import views_per_scene
+
+    key, wanted = group_key(scenario, crop), config.scenes(scenario)
+    scenario_spec, crop_spec = config.specs(scenario, crop)
+    recorded = state.get("scene_folders", {}).get(key, [])
+    # The run records its folders as the stage starts; before that they are the first `wanted` of the group.
+    folders = recorded or [f"{group_name(scenario_spec, crop_spec)}/{i:03d}" for i in range(wanted)]
+    count = sum(folder in made for folder in folders)
+    drawn = under_way = 0
+    for folder in folders:
+        journal = partial_dir(root / folder) / JOURNAL
+        if folder not in made and journal.is_file():
+            with open(journal, "rb") as lines:
+                drawn += sum(1 for _ in lines)
+            under_way += 1
+    started = bool(recorded) or count > 0 or under_way > 0
+    progress = f"{count} of {wanted} scenes" if started else "not started"
+    if under_way:
+        progress += f"; {under_way} more under way ({drawn:,} views drawn)"
+    left = _generation_left(root, [f for f in folders if f in made], wanted - count)
+    if left is None and seconds and drawn and not count:
+        # No scene finished yet: the views drawn on this stage's clock give the rate.
+        left = (wanted * views_per_scene(scenario_spec, crop_spec) - drawn) * seconds / drawn
+    return StageStatus(f"{key}: generate", bool(recorded) and count == wanted, progress, seconds, left)
 
 
 def _generation_left(root: Path, made: list[str], remaining: int) -> float | None:
