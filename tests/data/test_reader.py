@@ -50,6 +50,9 @@ def test_open_root_group_and_scene_folder(ours: Path) -> None:
     single = open_dataset(ours / "Single-Strawberry" / "001")
     assert [s.id for s in single] == ["Single-Strawberry/001"]
     assert single.splits == ds.splits
+    # A path through `..` names the folder it reaches: `001/..` is the group, not a scene `../001`.
+    through = open_dataset(ours / "Single-Strawberry" / "001" / "..")
+    assert through.root == ours.absolute() and [s.id for s in through] == [s.id for s in group]
 
 
 def test_scene_properties(ours: Path) -> None:

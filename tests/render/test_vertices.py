@@ -11,21 +11,26 @@ from hypothesis import strategies as st
 from davis_ag.render.scene_geometry import SceneGeometry
 from davis_ag.render.vertices import SHADOW_FORMAT, VERTEX_DTYPE, VERTEX_FORMAT, interleaved_vertices
 
-SIZES = {"f": 4, "u": 4, "i": 4}
+
+def offsets(layout: tuple[str, ...]) -> dict[str, tuple[int, int]]:
+    """Each attribute of a moderngl buffer format (``"3f 12x 1i", "in_a", "in_b"``): its byte
+    offset and size in one vertex, padding (``12x``) skipped; ``"_end"``: the vertex's size."""
+    at, found, names = 0, {}, iter(layout[1:])
+    for count, kind in re.findall(r"(\d+)([fuix])", layout[0]):
+        size = int(count) * (1 if kind == "x" else 4)
+        if kind != "x":
+            found[next(names).removeprefix("in_")] = (at, size)
+        at += size
+    found["_end"] = (at, 0)
+    return found
 
 
-def format_bytes(layout: str) -> int:
-    """Bytes one vertex of a moderngl buffer format takes (``3f``: 12, ``12x``: 12)."""
-    total = 0
-    for count, kind in re.findall(r"(\d+)([fuix])", layout):
-        total += int(count) * (1 if kind == "x" else SIZES[kind])
-    return total
-
-
-def test_both_formats_read_the_buffer_the_dtype_writes() -> None:
-    assert format_bytes(VERTEX_FORMAT[0]) == VERTEX_DTYPE.itemsize
-    assert format_bytes(SHADOW_FORMAT[0]) == VERTEX_DTYPE.itemsize
-    assert len(VERTEX_FORMAT) - 1 == len(VERTEX_DTYPE.names)
+def test_both_formats_read_each_attribute_where_the_dtype_writes_it() -> None:
+    fields = {name: (offset, dtype.itemsize) for name, (dtype, offset) in VERTEX_DTYPE.fields.items()}
+    assert offsets(VERTEX_FORMAT) == {**fields, "_end": (VERTEX_DTYPE.itemsize, 0)}
+    shadow = offsets(SHADOW_FORMAT)
+    assert shadow.pop("_end") == (VERTEX_DTYPE.itemsize, 0)  # the same stride
+    assert shadow == {name: fields[name] for name in ("position", "uv", "texture", "mode")}
 
 
 def geometry(uuids: list[int], patch: list[bool], ground: int) -> SceneGeometry:

@@ -10,6 +10,8 @@ the generator would have split it.
 
 from __future__ import annotations
 
+import os
+from pathlib import Path
 from typing import Any
 
 from davis_ag.errors import UserError
@@ -49,6 +51,10 @@ def dataset_splits(dataset: Any) -> dict[str, list[str]]:
 
     Returns:
         ``{"train": [...], "test": [...]}``.
+
+    Raises:
+        UserError: when splits.json names a scene, under the folder opened, whose folder is there
+            without a readable annotations.json: it would silently leave its split.
     """
     splits = getattr(dataset, "splits", None)
     if splits is not None:
@@ -66,13 +72,14 @@ def _refuse_unlabelled(dataset: Any, lists: dict[str, list[str]]) -> None:
     opened = getattr(dataset, "opened", None) or dataset.root
     for split, ids in lists.items():
         for scene_id in ids:
-            folder = dataset.root / scene_id
+            folder = Path(os.path.normpath(dataset.root / scene_id))  # an id with ".." is no scene of ours
             inside = folder == opened or opened in folder.parents
             if inside and scene_id not in readable and folder.is_dir() and not (folder / ANNOTATIONS).is_file():
                 raise UserError(
                     f"{folder}: a {split} scene of splits.json without a readable {ANNOTATIONS}, so it would "
-                    f"silently leave its split; move the folder out of the dataset and run davis-ag generate "
-                    "again to make it anew (davis-ag validate lists every such scene)"
+                    "silently leave its split; move the folder out of the dataset and run davis-ag generate (or the "
+                    "reproduce that made it) again to make it anew; davis-ag validate on the dataset root lists "
+                    "every such scene"
                 )
 
 
@@ -89,7 +96,8 @@ def select_scenes(dataset: Any, scenario: str, split: str, crop: str | None = No
         The selected scenes.
 
     Raises:
-        UserError: for an unknown split, or when nothing is left.
+        UserError: for an unknown split, when nothing is left, or when the split lost a scene
+            (:func:`dataset_splits`).
     """
     scenario = scenario_spec(scenario).name
     crop = crop_spec(crop).name if crop else None

@@ -57,7 +57,7 @@ def unlabelled_scenes(dataset: Dataset, whole: bool) -> list[Problem]:
                 Problem(
                     labels,
                     f"{what}: this scene has images but no labels; move the folder out of the dataset and run "
-                    "davis-ag generate again to make it anew",
+                    "davis-ag generate (or the reproduce that made it) again to make it anew",
                 )
             )
     return problems

@@ -12,6 +12,7 @@ here, so ``from davis_ag.data.reader import Box, exposure_rate`` works.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -415,7 +416,7 @@ def open_dataset(path: str | Path) -> Dataset:
     Raises:
         UserError: when the path does not exist or holds no DAVIS-Ag scene.
     """
-    path = Path(path).expanduser().absolute()
+    path = Path(os.path.normpath(Path(path).expanduser().absolute()))  # `G/000/..` is G, not a scene
     if not path.exists():
         raise UserError(f"{path}: no such folder; give the dataset root, a group folder or a scene folder")
     if not path.is_dir():

@@ -261,7 +261,7 @@ def validate_dataset(
         if on_problem:
             on_problem(problem)
 
-    whole = Path(path).expanduser().absolute() == dataset.root
+    whole = dataset.opened == dataset.root
     for problem in (
         check_splits(dataset, whole)
         + (check_dataset_file(dataset) if whole else [])

@@ -87,7 +87,7 @@ def check_scene_slot(root: Path, request: SceneRequest) -> bool:
         if not (scene_dir / ANNOTATIONS).is_file():
             raise UserError(
                 f"{scene_dir} has lost its {ANNOTATIONS} (missing or unreadable), so it is not complete: "
-                "move the folder out of the dataset and run again to make the scene anew"
+                "move the folder out of the dataset and run again to make the scene anew (validate lists every such scene)"
             )
         return True
     return False

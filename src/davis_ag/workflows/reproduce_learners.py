@@ -51,7 +51,7 @@ def train_learner(
         scenario, crop: What to train on.
         model: The model's ``.zip`` (:func:`davis_ag.workflows.results_policies.model_path`).
         timesteps: Environment steps.
-        config: The run's :class:`~davis_ag.workflows.reproduce.ReproduceConfig` (seed, environments).
+        config: The run's :class:`~davis_ag.workflows.reproduce_configs.ReproduceConfig` (seed, environments).
         settings: The algorithm's settings over ours (tests: a short PPO rollout); None: ours.
         **train_kwargs: Passed on to ``train_agent`` (tests: a small network, a callback).
 

@@ -1,11 +1,14 @@
 """``davis-ag reproduce --status``: where a long run stands, read from its files, touching nothing.
 
-A ``paper-scale`` run takes many sittings; its log says what the last one did. The status says
-what each stage of the whole run has done (scenes made, steps trained, evaluations written), how
-long it has worked on the stage's clock, and about how long is left: for a stage under way (a
-learner at the rate of its last sitting, a generate stage at the mean time of its scenes so
-far, or at the rate of the views drawn before its first scene ends), and for a learner not started, at the rate the same learner trained at on the run's other
-group; the stages with no rate yet are named, not guessed. Reading it while the run goes on is safe: every file it reads is written atomically.
+A ``paper-scale`` run takes many sittings; its log says what the last one did. The status says what
+each stage of the whole run has done (scenes made, steps trained, evaluations written), how long it
+has worked on the stage's clock, and about how long is left: for a stage under way (a learner at the
+rate of its last sitting, a generate stage at the mean time of its scenes so far, or at the rate of
+the views drawn before its first scene ends), and for a learner not started, at the rate the same
+learner trained at on the run's other group; the stages with no rate yet are named, not guessed.
+Reading it while the run goes on is safe: it writes nothing, every file it reads but one is written
+atomically, and the one that grows (a scene's journal of views) may vanish as its scene ends, which
+counts it as not under way.
 """
 
 from __future__ import annotations
@@ -141,10 +144,14 @@ def _generation_status(
     drawn = under_way = 0
     for folder in folders:
         journal = partial_dir(root / folder) / JOURNAL
-        if folder not in made and journal.is_file():
+        if folder in made:
+            continue
+        try:
             with open(journal, "rb") as lines:
                 drawn += sum(1 for _ in lines)
-            under_way += 1
+        except OSError:  # not begun, or finished and moved into place since `made` was read
+            continue
+        under_way += 1
     started = bool(recorded) or count > 0 or under_way > 0
     progress = f"{count} of {wanted} scenes" if started else "not started"
     if under_way:

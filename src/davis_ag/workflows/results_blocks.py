@@ -117,7 +117,7 @@ def readme_block(config: Any, state: dict[str, Any], out: Path | None = None) ->
 
 
 def _learner_gaps(scenario: str, result: dict[str, Any], out: Path | None, learner: str) -> str | None:
-    """``SP strawberry +.030 (+.020 to +.039), ahead on 18 of 23 test scenes, train +.040``."""
+    """``SP strawberry +.030 (+.020 to +.039), ahead on 18 of the 23 test scenes played, train +.040``."""
     paired = result.get(paired_key(learner))
     if not paired:
         return None

@@ -147,7 +147,7 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
 
     Args:
         path: The Markdown file.
-        config: The run's :class:`~davis_ag.workflows.reproduce.ReproduceConfig`.
+        config: The run's :class:`~davis_ag.workflows.reproduce_configs.ReproduceConfig`.
         state: The run's ``state.json``: ``results`` (per scenario), ``stages`` (seconds, notes,
             code) and ``scene_folders`` (per group).
         out: The work folder, for the scene and training records.
