@@ -42,6 +42,20 @@ def test_compare_ranks_methods_with_their_gaps(
     assert "Gap to Best fixed action [95 %]" in text
 
 
+def test_gaps_over_several_scenes_give_the_interval_over_scenes_too(sp_root: Path, tmp_path: Path) -> None:
+    # With two scenes or more, each gap also says whether it would hold on other scenes like these.
+    from davis_ag.benchmark.evaluation import format_table
+
+    results = evaluate([_always("up")], sp_root, "sp", split="all", sessions=2, episodes=8)
+    scenes = {e.scene for e in results.policies["always_up"].episodes}
+    assert len(scenes) >= 2
+    gap = results.policies["always_up"].paired["Rand"]
+    assert gap.scene_low is not None and gap.scene_low <= gap.scene_high
+    assert "  over scenes" in format_table(results)
+    rows = leaderboard([results.write(tmp_path / "up.json")])
+    assert " scenes [" in format_leaderboard(rows) and "over the test scenes resampled" in format_leaderboard(rows)
+
+
 def test_compare_refuses_another_dataset_or_split(
     sp_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

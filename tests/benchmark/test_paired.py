@@ -67,4 +67,31 @@ def test_the_gap_is_the_difference_of_means_and_lies_in_its_interval(rows: list,
     # Scene gaps weighted by their episodes give back the overall gap; the same seed, the same interval.
     assert sum(s.gap * s.episodes for s in gap.per_scene) / gap.episodes == pytest.approx(gap.gap, abs=1e-9)
     again = paired_gap(episodes(list(first), scenes), episodes(list(second), scenes), seed=seed)
-    assert (again.low, again.high) == (gap.low, gap.high)
+    assert (again.low, again.high, again.scene_low, again.scene_high) == (
+        gap.low,
+        gap.high,
+        gap.scene_low,
+        gap.scene_high,
+    )
+    # Resampled scenes average their gaps, so the interval over scenes lies within the scenes' own gaps.
+    if len(gap.per_scene) < 2:
+        assert gap.scene_low is gap.scene_high is None
+    else:
+        lowest, highest = min(s.gap for s in gap.per_scene), max(s.gap for s in gap.per_scene)
+        assert lowest - 1e-9 <= gap.scene_low <= gap.scene_high <= highest + 1e-9
+
+
+def test_a_gap_that_rests_on_one_scene_of_many_does_not_survive_resampling_the_scenes() -> None:
+    # Ten scenes of 60 episodes: a gap of .3 on one scene and none on the others is sure over
+    # episodes (600 of them) but not over scenes: another draw of ten scenes may leave it out.
+    scenes = [f"SP/{i // 60:03d}" for i in range(600)]
+    rng = np.random.default_rng(0)
+    base = rng.uniform(0.2, 0.5, 600)
+    better = base + np.where(np.arange(600) < 60, 0.3, 0.0) + rng.normal(0, 0.01, 600)
+    gap = paired_gap(episodes(list(better), scenes), episodes(list(base), scenes))
+    assert gap.low > 0  # over episodes: above zero
+    assert gap.scene_low is not None and gap.scene_low <= 0.001 < gap.gap < gap.scene_high
+    # The same gap spread over every scene survives either way.
+    even = base + 0.03 + rng.normal(0, 0.01, 600)
+    spread = paired_gap(episodes(list(even), scenes), episodes(list(base), scenes))
+    assert spread.low > 0 and spread.scene_low > 0

@@ -299,13 +299,21 @@ def format_table(results: EvaluationResults | dict[str, Any]) -> str:
             )
     baselines = [b for b in PAIRED_BASELINES if b in policies]
     for baseline in baselines:
-        row = ["", f"gap to {baseline}"]
+        row, over_scenes = ["", f"gap to {baseline}"], ["", "  over scenes"]
         for name in names:
             gap = policies[name].paired.get(baseline)
             row.append(
                 f"{signed_number(gap.gap)} [{signed_number(gap.low)}, {signed_number(gap.high)}]" if gap else "-"
             )
+            scene_low, scene_high = (gap.scene_low, gap.scene_high) if gap else (None, None)
+            over_scenes.append(
+                f"[{signed_number(scene_low)}, {signed_number(scene_high)}]"
+                if scene_low is not None and scene_high is not None
+                else "-"
+            )
         cells.append(row)
+        if any(cell != "-" for cell in over_scenes[2:]):
+            cells.append(over_scenes)
     widths = [max(len(row[i]) for row in cells) for i in range(len(cells[0]))]
     lines = ["  ".join(c.ljust(w) for c, w in zip(row, widths)).rstrip() for row in cells]
     lines.insert(1, "-" * len(lines[0]))
@@ -315,7 +323,8 @@ def format_table(results: EvaluationResults | dict[str, Any]) -> str:
     )
     if baselines:
         lines.append(
-            "gap: mean OER_tau minus the baseline's on the same episodes, [95 % bootstrap interval over episodes]"
+            "gap: mean OER_tau minus the baseline's on the same episodes, [95 % bootstrap interval over episodes]; "
+            "over scenes: [the same, resampling the test scenes]"
         )
     if BEST_FIXED in policies:
         lines.append(

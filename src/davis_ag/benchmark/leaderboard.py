@@ -144,7 +144,12 @@ def leaderboard(paths: list[str | os.PathLike[str]]) -> list[Row]:
 
 
 def _gap_cell(gap: PairedGap | None) -> str:
-    return "-" if gap is None else f"{signed_number(gap.gap)} [{signed_number(gap.low)}, {signed_number(gap.high)}]"
+    if gap is None:
+        return "-"
+    cell = f"{signed_number(gap.gap)} [{signed_number(gap.low)}, {signed_number(gap.high)}]"
+    if gap.scene_low is not None and gap.scene_high is not None:
+        cell += f" scenes [{signed_number(gap.scene_low)}, {signed_number(gap.scene_high)}]"
+    return cell
 
 
 def format_leaderboard(rows: list[Row]) -> str:
@@ -176,6 +181,8 @@ def format_leaderboard(rows: list[Row]) -> str:
     lines += [
         "",
         "Mean ± std over sessions. Gap: mean OER_tau minus the baseline's on the same episodes, with the "
-        "95 % bootstrap interval over episodes; `-`: the baseline itself, or a method that did not play the same episodes.",
+        "95 % bootstrap interval over episodes (would it hold on other starts of these scenes?) and, after "
+        "`scenes`, over the test scenes resampled (would it hold on other scenes like these?); `-`: the "
+        "baseline itself, or a method that did not play the same episodes.",
     ]
     return "\n".join(lines) + "\n"

@@ -56,13 +56,16 @@ class SceneGap(_Model):
 
 class PairedGap(_Model):
     """Mean OER_tau of a policy minus a baseline's on the same episodes, with the bootstrap
-    interval over episodes (:mod:`davis_ag.benchmark.paired`) and the gap per test scene."""
+    interval over episodes (:mod:`davis_ag.benchmark.paired`), the gap per test scene and the
+    interval over scenes (None with one scene, or in results from before it was given)."""
 
     gap: float
     low: float
     high: float
     episodes: int
     per_scene: list[SceneGap]
+    scene_low: float | None = None
+    scene_high: float | None = None
 
 
 class Episode(_Model):

@@ -107,9 +107,10 @@ def readme_block(config: Any, state: dict[str, Any], out: Path | None = None) ->
         lines += [
             "",
             f"Each learner minus `{BEST_FIXED}` on the same test episodes ({CONFIDENCE:.0%} bootstrap "
-            "interval), the test scenes it is ahead on, and on the train split its kept snapshot minus "
-            "the best fixed action there (ahead on train only: it does not carry over to unseen scenes; "
-            "ahead on neither: it did not learn):",
+            "interval over episodes), the test scenes it is ahead on (with the interval when the test "
+            "scenes themselves are resampled: whether the gap would hold on other scenes like them), "
+            "and on the train split its kept snapshot minus the best fixed action there (ahead on train "
+            "only: it does not carry over to unseen scenes; ahead on neither: it did not learn):",
             "",
         ]
         lines += [f"- {learner}: " + "; ".join(found) + "." for learner, found in gaps.items()]
@@ -117,7 +118,8 @@ def readme_block(config: Any, state: dict[str, Any], out: Path | None = None) ->
 
 
 def _learner_gaps(scenario: str, result: dict[str, Any], out: Path | None, learner: str) -> str | None:
-    """``SP strawberry +.030 (+.020 to +.039), ahead on 18 of the 23 test scenes played, train +.040``."""
+    """``SP strawberry +.030 (+.020 to +.039), ahead on 18 of the 23 test scenes played (+.012 to
+    +.047 resampling them), train +.040``."""
     paired = result.get(paired_key(learner))
     if not paired:
         return None
@@ -125,6 +127,8 @@ def _learner_gaps(scenario: str, result: dict[str, Any], out: Path | None, learn
     text = f"{TITLES[scenario]} {signed(paired['gap'])} ({signed(paired['low'])} to {signed(paired['high'])})"
     if scenes:
         text += f", ahead on {sum(s['gap'] > 0 for s in scenes)} of the {len(scenes)} test scenes played"
+    if paired.get("scene_low") is not None:
+        text += f" ({signed(paired['scene_low'])} to {signed(paired['scene_high'])} resampling them)"
     train = train_split_gap(scenario, result, out, learner)
     if train is not None:
         text += f", train {signed(train['kept'] - train['best'])}"

@@ -114,15 +114,26 @@ def paired_line(result: dict[str, Any], learner: str = "A2C") -> str | None:
         f"start{'s' if s['starts'] != 1 else ''})"
         for s in scenes
     )
-    side = "above" if paired["low"] > 0 else "below" if paired["high"] < 0 else "on both sides of"
+    over_scenes = (
+        f"Resampling the {len(scenes)} test scenes instead (each with all its episodes: would the gap hold on "
+        f"other scenes like these?), the {CONFIDENCE:.0%} interval is {signed(paired['scene_low'])} to "
+        f"{signed(paired['scene_high'])}, {_side(paired['scene_low'], paired['scene_high'])} zero."
+        if paired.get("scene_low") is not None
+        else "The interval covers the starts these test scenes hold, not other scenes; the per-scene gaps "
+        "hint at how much the scene matters."
+    )
     return (
         f"Episode by episode (every policy plays the same {paired['episodes']} episodes), {learner} minus "
         f"`{BEST_FIXED}`: {signed(paired['gap'])}, {CONFIDENCE:.0%} bootstrap interval over episodes "
-        f"{signed(paired['low'])} to {signed(paired['high'])} ({RESAMPLES:,} resamples), {side} zero. "
-        f"Per test scene: {per_scene}; {learner} is ahead on {ahead} of {len(scenes)}. The interval covers the "
-        "starts these test scenes hold, not other scenes; the per-scene gaps hint at how much the scene "
-        "matters."
+        f"{signed(paired['low'])} to {signed(paired['high'])} ({RESAMPLES:,} resamples), "
+        f"{_side(paired['low'], paired['high'])} zero. "
+        f"Per test scene: {per_scene}; {learner} is ahead on {ahead} of {len(scenes)}. {over_scenes}"
     )
+
+
+def _side(low: float, high: float) -> str:
+    """Where an interval lies against zero: ``above``, ``below`` or ``on both sides of``."""
+    return "above" if low > 0 else "below" if high < 0 else "on both sides of"
 
 
 def exact_table(policies: dict[str, Any], fixed: dict[str, dict[str, float]] | None) -> list[str]:
