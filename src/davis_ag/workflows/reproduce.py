@@ -111,7 +111,7 @@ def reproduce(
         if not validate_once(group, state, f"{key}: validate", clock, record):
             return 1
         split = evaluation_split(root, scenario_name, crop_name)
-        timesteps = config.sp_timesteps if scenario_name == "sp" else config.mp_timesteps
+        timesteps = config.timesteps(scenario_name)
         models = {}
         for algo in config.learners:
             models[algo] = model_path(out, key, algo)

@@ -48,6 +48,10 @@ class ReproduceConfig:
         """How many scenes the run makes of a scenario (``sp`` or ``mp``)."""
         return self.sp_scenes if scenario_name == "sp" else self.mp_scenes
 
+    def timesteps(self, scenario_name: str) -> int:
+        """Environment steps each learner trains for on a scenario (``sp`` or ``mp``)."""
+        return self.sp_timesteps if scenario_name == "sp" else self.mp_timesteps
+
     def specs(self, scenario_name: str, crop_name: str) -> tuple[ScenarioSpec, CropSpec]:
         """The scenario and crop of one group of the run, the MP grid cut to :attr:`mp_extent`."""
         crop = crop_spec(crop_name)

@@ -105,7 +105,7 @@ def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
         stages.append(
             StageStatus(stage, bool(note and note.endswith(": sound")), note or "not started", seconds(stage))
         )
-        timesteps = config.sp_timesteps if scenario == "sp" else config.mp_timesteps
+        timesteps = config.timesteps(scenario)
         for algo in config.learners:
             stage = f"{key}: train {algo.upper()}"
             stages.append(_training_status(out, key, algo, timesteps, stage, seconds(stage)))
