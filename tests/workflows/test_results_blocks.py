@@ -34,9 +34,10 @@ def test_the_readme_block_beside_docs_is_rewritten_from_the_run(tmp_path: Path) 
     page = write_results_md(tmp_path / "docs" / "results.md", CONFIGS["medium"], state, tmp_path).read_text()
     assert (
         "A2C minus `Best fixed action`: +.027, 95% bootstrap interval over episodes +.010 to +.040 (10,000 "
-        "resamples), above zero. Per test scene: Single-Strawberry/003 -.200 (22 episodes, 1 start); A2C is "
-        "ahead on 0 of 1."
+        "resamples), above zero. A2C is ahead on 0 of the 1 test scenes played (the table below)."
     ) in page
+    assert "| Scene | Episodes | Distinct starts | A2C |" in page
+    assert "| Single-Strawberry/003 | 22 | 1 | -.200 |" in page and "| ahead on | | | 0 of 1 |" in page
     text = readme.read_text()
     assert "stale" not in text and text.startswith("# p\n\nbefore\n") and text.endswith("after\n")
     assert "PPO" not in text and "PPO" not in page  # a run without PPO (medium's), whatever CONFIGS now lists

@@ -282,7 +282,7 @@ def test_a_run_with_ppo_shows_its_row_gap_settings_and_stage(tmp_path: Path, sp_
     gap = state["results"]["sp"]["ppo_vs_best_fixed"]
     ahead = sum(s["gap"] > 0 for s in gap["per_scene"])
     assert f"PPO minus `Best fixed action`: {'+' if gap['gap'] >= 0 else '-'}{_c(abs(gap['gap']))}" in text
-    assert f"PPO is ahead on {ahead} of 1." in text and "A2C is ahead on" in text
+    assert f"PPO is ahead on {ahead} of the 1 test scenes played" in text and "A2C is ahead on" in text
     assert "PPO: trained with n_steps=16, n_epochs=4, batch_size=32, learning_rate=lin_2.5e-4" in text
     assert "PPO beside it (RL Baselines3 Zoo's Atari settings" in text
     train_starts = state["results"]["sp"]["train_split"]["starts"]

@@ -109,11 +109,6 @@ def paired_line(result: dict[str, Any], learner: str = "A2C") -> str | None:
         return None
     scenes = paired["per_scene"]
     ahead = sum(s["gap"] > 0 for s in scenes)
-    per_scene = "; ".join(
-        f"{s['scene']} {signed(s['gap'])} ({s['episodes']} episodes, {s['starts']:,} "
-        f"start{'s' if s['starts'] != 1 else ''})"
-        for s in scenes
-    )
     over_scenes = (
         f"Resampling the {len(scenes)} test scenes instead (each with all its episodes: would the gap hold on "
         f"other scenes like these?), the {CONFIDENCE:.0%} interval is {signed(paired['scene_low'])} to "
@@ -127,8 +122,34 @@ def paired_line(result: dict[str, Any], learner: str = "A2C") -> str | None:
         f"`{BEST_FIXED}`: {signed(paired['gap'])}, {CONFIDENCE:.0%} bootstrap interval over episodes "
         f"{signed(paired['low'])} to {signed(paired['high'])} ({RESAMPLES:,} resamples), "
         f"{_side(paired['low'], paired['high'])} zero. "
-        f"Per test scene: {per_scene}; {learner} is ahead on {ahead} of {len(scenes)}. {over_scenes}"
+        f"{learner} is ahead on {ahead} of the {len(scenes)} test scenes played (the table below). {over_scenes}"
     )
+
+
+def per_scene_table(result: dict[str, Any], learners: list[str]) -> list[str]:
+    """Each learner minus the Best fixed action on each test scene, as a table (empty without gaps)."""
+    gaps = {learner: p for learner in learners if (p := result.get(paired_key(learner)))}
+    if not gaps:
+        return []
+    scenes: dict[str, dict[str, Any]] = {}
+    for learner, paired in gaps.items():
+        for scene in paired["per_scene"]:
+            scenes.setdefault(scene["scene"], {"episodes": scene["episodes"], "starts": scene["starts"]})[learner] = (
+                scene["gap"]
+            )
+    lines = [
+        f"Per test scene, each learner's mean OER_tau minus `{BEST_FIXED}`'s over the scene's episodes:",
+        "",
+        "| Scene | Episodes | Distinct starts | " + " | ".join(gaps) + " |",
+        "|---|---:|---:|" + "---:|" * len(gaps),
+    ]
+    for name in sorted(scenes):
+        row = scenes[name]
+        cells = [signed(row[learner]) if learner in row else "-" for learner in gaps]
+        lines.append(f"| {name} | {row['episodes']} | {row['starts']:,} | " + " | ".join(cells) + " |")
+    ahead = [f"{sum(s['gap'] > 0 for s in p['per_scene'])} of {len(p['per_scene'])}" for p in gaps.values()]
+    lines.append("| ahead on | | | " + " | ".join(ahead) + " |")
+    return lines + [""]
 
 
 def _side(low: float, high: float) -> str:
@@ -376,6 +397,7 @@ def policy_sections(scenario: str, result: dict[str, Any], out: Path | None, pag
         for line in (versus_best_fixed(policies, learner), paired_line(result, learner)):
             if line:
                 lines += [line, ""]
+    lines += per_scene_table(result, learners)
     if BEST_FIXED in policies:
         lines += [
             f"`{BEST_FIXED}` is the best of the policies that always play the same action, chosen "
