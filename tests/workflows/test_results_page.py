@@ -285,6 +285,8 @@ def test_a_run_with_ppo_shows_its_row_gap_settings_and_stage(tmp_path: Path, sp_
     assert f"PPO is ahead on {ahead} of the 1 test scenes played" in text and "A2C is ahead on" in text
     assert "PPO: trained with n_steps=16, n_epochs=4, batch_size=32, learning_rate=lin_2.5e-4" in text
     assert "PPO beside it (RL Baselines3 Zoo's Atari settings" in text
+    # Beside PPO, A2C's curve says it is A2C's.
+    assert "- sp-strawberry (A2C): rolling mean" in text and "- sp-strawberry (PPO): rolling mean" in text
     train_starts = state["results"]["sp"]["train_split"]["starts"]
     assert (
         f"Split `test` (1 scene(s), {both['protocol']['starts']:,} eligible starts; the train split: "

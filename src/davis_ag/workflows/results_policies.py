@@ -341,14 +341,16 @@ def learning_curve_section(out: Path | None, page: Path, results: dict[str, Any]
 
     if out is None:
         return []
-    # A2C's curves keep the group's name as their label, as on pages from before PPO.
-    records = {
-        key if learner == "A2C" else f"{key} ({learner})": training_record(out, key, learner)
+    found = {
+        (key, learner): r
         for key in GROUPS.values()
         for learner in LEARNERS
+        if (r := training_record(out, key, learner))
     }
-    records = {key: r for key, r in records.items() if r}
-    title = "A2C learning curve" if all(" (" not in key for key in records) else "Learning curves"
+    alone = {learner for _, learner in found} <= {"A2C"}
+    # A2C alone (the paper's run) labels its curves by group only; beside another learner, each says which.
+    records = {key if alone else f"{key} ({learner})": r for (key, learner), r in found.items()}
+    title = "A2C learning curve" if alone else "Learning curves"
     if not records:
         return []
     target = page.parent / "images" / "results-learning-curve"
