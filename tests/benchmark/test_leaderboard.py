@@ -54,6 +54,19 @@ def test_gaps_over_several_scenes_give_the_interval_over_scenes_too(sp_root: Pat
     assert "  over scenes" in format_table(results)
     rows = leaderboard([results.write(tmp_path / "up.json")])
     assert " scenes [" in format_leaderboard(rows) and "over the test scenes resampled" in format_leaderboard(rows)
+    # A file from before the interval over scenes gets it from its episodes.
+    path = tmp_path / "old.json"
+    data = json.loads((tmp_path / "up.json").read_text())
+    for policy in data["policies"].values():
+        for gap in policy.get("paired", {}).values():
+            gap.pop("scene_low", None), gap.pop("scene_high", None)
+    path.write_text(json.dumps(data))
+    row = next(r for r in leaderboard([path]) if r.name == "always_up")
+    assert row.gaps["Rand"].scene_low == gap_rand_low(rows)
+
+
+def gap_rand_low(rows: list) -> float:
+    return next(r for r in rows if r.name == "always_up").gaps["Rand"].scene_low
 
 
 def test_compare_refuses_another_dataset_or_split(

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from davis_ag.benchmark.paired import paired_gap
+from davis_ag.benchmark.paired import a2c_against_best_fixed, paired_gap
 
 
 def episodes(oer: list[float], scenes: list[str] | None = None) -> list[dict]:
@@ -95,3 +95,22 @@ def test_a_gap_that_rests_on_one_scene_of_many_does_not_survive_resampling_the_s
     even = base + 0.03 + rng.normal(0, 0.01, 600)
     spread = paired_gap(episodes(list(even), scenes), episodes(list(base), scenes))
     assert spread.low > 0 and spread.scene_low > 0
+
+
+def test_a_gap_stored_before_the_interval_over_scenes_gets_it_from_the_episodes() -> None:
+    scenes = [f"SP/{i % 4:03d}" for i in range(40)]
+    first, second = episodes([0.5 + i % 4 / 10 for i in range(40)], scenes), episodes([0.5] * 40, scenes)
+    fresh = paired_gap(first, second)
+    old = {k: v for k, v in fresh.__dict__.items() if not k.startswith("scene_")}  # as an older file kept it
+    results = {
+        "protocol": {"seed": 0},
+        "policies": {
+            "A2C": {"paired": {"Best fixed action": old}, "episodes": first},
+            "Best fixed action": {"episodes": second},
+        },
+    }
+    again = a2c_against_best_fixed(results)
+    assert (again["low"], again["scene_low"], again["scene_high"]) == (fresh.low, fresh.scene_low, fresh.scene_high)
+    # Without its episodes the stored gap is what there is.
+    del results["policies"]["A2C"]["episodes"]
+    assert a2c_against_best_fixed(results) is old

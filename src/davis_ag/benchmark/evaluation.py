@@ -33,6 +33,7 @@ import numpy as np
 
 from davis_ag.benchmark import exact
 from davis_ag.benchmark.agents import FixedActionAgent
+from davis_ag.benchmark.paired import FEW_SCENES
 from davis_ag.benchmark.policies import prepare
 from davis_ag.benchmark.results import (
     PROTOCOL_VERSION,
@@ -324,7 +325,7 @@ def format_table(results: EvaluationResults | dict[str, Any]) -> str:
     if baselines:
         lines.append(
             "gap: mean OER_tau minus the baseline's on the same episodes, [95 % bootstrap interval over episodes]; "
-            "over scenes: [the same, resampling the test scenes]"
+            f"over scenes: [the same, resampling the test scenes; coarse below {FEW_SCENES}]"
         )
     if BEST_FIXED in policies:
         lines.append(

@@ -17,6 +17,7 @@ from typing import Any
 from pathlib import Path
 
 from davis_ag.benchmark.evaluation import PAIRED_BASELINES
+from davis_ag.benchmark.paired import FEW_SCENES
 from davis_ag.benchmark.results import (
     EvaluationResults,
     PairedGap,
@@ -96,13 +97,15 @@ def _same_episodes(a: EvaluationResults, b: EvaluationResults) -> bool:
 def _gap(
     row_results: EvaluationResults, policy: PolicyResult, baseline: str, files: list[tuple[Path, EvaluationResults]]
 ) -> PairedGap | None:
-    """The row's gap to ``baseline``: its own file's, else across files that played the same episodes."""
-    if baseline in policy.paired:
-        return policy.paired[baseline]
+    """The row's gap to ``baseline``: its own file's, else across files that played the same episodes
+    (and so for a file from before the interval over scenes, when it kept its episodes)."""
+    from davis_ag.benchmark.paired import lacks_scene_interval, paired_gap
+
+    own = policy.paired.get(baseline)
+    if own is not None and (policy.episodes is None or not lacks_scene_interval(own.model_dump())):
+        return own
     if policy.episodes is None:
         return None
-    from davis_ag.benchmark.paired import paired_gap
-
     for _, other in files:
         theirs = other.policies.get(baseline)
         if theirs is not None and theirs.episodes and _same_episodes(row_results, other):
@@ -182,7 +185,7 @@ def format_leaderboard(rows: list[Row]) -> str:
         "",
         "Mean ± std over sessions. Gap: mean OER_tau minus the baseline's on the same episodes, with the "
         "95 % bootstrap interval over episodes (would it hold on other starts of these scenes?) and, after "
-        "`scenes`, over the test scenes resampled (would it hold on other scenes like these?); `-`: the "
-        "baseline itself, or a method that did not play the same episodes.",
+        f"`scenes`, over the test scenes resampled (would it hold on other scenes like these? coarse below "
+        f"{FEW_SCENES} scenes); `-`: the baseline itself, or a method that did not play the same episodes.",
     ]
     return "\n".join(lines) + "\n"

@@ -11,7 +11,7 @@ from pathlib import Path
 from typing import Any
 
 from davis_ag.benchmark.exact import BEST_FIXED
-from davis_ag.benchmark.paired import CONFIDENCE, paired_key
+from davis_ag.benchmark.paired import CONFIDENCE, FEW_SCENES, paired_key
 from davis_ag.workflows.reproduce_configs import beside_table4
 from davis_ag.workflows.stage_clock import machines
 from davis_ag.workflows.paper_table4 import PAPER_ORDERINGS, PAPER_TABLE4, PAPER_TABLE4_STD, TITLES, ordering_failures
@@ -107,8 +107,9 @@ def readme_block(config: Any, state: dict[str, Any], out: Path | None = None) ->
         lines += [
             "",
             f"Each learner minus `{BEST_FIXED}` on the same test episodes ({CONFIDENCE:.0%} bootstrap "
-            "interval over episodes), the test scenes it is ahead on (with the interval when the test "
-            "scenes themselves are resampled: whether the gap would hold on other scenes like them), "
+            f"interval over episodes), the test scenes it is ahead on, the {CONFIDENCE:.0%} interval when the "
+            "test scenes themselves are resampled (over scenes: whether the gap would hold on other scenes "
+            f"like them; coarse below {FEW_SCENES}), "
             "and on the train split its kept snapshot minus the best fixed action there (ahead on train "
             "only: it does not carry over to unseen scenes; ahead on neither: it did not learn):",
             "",
@@ -118,17 +119,20 @@ def readme_block(config: Any, state: dict[str, Any], out: Path | None = None) ->
 
 
 def _learner_gaps(scenario: str, result: dict[str, Any], out: Path | None, learner: str) -> str | None:
-    """``SP strawberry +.030 (+.020 to +.039), ahead on 18 of the 23 test scenes played (+.012 to
-    +.047 resampling them), train +.040``."""
+    """``SP strawberry +.030 (+.020 to +.039; over scenes +.016 to +.048), ahead on 18 of the 23
+    test scenes played, train +.040``."""
     paired = result.get(paired_key(learner))
     if not paired:
         return None
     scenes = paired.get("per_scene", [])
-    text = f"{TITLES[scenario]} {signed(paired['gap'])} ({signed(paired['low'])} to {signed(paired['high'])})"
+    intervals = f"{signed(paired['low'])} to {signed(paired['high'])}"
+    if paired.get("scene_low") is not None:
+        intervals += f"; over scenes {signed(paired['scene_low'])} to {signed(paired['scene_high'])}"
+        if len(scenes) < FEW_SCENES:
+            intervals += f", coarse with {len(scenes)}"
+    text = f"{TITLES[scenario]} {signed(paired['gap'])} ({intervals})"
     if scenes:
         text += f", ahead on {sum(s['gap'] > 0 for s in scenes)} of the {len(scenes)} test scenes played"
-    if paired.get("scene_low") is not None:
-        text += f" ({signed(paired['scene_low'])} to {signed(paired['scene_high'])} resampling them)"
     train = train_split_gap(scenario, result, out, learner)
     if train is not None:
         text += f", train {signed(train['kept'] - train['best'])}"

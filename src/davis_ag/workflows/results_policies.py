@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from davis_ag.benchmark.exact import BEST_FIXED, best_fixed_action
-from davis_ag.benchmark.paired import CONFIDENCE, RESAMPLES, paired_key
+from davis_ag.benchmark.paired import CONFIDENCE, FEW_SCENES, RESAMPLES, paired_key
 from davis_ag.workflows.run_groups import GROUPS
 
 #: The learners a run may train, as their rows are named (the paper's A2C first).
@@ -109,14 +109,25 @@ def paired_line(result: dict[str, Any], learner: str = "A2C") -> str | None:
         return None
     scenes = paired["per_scene"]
     ahead = sum(s["gap"] > 0 for s in scenes)
-    over_scenes = (
-        f"Resampling the {len(scenes)} test scenes instead (each with all its episodes: would the gap hold on "
-        f"other scenes like these?), the {CONFIDENCE:.0%} interval is {signed(paired['scene_low'])} to "
-        f"{signed(paired['scene_high'])}, {_side(paired['scene_low'], paired['scene_high'])} zero."
-        if paired.get("scene_low") is not None
-        else "The interval covers the starts these test scenes hold, not other scenes; the per-scene gaps "
-        "hint at how much the scene matters."
-    )
+    if paired.get("scene_low") is None:
+        over_scenes = (
+            "The interval covers the starts these test scenes hold, not other scenes; the per-scene gaps "
+            "hint at how much the scene matters."
+        )
+    elif len(scenes) < FEW_SCENES:
+        over_scenes = (
+            f"Resampling the {len(scenes)} test scenes played instead says little with so few: its "
+            f"{CONFIDENCE:.0%} interval, {signed(paired['scene_low'])} to {signed(paired['scene_high'])}, is "
+            "about the range of their own gaps; the table below is the better hint of how another scene "
+            "would score."
+        )
+    else:
+        over_scenes = (
+            f"Resampling the {len(scenes)} test scenes played instead (each with all its episodes: would the "
+            f"gap hold on other scenes like these?), the {CONFIDENCE:.0%} interval is "
+            f"{signed(paired['scene_low'])} to {signed(paired['scene_high'])}, "
+            f"{_side(paired['scene_low'], paired['scene_high'])} zero."
+        )
     return (
         f"Episode by episode (every policy plays the same {paired['episodes']} episodes), {learner} minus "
         f"`{BEST_FIXED}`: {signed(paired['gap'])}, {CONFIDENCE:.0%} bootstrap interval over episodes "
