@@ -52,6 +52,8 @@ def test_gaps_over_several_scenes_give_the_interval_over_scenes_too(sp_root: Pat
     gap = results.policies["always_up"].paired["Rand"]
     assert gap.scene_low is not None and gap.scene_low <= gap.scene_high
     assert "  over scenes" in format_table(results)
+    one_scene = evaluate([_always("up")], sp_root, "sp", sessions=1, episodes=4)  # the test split: one scene
+    assert "over scenes" not in format_table(one_scene)
     rows = leaderboard([results.write(tmp_path / "up.json")])
     assert " scenes [" in format_leaderboard(rows) and "over the test scenes resampled" in format_leaderboard(rows)
     # A file from before the interval over scenes gets it from its episodes.

@@ -299,6 +299,7 @@ def format_table(results: EvaluationResults | dict[str, Any]) -> str:
                 ]
             )
     baselines = [b for b in PAIRED_BASELINES if b in policies]
+    shown_over_scenes = False
     for baseline in baselines:
         row, over_scenes = ["", f"gap to {baseline}"], ["", "  over scenes"]
         for name in names:
@@ -315,6 +316,7 @@ def format_table(results: EvaluationResults | dict[str, Any]) -> str:
         cells.append(row)
         if any(cell != "-" for cell in over_scenes[2:]):
             cells.append(over_scenes)
+            shown_over_scenes = True
     widths = [max(len(row[i]) for row in cells) for i in range(len(cells[0]))]
     lines = ["  ".join(c.ljust(w) for c, w in zip(row, widths)).rstrip() for row in cells]
     lines.insert(1, "-" * len(lines[0]))
@@ -324,8 +326,12 @@ def format_table(results: EvaluationResults | dict[str, Any]) -> str:
     )
     if baselines:
         lines.append(
-            "gap: mean OER_tau minus the baseline's on the same episodes, [95 % bootstrap interval over episodes]; "
-            f"over scenes: [the same, resampling the test scenes; coarse below {FEW_SCENES}]"
+            "gap: mean OER_tau minus the baseline's on the same episodes, [95 % bootstrap interval over episodes]"
+            + (
+                f"; over scenes: [the same, resampling the test scenes; coarse below {FEW_SCENES}]"
+                if shown_over_scenes
+                else ""
+            )
         )
     if BEST_FIXED in policies:
         lines.append(
