@@ -216,7 +216,11 @@ def test_the_page_shows_what_each_policy_does(tmp_path: Path, sp_root: Path, one
     assert (shares >= 0.05).sum() >= 2, policies["A2C"]["action_counts"]
     counts = best["action_counts"]
     assert "| Best fixed action | " + " | ".join("100" if a == best["action"] else "0" for a in counts) + " |" in text
-    for picture in ("results-sp-strawberry-actions.png", "results-learning-curve.png"):
+    for picture in (
+        "results-sp-strawberry-actions.png",
+        "results-learning-curve.png",
+        "results-sp-strawberry-scene-gaps.png",
+    ):
         assert f"(images/{picture})" in text and (tmp_path / "docs" / "images" / picture).is_file()
     assert "PPO" not in text  # this run trained A2C only
 

@@ -1,5 +1,6 @@
-"""Charts of benchmark results and training runs: the Table 4 bar chart of an evaluation and the
-training curve of a continuous-pose PPO run, each saved atomically as PNG.
+"""Charts of benchmark results and training runs: the Table 4 bar chart of an evaluation, each
+learner's gap to the Best fixed action scene by scene, and the training curve of a
+continuous-pose PPO run, each saved atomically as PNG.
 """
 
 from __future__ import annotations
@@ -85,5 +86,60 @@ def plot_training_curve(records: list[dict], path: str | os.PathLike[str], title
     fig.tight_layout()
     try:
         return save_figure_atomic(fig, path, dpi=110)
+    finally:
+        plt.close(fig)
+
+
+def plot_scene_gaps(gaps: dict[str, dict[str, Any]], path: str | os.PathLike[str], title: str) -> Path:
+    """Each learner's gap to the Best fixed action on each test scene, as PNG: a dot per scene
+    (its area by the scene's episodes), the mean gap as a line, and the intervals over episodes
+    (dark band) and over scenes (light band) around it, beside zero.
+
+    Args:
+        gaps: Per learner (``A2C``, ``PPO``), its paired gap as JSON
+            (:func:`davis_ag.benchmark.paired.a2c_against_best_fixed`).
+        path: The PNG to write.
+        title: The chart's title (the scenario and split).
+
+    Returns:
+        ``path``.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")  # files only: no display on servers
+    import matplotlib.pyplot as plt
+
+    scenes = sorted({s["scene"] for gap in gaps.values() for s in gap["per_scene"]})
+    x = {scene: i for i, scene in enumerate(scenes)}
+    fig, ax = plt.subplots(figsize=(max(6.0, 0.32 * len(scenes) + 2.5), 3.8))
+    ax.axhline(0.0, color="black", linewidth=0.8)
+    spread = 0.18 * (len(gaps) > 1)  # learners side by side within a scene's slot
+    for i, (learner, gap) in enumerate(gaps.items()):
+        colour = f"C{i}"
+        offset = spread * (i - (len(gaps) - 1) / 2)
+        per_scene = gap["per_scene"]
+        ax.scatter(
+            [x[s["scene"]] + offset for s in per_scene],
+            [s["gap"] for s in per_scene],
+            s=[12 + 2 * s["episodes"] for s in per_scene],
+            color=colour,
+            alpha=0.75,
+            label=f"{learner}: each test scene (area: episodes)",
+        )
+        ends = (-0.5, len(scenes) - 0.5)
+        if gap.get("scene_low") is not None:
+            ax.fill_between(ends, gap["scene_low"], gap["scene_high"], color=colour, alpha=0.12, linewidth=0)
+        ax.fill_between(ends, gap["low"], gap["high"], color=colour, alpha=0.3, linewidth=0)
+        ax.plot(ends, [gap["gap"]] * 2, color=colour, linewidth=1.5, label=f"{learner}: mean {gap['gap']:+.3f}")
+    ax.set_xlim(-0.5, len(scenes) - 0.5)
+    ax.set_xticks(range(len(scenes)))
+    ax.set_xticklabels([s.split("/")[-1] for s in scenes], fontsize=7)
+    ax.set_xlabel(f"test scene ({scenes[0].split('/')[0]}/…)" if scenes else "test scene")
+    ax.set_ylabel("OER_tau minus Best fixed action")
+    ax.set_title(f"{title}: bands, 95 % intervals over episodes (dark) and over scenes (light)", fontsize=9)
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=2, frameon=False)
+    fig.tight_layout()
+    try:
+        return save_figure_atomic(fig, path, dpi=120)
     finally:
         plt.close(fig)

@@ -163,6 +163,19 @@ def per_scene_table(result: dict[str, Any], learners: list[str]) -> list[str]:
     return lines + [""]
 
 
+def scene_gap_figure(scenario: str, result: dict[str, Any], learners: list[str], page: Path) -> str | None:
+    """Draw the per-scene gaps into ``images/`` beside the page; its Markdown link (None without gaps)."""
+    from davis_ag.figures.result_charts import plot_scene_gaps
+
+    gaps = {learner: p for learner in learners if (p := result.get(paired_key(learner)))}
+    if not gaps:
+        return None
+    target = page.parent / "images" / f"results-{GROUPS[scenario]}-scene-gaps.png"
+    split = result["protocol"]["split"]
+    plot_scene_gaps(gaps, target, f"{GROUPS[scenario]}, {split} split")
+    return f"![each learner minus the Best fixed action per test scene, {GROUPS[scenario]}](images/{target.name})"
+
+
 def _side(low: float, high: float) -> str:
     """Where an interval lies against zero: ``above``, ``below`` or ``on both sides of``."""
     return "above" if low > 0 else "below" if high < 0 else "on both sides of"
@@ -411,6 +424,9 @@ def policy_sections(scenario: str, result: dict[str, Any], out: Path | None, pag
             if line:
                 lines += [line, ""]
     lines += per_scene_table(result, learners)
+    chart = scene_gap_figure(scenario, result, learners, page)
+    if chart:
+        lines += [chart, ""]
     if BEST_FIXED in policies:
         lines += [
             f"`{BEST_FIXED}` is the best of the policies that always play the same action, chosen "
