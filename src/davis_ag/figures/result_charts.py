@@ -137,8 +137,8 @@ def plot_scene_gaps(gaps: dict[str, dict[str, Any]], path: str | os.PathLike[str
     ax.set_xlabel(f"test scene ({scenes[0].split('/')[0]}/…)" if scenes else "test scene")
     ax.set_ylabel("OER_tau minus Best fixed action")
     ax.set_title(f"{title}: bands, 95 % intervals over episodes (dark) and over scenes (light)", fontsize=9)
-    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=2, frameon=False)
-    fig.tight_layout()
+    fig.legend(fontsize=7, loc="lower center", ncol=2 * len(gaps), frameon=False, markerscale=0.5)
+    fig.tight_layout(rect=(0, 0.08, 1, 1))  # the legend's row below the axes
     try:
         return save_figure_atomic(fig, path, dpi=120)
     finally:
