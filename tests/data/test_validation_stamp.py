@@ -80,3 +80,16 @@ def test_another_validator_gives_another_stamp(dataset: Path, monkeypatch: pytes
     before = validation_stamp(dataset / GROUP)
     monkeypatch.setattr(module, "VALIDATOR_PACKAGES", ("data",))
     assert validation_stamp(dataset / GROUP) != before
+
+
+def test_the_validators_code_counts_not_its_comments_or_docstrings() -> None:
+    # A docstring reworded in data/ re-read 24,510 paper-scale views at the next sitting; a change of
+    # what the code does must still give another stamp.
+    from davis_ag.data.validation_stamp import code_of
+
+    code = 'def ok(n):\n    """Say whether n is sound."""\n    return n > 0  # positive\n'
+    reworded = '"""A module."""\n\n\ndef ok(n):\n    """Whether n is sound, reworded."""\n\n    return (\n        n > 0\n    )\n'
+    assert code_of(reworded) == code_of(code)
+    assert code_of(code.replace("n > 0", "n >= 0")) != code_of(code)
+    assert code_of('def f():\n    """Only a docstring."""\n') == code_of("def f():\n    pass\n")
+    assert code_of('x = "a string that is data, not a docstring"\n') != code_of('x = "another"\n')

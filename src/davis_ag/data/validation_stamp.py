@@ -11,6 +11,7 @@ writer of ours does (``davis-ag validate`` always reads everything).
 
 from __future__ import annotations
 
+import ast
 import hashlib
 import os
 from pathlib import Path
@@ -23,8 +24,10 @@ VALIDATOR_PACKAGES = ("data", "formats")
 
 
 def validator_digest() -> bytes:
-    """SHA-256 of the source of :data:`VALIDATOR_PACKAGES` (this module aside), file by file in
-    name order."""
+    """SHA-256 of the code of :data:`VALIDATOR_PACKAGES` (this module aside), file by file in name
+    order: each file's syntax tree without its docstrings (:func:`code_of`), so a comment, a
+    docstring or a reflowed line leaves a long run's validation standing, and any change of what
+    the code does does not."""
     package = Path(__file__).resolve().parent.parent
     digest = hashlib.sha256()
     for name in VALIDATOR_PACKAGES:
@@ -32,8 +35,21 @@ def validator_digest() -> bytes:
             if source.name == Path(__file__).name:  # the stamp's own rule decides nothing validation finds
                 continue
             digest.update(f"{name}/{source.name}\0".encode())
-            digest.update(source.read_bytes())
+            digest.update(code_of(source.read_text(encoding="utf-8")).encode())
     return digest.digest()
+
+
+def code_of(source: str) -> str:
+    """What a Python source does, as text: its syntax tree (no comments, no layout, no line
+    numbers) with every docstring taken out."""
+    tree = ast.parse(source)
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)):
+            body = node.body
+            if body and isinstance(body[0], ast.Expr) and isinstance(getattr(body[0], "value", None), ast.Constant):
+                if isinstance(body[0].value.value, str):
+                    node.body = body[1:] or [ast.Pass()]
+    return ast.dump(tree)
 
 
 def validation_stamp(path: str | os.PathLike[str]) -> str:
