@@ -233,7 +233,7 @@ def test_a_run_with_ppo_shows_its_row_gap_settings_and_stage(tmp_path: Path, sp_
     from davis_ag.benchmark.training import train_agent
     from davis_ag.workflows.demo import run_baselines
     from davis_ag.figures.result_charts import plot_results
-    from davis_ag.workflows.reproduce import _reusable_results, _summary, add_train_split
+    from davis_ag.workflows.reproduce import _reusable_results, _summary, add_train_scores, add_train_split
     from davis_ag.workflows.results_policies import model_path
 
     (tmp_path / "docs").mkdir()
@@ -271,6 +271,12 @@ def test_a_run_with_ppo_shows_its_row_gap_settings_and_stage(tmp_path: Path, sp_
     assert _reusable_results(results_json, [models["a2c"], models["ppo"]], "test", config) is not None
     assert plot_results(both, results_json.with_suffix(".png")).is_file()  # the stage's chart, PPO's bar in it
     add_train_split(both, sp_root, "sp", "strawberry")
+    # The kept snapshots scored again on fresh train episodes, as on test: their selection scores run high.
+    assert add_train_scores(both, sp_root, "sp", "strawberry", models, config)
+    assert not add_train_scores(both, sp_root, "sp", "strawberry", models, config)  # scored once
+    fresh = both["train_split"]["learners"]
+    assert set(fresh) == {"A2C", "PPO"} and all(0 <= f["oer_tau"]["mean"] <= 1 for f in fresh.values())
+    assert fresh["A2C"]["sessions"] == 3 and fresh["A2C"]["episodes"] == 20
 
     state = {
         "scene_folders": {"sp-strawberry": ["Single-Strawberry/000", "Single-Strawberry/001"]},
@@ -297,6 +303,7 @@ def test_a_run_with_ppo_shows_its_row_gap_settings_and_stage(tmp_path: Path, sp_
         f"{train_starts:,} eligible starts), tau = 3" in text
     )
     assert "where the snapshot was chosen: A2C's kept snapshot (70 steps)" in text
+    assert f"scores OER_tau {_c(fresh['A2C']['oer_tau']['mean'])} (3 x 20 fresh episodes, as on test; " in text
     assert "where the snapshot was chosen: PPO's kept snapshot (64 steps)" in text
     how = text.split("## How this run was made", 1)[1]
     assert "  - A2C: 70 steps in 1 sitting(s)" in how and "  - PPO: 64 steps in 1 sitting(s)" in how

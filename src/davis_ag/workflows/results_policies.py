@@ -281,9 +281,10 @@ def train_split_gap(
         learner: ``A2C`` or ``PPO``.
 
     Returns:
-        ``kept`` (the kept snapshot's sampled OER_tau), ``best`` (the best fixed action's exact
-        OER_tau), ``action``, ``starts``, the record's ``selection`` and its snapshot ``scores``
-        by step; None when the run has no train-split record for it.
+        ``kept`` (the kept snapshot's OER_tau on fresh train episodes where the run scored it
+        so, else its selection score), ``fresh`` (that score's record, or None), ``best`` (the
+        best fixed action's exact OER_tau), ``action``, ``starts``, the record's ``selection``
+        and its snapshot ``scores`` by step; None when the run has no train-split record for it.
     """
     train = result.get("train_split")
     record = training_record(out, GROUPS[scenario], learner)
@@ -293,8 +294,10 @@ def train_split_gap(
         return None
     fixed = train["fixed_actions"]
     action = best_fixed_action(fixed)
+    fresh = (train.get("learners") or {}).get(learner)
     return {
-        "kept": scores[selection["kept_step"]],
+        "kept": fresh["oer_tau"]["mean"] if fresh else scores[selection["kept_step"]],
+        "fresh": fresh,
         "best": fixed[action]["oer_tau"],
         "action": action,
         "starts": train["starts"],
@@ -316,10 +319,19 @@ def train_split_line(scenario: str, result: dict[str, Any], out: Path | None, le
     selection, scores = found["selection"], found["scores"]
     gap = found["kept"] - found["best"]
     last_step = max(scores)
+    chosen_by = f"{selection['episodes']} {selection['play']} episodes"
+    fresh = found["fresh"]
+    if fresh:
+        # The selection score is the best of many noisy ones, so it runs high: fresh episodes say more.
+        played = f"{fresh['sessions']} x {fresh['episodes']} fresh episodes, as on test"
+        chosen_by = (
+            f"{played}; {cell(scores[selection['kept_step']])} in the {chosen_by} that chose it, the best of "
+            f"{len(scores)} such scores and so high by luck as much as by skill"
+        )
     return (
         f"On the train split ({found['starts']:,} eligible starts), where the snapshot was chosen: {learner}'s "
         f"kept snapshot ({selection['kept_step']:,} steps) scores OER_tau {cell(found['kept'])} "
-        f"({selection['episodes']} {selection['play']} episodes), the best fixed action there "
+        f"({chosen_by}), the best fixed action there "
         f"(always `{found['action']}`) {cell(found['best'])} exactly, {cell(abs(gap))} "
         f"{'above' if gap >= 0 else 'below'} it; "
         f"the last snapshot ({last_step:,} steps) {cell(scores[last_step])}. "
