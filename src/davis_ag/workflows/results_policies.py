@@ -326,7 +326,7 @@ def train_split_line(scenario: str, result: dict[str, Any], out: Path | None, le
         played = f"{fresh['sessions']} x {fresh['episodes']} fresh episodes, as on test"
         chosen_by = (
             f"{played}; {cell(scores[selection['kept_step']])} in the {chosen_by} that chose it, the best of "
-            f"{len(scores)} such scores and so high by luck as much as by skill"
+            f"{len(scores)} such scores, which runs high"
         )
     return (
         f"On the train split ({found['starts']:,} eligible starts), where the snapshot was chosen: {learner}'s "
