@@ -43,7 +43,6 @@ from davis_ag.benchmark.results import (
     Protocol,
     as_results,
     identify_dataset,
-    signed_number,
     split_text,
     table_number,
 )
@@ -304,15 +303,8 @@ def format_table(results: EvaluationResults | dict[str, Any]) -> str:
         row, over_scenes = ["", f"gap to {baseline}"], ["", "  over scenes"]
         for name in names:
             gap = policies[name].paired.get(baseline)
-            row.append(
-                f"{signed_number(gap.gap)} [{signed_number(gap.low)}, {signed_number(gap.high)}]" if gap else "-"
-            )
-            scene_low, scene_high = (gap.scene_low, gap.scene_high) if gap else (None, None)
-            over_scenes.append(
-                f"[{signed_number(scene_low)}, {signed_number(scene_high)}]"
-                if scene_low is not None and scene_high is not None
-                else "-"
-            )
+            row.append(gap.text() if gap else "-")
+            over_scenes.append((gap.scenes_text() if gap else None) or "-")
         cells.append(row)
         if any(cell != "-" for cell in over_scenes[2:]):
             cells.append(over_scenes)

@@ -23,7 +23,6 @@ from davis_ag.benchmark.results import (
     PairedGap,
     PolicyResult,
     load_results,
-    signed_number,
     split_text,
     table_number,
 )
@@ -149,10 +148,8 @@ def leaderboard(paths: list[str | os.PathLike[str]]) -> list[Row]:
 def _gap_cell(gap: PairedGap | None) -> str:
     if gap is None:
         return "-"
-    cell = f"{signed_number(gap.gap)} [{signed_number(gap.low)}, {signed_number(gap.high)}]"
-    if gap.scene_low is not None and gap.scene_high is not None:
-        cell += f" scenes [{signed_number(gap.scene_low)}, {signed_number(gap.scene_high)}]"
-    return cell
+    over_scenes = gap.scenes_text()
+    return gap.text() + (f" scenes {over_scenes}" if over_scenes else "")
 
 
 def format_leaderboard(rows: list[Row]) -> str:

@@ -67,6 +67,16 @@ class PairedGap(_Model):
     scene_low: float | None = None
     scene_high: float | None = None
 
+    def text(self) -> str:
+        """``+.030 [+.020, +.039]``: the gap and its interval over episodes, as tables print it."""
+        return f"{signed_number(self.gap)} [{signed_number(self.low)}, {signed_number(self.high)}]"
+
+    def scenes_text(self) -> str | None:
+        """``[+.016, +.048]``: the interval over scenes, as tables print it; None without one."""
+        if self.scene_low is None or self.scene_high is None:
+            return None
+        return f"[{signed_number(self.scene_low)}, {signed_number(self.scene_high)}]"
+
 
 class Episode(_Model):
     """One episode of one policy. ``path`` holds view names on the grid and poses

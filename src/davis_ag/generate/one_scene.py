@@ -35,8 +35,8 @@ from davis_ag.scene.specs import (
     SCENARIOS,
     CropSpec,
     ScenarioSpec,
-    group_name,
     plant_centres,
+    scene_folder,
 )
 from davis_ag.scene.view_grid import build_view_grid
 
@@ -133,7 +133,7 @@ class SceneRequest(SceneSettings):
     @property
     def folder(self) -> str:
         """Path of the scene folder below the dataset root."""
-        return f"{group_name(self.scenario, self.crop)}/{self.index:03d}"
+        return scene_folder(self.scenario, self.crop, self.index)
 
 
 def scene_seed(dataset_seed: int, scenario: ScenarioSpec, crop: CropSpec, index: int) -> int:

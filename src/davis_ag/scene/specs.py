@@ -325,6 +325,11 @@ def group_name(scenario: ScenarioSpec, crop: CropSpec) -> str:
     return f"{scenario.title}-{crop.title}"
 
 
+def scene_folder(scenario: ScenarioSpec, crop: CropSpec, index: int) -> str:
+    """The published folder of a scene below the dataset root, e.g. ``Single-Strawberry/003``."""
+    return f"{group_name(scenario, crop)}/{index:03d}"
+
+
 def parse_group_name(name: str) -> tuple[ScenarioSpec, CropSpec] | None:
     """Invert :func:`group_name`; ``None`` for a folder that is not a DAVIS-Ag group."""
     scenario_title, _, crop_title = name.partition("-")

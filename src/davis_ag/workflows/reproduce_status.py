@@ -132,14 +132,14 @@ def _generation_status(
     progress before its first scene ends.
     """
     from davis_ag.generate.scene_writer import JOURNAL, partial_dir
-    from davis_ag.scene.specs import group_name
+    from davis_ag.scene.specs import scene_folder
     from davis_ag.scene.view_grid import views_per_scene
 
     key, wanted = group_key(scenario, crop), config.scenes(scenario)
     scenario_spec, crop_spec = config.specs(scenario, crop)
     recorded = state.get("scene_folders", {}).get(key, [])
     # The run records its folders as the stage starts; before that they are the first `wanted` of the group.
-    folders = recorded or [f"{group_name(scenario_spec, crop_spec)}/{i:03d}" for i in range(wanted)]
+    folders = recorded or [scene_folder(scenario_spec, crop_spec, i) for i in range(wanted)]
     count = sum(folder in made for folder in folders)
     drawn = under_way = 0
     for folder in folders:

@@ -15,7 +15,7 @@ from davis_ag.benchmark.paired import CONFIDENCE, FEW_SCENES, paired_key
 from davis_ag.workflows.reproduce_configs import beside_table4
 from davis_ag.workflows.stage_clock import machines
 from davis_ag.workflows.paper_table4 import PAPER_ORDERINGS, PAPER_TABLE4, PAPER_TABLE4_STD, TITLES, ordering_failures
-from davis_ag.workflows.results_policies import LEARNERS, cell, learners_run, signed, train_split_gap
+from davis_ag.workflows.results_policies import LEARNERS, cell, learners_run, scenes_ahead, signed, train_split_gap
 from davis_ag.workflows.run_groups import GROUPS
 
 #: The README's block that holds the run's OER_tau beside Table 4's (see :func:`readme_block`).
@@ -132,7 +132,7 @@ def _learner_gaps(scenario: str, result: dict[str, Any], out: Path | None, learn
             intervals += f", coarse with {len(scenes)}"
     text = f"{TITLES[scenario]} {signed(paired['gap'])} ({intervals})"
     if scenes:
-        text += f", ahead on {sum(s['gap'] > 0 for s in scenes)} of the {len(scenes)} test scenes played"
+        text += ", ahead on {} of the {} test scenes played".format(*scenes_ahead(paired))
     train = train_split_gap(scenario, result, out, learner)
     if train is not None:
         text += f", train {signed(train['kept'] - train['best'])}"

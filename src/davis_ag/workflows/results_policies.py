@@ -108,7 +108,6 @@ def paired_line(result: dict[str, Any], learner: str = "A2C") -> str | None:
     if not paired:
         return None
     scenes = paired["per_scene"]
-    ahead = sum(s["gap"] > 0 for s in scenes)
     if paired.get("scene_low") is None:
         over_scenes = (
             "The interval covers the starts these test scenes hold, not other scenes; the per-scene gaps "
@@ -133,13 +132,25 @@ def paired_line(result: dict[str, Any], learner: str = "A2C") -> str | None:
         f"`{BEST_FIXED}`: {signed(paired['gap'])}, {CONFIDENCE:.0%} bootstrap interval over episodes "
         f"{signed(paired['low'])} to {signed(paired['high'])} ({RESAMPLES:,} resamples), "
         f"{_side(paired['low'], paired['high'])} zero. "
-        f"{learner} is ahead on {ahead} of the {len(scenes)} test scenes played (the table below). {over_scenes}"
+        "{} is ahead on {} of the {} test scenes played (the table below). ".format(learner, *scenes_ahead(paired))
+        + over_scenes
     )
 
 
-def per_scene_table(result: dict[str, Any], learners: list[str]) -> list[str]:
-    """Each learner minus the Best fixed action on each test scene, as a table (empty without gaps)."""
-    gaps = {learner: p for learner in learners if (p := result.get(paired_key(learner)))}
+def learner_gaps(result: dict[str, Any], learners: list[str]) -> dict[str, dict[str, Any]]:
+    """Each learner's paired gap to the Best fixed action in a scenario's summary, where it has one."""
+    return {learner: p for learner in learners if (p := result.get(paired_key(learner)))}
+
+
+def scenes_ahead(paired: dict[str, Any]) -> tuple[int, int]:
+    """The test scenes a learner is ahead on, and those its episodes played."""
+    scenes = paired["per_scene"]
+    return sum(s["gap"] > 0 for s in scenes), len(scenes)
+
+
+def per_scene_table(gaps: dict[str, dict[str, Any]]) -> list[str]:
+    """Each learner minus the Best fixed action on each test scene (:func:`learner_gaps`), as a
+    table (empty without gaps)."""
     if not gaps:
         return []
     scenes: dict[str, dict[str, Any]] = {}
@@ -158,16 +169,15 @@ def per_scene_table(result: dict[str, Any], learners: list[str]) -> list[str]:
         row = scenes[name]
         cells = [signed(row[learner]) if learner in row else "-" for learner in gaps]
         lines.append(f"| {name} | {row['episodes']} | {row['starts']:,} | " + " | ".join(cells) + " |")
-    ahead = [f"{sum(s['gap'] > 0 for s in p['per_scene'])} of {len(p['per_scene'])}" for p in gaps.values()]
-    lines.append("| ahead on | | | " + " | ".join(ahead) + " |")
+    lines.append("| ahead on | | | " + " | ".join("{} of {}".format(*scenes_ahead(p)) for p in gaps.values()) + " |")
     return lines + [""]
 
 
-def scene_gap_figure(scenario: str, result: dict[str, Any], learners: list[str], page: Path) -> str | None:
-    """Draw the per-scene gaps into ``images/`` beside the page; its Markdown link (None without gaps)."""
+def scene_gap_figure(scenario: str, result: dict[str, Any], gaps: dict[str, dict[str, Any]], page: Path) -> str | None:
+    """Draw the per-scene gaps (:func:`learner_gaps`) into ``images/`` beside the page; its
+    Markdown link (None without gaps)."""
     from davis_ag.figures.result_charts import plot_scene_gaps
 
-    gaps = {learner: p for learner in learners if (p := result.get(paired_key(learner)))}
     if not gaps:
         return None
     target = page.parent / "images" / f"results-{GROUPS[scenario]}-scene-gaps.png"
@@ -435,8 +445,9 @@ def policy_sections(scenario: str, result: dict[str, Any], out: Path | None, pag
         for line in (versus_best_fixed(policies, learner), paired_line(result, learner)):
             if line:
                 lines += [line, ""]
-    lines += per_scene_table(result, learners)
-    chart = scene_gap_figure(scenario, result, learners, page)
+    gaps = learner_gaps(result, learners)
+    lines += per_scene_table(gaps)
+    chart = scene_gap_figure(scenario, result, gaps, page)
     if chart:
         lines += [chart, ""]
     if BEST_FIXED in policies:
