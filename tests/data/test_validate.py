@@ -178,6 +178,19 @@ def test_orphan_image_splits_and_counts(dataset: Path, capsys: pytest.CaptureFix
     ]
 
 
+def test_a_group_answers_for_its_own_split_entries(dataset: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # A group validated alone neither sees nor blames another group's entries; the whole dataset does.
+    splits = json.loads((dataset / "splits.json").read_text())
+    tomato = next(i for i in splits["train"] + splits["test"] if i.startswith("Multi-Tomato"))
+    splits["train"].append(tomato)
+    splits["test"].append(tomato)
+    (dataset / "splits.json").write_text(json.dumps(splits))
+    code, lines, _ = run(capsys, str(dataset / "Single-Strawberry"), "--quick")
+    assert code == 0 and lines[-1].endswith(": sound")
+    code, lines, _ = run(capsys, str(dataset), "--quick")
+    assert code == 1 and lines[0] == f"{dataset / 'splits.json'}: 1 scene(s) in both train and test, e.g. {tomato}"
+
+
 def test_wrong_mask_mode_and_size(dataset: Path, capsys: pytest.CaptureFixture[str]) -> None:
     images = dataset / SCENE / "images"
     Image.open(images / "0001_seg.png").convert("RGB").save(images / "0001_seg.png")

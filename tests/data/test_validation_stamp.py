@@ -74,6 +74,17 @@ def test_any_change_validation_would_see_gives_another_stamp(dataset: Path, chan
     assert validation_stamp(dataset / GROUP) != before
 
 
+def test_another_group_gaining_scenes_leaves_a_groups_stamp(dataset: Path) -> None:
+    # A paper-scale run rewrites splits.json with each MP vine scene it makes; SP strawberry's
+    # validation must stand meanwhile, or every sitting reads its 24,510 views again.
+    before, whole = validation_stamp(dataset / GROUP), validation_stamp(dataset)
+    splits = json.loads((dataset / "splits.json").read_text())
+    splits["train"].append("Multi-Vine/000")
+    (dataset / "splits.json").write_text(json.dumps(splits, indent=2))
+    assert validation_stamp(dataset / GROUP) == before
+    assert validation_stamp(dataset) != whole  # the whole dataset's validation reads that entry
+
+
 def test_another_validator_gives_another_stamp(dataset: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     from davis_ag.data import validation_stamp as module
 

@@ -125,5 +125,15 @@ def test_each_sitting_says_where_it_ran_and_older_ones_are_counted_apart(tmp_pat
         with StageClock(path, "a", machine=machine).timing("train"):
             pass
     sittings = read_clock(path)["train"]
-    assert machines(sittings) == "2 CPU cores, no GPU; 16 CPU cores, NVIDIA H200; 1 sitting(s) unrecorded"
+    assert (
+        machines(sittings)
+        == "2 CPU cores, no GPU; 16 CPU cores, NVIDIA H200; 1 sitting(s) with no machine or CPU model recorded"
+    )
+    # Once the same machine is named with its CPU model, the bare name adds nothing: counted apart.
+    with StageClock(path, "a", machine="2 CPU cores (Intel(R) Xeon(R) Processor), no GPU").timing("train"):
+        pass
+    assert machines(read_clock(path)["train"]) == (
+        "16 CPU cores, NVIDIA H200; 2 CPU cores (Intel(R) Xeon(R) Processor), no GPU; "
+        "3 sitting(s) with no machine or CPU model recorded"
+    )
     assert machines([]) == "-"

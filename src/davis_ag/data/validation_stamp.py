@@ -13,10 +13,11 @@ from __future__ import annotations
 
 import ast
 import hashlib
+import json
 import os
 from pathlib import Path
 
-from davis_ag.data.reader import open_dataset
+from davis_ag.data.reader import Dataset, open_dataset
 from davis_ag.formats.layout import DATASET_FILE, SPLITS_FILE
 
 #: The packages whose code decides what a validation finds: a change to any of them is a new stamp.
@@ -66,9 +67,9 @@ def validation_stamp(path: str | os.PathLike[str]) -> str:
     """
     dataset = open_dataset(path)
     digest = hashlib.sha256(validator_digest())
-    for name in (SPLITS_FILE, DATASET_FILE):  # small, and rewritten with the same bytes by each generate
-        file = dataset.root / name
-        digest.update(f"{name}\0".encode() + (file.read_bytes() if file.is_file() else b"-"))
+    digest.update(_own_split_entries(dataset))
+    file = dataset.root / DATASET_FILE  # small, and rewritten with the same bytes by each generate
+    digest.update(f"{DATASET_FILE}\0".encode() + (file.read_bytes() if file.is_file() else b"-"))
     for scene in dataset.scenes:
         for folder, subfolders, files in os.walk(scene.path):
             subfolders[:] = sorted(d for d in subfolders if not d.startswith("."))
@@ -77,3 +78,26 @@ def validation_stamp(path: str | os.PathLike[str]) -> str:
                 relative = os.path.relpath(os.path.join(folder, name), dataset.root)
                 digest.update(f"{relative}\0{stat.st_size}\0{stat.st_mtime_ns}\n".encode())
     return digest.hexdigest()
+
+
+def _own_split_entries(dataset: Dataset) -> bytes:
+    """What validating ``dataset`` reads of the root's ``splits.json``: the entries of its own scenes.
+
+    A group opened alone sees only its scenes' entries (:func:`davis_ag.data.dataset_checks.check_splits`),
+    and the file is rewritten whenever another group gains a scene: its bytes would give SP strawberry
+    a new stamp with every MP vine scene a run makes, and the run would read 24,510 views again at
+    each sitting. A whole dataset, or a file that does not parse, counts by its bytes.
+    """
+    file = dataset.root / SPLITS_FILE
+    if not file.is_file():
+        return f"{SPLITS_FILE}\0-".encode()
+    raw = file.read_bytes()
+    if dataset.opened == dataset.root:  # the whole dataset: validation reads every entry
+        return f"{SPLITS_FILE}\0".encode() + raw
+    own = {scene.id for scene in dataset.scenes}
+    try:
+        splits = json.loads(raw)
+        entries = {name: sorted(i for i in splits[name] if i in own) for name in ("train", "test")}
+    except (ValueError, TypeError, KeyError):
+        return f"{SPLITS_FILE}\0".encode() + raw
+    return f"{SPLITS_FILE} of these scenes\0{json.dumps(entries, sort_keys=True)}".encode()

@@ -14,6 +14,18 @@ from davis_ag.formats.scene_file import CameraRecord, RendererRecord, read_scene
 from davis_ag.workflows.run_groups import GROUPS
 from davis_ag.workflows.results_policies import LEARNERS, training_record
 
+#: Steps that a later sitting does whole again (a validation whose code changed, an evaluation),
+#: where generation and training resume: their clock adds up repeats, so the last sitting is one's cost.
+REDONE_WHOLE = ("validate", "evaluate")
+
+
+def last_whole_hours(stage: str, sittings: list[dict[str, Any]]) -> float | None:
+    """Hours of the last sitting of a stage that each sitting does whole, when it had more than one;
+    None otherwise (the stage's clock total is then its cost)."""
+    if stage.partition(": ")[2] not in REDONE_WHOLE or len(sittings) < 2:
+        return None
+    return float(sittings[-1]["seconds"]) / 3600
+
 
 def _counted(counter: Counter) -> str:
     return "; ".join(f"{value} ({n} scene{'s' if n > 1 else ''})" for value, n in counter.most_common())
@@ -142,6 +154,12 @@ def stage_rows(state: dict[str, Any], out: Path | None) -> list[tuple[str, float
                 f"{record.get('timesteps', 0):,} steps in {len(sittings)} sitting(s), "
                 f"{record.get('steps_per_second', 0):.1f} steps/s over the sittings' wall time"
                 + (f"; {len(timed)} sitting(s) on the run's clock" if timed else "")
+            )
+        last = last_whole_hours(stage, clock.get(stage, []))
+        if last is not None:
+            note += (
+                f"; {len(clock[stage])} sittings on the run's clock, each doing the whole {step} again "
+                f"(its code changed, or a sitting was stopped): the last took {last:.2f} h"
             )
         rows.append((stage, seconds, code, note))
     return rows

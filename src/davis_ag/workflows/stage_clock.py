@@ -10,6 +10,7 @@ redone after a kill included.
 from __future__ import annotations
 
 import json
+import re
 import threading
 import time
 from collections.abc import Iterator
@@ -113,12 +114,24 @@ class StageClock:
 
 def machines(sittings: list[dict[str, Any]]) -> str:
     """Where a stage's sittings ran, each machine once in order (``2 CPU cores (AMD EPYC), no GPU``), with
-    the sittings from before the clock recorded machines counted apart; ``-`` without sittings."""
+    the sittings that recorded less counted apart; ``-`` without sittings.
+
+    A sitting from before the clock named the CPU model (``2 CPU cores, no GPU``) is counted with
+    those that recorded no machine when the same machine with its model is listed: it adds nothing
+    the fuller name does not say, and may have run elsewhere.
+    """
     named = list(dict.fromkeys(s["machine"] for s in sittings if s.get("machine")))
-    unnamed = sum(1 for s in sittings if not s.get("machine"))
-    if unnamed:
-        named.append(f"{unnamed} sitting(s) unrecorded")
-    return "; ".join(named) or "-"
+    fuller = {_without_model(m) for m in named if _without_model(m) != m}
+    listed = [m for m in named if m not in fuller]
+    less = sum(1 for s in sittings if not s.get("machine") or s["machine"] in fuller)
+    if less:
+        listed.append(f"{less} sitting(s) with no machine or CPU model recorded")
+    return "; ".join(listed) or "-"
+
+
+def _without_model(machine: str) -> str:
+    """``2 CPU cores (Intel Xeon), no GPU`` as a sitting recorded it before the CPU model was named."""
+    return re.sub(r" \([^()]*(\([^()]*\)[^()]*)*\)", "", machine, count=1)
 
 
 def scene_seconds(timing: dict[str, Any]) -> float:
