@@ -43,7 +43,7 @@ def test_the_readme_block_beside_docs_is_rewritten_from_the_run(tmp_path: Path) 
     assert "PPO" not in text and "PPO" not in page  # a run without PPO (medium's), whatever CONFIGS now lists
     assert "| SP strawberry, ours (2 test scenes) | .600 ± .010 | .440 ± .010 | .300 ± .010 | .450 ± .010 | – |" in text
     assert "| SP strawberry, paper (Table 4) | .520 ± .004 | .433 ± .007 | .371 ± .008 | .438 ± .101 | - |" in text
-    assert "| MP vine, ours | not run |" in text and "| MP vine, paper (Table 4) | .369 ± .009 |" in text
+    assert "| MP vine, ours | not run yet |" in text and "| MP vine, paper (Table 4) | .369 ± .009 |" in text
     assert "SP strawberry: A2C > Rand ~ LRD > UDD **holds**." in text
     assert "SP strawberry +.027 (+.010 to +.040), ahead on 0 of the 1 test scenes played." in text
     # A page written elsewhere (a work folder beside the README) leaves the README alone.

@@ -83,7 +83,7 @@ def readme_block(config: Any, state: dict[str, Any], out: Path | None = None) ->
             )
             verdicts.append(f"{TITLES[scenario]}: {' '.join(PAPER_ORDERINGS[scenario])} {verdict}.")
         else:
-            lines.append(f"| {TITLES[scenario]}, ours | not run |" + " |" * (len(columns) - 1))
+            lines.append(f"| {TITLES[scenario]}, ours | not run yet |" + " |" * (len(columns) - 1))
         paper = PAPER_TABLE4[scenario]["oer_tau"]
         lines.append(
             f"| {TITLES[scenario]}, paper (Table 4) | "
