@@ -103,7 +103,7 @@ def test_the_blocks_beside_docs_give_the_train_gap_and_the_measured_hours(tmp_pa
         "+.200, is about the range of their own gaps"
     ) in page
     # With enough test scenes the interval over them is the verdict on other scenes like them.
-    from davis_ag.workflows.results_policies import paired_line
+    from davis_ag.workflows.results_gaps import paired_line
 
     many = [dict(per_scene[0], scene=f"Single-Strawberry/{i:03d}") for i in range(12)]
     line = paired_line(

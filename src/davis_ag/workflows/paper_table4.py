@@ -9,8 +9,6 @@ from __future__ import annotations
 
 from typing import Any
 
-from davis_ag.workflows.results_policies import cell
-
 #: Table 4 of the paper: scenario -> metric -> policy -> value.
 PAPER_TABLE4: dict[str, dict[str, dict[str, float]]] = {
     "sp": {
@@ -86,3 +84,16 @@ def ordering_holds(order: tuple[str, ...], policies: dict[str, dict[str, Any]], 
     """
     failures = ordering_failures(order, policies, metric)
     return None if failures is None else not failures
+
+
+def cell(value: float | None) -> str:
+    """Table 4 style: three decimals, no leading zero below 1 (``.433``)."""
+    if value is None:
+        return "–"
+    text = f"{value:.3f}"
+    return text[1:] if text.startswith("0.") else text
+
+
+def signed(value: float) -> str:
+    """A gap in Table 4 style with its sign (``+.013``, ``-.027``)."""
+    return ("+" if value >= 0 else "-") + cell(abs(value))

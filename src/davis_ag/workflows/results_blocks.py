@@ -14,9 +14,18 @@ from davis_ag.benchmark.exact import BEST_FIXED
 from davis_ag.benchmark.paired import CONFIDENCE, FEW_SCENES, paired_key
 from davis_ag.workflows.reproduce_configs import beside_table4
 from davis_ag.workflows.stage_clock import machines
-from davis_ag.workflows.paper_table4 import PAPER_ORDERINGS, PAPER_TABLE4, PAPER_TABLE4_STD, TITLES, ordering_failures
+from davis_ag.workflows.paper_table4 import (
+    PAPER_ORDERINGS,
+    PAPER_TABLE4,
+    PAPER_TABLE4_STD,
+    TITLES,
+    cell,
+    ordering_failures,
+    signed,
+)
+from davis_ag.workflows.results_gaps import scenes_ahead
 from davis_ag.workflows.results_provenance import last_whole_hours
-from davis_ag.workflows.results_policies import LEARNERS, cell, learners_run, scenes_ahead, signed, train_split_gap
+from davis_ag.workflows.results_policies import LEARNERS, learners_run, train_split_gap
 from davis_ag.workflows.run_groups import GROUPS
 
 #: The README's block that holds the run's OER_tau beside Table 4's (see :func:`readme_block`).

@@ -20,12 +20,12 @@ from davis_ag.workflows.paper_table4 import (
     PAPER_TABLE4_STD,
     PAPER_TIMESTEPS,
     TITLES,
+    cell,
     ordering_failures,
     ordering_holds,
 )
 from davis_ag.workflows.results_policies import (
     LEARNERS,
-    cell,
     learners_run,
     learning_curve_section,
     ordered,
