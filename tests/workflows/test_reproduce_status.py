@@ -146,3 +146,25 @@ def test_a_generate_stage_shows_its_views_before_its_first_scene_ends(tmp_path: 
     )
     views = views_per_scene(*CONFIG.specs("mp", "vine"))
     assert stage.left_s == pytest.approx((2 * views - 300) * 600.0 / 300)
+
+
+def test_a_validation_not_started_is_timed_at_the_other_groups_last_check(tmp_path: Path) -> None:
+    # SP strawberry was checked whole twice (its validator changed); MP vine reads at the views per
+    # second of the last check, not of the two added up.
+    from davis_ag.scene.view_grid import views_per_scene
+
+    out = a_run_part_way(tmp_path)
+    state = json.loads((out / "state.json").read_text())
+    state["stages"]["sp-strawberry: validate"] = {"seconds": 900.0, "note": "checked 3 scenes: sound", "code": "x"}
+    (out / "state.json").write_text(json.dumps(state))
+    clock = json.loads((out / "clock.json").read_text())
+    clock["stages"]["sp-strawberry: validate"] = [
+        {"started": "t", "seconds": 600.0, "code": "x"},
+        {"started": "t", "seconds": 300.0, "code": "y"},
+    ]
+    (out / "clock.json").write_text(json.dumps(clock))
+    sp_views = CONFIG.sp_scenes * views_per_scene(*CONFIG.specs("sp", "strawberry"))
+    mp_views = CONFIG.mp_scenes * views_per_scene(*CONFIG.specs("mp", "vine"))
+    stage = {s.stage: s for s in run_status(out)[1]}["mp-vine: validate"]
+    assert not stage.done and stage.progress.startswith(f"not started; {mp_views:,} views, timed at sp-strawberry's")
+    assert stage.left_s == pytest.approx(mp_views * 300.0 / sp_views)

@@ -4,8 +4,9 @@ A ``paper-scale`` run takes many sittings; its log says what the last one did. T
 each stage of the whole run has done (scenes made, steps trained, evaluations written), how long it
 has worked on the stage's clock, and about how long is left: for a stage under way (a learner at the
 rate of its last sitting, a generate stage at the mean time of its scenes so far, or at the rate of
-the views drawn before its first scene ends), and for a learner not started, at the rate the same
-learner trained at on the run's other group; the stages with no rate yet are named, not guessed.
+the views drawn before its first scene ends), for a learner not started, at the rate the same
+learner trained at on the run's other group, and for a validation not started, at the views per
+second of the other group's last whole check; the stages with no rate yet are named, not guessed.
 Reading it while the run goes on is safe: it writes nothing, every file it reads but one is written
 atomically, and the one that grows (a scene's journal of views) may vanish as its scene ends, which
 counts it as not under way.
@@ -105,6 +106,8 @@ def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
         stages.append(
             StageStatus(stage, bool(note and note.endswith(": sound")), note or "not started", seconds(stage))
         )
+        if not note:
+            stages[-1] = _validation_from_elsewhere(config, clock, recorded, scenario, crop, stages[-1])
         timesteps = config.timesteps(scenario)
         for algo in config.learners:
             stage = f"{key}: train {algo.upper()}"
@@ -221,6 +224,36 @@ def _estimated_from_elsewhere(out: Path, key: str, algo: str, timesteps: int, st
             return replace(
                 status, progress=f"not started; timed at {other}'s {rate:.1f} steps/s", left_s=timesteps / rate
             )
+    return status
+
+
+def _validation_from_elsewhere(
+    config: ReproduceConfig,
+    clock: dict[str, list[dict[str, Any]]],
+    recorded: dict[str, dict[str, Any]],
+    scenario: str,
+    crop: str,
+    status: StageStatus,
+) -> StageStatus:
+    """A validation not started, timed at the views per second of another group's last whole
+    check (every view is read, at the run's one image size), where one has passed."""
+    from dataclasses import replace
+
+    from davis_ag.scene.view_grid import views_per_scene
+
+    views = config.scenes(scenario) * views_per_scene(*config.specs(scenario, crop))
+    for other_scenario, other_crop in SCENARIO_CROPS:
+        other = group_key(other_scenario, other_crop)
+        sittings = clock.get(f"{other}: validate")
+        if other == group_key(scenario, crop) or not sittings or f"{other}: validate" not in recorded:
+            continue
+        checked = config.scenes(other_scenario) * views_per_scene(*config.specs(other_scenario, other_crop))
+        rate = checked / max(float(sittings[-1]["seconds"]), 1e-9)
+        return replace(
+            status,
+            progress=f"not started; {views:,} views, timed at {other}'s last check ({rate:.0f} views/s)",
+            left_s=views / rate,
+        )
     return status
 
 
