@@ -196,7 +196,7 @@ def run_block(config: Any, state: dict[str, Any], stages: list[tuple[str, float,
 
 def _stage_hours(step: str, seconds: float, sittings: list[dict[str, Any]]) -> str:
     """``validate 0.43 h``; a stage done whole again by later sittings reads by its last one."""
-    last = last_whole_hours(f"stage: {step}", sittings)
+    last = last_whole_hours(step, sittings)
     if last is None:
         return f"{step} {seconds / 3600:.2f} h"
     return f"{step} {last:.2f} h (the last of {len(sittings)} sittings that each did it whole; {seconds / 3600:.2f} h in all)"

@@ -15,14 +15,15 @@ from davis_ag.workflows.run_groups import GROUPS
 from davis_ag.workflows.results_policies import LEARNERS, training_record
 
 #: Steps that a later sitting does whole again (a validation whose code changed, an evaluation),
-#: where generation and training resume: their clock adds up repeats, so the last sitting is one's cost.
+#: where generation and training resume: their clock adds up the repeats, and the last sitting
+#: alone is what the step costs.
 REDONE_WHOLE = ("validate", "evaluate")
 
 
-def last_whole_hours(stage: str, sittings: list[dict[str, Any]]) -> float | None:
-    """Hours of the last sitting of a stage that each sitting does whole, when it had more than one;
-    None otherwise (the stage's clock total is then its cost)."""
-    if stage.partition(": ")[2] not in REDONE_WHOLE or len(sittings) < 2:
+def last_whole_hours(step: str, sittings: list[dict[str, Any]]) -> float | None:
+    """Hours of the last sitting of a step that each sitting does whole (``validate``), when it had
+    more than one; None otherwise (the stage's clock total is then its cost)."""
+    if step not in REDONE_WHOLE or len(sittings) < 2:
         return None
     return float(sittings[-1]["seconds"]) / 3600
 
@@ -155,7 +156,7 @@ def stage_rows(state: dict[str, Any], out: Path | None) -> list[tuple[str, float
                 f"{record.get('steps_per_second', 0):.1f} steps/s over the sittings' wall time"
                 + (f"; {len(timed)} sitting(s) on the run's clock" if timed else "")
             )
-        last = last_whole_hours(stage, clock.get(stage, []))
+        last = last_whole_hours(step, clock.get(stage, []))
         if last is not None:
             note += (
                 f"; {len(clock[stage])} sittings on the run's clock, each doing the whole {step} again "
