@@ -336,6 +336,8 @@ def pools_for(command: str, out: str) -> tuple[list[str], dict[str, st.SearchStr
             },
             ["--out"],
         )
+    if command == "verify":
+        return [], {"--keep": st.sampled_from([f"{out}/again", "/proc/x", "a-file", "a-file/sub", "data/again"])}, []
     raise AssertionError(command)
 
 
@@ -349,6 +351,7 @@ COVERED = (
     "evaluate",
     "compare",
     "validate",
+    "verify",
     "stats",
     "plot",
     "view",
@@ -396,6 +399,15 @@ def test_no_traceback_and_nothing_outside_the_output_changes(
                 ),
                 label="dir",
             ),
+        )
+    elif command == "verify":
+        argv[1:1] = data.draw(
+            st.lists(
+                st.sampled_from(["data/Single-Strawberry/000", "data/Single-Strawberry", "data", "missing", "a-file"]),
+                min_size=1,
+                max_size=2,
+            ),
+            label="scenes",
         )
     elif command == "plot":
         argv[1:1] = [

@@ -19,6 +19,7 @@ from davis_ag.provenance import code_version
 COMMANDS = [
     "generate",
     "validate",
+    "verify",
     "train",
     "evaluate",
     "compare",
@@ -44,6 +45,7 @@ KEPT_WHEN_STOPPED = {
     "evaluate": "nothing half-written was left",
     "export": "the files already exported are kept",
     "transfer": "finished stages are kept",
+    "verify": "the dataset was only read",
 }
 
 

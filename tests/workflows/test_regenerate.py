@@ -1,0 +1,94 @@
+"""``davis-ag verify``: a scene made again from its records comes out byte for byte, and any change
+to its files, or records that cannot rebuild it, is named."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from davis_ag.cli import main
+from davis_ag.errors import UserError
+from davis_ag.generate.run_config import load_dataset_config
+from davis_ag.generate.run_progress import RunOptions
+from davis_ag.generate.runner import run_dataset
+from davis_ag.workflows.regenerate import request_for
+
+#: A strawberry scene of 7 views on a grid of its own and the README altitudes, and a vine scene of
+#: 2 x 2 positions with 2 headings: the grid, the altitudes and the scenario come from the records.
+TINY = """\
+seed: 5
+image_size: 64x48
+strawberry_altitudes: readme
+groups:
+  - {scenario: sp, crop: strawberry, scenes: 1, first: 2, grid: {extent: [3.0, 3.0], step: 1.5, altitude_levels: [0]}}
+  - {scenario: mp, crop: vine, scenes: 1, grid: {extent: [1.0, 1.0], step: 1.0, altitude_levels: [0], headings: 2}}
+"""
+
+
+@pytest.fixture(scope="module")
+def dataset(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    config = tmp_path_factory.mktemp("config") / "tiny.yaml"
+    config.write_text(TINY)
+    root = tmp_path_factory.mktemp("data") / "data"
+    run_dataset(load_dataset_config(config).requests(), root, RunOptions(workers=1, progress=False))
+    return root
+
+
+@pytest.fixture
+def copy(dataset: Path, tmp_path: Path) -> Path:
+    return Path(shutil.copytree(dataset, tmp_path / "data"))
+
+
+def test_a_scene_is_rebuilt_from_its_records(dataset: Path) -> None:
+    for scene in ("Single-Strawberry/002", "Multi-Vine/000"):
+        request = request_for(dataset / scene)
+        recorded = json.loads((dataset / scene / "scene.json").read_text())
+        assert (request.folder, request.seed) == (scene, recorded["seed"])
+        assert (request.camera.width, request.camera.height) == (64, 48)
+    strawberry = request_for(dataset / "Single-Strawberry/002")
+    assert strawberry.scenario.extent == (3.0, 3.0) and strawberry.scenario.step == 1.5
+    assert strawberry.crop.altitudes == (0.50, 0.75, 1.00)  # the README altitudes, as recorded
+    assert request_for(dataset / "Multi-Vine/000").scenario.headings == 2
+
+
+def test_both_scenes_come_out_identical_and_the_dataset_is_untouched(
+    dataset: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    before = {p: p.stat().st_mtime_ns for p in dataset.rglob("*")}
+    monkeypatch.chdir(dataset.parent)  # relative paths, as a user types them
+    assert main(["verify", "data/Single-Strawberry/002", "data/Multi-Vine/000", "--keep", str(tmp_path / "again")]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith("Single-Strawberry/002: identical, ") and "files byte for byte" in lines[0]
+    assert lines[1].startswith("Multi-Vine/000: identical, ")
+    assert lines[-1] == "2 of 2 scenes identical"
+    assert {p: p.stat().st_mtime_ns for p in dataset.rglob("*")} == before
+    assert (tmp_path / "again" / "Multi-Vine" / "000" / "annotations.json").is_file()  # kept as asked
+
+
+def test_a_changed_file_is_named(copy: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    scene = copy / "Single-Strawberry" / "002"
+    mask = next((scene / "images").glob("*_seg.png"))
+    data = bytearray(mask.read_bytes())
+    data[-20] ^= 1
+    mask.write_bytes(bytes(data))
+    assert main(["verify", str(scene)]) == 1
+    (line,) = capsys.readouterr().out.splitlines()
+    assert line.startswith("Single-Strawberry/002: 1 of ") and f"files differ (images/{mask.name}; made by " in line
+
+
+def test_records_that_cannot_rebuild_the_scene_get_one_line(copy: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    moved = copy / "Single-Strawberry" / "007"
+    (copy / "Single-Strawberry" / "002").rename(moved)  # a scene folder renamed by hand
+    with pytest.raises(UserError, match="rebuild scene Single-Strawberry/007 with seed .*not Single-Strawberry/002"):
+        request_for(moved)
+    assert main(["verify", str(copy / "Single-Strawberry")]) == 2  # a group folder is not a scene
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "scene.json: not found" in err
+    # --keep inside the dataset would write there: refused before any scene is made.
+    vine = copy / "Multi-Vine" / "000"
+    assert main(["verify", str(vine), "--keep", str(copy / "again")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "lies in the dataset" in err and not (copy / "again").exists()
