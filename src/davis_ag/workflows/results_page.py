@@ -200,7 +200,7 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
         lines += [f"## {TITLES[scenario]}", ""]
         result = state.get("results", {}).get(scenario)
         if not result:
-            lines += ["Not run (yet): the run stopped before this benchmark.", ""]
+            lines += ["Not evaluated yet: the run had not reached this benchmark when this page was written.", ""]
             continue
         protocol, policies = result["protocol"], result["policies"]
         starts = f", {protocol['starts']:,} eligible starts" if "starts" in protocol else ""
