@@ -83,6 +83,9 @@ def test_another_group_gaining_scenes_leaves_a_groups_stamp(dataset: Path) -> No
     (dataset / "splits.json").write_text(json.dumps(splits, indent=2))
     assert validation_stamp(dataset / GROUP) == before
     assert validation_stamp(dataset) != whole  # the whole dataset's validation reads that entry
+    splits["seed"] = "not a seed"  # a damage the group's validation reports: a new stamp
+    (dataset / "splits.json").write_text(json.dumps(splits, indent=2))
+    assert validation_stamp(dataset / GROUP) != before
 
 
 def test_another_validator_gives_another_stamp(dataset: Path, monkeypatch: pytest.MonkeyPatch) -> None:

@@ -3,18 +3,16 @@ to its files, or records that cannot rebuild it, is named."""
 
 from __future__ import annotations
 
-import json
 import shutil
 from pathlib import Path
 
 import pytest
 
 from davis_ag.cli import main
-from davis_ag.errors import UserError
 from davis_ag.generate.run_config import load_dataset_config
 from davis_ag.generate.run_progress import RunOptions
 from davis_ag.generate.runner import run_dataset
-from davis_ag.workflows.regenerate import request_for
+from davis_ag.workflows.regenerate import request_for, verify_scene
 
 #: A strawberry scene of 7 views on a grid of its own and the README altitudes, and a vine scene of
 #: 2 x 2 positions with 2 headings: the grid, the altitudes and the scenario come from the records.
@@ -29,11 +27,16 @@ groups:
 
 
 @pytest.fixture(scope="module")
-def dataset(tmp_path_factory: pytest.TempPathFactory) -> Path:
+def tiny_config(tmp_path_factory: pytest.TempPathFactory) -> Path:
     config = tmp_path_factory.mktemp("config") / "tiny.yaml"
     config.write_text(TINY)
+    return config
+
+
+@pytest.fixture(scope="module")
+def dataset(tiny_config: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
     root = tmp_path_factory.mktemp("data") / "data"
-    run_dataset(load_dataset_config(config).requests(), root, RunOptions(workers=1, progress=False))
+    run_dataset(load_dataset_config(tiny_config).requests(), root, RunOptions(workers=1, progress=False))
     return root
 
 
@@ -42,16 +45,13 @@ def copy(dataset: Path, tmp_path: Path) -> Path:
     return Path(shutil.copytree(dataset, tmp_path / "data"))
 
 
-def test_a_scene_is_rebuilt_from_its_records(dataset: Path) -> None:
+def test_a_scene_is_rebuilt_from_its_records(dataset: Path, tiny_config: Path) -> None:
+    # The grid, the README altitudes and the vine's two headings come back from scene.json alone.
+    made = {r.folder: r for r in load_dataset_config(tiny_config).requests()}
     for scene in ("Single-Strawberry/002", "Multi-Vine/000"):
-        request = request_for(dataset / scene)
-        recorded = json.loads((dataset / scene / "scene.json").read_text())
-        assert (request.folder, request.seed) == (scene, recorded["seed"])
-        assert (request.camera.width, request.camera.height) == (64, 48)
-    strawberry = request_for(dataset / "Single-Strawberry/002")
-    assert strawberry.scenario.extent == (3.0, 3.0) and strawberry.scenario.step == 1.5
-    assert strawberry.crop.altitudes == (0.50, 0.75, 1.00)  # the README altitudes, as recorded
-    assert request_for(dataset / "Multi-Vine/000").scenario.headings == 2
+        assert request_for(dataset / scene) == made[scene]
+    assert made["Single-Strawberry/002"].crop.altitudes == (0.50, 0.75, 1.00)
+    assert made["Multi-Vine/000"].scenario.headings == 2
 
 
 def test_both_scenes_come_out_identical_and_the_dataset_is_untouched(
@@ -79,16 +79,33 @@ def test_a_changed_file_is_named(copy: Path, capsys: pytest.CaptureFixture[str])
     assert line.startswith("Single-Strawberry/002: 1 of ") and f"files differ (images/{mask.name}; made by " in line
 
 
-def test_records_that_cannot_rebuild_the_scene_get_one_line(copy: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_live_cache_beside_the_scene_is_not_a_difference(copy: Path) -> None:
+    from davis_ag.live.reopen import CACHE_FILE
+
+    scene = copy / "Multi-Vine" / "000"
+    (scene / CACHE_FILE).write_bytes(b"written by davis-ag live, not by generate")
+    assert verify_scene(scene, progress=False).identical
+
+
+def test_what_cannot_be_verified_is_refused_in_one_line_before_any_scene_is_made(
+    copy: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    def refused(*argv: str) -> str:
+        assert main(["verify", *argv]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1, err
+        return err
+
     moved = copy / "Single-Strawberry" / "007"
     (copy / "Single-Strawberry" / "002").rename(moved)  # a scene folder renamed by hand
-    with pytest.raises(UserError, match="rebuild scene Single-Strawberry/007 with seed .*not Single-Strawberry/002"):
-        request_for(moved)
-    assert main(["verify", str(copy / "Single-Strawberry")]) == 2  # a group folder is not a scene
-    err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "scene.json: not found" in err
-    # --keep inside the dataset would write there: refused before any scene is made.
+    assert "records scene Single-Strawberry/002, not this folder: was the folder renamed" in refused(str(moved))
+    assert "scene.json: missing" in refused(str(copy / "Single-Strawberry"))  # a group is not a scene
     vine = copy / "Multi-Vine" / "000"
-    assert main(["verify", str(vine), "--keep", str(copy / "again")]) == 2
-    err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "lies in the dataset" in err and not (copy / "again").exists()
+    assert "is given twice" in refused(str(vine), str(copy / "Multi-Vine" / ".." / "Multi-Vine" / "000"))
+    # --keep inside the dataset would write there, through `..` too; a full folder could mix scenes.
+    for keep in (copy / "again", tmp_path / "elsewhere" / ".." / "data" / "again"):
+        assert "lies in the dataset" in refused(str(vine), "--keep", str(keep))
+    (tmp_path / "full").mkdir()
+    (tmp_path / "full" / "notes.txt").write_text("mine")
+    assert "is not empty" in refused(str(vine), "--keep", str(tmp_path / "full"))
+    assert not (copy / "again").exists() and (tmp_path / "full" / "notes.txt").read_text() == "mine"

@@ -155,12 +155,18 @@ def test_a_validation_not_started_is_timed_at_the_other_groups_last_check(tmp_pa
 
     out = a_run_part_way(tmp_path)
     state = json.loads((out / "state.json").read_text())
-    state["stages"]["sp-strawberry: validate"] = {"seconds": 900.0, "note": "checked 3 scenes: sound", "code": "x"}
+    state["stages"]["sp-strawberry: validate"] = {
+        "seconds": 900.0,
+        "note": "checked 3 scenes: sound",
+        "code": "x",
+        "check_seconds": 300.0,
+    }
     (out / "state.json").write_text(json.dumps(state))
     clock = json.loads((out / "clock.json").read_text())
     clock["stages"]["sp-strawberry: validate"] = [
         {"started": "t", "seconds": 600.0, "code": "x"},
         {"started": "t", "seconds": 300.0, "code": "y"},
+        {"started": "t", "seconds": 20.0, "code": "z"},  # a re-check stopped early: not a whole check
     ]
     (out / "clock.json").write_text(json.dumps(clock))
     sp_views = CONFIG.sp_scenes * views_per_scene(*CONFIG.specs("sp", "strawberry"))
@@ -168,3 +174,8 @@ def test_a_validation_not_started_is_timed_at_the_other_groups_last_check(tmp_pa
     stage = {s.stage: s for s in run_status(out)[1]}["mp-vine: validate"]
     assert not stage.done and stage.progress.startswith(f"not started; {mp_views:,} views, timed at sp-strawberry's")
     assert stage.left_s == pytest.approx(mp_views * 300.0 / sp_views)
+    # Once MP's own check is on the clock, it is under way, not "not started".
+    clock["stages"]["mp-vine: validate"] = [{"started": "t", "seconds": 60.0, "code": "x"}]
+    (out / "clock.json").write_text(json.dumps(clock))
+    stage = {s.stage: s for s in run_status(out)[1]}["mp-vine: validate"]
+    assert (stage.done, stage.progress, stage.seconds) == (False, "under way", 60.0)

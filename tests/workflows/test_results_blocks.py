@@ -78,7 +78,7 @@ def test_the_blocks_beside_docs_give_the_train_gap_and_the_measured_hours(tmp_pa
         "results": {"sp": result},
         "stages": {
             "sp-strawberry: generate": {"seconds": 8460.0, "note": "86 scene(s)"},
-            "sp-strawberry: validate": {"seconds": 900.0, "note": "sound"},
+            "sp-strawberry: validate": {"seconds": 900.0, "note": "sound", "check_seconds": 330.0},
             "sp-strawberry: evaluate": {"seconds": 36.0, "note": "split test"},
         },
     }
@@ -88,7 +88,7 @@ def test_the_blocks_beside_docs_give_the_train_gap_and_the_measured_hours(tmp_pa
         "code": "x",
         "machine": "2 CPU cores (AMD EPYC), no GPU",
     }
-    # Validation ran whole twice (its code changed between sittings): its cost is the last one's.
+    # Validation ran whole twice (its code changed between sittings): its cost is one whole check's.
     checks = [dict(sitting, seconds=540.0), dict(sitting, seconds=360.0)]
     clock = {"sp-strawberry: evaluate": [sitting], "sp-strawberry: validate": checks}
     (tmp_path / "clock.json").write_text(json.dumps({"stages": clock}))
@@ -119,12 +119,12 @@ def test_the_blocks_beside_docs_give_the_train_gap_and_the_measured_hours(tmp_pa
     assert "(Table 3's scenes and images): 86 SP strawberry and 44 MP vine scenes at 1280x720" in benchmark
     assert "evaluated on SP strawberry 2 test scenes, 507 eligible starts; MP vine not evaluated yet" in benchmark
     assert (
-        "took 2.6 hours of wall time by the run's clock (SP strawberry: generate 2.35 h, validate 0.10 h (the last "
-        "of 2 sittings that each did it whole; 0.25 h in all), evaluate 0.01 h; MP vine: no stage finished yet), "
+        "took 2.6 hours of wall time by the run's clock (SP strawberry: generate 2.35 h, validate 0.09 h (2 "
+        "sittings each did it whole again: 0.25 h in all), evaluate 0.01 h; MP vine: no stage finished yet), "
         "on 2 CPU cores (AMD EPYC), no GPU; results.md" in benchmark
     )
     assert (
         "| sp-strawberry: validate | 900 | 0.25 | 2 CPU cores (AMD EPYC), no GPU | unrecorded | sound; 2 sittings on "
-        "the run's clock, each doing the whole validate again (its code changed, or a sitting was stopped): the "
-        "last took 0.10 h |" in page
+        "the run's clock, each doing the whole validate again (its code changed, or a sitting was stopped): one "
+        "whole validate took 0.09 h |" in page
     )

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from davis_ag.commands import arguments
 
@@ -37,17 +38,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Verify each scene in turn; 0 when all are identical, 1 otherwise."""
-    from davis_ag.errors import UserError
-    from davis_ag.workflows.regenerate import request_for, scene_folder_of, verify_scene
+    from davis_ag.workflows.regenerate import verify_scene
 
-    for scene in args.scenes:  # every scene's records, before the first long regeneration
-        request_for(scene)
-    if args.keep is not None:
-        keep = arguments.prove_writable_folder(args.keep, "--keep")
-        for scene in args.scenes:
-            root = scene_folder_of(scene).parent.parent
-            if keep == root or root in keep.parents:
-                raise UserError(f"--keep {args.keep} lies in the dataset of {scene}: choose a folder outside it")
+    check_before_making(args.scenes, args.keep)
     verdicts = []
     for scene in args.scenes:
         verdict = verify_scene(scene, args.keep)
@@ -57,3 +50,40 @@ def run(args: argparse.Namespace) -> int:
     if len(verdicts) > 1:
         print(f"{same} of {len(verdicts)} scenes identical")
     return 0 if same == len(verdicts) else 1
+
+
+def check_before_making(scenes: list[Path], keep: Path | None) -> None:
+    """Refuse, before the first scene is made again (minutes to hours each), what would fail later:
+    records that cannot rebuild a scene, a scene given twice, and a ``--keep`` folder that lies in
+    a dataset given, is not empty, or would hold scenes of datasets made with other settings.
+
+    Raises:
+        UserError: naming the scene or folder and what to do.
+    """
+    import os
+
+    from davis_ag.errors import UserError
+    from davis_ag.generate.dataset_files import dataset_settings
+    from davis_ag.workflows.regenerate import request_for, scene_folder_of
+
+    requests = [request_for(scene) for scene in scenes]
+    folders = [os.path.realpath(scene_folder_of(scene)) for scene in scenes]
+    if len(set(folders)) < len(folders):
+        twice = next(f for f in folders if folders.count(f) > 1)
+        raise UserError(f"{twice} is given twice: give each scene once")
+    if keep is None:
+        return
+    kept = Path(os.path.realpath(arguments.prove_writable_folder(keep, "--keep")))
+    for folder in folders:
+        root = Path(folder).parent.parent
+        if kept == root or root in kept.parents:
+            raise UserError(f"--keep {keep} lies in the dataset {root}: choose a folder outside it")
+    if kept.is_dir() and any(kept.iterdir()):
+        raise UserError(f"--keep {keep} is not empty: choose a new or empty folder")
+    try:
+        dataset_settings(requests)
+    except UserError:
+        raise UserError(
+            f"--keep {keep} would hold scenes made with other seeds, sizes or settings: verify them "
+            "with one --keep folder each"
+        ) from None

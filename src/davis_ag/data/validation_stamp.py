@@ -19,6 +19,7 @@ from pathlib import Path
 
 from davis_ag.data.reader import Dataset, open_dataset
 from davis_ag.formats.layout import DATASET_FILE, SPLITS_FILE
+from davis_ag.formats.models import SplitsFile
 
 #: The packages whose code decides what a validation finds: a change to any of them is a new stamp.
 VALIDATOR_PACKAGES = ("data", "formats")
@@ -86,7 +87,7 @@ def _own_split_entries(dataset: Dataset) -> bytes:
     A group opened alone sees only its scenes' entries (:func:`davis_ag.data.dataset_checks.check_splits`),
     and the file is rewritten whenever another group gains a scene: its bytes would give SP strawberry
     a new stamp with every MP vine scene a run makes, and the run would read 24,510 views again at
-    each sitting. A whole dataset, or a file that does not parse, counts by its bytes.
+    each sitting. A whole dataset, or a file the validator would refuse, counts by its bytes.
     """
     file = dataset.root / SPLITS_FILE
     if not file.is_file():
@@ -94,10 +95,10 @@ def _own_split_entries(dataset: Dataset) -> bytes:
     raw = file.read_bytes()
     if dataset.opened == dataset.root:  # the whole dataset: validation reads every entry
         return f"{SPLITS_FILE}\0".encode() + raw
-    own = {scene.id for scene in dataset.scenes}
-    try:
-        splits = json.loads(raw)
-        entries = {name: sorted(i for i in splits[name] if i in own) for name in ("train", "test")}
-    except (ValueError, TypeError, KeyError):
+    try:  # a file the validator would refuse counts by its bytes, whatever part is damaged
+        splits = SplitsFile.model_validate(json.loads(raw))
+    except (ValueError, TypeError):
         return f"{SPLITS_FILE}\0".encode() + raw
+    own = {scene.id for scene in dataset.scenes}
+    entries = {"train": sorted(set(splits.train) & own), "test": sorted(set(splits.test) & own)}
     return f"{SPLITS_FILE} of these scenes\0{json.dumps(entries, sort_keys=True)}".encode()

@@ -30,7 +30,16 @@ from davis_ag.formats.scene_file import SCENE_FORMAT, GeneratorRecord, RendererR
 from davis_ag.errors import UserError
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.lighting import Lighting
-from davis_ag.scene.specs import DEFAULT_PLANTS, CropSpec, ScenarioSpec, check_plants, crop_spec, scenario_spec
+from davis_ag.scene.specs import (
+    DEFAULT_PLANTS,
+    STRAWBERRY_ALTITUDES,
+    CropSpec,
+    ScenarioSpec,
+    check_plants,
+    crop_spec,
+    scenario_spec,
+    with_strawberry_altitudes,
+)
 from davis_ag.scene.view_grid import Viewpoint
 
 T = TypeVar("T")
@@ -98,6 +107,20 @@ def antialiasing_of(renderer: RendererRecord) -> str:
     return "msaa" if text.startswith("4x") or renderer.name == "helios" else "none"
 
 
+def _crop_at(crop: CropSpec, altitudes: list[float]) -> tuple[CropSpec, tuple[int, ...]]:
+    """The crop whose camera altitudes hold the recorded ones (strawberry has two choices,
+    ``--strawberry-altitudes``), and the levels they are.
+
+    Raises:
+        ValueError: when no choice holds them.
+    """
+    for choice in (None, *STRAWBERRY_ALTITUDES):
+        candidate = crop if choice is None else with_strawberry_altitudes(crop, choice)
+        if all(a in candidate.altitudes for a in altitudes):
+            return candidate, tuple(candidate.altitudes.index(a) for a in altitudes)
+    raise ValueError(f"grid.altitudes_m {altitudes} are not {crop.name}'s camera altitudes {list(crop.altitudes)}")
+
+
 def _needed(value: T | None, key: str) -> T:
     """``value``, or a ValueError naming the scene.json key it should have come from."""
     if value is None:
@@ -114,7 +137,7 @@ def read_settings(scene_dir: str | Path) -> SceneSettings:
     folder = Path(scene_dir)
     path = folder / SCENE_METADATA
     if not path.is_file():
-        raise UserError(f"{path}: missing; only scenes made by `davis-ag generate` can be reopened live")
+        raise UserError(f"{path}: missing; only scenes made by `davis-ag generate` can be regrown")
     metadata = read_scene_file(path)
     if not metadata.ours:
         raise UserError(
@@ -123,13 +146,16 @@ def read_settings(scene_dir: str | Path) -> SceneSettings:
         )
     try:
         grid, renderer = _needed(metadata.grid, "grid"), _needed(metadata.renderer, "renderer")
-        crop = crop_spec(_needed(metadata.crop, "crop"))
-        levels = tuple(crop.altitudes.index(a) for a in _needed(grid.altitudes_m, "grid.altitudes_m"))
+        crop, levels = _crop_at(
+            crop_spec(_needed(metadata.crop, "crop")), _needed(grid.altitudes_m, "grid.altitudes_m")
+        )
+        scenario = scenario_spec(_needed(metadata.scenario, "scenario"), crop)
         scenario = replace(
-            scenario_spec(_needed(metadata.scenario, "scenario"), crop),
+            scenario,
             extent=tuple(_needed(grid.extent_m, "grid.extent_m")),
             step=float(_needed(grid.step_m, "grid.step_m")),
             altitude_levels=levels,
+            headings=int(grid.headings or scenario.headings),  # reduced grids may have fewer
         )
         width, height = _needed(metadata.image_size(), "camera.width and height")
         camera = Camera(width, height, float(_needed(metadata.camera.vfov_deg, "camera.vfov_deg")))  # type: ignore[union-attr]

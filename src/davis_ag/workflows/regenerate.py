@@ -2,10 +2,10 @@
 
 A dataset is reproducible when the code grows and draws the same bytes from the same records.
 ``davis-ag verify`` proves it scene by scene: the request that made a scene is rebuilt from its
-``scene.json`` (seed, scenario, crop, camera, renderer, plants, appearance) and the dataset's
-``dataset.json`` (its group's grid), the scene is made again in a folder of its own, and every file
-is compared byte for byte; ``scene.json`` is compared as JSON without what records the making
-(the generator's versions and the timings). Nothing is written inside the dataset.
+``scene.json`` (seed, scenario, crop, grid, camera, renderer, plants, appearance), the scene is
+made again in a folder of its own, and every file is compared byte for byte; ``scene.json`` is
+compared as JSON without what records the making (the generator's versions and the timings).
+Nothing is written inside the dataset.
 """
 
 from __future__ import annotations
@@ -14,16 +14,14 @@ import json
 import os
 import tempfile
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from davis_ag.errors import UserError
-from davis_ag.formats.layout import DATASET_FILE, SCENE_METADATA
+from davis_ag.formats.layout import SCENE_METADATA
+from davis_ag.formats.scene_file import read_scene_file
 from davis_ag.generate.one_scene import SceneRequest
-from davis_ag.render.backends import ANTIALIASING_DESCRIPTIONS
-from davis_ag.scene.camera import Camera
-from davis_ag.scene.specs import STRAWBERRY_ALTITUDES, crop_spec, scenario_spec, with_strawberry_altitudes
 
 #: What ``scene.json`` records of the making rather than of the scene: left out of the comparison.
 MAKING = ("generator", "timing_s")
@@ -71,66 +69,50 @@ def scene_folder_of(path: str | os.PathLike[str]) -> Path:
     return Path(os.path.normpath(Path(path).absolute()))
 
 
-def request_for(scene_dir: Path) -> SceneRequest:
-    """The request that made a scene of ours, rebuilt from its records.
+def request_for(scene_dir: str | os.PathLike[str]) -> SceneRequest:
+    """The request that made a scene of ours, rebuilt from its ``scene.json``.
+
+    The scene's settings are read as a live scene reads them
+    (:func:`davis_ag.live.reopen.read_settings`: grid, altitudes, camera, renderer, plants); what
+    ``generate`` writes besides (depth, organ classes, appearance) is read here.
 
     Args:
-        scene_dir: A scene folder (``DATA/Single-Strawberry/000``) holding ``scene.json``, in a
-            dataset whose root holds ``dataset.json``.
+        scene_dir: A scene folder (``DATA/Single-Strawberry/000``).
 
     Returns:
-        The :class:`SceneRequest`, whose seed is the scene's.
+        The :class:`SceneRequest`, whose seed, folder and view count are the scene's.
 
     Raises:
-        UserError: when the folder is not a scene of ours, or its records do not rebuild its seed.
+        UserError: when the folder is not a scene of ours, or its records do not rebuild it.
     """
-    scene_dir = scene_folder_of(scene_dir)
-    scene = _read_json(scene_dir / SCENE_METADATA)
-    dataset = _read_json(scene_dir.parent.parent / DATASET_FILE)
-    where = scene_dir / SCENE_METADATA
-    try:
-        crop = crop_spec(scene["crop"])
-        scenario = scenario_spec(scene["scenario"], crop)
-        grid = dataset["groups"][scene_dir.parent.name]["grid"]
-        altitudes = tuple(grid.get("altitudes_m", ()))
-        for choice, heights in STRAWBERRY_ALTITUDES.items():  # strawberry's two altitude choices
-            if crop.name == "strawberry" and altitudes == tuple(heights[i] for i in grid["altitude_levels"]):
-                crop = with_strawberry_altitudes(crop, choice)
-        scenario = replace(
-            scenario,
-            extent=tuple(grid["extent"]),
-            step=grid["step"],
-            altitude_levels=tuple(grid["altitude_levels"]),
-            headings=grid["headings"],
-        )
-        camera = scene["camera"]
-        renderer = scene["renderer"]
-        antialiasing = {text: mode for mode, text in ANTIALIASING_DESCRIPTIONS.items()}.get(
-            renderer.get("antialiasing"), "fxaa"
-        )
-        request = SceneRequest(
-            scenario,
-            crop,
-            int(scene_dir.name),
-            int(scene["dataset_seed"]),
-            Camera(int(camera["width"]), int(camera["height"]), float(camera["vfov_deg"])),
-            renderer=renderer["name"],
-            look=renderer.get("look"),
-            depth=scene.get("depth") is not None,
-            antialiasing=antialiasing,
-            plants=scene.get("plant_generator", "canopy"),
-            appearance=(scene.get("appearance") or {}).get("mode", "paper"),
-            classes=scene.get("classes") is not None,
-        )
-    except (KeyError, TypeError, ValueError) as error:
-        raise UserError(
-            f"{where}: cannot rebuild how this scene was made ({error}): only scenes of ours can be verified"
-        ) from None
-    if request.seed != scene.get("seed") or request.folder != scene.get("scene"):
-        raise UserError(
-            f"{where}: its records rebuild scene {request.folder} with seed {request.seed}, not "
-            f"{scene.get('scene')} with seed {scene.get('seed')}: was the folder renamed or moved?"
-        )
+    from davis_ag.live.reopen import read_settings
+    from davis_ag.scene.view_grid import views_per_scene
+
+    folder = scene_folder_of(scene_dir)
+    where = folder / SCENE_METADATA
+    settings = read_settings(folder)
+    meta = settings.metadata
+    request = SceneRequest(
+        settings.scenario,
+        settings.crop,
+        settings.index,
+        settings.dataset_seed,
+        settings.camera,
+        renderer=settings.renderer,
+        look=settings.look,
+        depth=meta.depth is not None,
+        antialiasing=settings.antialiasing,
+        plants=settings.plants,
+        appearance=str((meta.appearance or {}).get("mode", "paper")),
+        classes=meta.classes is not None,
+    )
+    if f"{folder.parent.name}/{folder.name}" != meta.scene:
+        raise UserError(f"{where}: it records scene {meta.scene}, not this folder: was the folder renamed or moved?")
+    if request.seed != settings.seed:
+        raise UserError(f"{where}: its settings give seed {request.seed}, not its recorded {settings.seed}")
+    views = views_per_scene(request.scenario, request.crop)
+    if meta.grid is not None and meta.grid.views not in (None, views):
+        raise UserError(f"{where}: its grid gives {views} views, not its recorded {meta.grid.views}")
     return request
 
 
@@ -152,13 +134,12 @@ def verify_scene(scene_dir: Path, work: Path | None = None, progress: bool = Tru
 
     scene_dir = scene_folder_of(scene_dir)
     request = request_for(scene_dir)
-    if work is not None and (Path(work) / request.folder).exists():
-        raise UserError(f"{Path(work) / request.folder} already exists: choose a folder that does not hold this scene")
     with tempfile.TemporaryDirectory(prefix="davis-ag-verify-") as temporary:
         root = Path(work) if work is not None else Path(temporary)
         run_dataset([request], root, RunOptions(workers=1, progress=progress))
         differing, files = compare_scenes(scene_dir, root / request.folder)
-    made_by = _read_json(scene_dir / SCENE_METADATA).get("generator", {}).get("version", "unrecorded")
+    generator = read_scene_file(scene_dir / SCENE_METADATA).generator
+    made_by = (generator.version if generator else None) or "unrecorded"
     return Verdict(request.folder, files, tuple(differing), made_by, code_version())
 
 
@@ -183,10 +164,16 @@ def compare_scenes(ours: Path, again: Path) -> tuple[list[str], int]:
 
 
 def _files(folder: Path) -> list[str]:
+    """A scene's files, relative to it: hidden ones and the live geometry cache (written beside a
+    scene by ``davis-ag live``, not by ``generate``) left out."""
+    from davis_ag.live.reopen import CACHE_FILE
+
     return sorted(
         str(path.relative_to(folder))
         for path in folder.rglob("*")
-        if path.is_file() and not any(part.startswith(".") for part in path.relative_to(folder).parts)
+        if path.is_file()
+        and path.relative_to(folder).as_posix() != CACHE_FILE
+        and not any(part.startswith(".") for part in path.relative_to(folder).parts)
     )
 
 
@@ -202,18 +189,6 @@ def _same_bytes(a: Path, b: Path) -> bool:
 
 def _same_scene_file(a: Path, b: Path) -> bool:
     def scene(path: Path) -> dict[str, Any]:
-        return {k: v for k, v in _read_json(path).items() if k not in MAKING}
+        return {k: v for k, v in json.loads(path.read_text()).items() if k not in MAKING}
 
     return scene(a) == scene(b)
-
-
-def _read_json(path: Path) -> dict[str, Any]:
-    try:
-        data = json.loads(path.read_text())
-    except FileNotFoundError:
-        raise UserError(f"{path}: not found; give a scene folder of a dataset made by davis-ag generate") from None
-    except (OSError, ValueError) as error:
-        raise UserError(f"{path}: cannot be read ({error})") from None
-    if not isinstance(data, dict):
-        raise UserError(f"{path}: not a JSON object")
-    return data

@@ -14,7 +14,7 @@ counts it as not under way.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -106,7 +106,9 @@ def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
         stages.append(
             StageStatus(stage, bool(note and note.endswith(": sound")), note or "not started", seconds(stage))
         )
-        if not note:
+        if not note and seconds(stage) is not None:
+            stages[-1] = replace(stages[-1], progress="under way")
+        elif not note:
             stages[-1] = _validation_from_elsewhere(config, clock, recorded, scenario, crop, stages[-1])
         timesteps = config.timesteps(scenario)
         for algo in config.learners:
@@ -214,7 +216,6 @@ def _training_status(out: Path, key: str, algo: str, timesteps: int, stage: str,
 def _estimated_from_elsewhere(out: Path, key: str, algo: str, timesteps: int, status: StageStatus) -> StageStatus:
     """A learner not started, timed at the rate the same learner trained at on another group of
     the run (the same network and observations; the scenes differ), where one has finished."""
-    from dataclasses import replace
 
     from davis_ag.workflows.results_policies import training_record
 
@@ -237,7 +238,6 @@ def _validation_from_elsewhere(
 ) -> StageStatus:
     """A validation not started, timed at the views per second of another group's last whole
     check (every view is read, at the run's one image size), where one has passed."""
-    from dataclasses import replace
 
     from davis_ag.scene.view_grid import views_per_scene
 
@@ -248,7 +248,8 @@ def _validation_from_elsewhere(
         if other == group_key(scenario, crop) or not sittings or f"{other}: validate" not in recorded:
             continue
         checked = config.scenes(other_scenario) * views_per_scene(*config.specs(other_scenario, other_crop))
-        rate = checked / max(float(sittings[-1]["seconds"]), 1e-9)
+        took = recorded[f"{other}: validate"].get("check_seconds", sittings[-1]["seconds"])  # one whole check
+        rate = checked / max(float(took), 1e-9)
         return replace(
             status,
             progress=f"not started; {views:,} views, timed at {other}'s last check ({rate:.0f} views/s)",

@@ -24,7 +24,7 @@ from davis_ag.workflows.paper_table4 import (
     signed,
 )
 from davis_ag.workflows.results_gaps import scenes_ahead
-from davis_ag.workflows.results_provenance import last_whole_hours
+from davis_ag.workflows.results_provenance import one_whole_hours
 from davis_ag.workflows.results_policies import LEARNERS, learners_run, train_split_gap
 from davis_ag.workflows.run_groups import GROUPS
 
@@ -175,7 +175,7 @@ def run_block(config: Any, state: dict[str, Any], stages: list[tuple[str, float,
     for scenario, key in GROUPS.items():
         times = (
             ", ".join(
-                _stage_hours(stage.partition(": ")[2], seconds, sittings)
+                _stage_hours(stage.partition(": ")[2], seconds, state.get("stages", {}).get(stage, {}), sittings)
                 for stage, seconds, sittings in stages
                 if stage.startswith(f"{key}: ")
             )
@@ -194,12 +194,12 @@ def run_block(config: Any, state: dict[str, Any], stages: list[tuple[str, float,
     )
 
 
-def _stage_hours(step: str, seconds: float, sittings: list[dict[str, Any]]) -> str:
-    """``validate 0.43 h``; a stage done whole again by later sittings reads by its last one."""
-    last = last_whole_hours(step, sittings)
-    if last is None:
+def _stage_hours(step: str, seconds: float, entry: dict[str, Any], sittings: list[dict[str, Any]]) -> str:
+    """``validate 0.43 h``; a stage done whole again by later sittings reads by one whole run of it."""
+    one = one_whole_hours(step, entry, sittings)
+    if one is None:
         return f"{step} {seconds / 3600:.2f} h"
-    return f"{step} {last:.2f} h (the last of {len(sittings)} sittings that each did it whole; {seconds / 3600:.2f} h in all)"
+    return f"{step} {one:.2f} h ({len(sittings)} sittings each did it whole again: {seconds / 3600:.2f} h in all)"
 
 
 def write_blocks_beside(page: Path, config: Any, state: dict[str, Any], out: Path | None, stages: list) -> None:

@@ -15,17 +15,24 @@ from davis_ag.workflows.run_groups import GROUPS
 from davis_ag.workflows.results_policies import LEARNERS, training_record
 
 #: Steps that a later sitting does whole again (a validation whose code changed, an evaluation),
-#: where generation and training resume: their clock adds up the repeats, and the last sitting
-#: alone is what the step costs.
+#: where generation and training resume: their clock adds up the repeats.
 REDONE_WHOLE = ("validate", "evaluate")
 
 
-def last_whole_hours(step: str, sittings: list[dict[str, Any]]) -> float | None:
-    """Hours of the last sitting of a step that each sitting does whole (``validate``), when it had
-    more than one; None otherwise (the stage's clock total is then its cost)."""
+def one_whole_hours(step: str, entry: dict[str, Any], sittings: list[dict[str, Any]]) -> float | None:
+    """Hours one whole run of a step that each sitting does whole (``validate``) took, when the
+    clock holds more than one sitting of it; None otherwise (the clock's total is then its cost).
+
+    Args:
+        step: The stage's step (``validate``).
+        entry: The stage's record in ``state.json``: its ``check_seconds`` where the run recorded it.
+        sittings: The stage's sittings on the run's clock; a record without ``check_seconds`` (a
+            run from before it) is read by the last, which completed the stage.
+    """
     if step not in REDONE_WHOLE or len(sittings) < 2:
         return None
-    return float(sittings[-1]["seconds"]) / 3600
+    seconds = entry.get("check_seconds", sittings[-1]["seconds"])
+    return float(seconds) / 3600
 
 
 def _counted(counter: Counter) -> str:
@@ -156,11 +163,11 @@ def stage_rows(state: dict[str, Any], out: Path | None) -> list[tuple[str, float
                 f"{record.get('steps_per_second', 0):.1f} steps/s over the sittings' wall time"
                 + (f"; {len(timed)} sitting(s) on the run's clock" if timed else "")
             )
-        last = last_whole_hours(step, clock.get(stage, []))
-        if last is not None:
+        one = one_whole_hours(step, entry, clock.get(stage, []))
+        if one is not None:
             note += (
                 f"; {len(clock[stage])} sittings on the run's clock, each doing the whole {step} again "
-                f"(its code changed, or a sitting was stopped): the last took {last:.2f} h"
+                f"(its code changed, or a sitting was stopped): one whole {step} took {one:.2f} h"
             )
         rows.append((stage, seconds, code, note))
     return rows
