@@ -120,7 +120,7 @@ def test_the_blocks_beside_docs_give_the_train_gap_and_the_measured_hours(tmp_pa
     assert "evaluated on SP strawberry 2 test scenes, 507 eligible starts; MP vine not evaluated yet" in benchmark
     assert (
         "took 2.6 hours of wall time by the run's clock (SP strawberry: generate 2.35 h, validate 0.09 h (2 "
-        "sittings each did it whole again: 0.25 h in all), evaluate 0.01 h; MP vine: no stage finished yet), "
+        "sittings, each doing it whole: 0.25 h in all), evaluate 0.01 h; MP vine: no stage finished yet), "
         "on 2 CPU cores (AMD EPYC), no GPU; results.md" in benchmark
     )
     assert (

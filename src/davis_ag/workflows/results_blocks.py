@@ -199,7 +199,7 @@ def _stage_hours(step: str, seconds: float, entry: dict[str, Any], sittings: lis
     one = one_whole_hours(step, entry, sittings)
     if one is None:
         return f"{step} {seconds / 3600:.2f} h"
-    return f"{step} {one:.2f} h ({len(sittings)} sittings each did it whole again: {seconds / 3600:.2f} h in all)"
+    return f"{step} {one:.2f} h ({len(sittings)} sittings, each doing it whole: {seconds / 3600:.2f} h in all)"
 
 
 def write_blocks_beside(page: Path, config: Any, state: dict[str, Any], out: Path | None, stages: list) -> None:

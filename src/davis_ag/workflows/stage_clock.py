@@ -131,7 +131,7 @@ def machines(sittings: list[dict[str, Any]]) -> str:
 
 def _without_model(machine: str) -> str:
     """``2 CPU cores (Intel Xeon), no GPU`` as a sitting recorded it before the CPU model was named."""
-    return re.sub(r" \([^()]*(\([^()]*\)[^()]*)*\)", "", machine, count=1)
+    return re.sub(r"^(\d+ CPU cores) \((?:[^()]|\([^()]*\))*\)", r"\1", machine)
 
 
 def scene_seconds(timing: dict[str, Any]) -> float:
