@@ -140,5 +140,5 @@ def test_results_markdown_puts_ours_beside_the_paper(tmp_path: Path) -> None:
     }
     text = write_results_md(tmp_path / "results.md", CONFIGS["small"], state, tmp_path).read_text()
     assert "| A2C | .500 ± .010 | .520 ± .004 |" in text
-    assert "## MP vine" in text and "Not run" in text
+    assert "## MP vine" in text and "Not evaluated yet" in text
     assert "CPU cores" in text and "| total | 12 | 0.00 | |" in text
