@@ -58,6 +58,11 @@ def test_the_dataset_and_its_scenes_are_recognised(data: Path, tmp_path: Path) -
     assert dataset_holding(data / "splits.json") == data
     assert dataset_holding(data / "results" / "r.json") == data
     assert dataset_holding(tmp_path / "results" / "r.json") is None
+    # Through a folder not made yet and back up: the file system cannot follow `new/..` while `new`
+    # is missing, but the folders a command makes would put the output in the dataset.
+    assert dataset_holding(data.parent / "new" / ".." / data.name / "results" / "r.json") == data
+    (tmp_path / "link").symlink_to(data)  # and through a link to it
+    assert dataset_holding(tmp_path / "link" / "results" / "r.json") is not None
 
 
 @pytest.mark.parametrize(

@@ -104,7 +104,7 @@ def test_what_cannot_be_verified_is_refused_in_one_line_before_any_scene_is_made
     assert "is given twice" in refused(str(vine), str(copy / "Multi-Vine" / ".." / "Multi-Vine" / "000"))
     # --keep inside the dataset would write there, through `..` too; a full folder could mix scenes.
     for keep in (copy / "again", tmp_path / "elsewhere" / ".." / "data" / "again"):
-        assert "lies in the dataset" in refused(str(vine), "--keep", str(keep))
+        assert "which is a dataset: only davis-ag generate writes there" in refused(str(vine), "--keep", str(keep))
     (tmp_path / "full").mkdir()
     (tmp_path / "full" / "notes.txt").write_text("mine")
     assert "is not empty" in refused(str(vine), "--keep", str(tmp_path / "full"))

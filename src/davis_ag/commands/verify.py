@@ -55,7 +55,8 @@ def run(args: argparse.Namespace) -> int:
 def check_before_making(scenes: list[Path], keep: Path | None) -> None:
     """Refuse, before the first scene is made again (minutes to hours each), what would fail later:
     records that cannot rebuild a scene, a scene given twice, and a ``--keep`` folder that lies in
-    a dataset given, is not empty, or would hold scenes of datasets made with other settings.
+    a dataset (:mod:`the output rule <davis_ag.formats.outputs>`), is not empty, or would hold
+    scenes of datasets made with other settings.
 
     Raises:
         UserError: naming the scene or folder and what to do.
@@ -63,6 +64,7 @@ def check_before_making(scenes: list[Path], keep: Path | None) -> None:
     import os
 
     from davis_ag.errors import UserError
+    from davis_ag.formats.outputs import check_outside_datasets
     from davis_ag.generate.dataset_files import dataset_settings
     from davis_ag.workflows.regenerate import request_for, scene_folder_of
 
@@ -73,11 +75,8 @@ def check_before_making(scenes: list[Path], keep: Path | None) -> None:
         raise UserError(f"{twice} is given twice: give each scene once")
     if keep is None:
         return
-    kept = Path(os.path.realpath(arguments.prove_writable_folder(keep, "--keep")))
-    for folder in folders:
-        root = Path(folder).parent.parent
-        if kept == root or root in kept.parents:
-            raise UserError(f"--keep {keep} lies in the dataset {root}: choose a folder outside it")
+    check_outside_datasets(keep, "--keep")  # the output rule's owner: only generate writes in a dataset
+    kept = arguments.prove_writable_folder(keep, "--keep")
     if kept.is_dir() and any(kept.iterdir()):
         raise UserError(f"--keep {keep} is not empty: choose a new or empty folder")
     try:

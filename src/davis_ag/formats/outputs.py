@@ -112,15 +112,19 @@ def file_lock_path(path: Path) -> Path:
 def dataset_holding(path: str | os.PathLike[str]) -> Path | None:
     """The dataset root or scene folder ``path`` lies in (or is), else None.
 
-    A folder counts when it holds a file of :data:`DATASET_MARKS` or :data:`SCENE_MARKS`.
+    A folder counts when it holds a file of :data:`DATASET_MARKS` or :data:`SCENE_MARKS`. The path
+    is read both as written with its ``..`` collapsed and with its links followed: a path through
+    a folder that does not exist yet (``out/new/../DATA/x``) ends in the dataset once the folders
+    are made, which the file system cannot tell while ``new`` is missing.
     """
     target = Path(path).expanduser().absolute()
-    for folder in (target, *target.parents):
-        try:
-            if any((folder / mark).is_file() for mark in DATASET_MARKS + SCENE_MARKS):
-                return folder
-        except OSError:  # an unreadable ancestor says nothing either way
-            continue
+    for candidate in dict.fromkeys((Path(os.path.normpath(target)), Path(os.path.realpath(target)))):
+        for folder in (candidate, *candidate.parents):
+            try:
+                if any((folder / mark).is_file() for mark in DATASET_MARKS + SCENE_MARKS):
+                    return folder
+            except OSError:  # an unreadable ancestor says nothing either way
+                continue
     return None
 
 
