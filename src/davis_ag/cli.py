@@ -45,7 +45,7 @@ KEPT_WHEN_STOPPED = {
     "evaluate": "nothing half-written was left",
     "export": "the files already exported are kept",
     "transfer": "finished stages are kept",
-    "verify": "the dataset was only read; a scene under way in --keep DIR resumes",
+    "verify": "the dataset was only read (run it again with a new --keep folder)",
 }
 
 

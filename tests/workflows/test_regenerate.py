@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 
 from davis_ag.cli import main
+from davis_ag.errors import UserError
 from davis_ag.generate.run_config import load_dataset_config
 from davis_ag.generate.run_progress import RunOptions
 from davis_ag.generate.runner import run_dataset
@@ -52,6 +53,17 @@ def test_a_scene_is_rebuilt_from_its_records(dataset: Path, tiny_config: Path) -
         assert request_for(dataset / scene) == made[scene]
     assert made["Single-Strawberry/002"].crop.altitudes == (0.50, 0.75, 1.00)
     assert made["Multi-Vine/000"].scenario.headings == 2
+
+
+def test_a_scene_without_depth_and_with_a_random_look_is_rebuilt_too(tmp_path: Path) -> None:
+    config = tmp_path / "other.yaml"
+    config.write_text(
+        "seed: 9\nimage_size: 48x32\ndepth: false\nappearance: random\n"
+        "groups:\n  - {scenario: sp, crop: strawberry, scenes: 1, grid: {extent: [3.0, 3.0], step: 1.5, altitude_levels: [1]}}\n"
+    )
+    (made,) = load_dataset_config(config).requests()
+    run_dataset([made], tmp_path / "data", RunOptions(workers=1, progress=False))
+    assert request_for(tmp_path / "data" / made.folder) == made
 
 
 def test_both_scenes_come_out_identical_and_the_dataset_is_untouched(
@@ -109,3 +121,12 @@ def test_what_cannot_be_verified_is_refused_in_one_line_before_any_scene_is_made
     (tmp_path / "full" / "notes.txt").write_text("mine")
     assert "is not empty" in refused(str(vine), "--keep", str(tmp_path / "full"))
     assert not (copy / "again").exists() and (tmp_path / "full" / "notes.txt").read_text() == "mine"
+    # Two datasets' scenes of one id would meet in one --keep folder: refused; apart, both are fine.
+    other = Path(shutil.copytree(copy, tmp_path / "other"))
+    assert "two scenes given are Multi-Vine/000" in refused(
+        str(vine), str(other / "Multi-Vine" / "000"), "--keep", str(tmp_path / "one")
+    )
+    # A folder that already holds the scene would be compared, not made again.
+    (tmp_path / "holds" / "Multi-Vine" / "000").mkdir(parents=True)
+    with pytest.raises(UserError, match="already exists: make the scene again in another folder"):
+        verify_scene(vine, tmp_path / "holds", progress=False)

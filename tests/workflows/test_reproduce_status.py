@@ -174,8 +174,8 @@ def test_a_validation_not_started_is_timed_at_the_other_groups_last_check(tmp_pa
     stage = {s.stage: s for s in run_status(out)[1]}["mp-vine: validate"]
     assert not stage.done and stage.progress.startswith(f"not started; {mp_views:,} views, timed at sp-strawberry's")
     assert stage.left_s == pytest.approx(mp_views * 300.0 / sp_views)
-    # Once MP's own check is on the clock, it is under way, not "not started".
+    # Once MP's own check is on the clock (running, or stopped part way), it is no longer "not started".
     clock["stages"]["mp-vine: validate"] = [{"started": "t", "seconds": 60.0, "code": "x"}]
     (out / "clock.json").write_text(json.dumps(clock))
     stage = {s.stage: s for s in run_status(out)[1]}["mp-vine: validate"]
-    assert (stage.done, stage.progress, stage.seconds) == (False, "under way", 60.0)
+    assert (stage.done, stage.progress, stage.seconds) == (False, "started, not finished", 60.0)

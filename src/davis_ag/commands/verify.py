@@ -4,14 +4,14 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import Any
 
 from davis_ag.commands import arguments
 
 HELP = "make scenes again from their scene.json and compare every file byte for byte"
 DESCRIPTION = (
     "Prove that a dataset of ours regenerates bit for bit: each SCENE folder is grown and drawn again "
-    "from its scene.json and the dataset's dataset.json (seed, grid, camera, renderer, plants, "
-    "appearance) in a folder of its own, and every file is compared with the one on disk "
+    "from its scene.json (seed, grid, camera, renderer, plants, appearance) in a folder of its own, and every file is compared with the one on disk "
     "(scene.json as JSON, without the generator's versions and the timings). Nothing is written "
     "inside the dataset. Prints one line per scene; exits 0 when every scene came out identical, "
     "1 otherwise. A scene takes as long as generate takes to make it."
@@ -65,7 +65,7 @@ def check_before_making(scenes: list[Path], keep: Path | None) -> None:
 
     from davis_ag.errors import UserError
     from davis_ag.formats.outputs import check_outside_datasets
-    from davis_ag.generate.dataset_files import dataset_settings
+    from davis_ag.generate.run_config import grid_settings
     from davis_ag.workflows.regenerate import request_for, scene_folder_of
 
     requests = [request_for(scene) for scene in scenes]
@@ -79,10 +79,21 @@ def check_before_making(scenes: list[Path], keep: Path | None) -> None:
     kept = arguments.prove_writable_folder(keep, "--keep")
     if kept.is_dir() and any(kept.iterdir()):
         raise UserError(f"--keep {keep} is not empty: choose a new or empty folder")
-    try:
-        dataset_settings(requests)
-    except UserError:
-        raise UserError(
-            f"--keep {keep} would hold scenes made with other seeds, sizes or settings: verify them "
-            "with one --keep folder each"
-        ) from None
+    # One --keep folder is one dataset: its scenes share every setting, and a scene id is made once.
+    ids = [request.folder for request in requests]
+    if len(set(ids)) < len(ids):
+        twice = next(i for i in ids if ids.count(i) > 1)
+        raise UserError(f"two scenes given are {twice}: verify them with one --keep folder each")
+
+    def made_as(request: Any) -> tuple:
+        """What one dataset's scenes share (its seed, camera and settings); a group shares its grid."""
+        return request.dataset_seed, request.camera, request.scene_settings(), request.classes
+
+    grids: dict[str, dict[str, Any]] = {}
+    for request in requests:
+        grid = grid_settings(request.scenario, request.crop)
+        if made_as(request) != made_as(requests[0]) or grids.setdefault(request.folder.split("/")[0], grid) != grid:
+            raise UserError(
+                f"--keep {keep} would hold {requests[0].folder} and {request.folder}, made with other seeds, "
+                "sizes, grids or settings: verify them with one --keep folder each"
+            )

@@ -96,7 +96,7 @@ def _own_split_entries(dataset: Dataset) -> bytes:
     if dataset.opened == dataset.root:  # the whole dataset: validation reads every entry
         return f"{SPLITS_FILE}\0".encode() + raw
     try:  # a file the validator would refuse counts by its bytes, whatever part is damaged
-        splits = SplitsFile.model_validate(json.loads(raw))
+        splits = SplitsFile.model_validate(json.loads(raw.decode("utf-8")))
     except (ValueError, TypeError):
         return f"{SPLITS_FILE}\0".encode() + raw
     own = {scene.id for scene in dataset.scenes}

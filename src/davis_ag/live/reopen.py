@@ -107,7 +107,7 @@ def antialiasing_of(renderer: RendererRecord) -> str:
     return "msaa" if text.startswith("4x") or renderer.name == "helios" else "none"
 
 
-def _crop_at(crop: CropSpec, altitudes: list[float]) -> tuple[CropSpec, tuple[int, ...]]:
+def _crop_with_altitudes(crop: CropSpec, altitudes: list[float]) -> tuple[CropSpec, tuple[int, ...]]:
     """The crop whose camera altitudes hold the recorded ones (strawberry has two choices,
     ``--strawberry-altitudes``), and the levels they are.
 
@@ -146,7 +146,7 @@ def read_settings(scene_dir: str | Path) -> SceneSettings:
         )
     try:
         grid, renderer = _needed(metadata.grid, "grid"), _needed(metadata.renderer, "renderer")
-        crop, levels = _crop_at(
+        crop, levels = _crop_with_altitudes(
             crop_spec(_needed(metadata.crop, "crop")), _needed(grid.altitudes_m, "grid.altitudes_m")
         )
         scenario = scenario_spec(_needed(metadata.scenario, "scenario"), crop)

@@ -74,7 +74,9 @@ def request_for(scene_dir: str | os.PathLike[str]) -> SceneRequest:
 
     The scene's settings are read as a live scene reads them
     (:func:`davis_ag.live.reopen.read_settings`: grid, altitudes, camera, renderer, plants); what
-    ``generate`` writes besides (depth, organ classes, appearance) is read here.
+    ``generate`` writes besides (depth, organ classes, appearance) is read here. A scene drawn by
+    Helios's Visualizer comes back with ``msaa`` where ``generate`` had its default ``fxaa``: that
+    renderer ignores the setting and records the same words for either.
 
     Args:
         scene_dir: A scene folder (``DATA/Single-Strawberry/000``).
@@ -134,6 +136,8 @@ def verify_scene(scene_dir: Path, work: Path | None = None, progress: bool = Tru
 
     scene_dir = scene_folder_of(scene_dir)
     request = request_for(scene_dir)
+    if work is not None and (Path(work) / request.folder).exists():  # it would be kept, not made again
+        raise UserError(f"{Path(work) / request.folder} already exists: make the scene again in another folder")
     with tempfile.TemporaryDirectory(prefix="davis-ag-verify-") as temporary:
         root = Path(work) if work is not None else Path(temporary)
         run_dataset([request], root, RunOptions(workers=1, progress=progress))

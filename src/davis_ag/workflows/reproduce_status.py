@@ -107,7 +107,7 @@ def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
             StageStatus(stage, bool(note and note.endswith(": sound")), note or "not started", seconds(stage))
         )
         if not note and seconds(stage) is not None:
-            stages[-1] = replace(stages[-1], progress="under way")
+            stages[-1] = replace(stages[-1], progress="started, not finished")
         elif not note:
             stages[-1] = _validation_from_elsewhere(config, clock, recorded, scenario, crop, stages[-1])
         timesteps = config.timesteps(scenario)
