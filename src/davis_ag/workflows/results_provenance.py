@@ -55,7 +55,13 @@ def scene_provenance(dataset: Path, scenes: list[str]) -> list[str]:
         camera = meta.camera or CameraRecord()
         sizes[f"{camera.width or '?'}x{camera.height or '?'}"] += 1
     lines = [
-        f"code: {_counted(versions)}" + (" — made by more than one version of the code" if len(versions) > 1 else ""),
+        f"code: {_counted(versions)}"
+        + (
+            " — made by more than one version of the code (`davis-ag verify DATA/GROUP/NNN` makes a "
+            "scene again with the code at hand and says whether every file comes out the same)"
+            if len(versions) > 1
+            else ""
+        ),
         f"plants grown by {_counted(plants)}",
         f"drawn with the {_counted(renderers)}",
         f"image size {_counted(sizes)}",
