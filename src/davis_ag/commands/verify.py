@@ -10,11 +10,12 @@ from davis_ag.commands import arguments
 
 HELP = "make scenes again from their scene.json and compare every file byte for byte"
 DESCRIPTION = (
-    "Prove that a dataset of ours regenerates bit for bit: each SCENE folder is grown and drawn again "
-    "from its scene.json (seed, grid, camera, renderer, plants, appearance) in a folder of its own, and every file is compared with the one on disk "
-    "(scene.json as JSON, without the generator's versions and the timings). Nothing is written "
-    "inside the dataset. Prints one line per scene; exits 0 when every scene came out identical, "
-    "1 otherwise. A scene takes as long as generate takes to make it."
+    "Prove that a dataset of ours regenerates bit for bit: each SCENE folder is grown and drawn "
+    "again from its scene.json (seed, grid, camera, renderer, plants, appearance) in a folder of "
+    "its own, and every file is compared with the one on disk (scene.json as JSON, without the "
+    "generator's versions and the timings). Nothing is written inside the dataset. Prints one line "
+    "per scene; exits 0 when every scene came out identical, 1 otherwise. A scene takes as long as "
+    "generate takes to make it."
 )
 
 
