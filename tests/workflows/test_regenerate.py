@@ -111,7 +111,9 @@ def test_what_cannot_be_verified_is_refused_in_one_line_before_any_scene_is_made
     moved = copy / "Single-Strawberry" / "007"
     (copy / "Single-Strawberry" / "002").rename(moved)  # a scene folder renamed by hand
     assert "records scene Single-Strawberry/002, not this folder: was the folder renamed" in refused(str(moved))
-    assert "scene.json: missing" in refused(str(copy / "Single-Strawberry"))  # a group is not a scene
+    # A group or a dataset is not a scene: the line names one of its scenes to give instead.
+    assert f"is not a scene folder: give scene folders, such as {copy / 'Multi-Vine' / '000'}" in refused(str(copy))
+    assert "is not a scene folder: give scene folders, such as " in refused(str(copy / "Single-Strawberry"))
     vine = copy / "Multi-Vine" / "000"
     assert "is given twice" in refused(str(vine), str(copy / "Multi-Vine" / ".." / "Multi-Vine" / "000"))
     # --keep inside the dataset would write there, through `..` too; a full folder could mix scenes.

@@ -92,6 +92,10 @@ def request_for(scene_dir: str | os.PathLike[str]) -> SceneRequest:
 
     folder = scene_folder_of(scene_dir)
     where = folder / SCENE_METADATA
+    if folder.is_dir() and not where.exists():  # a dataset or group folder given for its scenes
+        inside = sorted(p.parent for p in [*folder.glob(f"*/{SCENE_METADATA}"), *folder.glob(f"*/*/{SCENE_METADATA}")])
+        if inside:
+            raise UserError(f"{folder} is not a scene folder: give scene folders, such as {inside[0]}")
     settings = read_settings(folder)
     meta = settings.metadata
     request = SceneRequest(
