@@ -20,7 +20,7 @@ import json
 import sys
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 
@@ -41,6 +41,9 @@ from davis_ag.scene.specs import (
     with_strawberry_altitudes,
 )
 from davis_ag.scene.view_grid import Viewpoint
+
+if TYPE_CHECKING:
+    from davis_ag.generate.one_scene import SceneRequest
 
 T = TypeVar("T")
 CACHE_FILE = "live_geometry.npz"
@@ -75,6 +78,23 @@ class SceneSettings:
     look: str
     antialiasing: str
     plants: str = DEFAULT_PLANTS
+
+    def request(self, **drawing: Any) -> SceneRequest:
+        """The generate request these settings describe; ``drawing`` adds what only drawing and
+        writing need (``depth``, ``antialiasing``, ``appearance``, ``classes``)."""
+        from davis_ag.generate.one_scene import SceneRequest
+
+        return SceneRequest(
+            self.scenario,
+            self.crop,
+            self.index,
+            self.dataset_seed,
+            self.camera,
+            renderer=self.renderer,
+            look=self.look,
+            plants=self.plants,
+            **drawing,
+        )
 
     @property
     def cache_key(self) -> str:
@@ -228,18 +248,9 @@ def regrow(settings: SceneSettings) -> SceneAssets:
         UserError: when the regrown plants, fruit or grid poses differ from the stored ones
             (another pyhelios or davis-ag version grows differently).
     """
-    from davis_ag.generate.one_scene import SceneRequest, grow_scene
+    from davis_ag.generate.one_scene import grow_scene
 
-    request = SceneRequest(
-        settings.scenario,
-        settings.crop,
-        settings.index,
-        settings.dataset_seed,
-        settings.camera,
-        renderer=settings.renderer,
-        look=settings.look,
-        plants=settings.plants,
-    )
+    request = settings.request()
     if request.seed != settings.seed:
         raise UserError(
             f"{settings.folder}/scene.json: seed {settings.seed} does not follow from dataset seed "

@@ -98,17 +98,9 @@ def request_for(scene_dir: str | os.PathLike[str]) -> SceneRequest:
             raise UserError(f"{folder} is not a scene folder: give scene folders, such as {inside[0]}")
     settings = read_settings(folder)
     meta = settings.metadata
-    request = SceneRequest(
-        settings.scenario,
-        settings.crop,
-        settings.index,
-        settings.dataset_seed,
-        settings.camera,
-        renderer=settings.renderer,
-        look=settings.look,
+    request = settings.request(
         depth=meta.depth is not None,
         antialiasing=settings.antialiasing,
-        plants=settings.plants,
         appearance=str((meta.appearance or {}).get("mode", "paper")),
         classes=meta.classes is not None,
     )
