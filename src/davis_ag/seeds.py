@@ -9,7 +9,9 @@ Streams are NumPy ``SeedSequence`` keys, so two streams never share draws howeve
   which leaves those draws as they were;
 - a scene's random appearance: ``[scene seed, APPEARANCE_STREAM]``;
 - a group's train/test split: ``[split seed, scenario's index, crop's index, SPLIT_STREAM]``;
-- our renderer's per-view noise: ``[lighting's noise seed, view index]``;
+- our renderer's per-view noise: ``[lighting's noise seed, view index]`` for a grid view, and
+  ``[lighting's noise seed, OFF_GRID_STREAM, digest of the pose]`` for a pose off the grid (a live
+  scene's free camera): the same pose always gets the same noise (:func:`view_noise_seed`);
 - evaluation session ``s``: ``[seed, s]`` for the environment's resets and ``[seed, s, AGENT_STREAM]``
   for the agent's own draws (:mod:`davis_ag.benchmark.evaluation`).
 
@@ -17,6 +19,9 @@ A new stream takes a new number here, never an old one.
 """
 
 from __future__ import annotations
+
+import hashlib
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -26,6 +31,8 @@ SPLIT_STREAM = 1
 APPEARANCE_STREAM = 2
 #: An evaluation session's agent draws, after ``[seed, session]``.
 AGENT_STREAM = 1
+#: Noise of a pose off the grid, after the noise seed; larger than any grid's view index.
+OFF_GRID_STREAM = 2**32 - 1
 
 
 def derived_seed(*keys: int) -> int:
@@ -36,3 +43,19 @@ def derived_seed(*keys: int) -> int:
 def stream_rng(*keys: int) -> np.random.Generator:
     """A generator for the stream named by ``keys``."""
     return np.random.default_rng(np.random.SeedSequence(list(keys)))
+
+
+def view_noise_seed(noise_seed: int, index: int, pose: Sequence[float]) -> int:
+    """The seed of one view's sensor noise.
+
+    Args:
+        noise_seed: The lighting's noise seed (the scene seed).
+        index: The view's index in its grid; negative for a pose off the grid.
+        pose: x, y, z, yaw, pitch: what names a pose off the grid (rounded to a micrometre and a
+            microdegree, so a pose read back from a file draws the same noise).
+    """
+    if index >= 0:
+        return derived_seed(noise_seed, index)
+    rounded = np.round(np.asarray(pose, dtype=np.float64), 6) + 0.0  # + 0.0: -0.0 and 0.0 alike
+    digest = int.from_bytes(hashlib.sha256(rounded.tobytes()).digest()[:8], "little")
+    return derived_seed(noise_seed, OFF_GRID_STREAM, digest)

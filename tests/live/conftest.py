@@ -20,6 +20,12 @@ REQUEST = SceneRequest(SCENARIO, CROPS["strawberry"], index=0, dataset_seed=0, c
 
 
 @pytest.fixture(scope="session")
+def live_request() -> SceneRequest:
+    """What made the scene."""
+    return REQUEST
+
+
+@pytest.fixture(scope="session")
 def grown() -> tuple:
     """The scene as the generator grew it: its model and grid (real Helios plants)."""
     return grow_scene(REQUEST)

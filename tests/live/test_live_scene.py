@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import shutil
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +15,7 @@ from PIL import Image
 from davis_ag.data.reader import open_dataset
 from davis_ag.data.validate import validate_dataset
 from davis_ag.errors import UserError
+from davis_ag.generate.one_scene import SceneRequest, draw_scene, grow_scene
 from davis_ag.live.reopen import CACHE_FILE, read_settings, regrow
 from davis_ag.live.scene import LiveScene, merge_ground, open_live_scene
 
@@ -161,3 +163,24 @@ def test_a_scene_whose_cache_cannot_be_written_reopens_uncached(
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "cannot cache" in err[0]
     assert (copy / CACHE_FILE / "keep").read_text() == "mine"
+
+
+def test_a_random_appearance_scene_reopens_in_its_own_light(
+    tmp_path: Path, live_request: SceneRequest, live_scene: LiveScene
+) -> None:
+    """Soil, sun, sky, exposure and sensor noise are drawn from the scene's seed: regrown or read
+    from the cache, a grid pose draws as stored, and a free pose draws the same noise every time."""
+    request = replace(live_request, appearance="random")
+    scene_dir, _ = draw_scene(request, *grow_scene(request), tmp_path)
+    stored = np.asarray(Image.open(scene_dir / "images" / "0003.jpeg")).astype(np.int64)
+    free = live_scene.aimed_pose(0.9, -0.6, 0.33)
+    drawn = []
+    for from_cache in (False, True):
+        with open_live_scene(scene_dir) as scene:
+            assert scene.assets.from_cache == from_cache and scene.settings.appearance == "random"
+            grid = scene.render(scene.grid_view("0003.jpeg"), fractions=False)
+            assert np.abs(stored - grid.colour).mean() < 4.0  # JPEG quality, not the drawing
+            drawn.append((grid.colour, scene.render(free, 64, 64, fractions=False).colour))
+    assert all(np.array_equal(a, b) for a, b in zip(*drawn))
+    paper = live_scene.render(live_scene.grid_view("0003.jpeg"), fractions=False).colour
+    assert np.abs(paper.astype(np.int64) - drawn[0][0]).mean() > 8.0  # another light, another soil

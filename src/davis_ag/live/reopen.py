@@ -18,7 +18,7 @@ import hashlib
 import importlib.util
 import json
 import sys
-from dataclasses import dataclass, replace
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
@@ -28,6 +28,7 @@ from davis_ag.atomic_files import atomic_output
 from davis_ag.formats.layout import ANNOTATIONS, SCENE_METADATA, view_name
 from davis_ag.formats.scene_file import SCENE_FORMAT, GeneratorRecord, RendererRecord, SceneFile, read_scene_file
 from davis_ag.errors import UserError
+from davis_ag.scene.appearance import DEFAULT_APPEARANCE, resolve_appearance
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.lighting import Lighting
 from davis_ag.scene.specs import (
@@ -47,8 +48,8 @@ if TYPE_CHECKING:
 
 T = TypeVar("T")
 CACHE_FILE = "live_geometry.npz"
-#: Bump when the cache's content changes.
-CACHE_VERSION = 1
+#: Bump when the cache's content changes (2: the whole lighting, appearance included).
+CACHE_VERSION = 2
 _GEOMETRY_FIELDS = ("positions", "uvs", "normals", "uuids", "colours", "texture", "mode", "caster", "patch")
 
 
@@ -64,6 +65,7 @@ class SceneSettings:
         camera: The camera its views were drawn with.
         renderer, look, antialiasing: How its views were drawn.
         plants: The plant generator (scenes from before the choice grew ``architecture`` plants).
+        appearance: ``paper`` or ``random`` (soil, sun, sky, exposure and noise drawn from the seed).
     """
 
     folder: Path
@@ -78,10 +80,11 @@ class SceneSettings:
     look: str
     antialiasing: str
     plants: str = DEFAULT_PLANTS
+    appearance: str = DEFAULT_APPEARANCE
 
     def request(self, **drawing: Any) -> SceneRequest:
         """The generate request these settings describe; ``drawing`` adds what only drawing and
-        writing need (``depth``, ``antialiasing``, ``appearance``, ``classes``)."""
+        writing need (``depth``, ``antialiasing``, ``classes``)."""
         from davis_ag.generate.one_scene import SceneRequest
 
         return SceneRequest(
@@ -93,6 +96,7 @@ class SceneSettings:
             renderer=self.renderer,
             look=self.look,
             plants=self.plants,
+            appearance=self.appearance,
             **drawing,
         )
 
@@ -110,6 +114,7 @@ class SceneSettings:
             "grid": meta.grid.as_written() if meta.grid else None,
             "generator": meta.generator.as_written() if meta.generator else None,
             "plants": self.plants,
+            "appearance": self.appearance,
         }
         return hashlib.sha256(json.dumps(keyed, sort_keys=True).encode()).hexdigest()[:20]
 
@@ -192,8 +197,9 @@ def read_settings(scene_dir: str | Path) -> SceneSettings:
             str(renderer.look),
             antialiasing_of(renderer),
             check_plants(metadata.plant_generator or "architecture"),
+            resolve_appearance((metadata.appearance or {}).get("mode", "paper")),
         )
-    except (ValueError, TypeError, UserError) as error:
+    except (ValueError, TypeError, UserError, AttributeError) as error:
         raise UserError(
             f"{path}: lacks or mangles a setting needed to regrow the scene ({error}); generate the scene again"
         ) from None
@@ -239,6 +245,22 @@ def _resolve(path: str, root: Path | None) -> str:
     if path.startswith("pyhelios:") and root is not None:
         return str(root / path[len("pyhelios:") :])
     return path
+
+
+def _lighting_record(lighting: Lighting, root: Path | None) -> dict:
+    """The lighting as JSON, its sky's path portable."""
+    record = asdict(lighting)
+    record["sky_texture"] = _portable(lighting.sky_texture, root) if lighting.sky_texture else None
+    return record
+
+
+def _lighting_from(record: dict, root: Path | None) -> Lighting:
+    """The lighting a cache records (OSError when its sky image is gone: the cache is then redone)."""
+    sky = record.pop("sky_texture")
+    if sky is not None and not Path(sky := _resolve(sky, root)).is_file():
+        raise OSError(f"{sky} is gone")
+    balance = tuple(record.pop("white_balance"))
+    return Lighting(**record, sky_texture=sky, white_balance=balance)
 
 
 def regrow(settings: SceneSettings) -> SceneAssets:
@@ -320,8 +342,7 @@ def save_cache(path: Path, key: str, assets: SceneAssets) -> None:
         fruit_uuids=np.concatenate(uuids + [np.zeros(0, np.int64)]).astype(np.int64),
         uuid_count=np.array(assets.uuid_count),
         aim_height=np.array(assets.aim_height),
-        sun=np.array([assets.lighting.sun_elevation, assets.lighting.sun_azimuth]),
-        sky=np.array(assets.lighting.sky_texture or ""),
+        lighting=np.array(json.dumps(_lighting_record(assets.lighting, root))),
         view_grid=np.array([[v.ix, v.iy, v.level, v.heading] for v in views], dtype=np.int64).reshape(-1, 4),
         view_nominal=np.array([v.nominal for v in views], dtype=np.float64).reshape(-1, 3),
         view_position=np.array([v.position for v in views], dtype=np.float64).reshape(-1, 3),
@@ -348,7 +369,7 @@ def load_cache(path: Path, key: str) -> SceneAssets | None:
             fruit_uuids = {
                 int(f): data["fruit_uuids"][offsets[k] : offsets[k + 1]] for k, f in enumerate(data["fruit_ids"])
             }
-            sun = data["sun"]
+            lighting = _lighting_from(json.loads(str(data["lighting"])), root)
             views = [
                 Viewpoint(
                     k,
@@ -369,7 +390,7 @@ def load_cache(path: Path, key: str) -> SceneAssets | None:
                 geometry,
                 fruit_uuids,
                 int(data["uuid_count"]),
-                Lighting(float(sun[0]), float(sun[1]), str(data["sky"]) or None),
+                lighting,
                 float(data["aim_height"]),
                 views,
                 True,

@@ -34,7 +34,7 @@ from importlib import resources
 
 import numpy as np
 
-from davis_ag.seeds import derived_seed
+from davis_ag.seeds import view_noise_seed
 from davis_ag.render.egl_context import create_context, egl_current, egl_restore
 from davis_ag.render.projection import camera_matrices, gl_matrix, helios_shadow_box, light_matrix, matmul32
 from davis_ag.render.scene_geometry import SceneGeometry, read_scene_geometry
@@ -297,7 +297,7 @@ class OpenGLRenderer:
             for program in self._shading:
                 self._set(program, "shadow_box", gl_matrix(box))
         if self.lighting.noise_sigma > 0:  # a new noise pattern for every view, fixed by the scene's seed
-            seed = derived_seed(self.lighting.noise_seed, view.index)
+            seed = view_noise_seed(self.lighting.noise_seed, view.index, (*view.position, view.yaw, view.pitch))
             for program in (*self._shading, self._programs["sky"]):
                 self._set(program, "noise_seed", seed)
         self._set(

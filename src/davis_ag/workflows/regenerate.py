@@ -73,8 +73,8 @@ def request_for(scene_dir: str | os.PathLike[str]) -> SceneRequest:
     """The request that made a scene of ours, rebuilt from its ``scene.json``.
 
     The scene's settings are read as a live scene reads them
-    (:func:`davis_ag.live.reopen.read_settings`: grid, altitudes, camera, renderer, plants); what
-    ``generate`` writes besides (depth, organ classes, appearance) is read here. A scene drawn by
+    (:func:`davis_ag.live.reopen.read_settings`: grid, altitudes, camera, renderer, plants,
+    appearance); what ``generate`` writes besides (depth, organ classes) is read here. A scene drawn by
     Helios's Visualizer comes back with ``msaa`` where ``generate`` had its default ``fxaa``: that
     renderer ignores the setting and records the same words for either.
 
@@ -101,7 +101,6 @@ def request_for(scene_dir: str | os.PathLike[str]) -> SceneRequest:
     request = settings.request(
         depth=meta.depth is not None,
         antialiasing=settings.antialiasing,
-        appearance=str((meta.appearance or {}).get("mode", "paper")),
         classes=meta.classes is not None,
     )
     if f"{folder.parent.name}/{folder.name}" != meta.scene:
