@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import shutil
 from pathlib import Path
 from typing import Any
 
@@ -82,6 +83,38 @@ def test_compare_refuses_another_dataset_or_split(
         assert cli.main(["compare", str(ours), str(other)]) == 2
         err = capsys.readouterr().err.strip()
         assert what in err and "cannot be ranked together" in err and "\n" not in err
+
+
+def test_compare_refuses_the_same_seeds_drawn_otherwise(
+    sp_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Scene seeds follow from the dataset seed alone: a copy drawn with another appearance (or
+    size, renderer, plants, grid) has the same seeds and, on TVM-v0, the same starts. It was
+    ranked beside the original until the identity recorded how each scene was drawn."""
+    copy = shutil.copytree(sp_root, tmp_path / "copy")
+    ours = evaluate([], sp_root, "sp", sessions=1, episodes=3).write(tmp_path / "ours.json")
+    same = evaluate([], copy, "sp", sessions=1, episodes=3).write(tmp_path / "same.json")
+    assert cli.main(["compare", str(ours), str(same)]) == 0  # a copy elsewhere is the same dataset
+    for path in copy.glob("*/*/scene.json"):
+        meta = json.loads(path.read_text())
+        meta["appearance"] = {"mode": "random"}
+        path.write_text(json.dumps(meta))
+    other = evaluate([], copy, "sp", sessions=1, episodes=3).write(tmp_path / "other.json")
+    capsys.readouterr()
+    assert cli.main(["compare", str(ours), str(other)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "scene Single-Strawberry/000 was drawn otherwise" in err and "\n" not in err
+    # A file from before the identity said how scenes were drawn: evaluate it again.
+    for name in ("ours", "old"):
+        data = json.loads((tmp_path / "ours.json").read_text())
+        for scene in data["dataset"]["scenes"]:
+            scene["code"] = "0.1.0+abc"
+            if name == "old":
+                scene.pop("drawn")
+        data["dataset"]["fingerprint"] = name
+        (tmp_path / f"{name}.json").write_text(json.dumps(data))
+    assert cli.main(["compare", str(tmp_path / "ours.json"), str(tmp_path / "old.json")]) == 2
+    assert "evaluate it again" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize(

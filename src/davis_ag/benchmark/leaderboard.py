@@ -19,6 +19,7 @@ from pathlib import Path
 from davis_ag.benchmark.evaluation import PAIRED_BASELINES
 from davis_ag.benchmark.paired import FEW_SCENES
 from davis_ag.benchmark.results import (
+    DatasetIdentity,
     EvaluationResults,
     PairedGap,
     PolicyResult,
@@ -76,11 +77,43 @@ def check_comparable(files: list[tuple[Path, EvaluationResults]]) -> None:
     for path, results in others:
         found = _identity(results)
         for key, value in wanted.items():
+            if key == "dataset" and found[key] != value and results.dataset is not None:
+                raise UserError(
+                    f"{path} and {first} differ in dataset: {_scene_difference(results.dataset, base.dataset)}"
+                )
             if found[key] != value:
                 raise UserError(
                     f"{path} and {first} differ in {key} ({_shown(found[key])} against {_shown(value)}): "
                     "results of different datasets, splits or protocol versions cannot be ranked together"
                 )
+
+
+def _scene_difference(found: DatasetIdentity, wanted: DatasetIdentity) -> str:
+    """Where two datasets' identities part, in words, with what to do."""
+    theirs, ours = {s.id: s for s in found.scenes}, {s.id: s for s in wanted.scenes}
+    if set(theirs) != set(ours):
+        only = sorted(set(theirs) ^ set(ours))
+        return f"{len(only)} scene(s) are in one only ({only[0]}, ...); results of different datasets cannot be ranked together"
+    for scene_id in sorted(ours):
+        a, b = theirs[scene_id], ours[scene_id]
+        if a.seed != b.seed:
+            return f"scene {scene_id} has seed {a.seed} against {b.seed}; results of different datasets cannot be ranked together"
+        if (a.drawn is None) != (b.drawn is None) and a.code and b.code:
+            return (
+                f"one was written before results files recorded how each scene was drawn (scene {scene_id}); "
+                "evaluate it again with this davis-ag to rank them together"
+            )
+        if a.drawn != b.drawn:
+            return (
+                f"scene {scene_id} was drawn otherwise (image size, renderer, plants, appearance or grid); "
+                "results of different datasets cannot be ranked together"
+            )
+        if a.code != b.code:
+            return (
+                f"scene {scene_id} was made by {a.code} against {b.code}; results of different datasets "
+                "cannot be ranked together (davis-ag verify SCENE says whether today's code makes it the same)"
+            )
+    return "results of different datasets cannot be ranked together"
 
 
 def _shown(value: Any) -> Any:

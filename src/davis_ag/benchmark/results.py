@@ -113,12 +113,18 @@ class PolicyResult(_Model):
 
 
 class SceneIdentity(_Model):
-    """A scene of the dataset as generated: its id, seed and the code version that made it
-    (None for scenes without our scene.json, e.g. the original download)."""
+    """A scene of the dataset as generated: its id, seed, the code version that made it and how
+    it was grown and drawn (None for scenes without our scene.json, e.g. the original download).
+    The seed follows from the dataset seed alone: two datasets of one seed drawn at other sizes,
+    by another renderer, with other plants or another appearance differ only in ``drawn``."""
 
     id: str
     seed: int | None = None
     code: str | None = None
+    drawn: str | None = Field(
+        None,
+        description="digest of scene.json's camera, renderer, plant generator, appearance, grid and box threshold",
+    )
 
 
 class DatasetIdentity(_Model):
@@ -204,14 +210,26 @@ def load_results(path: str | os.PathLike[str]) -> EvaluationResults:
 
 def scene_identity(scene_id: str, metadata: SceneFile | None) -> SceneIdentity:
     """A scene's identity from its scene.json (None: a scene without one)."""
-    code = metadata.generator.version if metadata is not None and metadata.generator is not None else None
-    return SceneIdentity(id=str(scene_id), seed=metadata.seed if metadata is not None else None, code=code)
+    if metadata is None:
+        return SceneIdentity(id=str(scene_id))
+    code = metadata.generator.version if metadata.generator is not None else None
+    drawn = {
+        "camera": metadata.camera.as_written() if metadata.camera else None,
+        "renderer": metadata.renderer.as_written() if metadata.renderer else None,
+        "plants": metadata.plant_generator,
+        "appearance": metadata.appearance,
+        "grid": metadata.grid.as_written() if metadata.grid else None,
+        "min_fruit_pixels": metadata.min_fruit_pixels,
+    }
+    digest = hashlib.sha256(json.dumps(drawn, sort_keys=True).encode()).hexdigest()[:16]
+    return SceneIdentity(id=str(scene_id), seed=metadata.seed, code=code, drawn=digest)
 
 
 def dataset_identity(scenes: list[SceneIdentity]) -> DatasetIdentity:
     """The identity of a dataset's scenes (sorted by id) and its fingerprint."""
     ordered = sorted(scenes, key=lambda s: s.id)
-    text = json.dumps([s.model_dump() for s in ordered], sort_keys=True)
+    # ``drawn`` only where known: the original download hashes as it did before the field.
+    text = json.dumps([s.model_dump(exclude={"drawn"} if s.drawn is None else None) for s in ordered], sort_keys=True)
     return DatasetIdentity(fingerprint=hashlib.sha256(text.encode()).hexdigest()[:16], scenes=ordered)
 
 
