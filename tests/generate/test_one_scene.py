@@ -280,6 +280,32 @@ def test_a_scene_made_with_another_seed_is_not_overwritten(
     assert {p.name for p in root.iterdir()} <= {"Single-Strawberry", *ROOT_FILES}
 
 
+@pytest.mark.parametrize(
+    "asked, said",
+    [
+        (["--no-depth"], "made with depth images, this run asks without: drop --no-depth"),
+        (["--antialiasing", "msaa"], "drawn with antialiasing fxaa, not msaa: use --antialiasing fxaa"),
+    ],
+)
+def test_a_resumed_run_adds_no_scene_drawn_otherwise(
+    asked: list[str],
+    said: str,
+    generated: tuple[Path, Path, dict],
+    capsys: pytest.CaptureFixture[str],
+    tmp_path: Path,
+) -> None:
+    """dataset.json does not hold the depth choice or the antialiasing: a resumed run with
+    another choice skipped the finished scene as complete and added scenes without depth (or
+    drawn otherwise) beside it."""
+    _, scene_dir, _ = generated
+    root = tmp_path / "ds"
+    shutil.copytree(scene_dir, root / "Single-Strawberry" / "000")
+    before = snapshot(root / "Single-Strawberry")
+    line = refused(capsys, "--out", str(root), "--scenes", "2", "--size", "96x54", *asked)
+    assert said in line and str(root / "Single-Strawberry" / "000") in line
+    assert snapshot(root / "Single-Strawberry") == before  # nothing added beside it
+
+
 def test_mock_pyhelios_is_a_clear_error(monkeypatch: pytest.MonkeyPatch) -> None:
     import pyhelios.plugins
 

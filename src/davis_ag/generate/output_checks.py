@@ -1,5 +1,5 @@
 """The output folder's rules: refuse a folder we could damage, skip a finished scene, and never
-replace one made with another seed or image size.
+replace one made with another seed, nor add scenes drawn otherwise beside it.
 """
 
 from __future__ import annotations
@@ -10,24 +10,17 @@ from typing import TYPE_CHECKING
 from davis_ag.atomic_files import PROBE_PREFIX, prove_writable_folder
 from davis_ag.errors import UserError
 from davis_ag.formats.layout import ANNOTATIONS, ROOT_FILES, SCENE_METADATA
-from davis_ag.formats.scene_file import read_scene_file
+from davis_ag.formats.scene_file import SceneFile, read_scene_file
+from davis_ag.render.backends import antialiasing_of
 
 if TYPE_CHECKING:
     from davis_ag.generate.one_scene import SceneRequest
 
 
-def read_scene_seed(scene_dir: Path) -> int | None:
-    """The seed a finished scene was made with, or None when it carries no scene.json of ours."""
+def read_scene_record(scene_dir: Path) -> SceneFile | None:
+    """A finished scene's scene.json, or None when it carries none of ours that can be read."""
     try:
-        return read_scene_file(scene_dir / SCENE_METADATA).seed
-    except UserError:
-        return None
-
-
-def read_scene_size(scene_dir: Path) -> tuple[int, int] | None:
-    """The image size a finished scene was drawn at, or None when its scene.json does not say."""
-    try:
-        return read_scene_file(scene_dir / SCENE_METADATA).image_size()
+        return read_scene_file(scene_dir / SCENE_METADATA)
     except UserError:
         return None
 
@@ -67,27 +60,49 @@ def check_scene_slot(root: Path, request: SceneRequest) -> bool:
     complete nor drawn over.
 
     Raises:
-        UserError: when a finished scene was made with a different seed or image size, or has
-            lost its labels: it is never replaced.
+        UserError: when a finished scene was made with a different seed, image size, depth
+            choice or antialiasing, or has lost its labels: it is never replaced.
     """
     scene_dir = root / request.folder
-    if scene_dir.exists():
-        seed = read_scene_seed(scene_dir)
-        if seed != request.seed:
+    if not scene_dir.exists():
+        return False
+    record = read_scene_record(scene_dir)
+    seed = record.seed if record is not None else None
+    if seed != request.seed:
+        raise UserError(
+            f"{scene_dir} already holds a scene made with other settings (seed {seed}, "
+            f"not {request.seed}): use another --out or --seed, or move it away"
+        )
+    if record is not None:
+        _check_drawn_alike(scene_dir, record, request)
+    if not (scene_dir / ANNOTATIONS).is_file():
+        raise UserError(
+            f"{scene_dir} has lost its {ANNOTATIONS} (missing or unreadable), so it is not complete: "
+            "move the folder out of the dataset and run again to make the scene anew (validate lists every such scene)"
+        )
+    return True
+
+
+def _check_drawn_alike(scene_dir: Path, record: SceneFile, request: SceneRequest) -> None:
+    """What dataset.json does not hold but each scene.json does: a resumed run must not add scenes
+    drawn otherwise beside the finished ones (a depth-less scene among scenes with depth stops
+    ``export pointcloud`` halfway)."""
+    size = record.image_size()
+    if size is not None and size != (request.camera.width, request.camera.height):
+        raise UserError(
+            f"{scene_dir} was drawn at {size[0]}x{size[1]}, not {request.camera.width}x"
+            f"{request.camera.height}: use the same --size or another --out"
+        )
+    if (record.depth is not None) != request.depth:
+        made, asked = ("with", "without") if record.depth is not None else ("without", "with")
+        raise UserError(
+            f"{scene_dir} was made {made} depth images, this run asks {asked}: "
+            f"{'drop' if request.depth is False else 'add'} --no-depth (config: depth) or use another --out"
+        )
+    if record.renderer is not None and record.renderer.name == "opengl" == request.renderer:
+        drawn = antialiasing_of(record.renderer)
+        if drawn != request.antialiasing:
             raise UserError(
-                f"{scene_dir} already holds a scene made with other settings (seed {seed}, "
-                f"not {request.seed}): use another --out or --seed, or move it away"
+                f"{scene_dir} was drawn with antialiasing {drawn}, not {request.antialiasing}: "
+                f"use --antialiasing {drawn} (config: antialiasing) or another --out"
             )
-        size = read_scene_size(scene_dir)
-        if size is not None and size != (request.camera.width, request.camera.height):
-            raise UserError(
-                f"{scene_dir} was drawn at {size[0]}x{size[1]}, not {request.camera.width}x"
-                f"{request.camera.height}: use the same --size or another --out"
-            )
-        if not (scene_dir / ANNOTATIONS).is_file():
-            raise UserError(
-                f"{scene_dir} has lost its {ANNOTATIONS} (missing or unreadable), so it is not complete: "
-                "move the folder out of the dataset and run again to make the scene anew (validate lists every such scene)"
-            )
-        return True
-    return False

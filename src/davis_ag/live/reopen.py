@@ -26,7 +26,8 @@ import numpy as np
 
 from davis_ag.atomic_files import atomic_output
 from davis_ag.formats.layout import ANNOTATIONS, SCENE_METADATA, view_name
-from davis_ag.formats.scene_file import SCENE_FORMAT, GeneratorRecord, RendererRecord, SceneFile, read_scene_file
+from davis_ag.formats.scene_file import SCENE_FORMAT, GeneratorRecord, SceneFile, read_scene_file
+from davis_ag.render.backends import antialiasing_of
 from davis_ag.errors import UserError
 from davis_ag.scene.appearance import DEFAULT_APPEARANCE, resolve_appearance
 from davis_ag.scene.camera import Camera
@@ -117,19 +118,6 @@ class SceneSettings:
             "appearance": self.appearance,
         }
         return hashlib.sha256(json.dumps(keyed, sort_keys=True).encode()).hexdigest()[:20]
-
-
-def antialiasing_of(renderer: RendererRecord) -> str:
-    """The antialiasing mode a scene.json's renderer entry names: its description (as
-    :data:`~davis_ag.render.backends.ANTIALIASING_DESCRIPTIONS` writes it), Helios's Visualizer
-    (4x multisampling), or an earlier version's 4x / 1x wording."""
-    from davis_ag.render.backends import ANTIALIASING_DESCRIPTIONS
-
-    text = renderer.antialiasing or ""
-    by_description = {description: mode for mode, description in ANTIALIASING_DESCRIPTIONS.items()}
-    if text in by_description:
-        return by_description[text]
-    return "msaa" if text.startswith("4x") or renderer.name == "helios" else "none"
 
 
 def _crop_with_altitudes(crop: CropSpec, altitudes: list[float]) -> tuple[CropSpec, tuple[int, ...]]:

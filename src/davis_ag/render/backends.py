@@ -12,6 +12,7 @@ The Helios renderer always draws the ``helios`` look.
 from __future__ import annotations
 
 from davis_ag.errors import UserError
+from davis_ag.formats.scene_file import RendererRecord
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.lighting import Lighting
 
@@ -68,6 +69,17 @@ def resolve_antialiasing(value: str | int | None) -> str:
     if text not in ANTIALIASING:
         raise UserError(f"antialiasing {value!r}: choose one of {', '.join(ANTIALIASING)}")
     return text
+
+
+def antialiasing_of(renderer: RendererRecord) -> str:
+    """The antialiasing mode a scene.json's renderer entry names: its description (as
+    :data:`ANTIALIASING_DESCRIPTIONS` writes it), Helios's Visualizer
+    (4x multisampling), or an earlier version's 4x / 1x wording."""
+    text = renderer.antialiasing or ""
+    by_description = {description: mode for mode, description in ANTIALIASING_DESCRIPTIONS.items()}
+    if text in by_description:
+        return by_description[text]
+    return "msaa" if text.startswith("4x") or renderer.name == "helios" else "none"
 
 
 def open_renderer(
