@@ -419,8 +419,9 @@ def test_organ_classes_come_from_the_same_pass_as_the_masks(generated: tuple[Pat
         seen |= set(np.unique(classes).tolist())
     assert {SKY, SOIL, FRUIT, LEAF, STEM} <= seen
 
-    # A scene without class images (the original layout, older datasets) still reads and validates;
-    # a class image that calls fruit pixels leaves is reported.
+    # Class images lost from a scene whose scene.json records them are reported, one line each; a
+    # scene without them (the original layout, older datasets) still reads and validates; a class
+    # image that calls fruit pixels leaves is reported.
     copy = tmp_path / "copy"
     shutil.copytree(root, copy)
     images = copy / scene_dir.relative_to(root) / "images"
@@ -429,6 +430,10 @@ def test_organ_classes_come_from_the_same_pass_as_the_masks(generated: tuple[Pat
         if path.name != boxed.class_path.name:
             path.unlink()
     assert all(v.classes() is None for v in open_dataset(copy).scenes[0] if v.name != boxed.name)
+    lost = [str(p) for p in validate_dataset(copy).problems]
+    assert len(lost) == VIEWS - 1 and all("_class.png" in p and "records organ class images" in p for p in lost)
+    meta_path = copy / scene_dir.relative_to(root) / "scene.json"
+    meta_path.write_text(json.dumps({**json.loads(meta_path.read_text()), "classes": None}))
     assert validate_dataset(copy).ok
     wrong = np.where(boxed.mask() != 255, LEAF, boxed.classes()).astype(np.uint8)
     Image.fromarray(wrong, mode="L").save(images / boxed.class_path.name)

@@ -148,6 +148,9 @@ def validate_scene(
         depth = view_file(scene.path, record.name, "depth")
         if metadata is not None and metadata.depth and not depth.is_file():
             flag(depth, f"missing: scene.json records depth images but {record.name} has none")
+        classes = view_file(scene.path, record.name, "classes")
+        if metadata is not None and metadata.classes and not classes.is_file():
+            flag(classes, f"missing: scene.json records organ class images but {record.name} has none")
         if quick:
             size = camera_size(metadata)
             if size:
