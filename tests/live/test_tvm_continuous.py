@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import tempfile
+from dataclasses import replace
 from pathlib import Path
 
 import gymnasium
@@ -17,11 +18,12 @@ from davis_ag.errors import UserError
 from davis_ag.benchmark.evaluation import evaluate_policies
 from davis_ag.benchmark.policies import ModelPolicy
 from davis_ag.live.policies import Greedy, RandomAxes, build_policies
+from davis_ag.live.scene import LiveScene
 from davis_ag.figures.result_charts import plot_training_curve
 from davis_ag.live.training import train_continuous
 from davis_ag.live.tvm_continuous import TVMContinuousEnv
 from davis_ag.workflows.bench import steps_per_second
-from davis_ag.scene.specs import SLIP_SIGMA
+from davis_ag.scene.specs import SLIP_SIGMA, with_strawberry_altitudes
 
 
 @pytest.fixture(scope="module")
@@ -47,6 +49,32 @@ def test_gymnasium_and_sb3_checkers_pass(env: TVMContinuousEnv) -> None:
     check_env(env, skip_render_check=True)
     sb3_check_env(env)
     assert env.observation_space.shape == (224, 224, 4) and env.action_space.shape == (3,)
+
+
+def test_a_full_action_follows_each_scene_s_own_grid(live_scene_dir: Path) -> None:
+    """One grid step, half the altitude span and one heading's turn, of the scene being played:
+    the scales were the first scene's for every scene (a tomato scene climbed strawberry's span)
+    and the turn was fixed at 30 degrees whatever the grid's headings."""
+    with TVMContinuousEnv(live_scene_dir, "sp", aim="free") as made:
+        settings = made.scenes[0].settings
+        altitudes = [settings.crop.altitudes[i] for i in settings.scenario.altitude_levels]
+        assert made.max_move == settings.scenario.step == 0.5
+        assert made.max_climb == pytest.approx((max(altitudes) - min(altitudes)) / 2)
+        assert made.max_turn == 30.0  # one heading: the MP grid's turn
+        # Another scene of the split on a reduced grid of four headings, a longer step and the
+        # readme's altitudes: its own scales once it is the one played.
+        other = replace(
+            settings,
+            scenario=replace(settings.scenario, step=1.0, headings=4),
+            crop=with_strawberry_altitudes(settings.crop, "readme"),
+        )
+        made.scenes.append(LiveScene(other, made.scenes[0].assets))
+        made._scene = 1
+        assert (made.max_move, made.max_turn) == (1.0, 90.0)
+        assert made.max_climb == pytest.approx((0.75 - 0.50) / 2)  # levels 0 and 1 of 0.50/0.75/1.00 m
+        made.scenes.pop()
+    with TVMContinuousEnv(live_scene_dir, "sp", max_move=0.3, max_climb=0.1, max_turn=10.0) as given:
+        assert (given.max_move, given.max_climb, given.max_turn) == (0.3, 0.1, 10.0)
 
 
 def test_a_seed_fixes_the_start_and_the_slip(env: TVMContinuousEnv) -> None:

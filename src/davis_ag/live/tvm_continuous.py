@@ -10,9 +10,10 @@ download included, and knows nothing of Helios or renderers. This one must rende
 so it needs a scene of ours (one with a scene.json to regrow from) and an OpenGL context.
 
 - Action: a Box in [-1, 1]: ``(dx, dy, dz)`` in the world frame, scaled by ``max_move`` (default
-  the scenario's grid step, 0.25 m SP, 0.5 m MP) and ``max_climb`` (default half the span of the
-  scenario's altitudes); with ``aim="free"`` (MP default) two more, ``(dyaw, dpitch)``, scaled by
-  ``max_turn`` degrees (30, the MP grid's rotation). With ``aim="plant"`` (SP default) the camera
+  the scene's grid step) and ``max_climb`` (default half the span of the scene's altitudes); with
+  ``aim="free"`` (MP default) two more, ``(dyaw, dpitch)``, scaled by ``max_turn`` degrees
+  (default the scene grid's turn between headings: 30 on the MP grid's 12). Defaults follow each
+  scene's own grid as scene.json records it (reduced grids, crops of other altitudes). With ``aim="plant"`` (SP default) the camera
   always looks at the plant, as the SP grid's views do.
 - Slip (section III-B): a move with a horizontal part lands off by Gaussian noise of 2.5 cm on x
   and y; turning and climbing in place do not slip. Slip draws from ``self.np_random`` only.
@@ -96,7 +97,7 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         tau: int | None = None,
         max_move: float | None = None,
         max_climb: float | None = None,
-        max_turn: float = 30.0,
+        max_turn: float | None = None,
         max_start_oer: float = MAX_START_OER,
         size: int = OBS_SIZE,
         antialiasing: str = "none",
@@ -111,9 +112,10 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
             crop: Keep one crop only.
             aim: ``plant`` (camera looks at the plant; SP default) or ``free`` (MP default).
             tau: Steps per episode (default the scenario's: 3 SP, 5 MP).
-            max_move: Horizontal move of a full action, m (default the scenario's grid step).
-            max_climb: Vertical move of a full action, m (default half the altitude span).
-            max_turn: Yaw and pitch change of a full action, degrees (``aim="free"``).
+            max_move: Horizontal move of a full action, m (default the scene's grid step).
+            max_climb: Vertical move of a full action, m (default half the scene's altitude span).
+            max_turn: Yaw and pitch change of a full action, degrees (``aim="free"``; default
+                360 over the scene grid's headings, or 30 for a grid of one heading).
             max_start_oer: A target must start below this OER.
             size: Observation side, pixels.
             antialiasing: The renderer's: ``none`` (default: the fastest), ``fxaa`` or ``msaa``; ids are
@@ -155,11 +157,7 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         except BaseException:
             self.close()
             raise
-        grid = self.scenes[0].settings
-        self.max_move = float(max_move if max_move is not None else grid.scenario.step)
-        altitudes = [grid.crop.altitudes[i] for i in grid.scenario.altitude_levels]
-        self.max_climb = float(max_climb if max_climb is not None else (max(altitudes) - min(altitudes)) / 2)
-        self.max_turn = float(max_turn)
+        self._given_scales = (max_move, max_climb, max_turn)
         self.max_start_oer = float(max_start_oer)
         self.action_space = spaces.Box(-1.0, 1.0, (3 if aim == "plant" else 5,), dtype=np.float32)
         self.observation_space = spaces.Box(0, 255, (self.size, self.size, 4), dtype=np.uint8)
@@ -316,6 +314,37 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
             "dataset": self.dataset_root,
             "actions": ["dx", "dy", "dz", "dyaw", "dpitch"][: self.action_space.shape[0]],
         }
+
+    @property
+    def _grid(self):
+        """The current scene's settings (the first scene's before any reset)."""
+        return self.scenes[max(self._scene, 0)].settings
+
+    @property
+    def max_move(self) -> float:
+        """Horizontal move of a full action, m: as given, else the current scene's grid step."""
+        given = self._given_scales[0]
+        return float(given if given is not None else self._grid.scenario.step)
+
+    @property
+    def max_climb(self) -> float:
+        """Vertical move of a full action, m: as given, else half the current scene's altitude span."""
+        given = self._given_scales[1]
+        if given is not None:
+            return float(given)
+        grid = self._grid
+        altitudes = [grid.crop.altitudes[i] for i in grid.scenario.altitude_levels]
+        return (max(altitudes) - min(altitudes)) / 2
+
+    @property
+    def max_turn(self) -> float:
+        """Yaw and pitch change of a full action, degrees: as given, else the current scene grid's
+        turn between headings (30 for a grid of one heading)."""
+        given = self._given_scales[2]
+        if given is not None:
+            return float(given)
+        headings = self._grid.scenario.headings
+        return 360.0 / headings if headings > 1 else 30.0
 
     def _action(self, action: Any) -> np.ndarray:
         a = np.asarray(action, dtype=np.float64).reshape(-1)
