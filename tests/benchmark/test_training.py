@@ -126,6 +126,39 @@ def test_a_checkpoint_from_before_datasets_were_recorded_still_resumes(
     assert "resuming" in capsys.readouterr().out
 
 
+def test_a_model_is_never_scored_on_the_scenes_it_learnt_from(
+    tmp_path: Path, one_thread: None, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The split depends on the group's scene count: scenes added after training move some train
+    scenes into the test split. The record lists the train scenes; evaluation refuses a test split
+    holding one, a checkpoint of another split is not resumed, and one from before the list
+    was recorded still is (a run under way keeps its hours)."""
+    from davis_ag.benchmark import evaluate
+    from davis_ag.benchmark.policies import ModelPolicy
+
+    root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2)
+    out = tmp_path / "a2c.zip"
+    with pytest.raises(KeyboardInterrupt):
+        train_a2c(root, "sp", total_timesteps=100, seed=1, out_path=out, **TINY_RUN, callback=KillAfter(50))
+    settings_file = checkpoint_paths(out)[1]
+    saved = json.loads(settings_file.read_text())
+    assert saved["train_scenes"] == ["Single-Strawberry/000"]
+    settings_file.write_text(json.dumps({k: v for k, v in saved.items() if k != "train_scenes"}))  # older
+    train_a2c(root, "sp", total_timesteps=100, seed=1, out_path=out, **TINY_RUN)
+    assert "resuming" in capsys.readouterr().out
+    assert json.loads(training_record_path(out).read_text())["train_scenes"] == ["Single-Strawberry/000"]
+    assert evaluate([ModelPolicy(out)], root, "sp", sessions=1, episodes=2).policies  # its own test split
+    # The split changes (here by hand): the scene it learnt from is now a test scene.
+    splits = root / "splits.json"
+    splits.write_text(
+        json.dumps(
+            {**json.loads(splits.read_text()), "train": [], "test": ["Single-Strawberry/000", "Single-Strawberry/001"]}
+        )
+    )
+    with pytest.raises(UserError, match="trained on 1 of the 2 test scenes .*Single-Strawberry/000.*train it again"):
+        evaluate([ModelPolicy(out)], root, "sp", sessions=1, episodes=2)
+
+
 def test_other_settings_never_resume_a_checkpoint(
     tmp_path: Path, one_thread: None, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -265,10 +265,14 @@ def test_a_run_with_ppo_shows_its_row_gap_settings_and_stage(tmp_path: Path, sp_
     results_json.parent.mkdir()
     results_json.write_text(json.dumps(before))
     config = replace(CONFIGS["small"], episodes=20, sessions=3)
-    assert _reusable_results(results_json, [models["a2c"]], "test", config) is not None
-    assert _reusable_results(results_json, [models["a2c"], models["ppo"]], "test", config) is None
+    test_scenes = ["Single-Strawberry/001"]
+    assert _reusable_results(results_json, [models["a2c"]], "test", test_scenes, config) is not None
+    assert _reusable_results(results_json, [models["a2c"], models["ppo"]], "test", test_scenes, config) is None
     results_json.write_text(json.dumps(both))
-    assert _reusable_results(results_json, [models["a2c"], models["ppo"]], "test", config) is not None
+    assert _reusable_results(results_json, [models["a2c"], models["ppo"]], "test", test_scenes, config) is not None
+    # A group that grew has another test split: evaluated anew.
+    grown = [*test_scenes, "Single-Strawberry/002"]
+    assert _reusable_results(results_json, [models["a2c"], models["ppo"]], "test", grown, config) is None
     assert plot_results(both, results_json.with_suffix(".png")).is_file()  # the stage's chart, PPO's bar in it
     add_train_split(both, sp_root, "sp", "strawberry")
     # The kept snapshots scored again on fresh train episodes, as on test: their selection scores run high.

@@ -43,6 +43,8 @@ def resumable(settings_file: Path, model_file: Path, settings: dict[str, Any]) -
         saved.setdefault("a2c_settings", SB3_DEFAULT_SETTINGS)
     saved.setdefault("start_rule", "scene")  # and drew starts scene first
     saved.setdefault("keep", "last")  # and kept the last snapshot
+    # Checkpoints from before the train scenes were recorded are taken for the split as it is.
+    saved.setdefault("train_scenes", settings.get("train_scenes"))
     if saved.get("dataset") == "/":
         # Checkpoints before this version recorded Path.root ("/") for any dataset given as a
         # path; they are taken as they were then, for whatever dataset the run names.
@@ -95,7 +97,9 @@ def _checkpoint_problem(settings_file: Path, model_file: Path, settings: dict[st
     if not isinstance(saved, dict):
         return f"the checkpoint is damaged ({settings_file.name} is not a record), so it cannot be resumed"
     differ = [
-        f"{key} {saved.get(key)!r}, not {settings[key]!r}"
+        "another train split (scenes added or removed)"
+        if key == "train_scenes"
+        else f"{key} {saved.get(key)!r}, not {settings[key]!r}"
         for key in settings
         if key in saved and saved[key] != settings[key] and key != "dataset"
     ]

@@ -244,7 +244,12 @@ class ModelPolicy:
         Raises:
             UserError: when the file is missing or not an SB3 model.
         """
+        #: The scenes it was trained on, where its training record says (``davis-ag train``'s).
+        self.trained_on: list[str] | None = None
         if isinstance(model, (str, os.PathLike)):
+            from davis_ag.benchmark.training import recorded_train_scenes
+
+            self.trained_on = recorded_train_scenes(model)
             model = load_model(model, device)
         # A Q-learner's policy is its greedy action: SB3's "sampled" DQN is epsilon-greedy with
         # training's exploration rate, which is no distribution of the learnt policy.
@@ -288,6 +293,16 @@ class ModelPolicy:
                 f"{self.name}: the model takes observations of shape {shape}, the environment gives "
                 f"{env.observation_space.shape}: use a model trained by davis-ag train"
             )
+        inner = getattr(env, "unwrapped", env)
+        described = inner.describe() if hasattr(inner, "describe") else {}
+        if self.trained_on and described.get("split") == "test":
+            seen = sorted(set(self.trained_on) & set(described.get("scenes", [])))
+            if seen:
+                raise UserError(
+                    f"{self.name}: trained on {len(seen)} of the {len(described['scenes'])} test scenes "
+                    f"({seen[0]}{', ...' if len(seen) > 1 else ''}): the split changed after it was trained "
+                    "(scenes added or removed); train it again on this dataset"
+                )
 
     def act(self, observation: np.ndarray, info: dict[str, Any]) -> Any:
         """The model's action for ``observation``."""

@@ -13,6 +13,7 @@ to an uninterrupted one.
 
 from __future__ import annotations
 
+import json
 import os
 from pathlib import Path
 from typing import Any
@@ -36,6 +37,7 @@ from davis_ag.benchmark.checkpoints import CheckpointEvery, Sittings, check_chec
 from davis_ag.benchmark.networks import ARCHITECTURES
 from davis_ag.benchmark.progress import LearningCurve, TrainingProgress
 from davis_ag.benchmark.selection import KeepBestOnTrain, check_keep, snapshot_path
+from davis_ag.benchmark.splits import select_scenes
 from davis_ag.benchmark.tvm import as_dataset
 from davis_ag.errors import MachineError, UserError
 from davis_ag.formats.models import check_seed
@@ -97,6 +99,17 @@ def training_record_path(out_path: str | os.PathLike[str]) -> Path:
     """``NAME.training.json`` beside the model ``NAME.zip``: settings, sittings, steps/s."""
     stem = model_path(out_path).with_suffix("")
     return stem.with_name(stem.name + ".training.json")
+
+
+def recorded_train_scenes(out_path: str | os.PathLike[str]) -> list[str] | None:
+    """The train scenes a saved model's training record lists (None: no record, or one from before
+    they were recorded)."""
+    try:
+        record = json.loads(training_record_path(out_path).read_text())
+    except (OSError, ValueError):
+        return None
+    scenes = record.get("train_scenes") if isinstance(record, dict) else None
+    return [str(s) for s in scenes] if isinstance(scenes, list) else None
 
 
 def train_a2c(dataset: Any, scenario: str, **kwargs: Any) -> Path:
@@ -209,8 +222,11 @@ def train_agent(
         "start_rule": "pairs",
         "keep": keep,
     }
-    resumed = check_checkpoint(settings_file, model_file, settings, force)
     opened = as_dataset(dataset)
+    # What it learns from: evaluation refuses to score it on any of these (a split that changed
+    # since, as scenes were added), and a checkpoint of another split is not resumed.
+    settings["train_scenes"] = sorted(s.id for s in select_scenes(opened, scenario, "train", crop))
+    resumed = check_checkpoint(settings_file, model_file, settings, force)
     env = make_vec_tvm(opened, scenario, n_envs, seed, "train", crop, cache_dir)
     scores: list[dict[str, Any]] = []
     if resumed is not None:

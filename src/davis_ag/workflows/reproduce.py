@@ -126,7 +126,9 @@ def reproduce(
                 )
         print(f"benchmark on split {split!r}: {config.sessions} x {config.episodes} episodes", flush=True)
         results_json = out / "results" / f"{key}.json"
-        results = _reusable_results(results_json, list(models.values()), split, config)
+        results = _reusable_results(
+            results_json, list(models.values()), split, split_scene_ids(root, scenario_name, split, crop_name), config
+        )
         if results is None:
             with clock.timing(f"{key}: evaluate"):
                 results = run_baselines(
@@ -187,8 +189,19 @@ def validate_once(group: Path, state: dict[str, Any], stage: str, clock: Any, re
     return report.ok
 
 
-def _reusable_results(path: Path, models: list[Path], split: str, config: ReproduceConfig) -> dict[str, Any] | None:
-    """An earlier evaluation of the same models and protocol, or ``None`` to evaluate anew.
+def split_scene_ids(root: Path, scenario: str, split: str, crop: str) -> list[str]:
+    """The ids of a split's scenes of one group, as the environment takes them."""
+    from davis_ag.benchmark.splits import select_scenes
+    from davis_ag.benchmark.tvm import as_dataset
+
+    return [s.id for s in select_scenes(as_dataset(root), scenario, split, crop)]
+
+
+def _reusable_results(
+    path: Path, models: list[Path], split: str, scenes: list[str], config: ReproduceConfig
+) -> dict[str, Any] | None:
+    """An earlier evaluation of the same models, protocol and split scenes (``scenes``: a group
+    that grew moves scenes between the splits), or ``None`` to evaluate anew.
 
     One made before a learner of the run (PPO) existed is run anew with every row: the episodes
     are seeded, so the rows it had come out as they were, and the page is never half one
@@ -207,6 +220,7 @@ def _reusable_results(path: Path, models: list[Path], split: str, config: Reprod
         return None
     same = (
         protocol.get("split") == split
+        and sorted(protocol.get("scenes") or []) == sorted(scenes)
         and protocol.get("episodes") == config.episodes
         and protocol.get("sessions") == config.sessions
         and protocol.get("seed") == config.seed

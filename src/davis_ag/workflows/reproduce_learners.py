@@ -63,7 +63,11 @@ def train_learner(
     stamp = model.with_suffix(".json")
     made = {"keep": "last", **load_json_object(stamp)}
     wanted = learner_stamp(algo, timesteps, settings)
-    if model.is_file() and all(made.get(k) == v for k, v in wanted.items()):
+    if (
+        model.is_file()
+        and all(made.get(k) == v for k, v in wanted.items())
+        and _split_unchanged(model, root, scenario, crop)
+    ):
         return None
     network = "the paper's network" + (" as features extractor" if algo != "a2c" else "")
     print(f"training {algo.upper()} ({network}) on {scenario} train split for {timesteps} steps", flush=True)
@@ -86,3 +90,16 @@ def train_learner(
     seconds = time.perf_counter() - start
     write_json_atomic(stamp, {**wanted, "seconds": seconds})
     return seconds
+
+
+def _split_unchanged(model: Path, root: Path, scenario: str, crop: str) -> bool:
+    """Whether a finished model was trained on today's train split (a group that grew moves
+    scenes between the splits); a model from before the scenes were recorded is taken as it is."""
+    from davis_ag.benchmark.splits import select_scenes
+    from davis_ag.benchmark.training import recorded_train_scenes
+    from davis_ag.benchmark.tvm import as_dataset
+
+    trained_on = recorded_train_scenes(model)
+    if trained_on is None:
+        return True
+    return trained_on == sorted(s.id for s in select_scenes(as_dataset(root), scenario, "train", crop))

@@ -163,6 +163,7 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
 
     strawberry, vine = crop_spec("strawberry"), crop_spec("vine")
     sp_views = views_per_scene(scenario_spec("sp", strawberry), strawberry)
+    sp_extent = " x ".join(f"{side:g}" for side in strawberry.sp_extent)
     mp_views = views_per_scene(scenario_spec("mp", vine), vine)
     mp_grid = (
         f"{config.mp_extent[0]:g} x {config.mp_extent[1]:g} m around the middle vine"
@@ -176,8 +177,8 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
         "the *ours* columns was measured by the run described here; the *paper* columns are Table 4 of "
         "the paper.",
         "",
-        f"- **Configuration** `{config.name}`: {config.sp_scenes} SP strawberry scene(s) (Table 2's "
-        f"grid, {sp_views} views each) and {config.mp_scenes} MP vine scene(s) (grid {mp_grid}, 0.5 m "
+        f"- **Configuration** `{config.name}`: {config.sp_scenes} SP strawberry scene(s) (strawberry's "
+        f"{sp_extent} m grid, {sp_views} views each, as Table 3 counts them) and {config.mp_scenes} MP vine scene(s) (grid {mp_grid}, 0.5 m "
         f"step, 12 headings, 2 altitudes) at {config.size[0]}x{config.size[1]}, dataset seed "
         f"{config.seed}; box thresholds scaled by image area; A2C (Stable-Baselines3, the paper's "
         f"network of section V-B, {config.n_envs} environments; its settings under each scenario) for {config.sp_timesteps:,} (SP) and "
