@@ -47,7 +47,7 @@ def never_grow(monkeypatch: pytest.MonkeyPatch) -> None:
     import davis_ag.commands.preview as preview
     import davis_ag.workflows.demo as demo
 
-    monkeypatch.setattr(preview, "build_scene", forbidden)
+    monkeypatch.setattr(preview, "grow_scene", forbidden)
     monkeypatch.setattr(generate, "run_dataset", forbidden)
     monkeypatch.setattr(demo, "run_dataset", forbidden)
     monkeypatch.setattr(training, "make_vec_tvm", forbidden)

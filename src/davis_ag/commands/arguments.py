@@ -151,7 +151,8 @@ def antialiasing_mode(text: str) -> str:
 
 
 def add_renderer_flags(parser: argparse.ArgumentParser) -> None:
-    """``--renderer`` and ``--look``, shared by generate and preview."""
+    """How a scene is grown and drawn, shared by generate and preview: ``--renderer``, ``--look``,
+    ``--antialiasing``, ``--plants``, ``--appearance`` and ``--strawberry-altitudes``."""
     from davis_ag.render.backends import LOOKS, RENDERERS
     from davis_ag.scene.specs import PLANT_GENERATORS
 
@@ -178,6 +179,18 @@ def add_renderer_flags(parser: argparse.ArgumentParser) -> None:
         choices=PLANT_GENERATORS,
         help="canopy: Helios's Canopy Generator plants, as the paper's (default); architecture: "
         "pyhelios3d's PlantArchitecture plants bent towards them",
+    )
+    parser.add_argument(
+        "--appearance",
+        choices=("paper", "random"),
+        help="paper: the paper's sky, soil and exposure (default); random: per scene, from its "
+        "seed, the sun, sky, soil, exposure, white balance and sensor noise (labels unchanged)",
+    )
+    parser.add_argument(
+        "--strawberry-altitudes",
+        choices=("table1", "readme"),
+        help="strawberry camera altitudes: table1 = Table 1's 25/40/55 cm (default), "
+        "readme = the dataset README's and Fig. 2's 0.50/0.75/1.00 m",
     )
 
 

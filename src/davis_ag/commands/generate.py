@@ -42,19 +42,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         action="store_true",
         help="do not write images/NNNN_depth.png (uint16 millimetres along the optical axis)",
     )
-    parser.add_argument(
-        "--appearance",
-        choices=("paper", "random"),
-        help="paper: the paper's sky, soil and exposure (default); random: per scene, from its "
-        "seed, the sun, sky, soil, exposure, white balance and sensor noise (labels unchanged)",
-    )
     parser.add_argument("--out", type=arguments.path, required=True, help="dataset folder")
-    parser.add_argument(
-        "--strawberry-altitudes",
-        choices=("table1", "readme"),
-        help="strawberry camera altitudes: table1 = Table 1's 25/40/55 cm (default), "
-        "readme = the dataset README's and Fig. 2's 0.50/0.75/1.00 m",
-    )
     parser.add_argument(
         "--only",
         action="append",

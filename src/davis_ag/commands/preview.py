@@ -1,28 +1,27 @@
 """``davis-ag preview``: render a few views of one scene, with fruit boxes drawn, without a dataset.
 
-It grows the same scene ``generate`` would (same dataset seed and index give the same plants,
-sun and slip) and draws the chosen views, so a researcher can look before rendering hundreds.
+It grows the same scene ``generate`` would (same dataset seed, index and options give the same
+plants, light, appearance and slip) and draws the chosen views, so a researcher can look before
+rendering hundreds.
 """
 
 from __future__ import annotations
 
 import argparse
 
-import numpy as np
 from PIL import Image, ImageDraw
 
 from davis_ag.atomic_files import atomic_output
 from davis_ag.commands import arguments
 from davis_ag.errors import UserError
 from davis_ag.formats.layout import IMAGE_SUFFIX, JPEG_QUALITY, view_name, view_stem
-from davis_ag.generate.one_scene import SceneRequest
+from davis_ag.generate.one_scene import SceneRequest, grow_scene
 from davis_ag.generate.run_progress import count_views
 from davis_ag.labels.fruit_labels import fruit_lookup, label_view, visible_fractions
 from davis_ag.render.backends import DEFAULT_RENDERER, open_renderer, resolve_look
-from davis_ag.scene.build import build_scene
+from davis_ag.scene.appearance import DEFAULT_APPEARANCE
 from davis_ag.scene.camera import Camera
-from davis_ag.scene.specs import DEFAULT_PLANTS, crop_spec, plant_centres, scenario_spec
-from davis_ag.scene.view_grid import build_view_grid
+from davis_ag.scene.specs import DEFAULT_PLANTS, crop_spec, scenario_spec, with_strawberry_altitudes
 
 HELP = "render a few views of one scene with boxes drawn"
 DESCRIPTION = __doc__
@@ -44,6 +43,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     crop = crop_spec(args.crop)
+    if args.strawberry_altitudes:
+        crop = with_strawberry_altitudes(crop, args.strawberry_altitudes)
     scenario = scenario_spec(args.scenario, crop)
     numbers = args.views
     renderer_name = args.renderer or DEFAULT_RENDERER
@@ -61,10 +62,9 @@ def run(args: argparse.Namespace) -> int:
         renderer=renderer_name,
         look=look,
         plants=args.plants or DEFAULT_PLANTS,
+        appearance=args.appearance or DEFAULT_APPEARANCE,
     )
-    rng = np.random.default_rng(request.seed)
-    model = build_scene(scenario, crop, rng, request.plants)
-    grid = build_view_grid(scenario, crop, plant_centres(scenario, crop), model.aim_height, rng)
+    model, grid = grow_scene(request)  # generate's own growth: the same plants, light and slip
     _check_views(numbers, len(grid.viewpoints))
     lookup = fruit_lookup({f.id: f.uuids for f in model.fruits}, model.uuid_count)
     polygons = {f.id: f.polygons for f in model.fruits}
