@@ -88,6 +88,43 @@ def test_cache_dir_option(root: Path, tmp_path: Path) -> None:
     assert not (root / CACHE_FOLDER).exists()
 
 
+def test_a_cache_dir_on_a_dataset_leaves_its_scenes_alone(
+    root: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A --cache-dir naming a dataset (this one, a copy, the original download) put each scene's
+    cache where the scene folder is, took the scene for a stale cache and deleted it."""
+    from davis_ag import cli
+
+    before = {p: p.read_bytes() for p in root.rglob("*") if p.is_file()}
+    code = cli.main(
+        [
+            "evaluate",
+            "--dataset",
+            str(root),
+            "--scenario",
+            "sp",
+            "--episodes",
+            "1",
+            "--sessions",
+            "1",
+            "--cache-dir",
+            str(root),
+            "--out",
+            str(tmp_path / "r.json"),
+        ]
+    )
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "not an observation cache" in err and "\n" not in err
+    assert {p: p.read_bytes() for p in root.rglob("*") if p.is_file()} == before
+    # A stale cache of ours is still replaced.
+    TVMEnv(root, "sp", "all", cache_dir=tmp_path / "caches")
+    meta = tmp_path / "caches" / "Single-Strawberry/000" / "meta.json"
+    meta.write_text(json.dumps({**json.loads(meta.read_text()), "fingerprint": "old"}))
+    cache_module._OPEN.clear()  # as a new process finds it
+    TVMEnv(root, "sp", "all", cache_dir=tmp_path / "caches")
+    assert json.loads(meta.read_text())["fingerprint"] != "old"
+
+
 def test_steps_never_decode(root: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     env = TVMEnv(root, "sp", "all")
 

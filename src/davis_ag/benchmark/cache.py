@@ -343,6 +343,24 @@ def cache_folder(scene: Any, root: Path, cache_dir: str | os.PathLike[str] | Non
     return base / scene.id
 
 
+#: The files of a scene's cache: all a folder may hold to be replaced as a stale cache.
+_CACHE_FILES = frozenset({"meta.json", "tables.npz", "images.npy"})
+
+
+def _replaceable(folder: Path) -> bool:
+    """Whether an existing folder is a cache of ours (of another version or scene state), the
+    only thing a rebuild may delete: a ``--cache-dir`` pointed at a dataset would otherwise
+    replace its scene folders."""
+    if folder.is_symlink() or not folder.is_dir():
+        return False
+    try:
+        names = {p.name for p in folder.iterdir()}
+        meta = json.loads((folder / "meta.json").read_text())
+    except (OSError, ValueError):
+        return False
+    return names <= _CACHE_FILES and isinstance(meta, dict) and "fingerprint" in meta
+
+
 def load_scene_cache(scene: Any, root: Path, cache_dir: str | os.PathLike[str] | None = None) -> SceneCache:
     """Open a scene's cache, building (or rebuilding a stale one) first.
 
@@ -365,6 +383,12 @@ def load_scene_cache(scene: Any, root: Path, cache_dir: str | os.PathLike[str] |
     if cache is not None:
         _OPEN[key] = cache
         return cache
+    if folder.exists() and not _replaceable(folder):
+        raise UserError(
+            f"{folder} holds something that is not an observation cache (a scene folder of a dataset?), "
+            "so it is left alone: pass a --cache-dir (cache_dir) outside every dataset, or leave it out "
+            "for the dataset's own cache folder"
+        )
     try:
         folder.parent.mkdir(parents=True, exist_ok=True)
         tmp = Path(tempfile.mkdtemp(prefix=f".{folder.name}.tmp-", dir=folder.parent))
