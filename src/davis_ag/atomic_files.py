@@ -104,6 +104,20 @@ def is_machine_failure(error: OSError) -> bool:
     return error.errno in MACHINE_ERRNOS
 
 
+def read_page(path: str | os.PathLike[str], flag: str) -> str:
+    """The text of a page a command rewrites (a Markdown page with measured sections).
+
+    Raises:
+        UserError: one line when it cannot be read or is not UTF-8 text.
+    """
+    try:
+        return Path(path).read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise UserError(f"{flag} {path}: not UTF-8 text, so not a page of ours to rewrite; give another") from None
+    except OSError as error:
+        raise UserError(f"{flag} {path}: cannot read it ({error.strerror or error})") from None
+
+
 def write_marked_section(doc: str | os.PathLike[str], marker: str, text: str) -> None:
     """Replace what lies between ``<!-- MARKER:start -->`` and ``<!-- MARKER:end -->`` in a file.
 
@@ -114,7 +128,7 @@ def write_marked_section(doc: str | os.PathLike[str], marker: str, text: str) ->
         UserError: when the file lacks either marker.
     """
     doc = Path(doc)
-    content = doc.read_text()
+    content = read_page(doc, "page")
     start, end = f"<!-- {marker}:start -->", f"<!-- {marker}:end -->"
     if start not in content or end not in content:
         raise UserError(f"{doc} has no {start} ... {end} section to write into")

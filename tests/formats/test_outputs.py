@@ -225,7 +225,21 @@ def test_every_command_that_writes_keeps_the_rule(
     evaluate = ["evaluate", "--dataset", str(data), "--scenario", "sp", "--episodes", "2", "--sessions", "1"]
     assert run(capsys, *evaluate, "--policies", "LRD", "--out", str(results))[0] == 0
     kept = results.read_bytes()
-    assert "is one of the results files compared" in one_line(capsys, "compare", str(results), "--out", str(results))
+    # An output that is an input, however spelt, is refused even with --force.
+    elsewhere = f"{tmp_path}/not-made-yet/../r.json"
+    for argv in (
+        ["compare", str(results), "--out", str(results)],
+        ["compare", str(results), "--out", elsewhere, "--force"],
+        ["plot", "actions", "--results", str(results), "--out", str(tmp_path / "r"), "--formats", "json", "--force"],
+    ):
+        line = one_line(capsys, *argv)
+        assert "which this run reads" in line or "--formats" in line, line
+    line = one_line(capsys, "plot", "actions", "--results", str(results), "--out", str(tmp_path / "r"), "--force")
+    assert f"--out {tmp_path / 'r.json'} is --results {results}, which this run reads" in line
+    line = one_line(capsys, *evaluate, "--out", str(tmp_path / "e.png"), "--plot", f"{tmp_path}/x/../e.png")
+    assert "name the same file" in line and not (tmp_path / "e.png").exists()
+    assert "--plot" in one_line(capsys, *evaluate, "--out", str(tmp_path / "e.json"), "--plot", str(tmp_path / "c.txt"))
+    assert not (tmp_path / "e.json").exists()
     page = tmp_path / "board.md"
     assert run(capsys, "compare", str(results), "--out", str(page))[0] == 0
     assert "already exists: give --force" in one_line(capsys, "compare", str(results), "--out", str(page))
@@ -238,6 +252,11 @@ def test_every_command_that_writes_keeps_the_rule(
         capsys, "reproduce", "--out", str(run_dir), "--rewrite-results", "--results", str(run_dir / "state.json")
     )
     assert "would replace the run's own records" in line and (run_dir / "state.json").read_text() == '{"config": {}}'
+    (tmp_path / "runlink").symlink_to(run_dir)
+    for spelt in (f"{run_dir}/x/../state.json", str(tmp_path / "runlink" / "state.json")):
+        line = one_line(capsys, "reproduce", "--out", str(run_dir), "--rewrite-results", "--results", spelt)
+        assert "would replace the run's own records" in line, spelt
+    assert (run_dir / "state.json").read_text() == '{"config": {}}'
     line = one_line(capsys, "reproduce", "--out", str(run_dir), "--results", str(splits))
     assert "--results" in line and "only davis-ag generate writes there" in line
 

@@ -33,6 +33,22 @@ def test_a_folder_that_is_no_docs_folder_is_refused(tmp_path: Path, capsys: pyte
     assert len(err.splitlines()) == 1 and "not the docs folder" in err and not list(tmp_path.iterdir())
 
 
+def test_a_page_that_is_not_utf8_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """scene-stats --docs and bench --doc read pages they rewrite: Latin-1 bytes ended in a
+    UnicodeDecodeError traceback."""
+    docs = tmp_path / "docs"
+    shutil.copytree(DOCS, docs, ignore=shutil.ignore_patterns("images", "transfer"))
+    page = docs / "plants.md"
+    page.write_bytes(page.read_bytes() + "caf\xe9".encode("latin-1"))
+    before = page.read_bytes()
+    assert cli.main(["scene-stats", "views", "--docs", str(docs)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "not UTF-8" in err and str(page) in err and page.read_bytes() == before
+    assert cli.main(["bench", "--doc", str(page), "--out", str(tmp_path / "b.json")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "--doc" in err and "not UTF-8" in err and not (tmp_path / "b.json").exists()
+
+
 def test_bench_flags_parse_and_bad_ones_are_one_line(capsys: pytest.CaptureFixture[str]) -> None:
     args = cli.build_parser().parse_args(["bench", "--crops", "vine,strawberry", "--repeats", "2"])
     assert args.crops == ["vine", "strawberry"] and args.repeats == 2 and args.out.name == "bench.json"

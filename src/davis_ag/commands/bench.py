@@ -73,7 +73,7 @@ def run(args: argparse.Namespace) -> int:
     from davis_ag.workflows.bench_training import write_training
     from davis_ag.workflows.bench_report import table, write_continuous
 
-    from davis_ag.atomic_files import prove_writable_folder
+    from davis_ag.atomic_files import prove_writable_folder, read_page
     from davis_ag.errors import UserError
 
     # Minutes of measuring come before anything is written: refuse a bad output first, and never
@@ -81,7 +81,7 @@ def run(args: argparse.Namespace) -> int:
     prove_writable_folder(args.out.parent)
     if args.out.exists() and not _is_report(args.out):
         raise UserError(f"--out {args.out}: holds something other than an earlier bench report; give a new .json path")
-    if args.doc is not None and not (args.doc.is_file() and "<!-- bench:start -->" in args.doc.read_text()):
+    if args.doc is not None and not (args.doc.is_file() and "<!-- bench:start -->" in read_page(args.doc, "--doc")):
         raise UserError(
             f"--doc {args.doc}: not a Markdown page with <!-- bench:start --> and <!-- bench:end --> "
             "markers; give docs/performance.md or leave --doc out"

@@ -37,12 +37,10 @@ def run(args: argparse.Namespace) -> int:
 
     from davis_ag.atomic_files import write_text_atomic
     from davis_ag.benchmark.leaderboard import format_leaderboard, leaderboard
-    from davis_ag.errors import UserError
     from davis_ag.formats.outputs import claim_output
 
-    if args.out and args.out.absolute() in {p.absolute() for p in args.results}:
-        raise UserError(f"--out {args.out} is one of the results files compared: choose another path for the page")
-    with claim_output(args.out, force=args.force) if args.out else nullcontext():  # the output rule
+    reads = [(path, "RESULTS") for path in args.results]
+    with claim_output(args.out, force=args.force, reads=reads) if args.out else nullcontext():  # the output rule
         page = format_leaderboard(leaderboard(args.results))
         print(page, end="")
         if args.out:

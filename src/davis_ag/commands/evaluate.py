@@ -9,6 +9,7 @@ from pathlib import Path
 from davis_ag.atomic_files import write_or_rescue
 from davis_ag.commands import arguments
 from davis_ag.errors import MachineError, UserError
+from davis_ag.figures.canvas import check_figure_path
 from davis_ag.formats.outputs import claim_output
 
 HELP = "score policies (yours, trained models, the baselines) as in Table 4"
@@ -103,8 +104,7 @@ def run(args: argparse.Namespace) -> int:
         )
     out = arguments.prove_writable_file(args.out)
     plot = arguments.prove_writable_file(args.plot or out.with_suffix(".png"), "--plot")
-    if plot == out:
-        raise UserError(f"--plot and --out are both {out}: give the chart another name")
+    check_figure_path(plot, "--plot")  # before the episodes, not after
     if args.cache_dir is not None:
         arguments.prove_writable_folder(args.cache_dir, "--cache-dir")
     with claim_output(out, force=args.force, also=[(plot, "--plot")]):  # the output rule

@@ -75,7 +75,12 @@ def run(args: argparse.Namespace) -> int:
     actions = [a.strip() for a in args.actions.split(",") if a.strip()]
     base = args.out.with_suffix("") if args.out.suffix.lower().lstrip(".") in ("png", "svg", "pdf") else args.out
     files = [base.with_name(f"{base.name}.{suffix}") for suffix in (*formats, "json")]
-    with claim_output(files[0], force=args.force, also=[(f, "--out") for f in files[1:]]):  # the output rule
+    with claim_output(  # the output rule
+        files[0],
+        force=args.force,
+        also=[(f, "--out") for f in files[1:]],
+        reads=[(args.results, "--results")] if args.results else [],
+    ):
         plotted = _draw(args, formats, actions)
     for path in plotted.paths:
         print(f"wrote {path}")

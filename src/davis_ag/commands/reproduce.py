@@ -73,10 +73,12 @@ def check_results_path(results: Path, out: Path) -> None:
     Raises:
         UserError: naming what the page would replace.
     """
-    from davis_ag.formats.outputs import check_outside_datasets
+    from davis_ag.formats.outputs import check_outside_datasets, resolved
     from davis_ag.workflows.stage_clock import CLOCK_FILE
 
-    page, work = check_outside_datasets(results, "--results"), out.expanduser().absolute()
+    # Resolved, as the file system will take them: `run/x/../state.json` or a link to the run
+    # folder name its records too.
+    page, work = resolved(check_outside_datasets(results, "--results")), resolved(out)
     records = [work / "state.json", work / CLOCK_FILE, work / "models", work / "results", work / "dataset"]
     if any(page == record or record in page.parents for record in records):
         raise UserError(

@@ -25,6 +25,24 @@ def new_figure(width: float, height: float) -> Figure:
 
 #: Formats ``davis-ag plot`` writes by default.
 FORMATS: tuple[str, ...] = ("png", "svg")
+#: Formats a figure's path may name by its suffix.
+FIGURE_SUFFIXES: tuple[str, ...] = ("png", "svg", "pdf")
+
+
+def check_figure_path(path: str | Path, flag: str) -> Path:
+    """Refuse, before any work, a figure path whose suffix names no format we write.
+
+    Raises:
+        UserError: naming the flag and the formats.
+    """
+    from davis_ag.errors import UserError
+
+    out = Path(path)
+    if out.suffix and out.suffix.lower().lstrip(".") not in FIGURE_SUFFIXES:
+        raise UserError(
+            f"{flag} {out}: a figure is written as {', '.join(FIGURE_SUFFIXES)}; end the name with one of them"
+        )
+    return out
 
 
 @dataclass
@@ -53,6 +71,6 @@ def save_formats(figure: Figure, out: str | Path, formats: tuple[str, ...] = FOR
         The paths written, in the order of ``formats``.
     """
     base = Path(out)
-    if base.suffix.lower().lstrip(".") in ("png", "svg", "pdf"):
+    if base.suffix.lower().lstrip(".") in FIGURE_SUFFIXES:
         base = base.with_suffix("")
     return [save_figure(figure, base.with_name(f"{base.name}.{fmt}")) for fmt in formats]

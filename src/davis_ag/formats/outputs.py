@@ -148,6 +148,27 @@ def check_outside_datasets(path: str | os.PathLike[str], flag: str = "--out") ->
     return target
 
 
+def resolved(path: str | os.PathLike[str]) -> Path:
+    """A path as the file system will take it: absolute, links followed, ``..`` collapsed (also
+    through folders not made yet), so two spellings of one file compare equal."""
+    return Path(os.path.realpath(Path(path).expanduser().absolute()))
+
+
+def _check_distinct(outputs: Sequence[tuple[Path, str]], reads: Sequence[tuple[Path, str]]) -> None:
+    """Refuse an output that is one of the run's inputs, or two outputs that are one file."""
+    seen: dict[Path, str] = {}
+    for path, flag in outputs:
+        real = resolved(path)
+        for read, read_flag in reads:
+            if resolved(read) == real:
+                raise UserError(
+                    f"{flag} {path} is {read_flag} {read}, which this run reads: choose another path for the output"
+                )
+        if real in seen:
+            raise UserError(f"{flag} {path} and {seen[real]} name the same file: give each output its own path")
+        seen[real] = f"{flag} {path}"
+
+
 def _exists(path: Path, ignore: Sequence[str]) -> bool:
     """Whether an output is already there: a file, or a folder holding anything but ``ignore``."""
     if path.is_dir():
@@ -164,6 +185,7 @@ def claim_output(
     folder: bool = False,
     also: Sequence[tuple[Path, str]] = (),
     temporaries: Sequence[str] = (),
+    reads: Sequence[tuple[Path, str]] = (),
 ) -> Iterator[Path]:
     """Claim an output for one run by :mod:`the output rule <davis_ag.formats.outputs>`.
 
@@ -176,16 +198,20 @@ def claim_output(
             temporaries cleaned (e.g. evaluate's chart).
         temporaries: Glob patterns, relative to a folder output, of what a killed run leaves
             (hidden working folders and files); removed under the lock.
+        reads: The run's input files, ``(path, flag)``: no output may be one of them, however
+            spelt (``..``, links), even with ``force``.
 
     Yields:
         The absolute path, locked for the run.
 
     Raises:
-        UserError: for a path inside a dataset, an unwritable path, an existing output without
-            ``force``, or another run holding the output.
+        UserError: for a path inside a dataset, an unwritable path, an output that is an input
+            or another output, an existing output without ``force``, or another run holding the
+            output.
     """
     target = Path(path).expanduser().absolute()
     files = [(target, flag), *[(Path(p).expanduser().absolute(), f) for p, f in also]]
+    _check_distinct(files, reads)
     for each, each_flag in files:
         check_outside_datasets(each, each_flag)
         if folder and each == target:

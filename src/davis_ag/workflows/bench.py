@@ -28,7 +28,6 @@ With ``--doc docs/performance.md`` the tables are written into that file between
 from __future__ import annotations
 
 import dataclasses
-import json
 import os
 import platform
 import statistics
@@ -40,6 +39,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from davis_ag.atomic_files import write_json_atomic
 from davis_ag.benchmark.cache import OBS_SIZE
 from davis_ag.errors import UserError
 from davis_ag.formats.layout import view_name, view_stem
@@ -340,7 +340,7 @@ def run_only(what: str, out: Path, doc: Path | None, devices: tuple[str, ...] = 
     load = (start, os.getloadavg()[0])
     print(table_of(result, load))
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps({key: result}, indent=1) + "\n")
+    write_json_atomic(out, {key: result})
     write(result, load, doc)
     return result
 
@@ -387,5 +387,5 @@ def run(out: Path, crops: list[str], repeats: int, antialiasing: str = "fxaa") -
         "end": [round(x, 2) for x in os.getloadavg()],
     }
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(report, indent=1) + "\n")
+    write_json_atomic(out, report)
     return report

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from davis_ag.atomic_files import write_json_atomic, write_text_atomic
+from davis_ag.atomic_files import read_page, write_json_atomic, write_text_atomic
 from davis_ag.scene.specs import CROPS, PHENOTYPE_SPREAD, SEEABLE_FRUIT_PIXELS
 
 #: The measurements' folder below the docs folder.
@@ -244,7 +244,7 @@ def render_markdown(docs: Path) -> str:
 def page_holding(docs: Path, name: str) -> Path | None:
     """The docs page (other than scenes.md) that holds the table ``name`` between its markers."""
     for page in sorted(docs.glob("*.md")):
-        if page.name != "scenes.md" and f"<!-- scene-stats:{name} -->" in page.read_text():
+        if page.name != "scenes.md" and f"<!-- scene-stats:{name} -->" in read_page(page, "--docs"):
             return page
     return None
 
@@ -253,7 +253,7 @@ def update_docs_pages(docs: Path, blocks: dict[str, list[str]]) -> None:
     """Replace the ``<!-- scene-stats:NAME -->`` blocks of the docs pages that hold them
     (docs/dataset-format.md: views; docs/plants.md: plants, findings) with the measured tables."""
     for page in sorted(docs.glob("*.md")):
-        text = original = page.read_text()
+        text = original = read_page(page, "--docs")
         for name, lines in blocks.items():
             begin, end = f"<!-- scene-stats:{name} -->", f"<!-- /scene-stats:{name} -->"
             if lines and begin in text and end in text:
