@@ -59,7 +59,7 @@ def _brute_force(next_view: np.ndarray, oer: np.ndarray, start: int, tau: int) -
     return best, fewest
 
 
-@pytest.mark.parametrize("scenario, tau", [("sp", 3), ("mp", 5)])  # section V-C
+@pytest.mark.parametrize("scenario, tau", [("sp", 3), ("mp", 5)])  # section V-D
 def test_oracle_plan_is_exact(scenario: str, tau: int, sp_root: Path, mp_root: Path) -> None:
     env = TVMEnv(sp_root if scenario == "sp" else mp_root, scenario, "all")
     assert env.tau == tau

@@ -1,4 +1,4 @@
-"""The section V-C protocol, the Table 4 summary, its files, and the train/evaluate commands."""
+"""The section V-D protocol, the Table 4 summary, its files, and the train/evaluate commands."""
 
 from __future__ import annotations
 

@@ -87,7 +87,7 @@ def test_pairs_rule_draws_every_eligible_start_equally(sp_root: Path) -> None:
     p_pairs, p_scene = env.start_probabilities(), old.start_probabilities()
     assert p_pairs == pytest.approx(np.full(len(env.starts), 1 / len(env.starts)))
     assert p_scene.sum() == pytest.approx(1.0) and not np.allclose(p_pairs, p_scene)
-    # Every eligible start meets section V-C's condition.
+    # Every eligible start meets section V-D's condition.
     for scene, box in env.starts:
         assert env.caches[scene].box_oer[box] < 0.4
     for rule_env, probs in ((env, p_pairs), (old, p_scene)):

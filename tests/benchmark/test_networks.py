@@ -1,4 +1,4 @@
-"""The A2C network is the paper's (section V-B): convolutions (kernel, stride) (8, 3), (4, 2),
+"""The A2C network is the paper's (section V-C): convolutions (kernel, stride) (8, 3), (4, 2),
 (3, 1), a 512-unit feature layer, and separate action and value heads."""
 
 from __future__ import annotations
@@ -11,10 +11,10 @@ from torch import nn
 
 from davis_ag.benchmark.networks import ARCHITECTURES, PaperCNN
 
-#: Section V-B of the paper.
+#: Section V-C of the paper.
 PAPER_KERNELS_STRIDES = [(8, 3), (4, 2), (3, 1)]
 PAPER_FEATURES = 512
-#: Section V-B: the input is 224x224 RGB plus the target box channel.
+#: Section V-C: the input is 224x224 RGB plus the target box channel.
 OBSERVATION = gym.spaces.Box(0, 255, (224, 224, 4), dtype=np.uint8)
 
 

@@ -216,7 +216,7 @@ def test_the_record_keeps_the_settings_and_a_learning_curve_across_sittings(
     assert steps == sorted(set(steps)) and steps[-1] == 240
     assert curve[: len(first)] == first and len(curve) > len(first)  # the first sitting's points kept
     # tau = 3 steps at most, so 240 steps end about 80 episodes or more (those in flight at a
-    # kill are lost); each point's reward is section IV-C's, within [0, 1].
+    # kill are lost); each point's reward is section V-C's, within [0, 1].
     assert sum(p["episodes"] for p in curve) >= 240 // 3 - 2
     assert all(0 <= p["reward"] <= 1 and 1 <= p["length"] <= 3 for p in curve)
     model = A2C.load(out, device="cpu")

@@ -1,4 +1,4 @@
-"""The TVM environment: API conformance, determinism, rules of section V-C, reward, speed."""
+"""The TVM environment: API conformance, determinism, rules of section V-D, reward, speed."""
 
 from __future__ import annotations
 

@@ -304,6 +304,10 @@ def test_a_resumed_run_adds_no_scene_drawn_otherwise(
     line = refused(capsys, "--out", str(root), "--scenes", "2", "--size", "96x54", *asked)
     assert said in line and str(root / "Single-Strawberry" / "000") in line
     assert snapshot(root / "Single-Strawberry") == before  # nothing added beside it
+    # A run that asks only for other scenes (--first) is held to the finished ones too.
+    line = refused(capsys, "--out", str(root), "--first", "1", "--scenes", "1", "--size", "96x54", *asked)
+    assert said in line
+    assert snapshot(root / "Single-Strawberry") == before
 
 
 def test_mock_pyhelios_is_a_clear_error(monkeypatch: pytest.MonkeyPatch) -> None:

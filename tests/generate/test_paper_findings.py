@@ -1,10 +1,10 @@
-"""The paper's findings on a generated single-plant strawberry scene (sections IV and V-C).
+"""The paper's findings on a generated single-plant strawberry scene (sections IV and V-D).
 
 One real scene: real Helios plants, the paper's grid thinned to every 0.5 m (90 of its 285
 views, every altitude kept), drawn at the paper's 1280x720.
 Section IV (Fig. 2) shows one strawberry plant with 24 fruit whose visible-fruit count ranges
 from fewer than 5 to 16 or more across positions, no view seeing all 24; Fig. 3 shows that
-changing altitude at a fixed position both loses and gains fruit. Section V-C: the OER of SP
+changing altitude at a fixed position both loses and gains fruit. Section V-D: the OER of SP
 strawberry boxes is right-skewed, 4 % of them below 0.4 (davis-ag scene-stats measures this
 over several scenes; docs/scenes.md has the result).
 
@@ -102,7 +102,7 @@ def test_changing_altitude_both_loses_and_gains_fruit(scene: dict) -> None:
 def test_oer_is_right_skewed(scene: dict) -> None:
     oer = scene["oer"]
     assert len(oer) > 150  # enough published boxes for a share of a few per cent to mean something
-    # Section V-C: right-skewed as the paper uses it: the mass at high OER with a tail towards 0,
+    # Section V-D: right-skewed as the paper uses it: the mass at high OER with a tail towards 0,
     # i.e. a negative third standardised moment (median against mean, the proxy used before,
     # differs by less than 0.01 on these distributions and so decides nothing: docs/scenes.md).
     centred = oer - oer.mean()
@@ -116,6 +116,6 @@ def test_oer_is_right_skewed(scene: dict) -> None:
     "docs/scenes.md. Strict: when the plants meet the paper, this test says so.",
 )
 def test_few_boxes_below_0_4_as_in_the_paper(scene: dict) -> None:
-    # Section V-C: 4 % below 0.4. One scene varies more than several (davis-ag scene-stats
+    # Section V-D: 4 % below 0.4. One scene varies more than several (davis-ag scene-stats
     # measures those, 2-8 % asked): 1-8 % here.
     assert 0.01 <= (scene["oer"] < 0.4).mean() <= 0.08

@@ -96,7 +96,7 @@ def test_the_observation_is_the_view_and_the_targets_box(env: TVMContinuousEnv) 
     box[y0 : y0 + h, x0 : x0 + w] = True
     assert np.array_equal(obs[..., 3] == 255, box) and set(np.unique(obs[..., 3])) == {0, 255}
     assert np.array_equal(obs[..., :3], env._labels.colour)
-    assert info["oer_0"] < 0.4  # section V-C's start condition
+    assert info["oer_0"] < 0.4  # section V-D's start condition
     assert info["oer_0"] == pytest.approx((env._labels.segmentation[box] == env.target).sum() / box.sum())
 
 
@@ -159,7 +159,7 @@ def test_moves_out_of_the_grid_or_through_the_plant_are_refused(free_env: TVMCon
     # Out of the grid's 1 m depth.
     _, _, _, _, info = free_env.step(np.array([0.0, 1.0, 0.0, 0.0, 0.0], dtype=np.float32))
     assert info["refused"] == "bounds" and info["path"][-1] == start
-    # Turning away from the plant loses the target: refused as section V-C refuses such moves.
+    # Turning away from the plant loses the target: refused as section V-D refuses such moves.
     _, _, _, _, info = free_env.step(np.array([0.0, 0.0, 0.0, 1.0, 0.0], dtype=np.float32))
     assert info["refused"] == "target lost" and info["path"][-1] == start
 

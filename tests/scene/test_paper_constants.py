@@ -1,6 +1,6 @@
 """The paper's numbers, written here as the paper prints them (never read back from our code):
 Table 1 (plants, altitudes), Table 2 (grids, actions), section III-B (slip), section III-C
-(box thresholds and invalid moves) and section V-C (tau)."""
+(box thresholds and invalid moves) and section V-D (tau)."""
 
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 #!/bin/sh
 # Remake every picture in this folder and docs/images/viewer.png from a small generated dataset.
-# Run from the repository root: sh docs/images/figures/make.sh [WORK_DIR] (it generates 192 views first)
+# Run from the repository root: sh docs/images/figures/make.sh [WORK_DIR] (it generates 180 views first)
 set -eu
 HERE=docs/images/figures
 WORK=${1:-out/figure-examples}

@@ -5,7 +5,7 @@ Importing this package registers the environment::
     import gymnasium, davis_ag.benchmark
     env = gymnasium.make("davis_ag/TVM-v0", dataset="data/", scenario="sp", split="train")
 
-To score policies of your own beside the baselines (section V-C's protocol, any environment)::
+To score policies of your own beside the baselines (section V-D's protocol, any environment)::
 
     results = davis_ag.benchmark.evaluate([my_policy], dataset="data/", scenario="sp")
 

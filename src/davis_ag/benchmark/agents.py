@@ -1,4 +1,4 @@
-"""The grid benchmark's baselines: the paper's heuristics (section IV-B), every fixed action, and
+"""The grid benchmark's baselines: the paper's heuristics (section V-B), every fixed action, and
 an exact Oracle upper bound. Trained models are :class:`davis_ag.benchmark.policies.ModelPolicy`.
 
 Every baseline is a :class:`davis_ag.benchmark.policies.Policy`: ``reset(seed)`` at the start of
@@ -21,7 +21,7 @@ from davis_ag.environments import TVM_ID
 from davis_ag.benchmark.exact import action_probabilities
 from davis_ag.errors import UserError
 
-#: Section IV-B action sets by agent name. Rand uses every action of the environment, which in
+#: Section V-B action sets by agent name. Rand uses every action of the environment, which in
 #: MP includes rotate_cw and rotate_ccw.
 HEURISTIC_ACTIONS: dict[str, tuple[str, ...] | None] = {
     "LRD": ("left", "right", "done"),

@@ -39,7 +39,7 @@ from davis_ag.errors import UserError
 from davis_ag.formats.layout import ANNOTATIONS, CACHE_FOLDER, IMAGES
 from davis_ag.scene.specs import ALL_ACTIONS
 
-#: Side of the square observation image (section IV-C: 224x224).
+#: Side of the square observation image (section V-C: 224x224).
 OBS_SIZE = 224
 #: Bumped whenever the files' meaning changes, so that old caches are rebuilt.
 CACHE_VERSION = 2

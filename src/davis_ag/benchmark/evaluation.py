@@ -1,4 +1,4 @@
-"""Benchmark any set of policies as in section V-C and Table 4, on TVM-v0 or TVMContinuous-v0.
+"""Benchmark any set of policies as in section V-D and Table 4, on TVM-v0 or TVMContinuous-v0.
 
 Protocol: the test split; ``sessions`` (3) sessions of ``episodes`` (200) episodes. Episode
 ``e`` of session ``s`` resets the environment with a seed drawn from
@@ -353,7 +353,7 @@ def evaluate(
     cache_dir: str | os.PathLike[str] | None = None,
     keep_episodes: bool = True,
 ) -> EvaluationResults:
-    """Score policies beside the baselines with section V-C's protocol (``davis_ag.benchmark.evaluate``).
+    """Score policies beside the baselines with section V-D's protocol (``davis_ag.benchmark.evaluate``).
 
     Args:
         policies: Each a :class:`davis_ag.benchmark.policies.Policy`, a callable

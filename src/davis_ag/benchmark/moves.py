@@ -1,4 +1,4 @@
-"""How often the environment refuses a move from an episode's start (section V-C's rule).
+"""How often the environment refuses a move from an episode's start (section V-D's rule).
 
 A move is refused, and the agent stays where it is, when it leads off the grid or too close to a
 plant (no pointer), or to a view where the target fruit has no box. Measured over every eligible

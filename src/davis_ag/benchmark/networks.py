@@ -1,6 +1,6 @@
-"""Feature extractors for the A2C agent: the paper's network (section V-B) and a fast one for tests.
+"""Feature extractors for the A2C agent: the paper's network (section V-C) and a fast one for tests.
 
-Section V-B: "three convolutional layers---(8, 3), (4, 2), and (3, 1), indicating (kernel size,
+Section V-C: "three convolutional layers---(8, 3), (4, 2), and (3, 1), indicating (kernel size,
 stride)---followed by a fully-connected layer to produce 512-dimensional feature vectors", with
 separate fully-connected action and value heads (SB3's ``CnnPolicy`` adds those). The paper gives
 no channel counts or activations; we take NatureCNN's (32, 64, 64 channels, ReLU), whose layout
@@ -16,16 +16,16 @@ import torch
 from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 from torch import nn
 
-#: (kernel, stride) of the paper's three convolutions, section V-B.
+#: (kernel, stride) of the paper's three convolutions, section V-C.
 PAPER_CONVOLUTIONS: tuple[tuple[int, int], ...] = ((8, 3), (4, 2), (3, 1))
-#: Size of the paper's feature vector, section V-B.
+#: Size of the paper's feature vector, section V-C.
 PAPER_FEATURES = 512
 #: Output channels of the three convolutions (not in the paper: NatureCNN's).
 CHANNELS: tuple[int, ...] = (32, 64, 64)
 
 
 class PaperCNN(BaseFeaturesExtractor):
-    """The network of section V-B: convolutions (8,3), (4,2), (3,1) with ReLU, then 512 features.
+    """The network of section V-C: convolutions (8,3), (4,2), (3,1) with ReLU, then 512 features.
 
     On the 224x224x4 observation the maps are 73x73, 35x35 and 33x33.
     """

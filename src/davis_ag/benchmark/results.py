@@ -23,7 +23,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError
 from davis_ag.errors import UserError
 from davis_ag.formats.scene_file import SceneFile
 
-#: Section V-C's protocol as this code implements it (see the module docstring).
+#: Section V-D's protocol as this code implements it (see the module docstring).
 PROTOCOL_VERSION = 1
 #: The ``format`` field of every results file.
 FORMAT = "davis-ag evaluation results"
@@ -136,7 +136,7 @@ class DatasetIdentity(_Model):
 
 
 class Protocol(_Model):
-    """Section V-C's protocol as run: environment, scenario, split, the split's scenes and
+    """Section V-D's protocol as run: environment, scenario, split, the split's scenes and
     eligible starts, sessions x episodes, the base seed (episode ``e`` of session ``s`` resets
     with ``SeedSequence([seed, s])``'s ``e``-th state, the policy with ``SeedSequence([seed, s, 1])``'s)."""
 

@@ -1,6 +1,6 @@
 """Which scenes an environment uses: scenario and crop filter, then the train/test split.
 
-Split (section V-C: 70 % of the data trains, 30 % tests): the dataset's ``splits.json``
+Split (section V-D: 70 % of the data trains, 30 % tests): the dataset's ``splits.json``
 (``Dataset.splits``) where it has one, its lists used as they are (scenes in neither list are
 only used by ``split="all"``); otherwise (e.g. the original download, which ships none) the
 generator's own rule, :mod:`davis_ag.formats.splits`, with the seed of the dataset's

@@ -1,5 +1,5 @@
 """Train an agent with Stable-Baselines3 on the train split, checkpointed and resumable: the paper's
-A2C (section IV-C), PPO or DQN (on the discrete moves), each with the paper's network as its
+A2C (section V-C), PPO or DQN (on the discrete moves), each with the paper's network as its
 features extractor, the same keep-best-train snapshot rule (:mod:`davis_ag.benchmark.selection`),
 checkpoints, training record and progress (a bar on a terminal, a line a minute in a log).
 
@@ -165,7 +165,7 @@ def train_agent(
         n_envs: Parallel environments per update.
         crop: Train on one crop only (the paper: strawberry for SP, vine for MP).
         cache_dir: Observation cache folder (default under the dataset root).
-        arch: ``paper`` (section V-B's network, default), ``nature`` (SB3's NatureCNN) or
+        arch: ``paper`` (section V-C's network, default), ``nature`` (SB3's NatureCNN) or
             ``pooled`` (fast, for smoke tests); see :mod:`davis_ag.benchmark.networks`.
         device: Torch device for SB3 (``auto``, ``cpu``, ``cuda``).
         verbose: SB3 verbosity.

@@ -1,25 +1,25 @@
-"""Target visibility maximisation (TVM, section IV-A) as a Gymnasium environment.
+"""Target visibility maximisation (TVM, section V-A) as a Gymnasium environment.
 
-An episode (section V-C):
+An episode (section V-D):
 
 - ``reset`` draws, from ``self.np_random`` only, a start: a (scene, view, target) of the split
   whose target fruit is boxed in that view with OER < 0.4 and has at least ``min_fruit_pixels``
   visible pixels (section III-C): scene.json's value where the scene has one (what its boxes
   were made with), else the crop's, scaled by image area relative to 1280x720. By default
-  (``start_rule="pairs"``) every such start is equally likely, section V-C's "a random
+  (``start_rule="pairs"``) every such start is equally likely, section V-D's "a random
   viewpoint showing a target fruit with an OER < .400"; ``start_rule="scene"`` (the rule
   before) draws a scene, then a view of it, then a target, each uniformly, so a scene with two
   eligible starts gets as many episodes as one with two hundred. The start list is built once;
   :meth:`TVMEnv.start_probabilities` gives each start's probability under the rule.
 - The observation is the view resized to 224x224 plus a fourth channel that is 255 inside the
-  target's box and 0 elsewhere (section IV-C uses 1; 255 keeps one uint8 image space, which
+  target's box and 0 elsewhere (section V-C uses 1; 255 keeps one uint8 image space, which
   Stable-Baselines3 scales by 1/255 anyway).
 - The box, and so the OER, is always the target's box as annotated in the *current* view (the
   instance id is stable across a scene's views).
 - Actions: the scenario's moves in :data:`davis_ag.scene.specs` order, then ``done``: SP forward,
   backward, left, right, up, down, done (7); MP adds rotate_cw, rotate_ccw before done (9).
 - A move that points to "" or to a view where the target has no box leaves the agent where it
-  is (section V-C); it still costs a step.
+  is (section V-D); it still costs a step.
 - Every action, ``done`` included, is a step; the episode ends after ``tau`` steps (3 SP, 5 MP)
   or on ``done``, so the episode length is the paper's "Ep. Length" (1 when ``done`` comes
   first). Both endings are ``terminated=True``: the reward is the final one and nothing
@@ -48,18 +48,18 @@ from davis_ag.benchmark.splits import scene_crop, select_scenes
 from davis_ag.errors import UserError
 from davis_ag.scene.specs import ALL_ACTIONS, crop_spec, scenario_spec
 
-#: Section V-C: an episode starts on a target with OER below this.
+#: Section V-D: an episode starts on a target with OER below this.
 MAX_START_OER = 0.4
 
 
 def can_start(oer: Any, max_start_oer: float = MAX_START_OER) -> Any:
-    """Section V-C's start rule: a fruit may be an episode's target when its OER is below the
+    """Section V-D's start rule: a fruit may be an episode's target when its OER is below the
     limit (a float, or an array of them); the grid and the continuous environments share it."""
     return oer < max_start_oer
 
 
 def episode_reward(oer_0: float, oer_end: float) -> float:
-    """Section IV-C's reward at an episode's end: ``max(OER_end - OER_0, 0) ** 2``."""
+    """Section V-C's reward at an episode's end: ``max(OER_end - OER_0, 0) ** 2``."""
     return float(max(oer_end - oer_0, 0.0) ** 2)
 
 
@@ -328,7 +328,7 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
 
     @staticmethod
     def reward(oer_0: float, oer_end: float) -> float:
-        """Section IV-C: ``max(OER_end - OER_0, 0) ** 2`` (:func:`episode_reward`)."""
+        """Section V-C: ``max(OER_end - OER_0, 0) ** 2`` (:func:`episode_reward`)."""
         return episode_reward(oer_0, oer_end)
 
     # ----------------------------------------------------------------------------- state

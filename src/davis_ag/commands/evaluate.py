@@ -1,4 +1,4 @@
-"""``davis-ag evaluate``: the section V-C benchmark (Table 4) on a dataset's test split, on the grid
+"""``davis-ag evaluate``: the section V-D benchmark (Table 4) on a dataset's test split, on the grid
 (TVM-v0) or with continuous camera poses (``--env continuous``, TVMContinuous-v0)."""
 
 from __future__ import annotations

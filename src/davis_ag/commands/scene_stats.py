@@ -1,5 +1,5 @@
 """``davis-ag scene-stats [views|plants|findings|refused]``: measure our scenes against the paper
-(Table 3's images per scene, fruit per plant, the Fig. 2-3 and section V-C findings, the moves
+(Table 3's images per scene, fruit per plant, the Fig. 2-3 and section V-D findings, the moves
 TVM-v0 refuses), keep each measurement under DOCS/data/ and rewrite DOCS/scenes.md and the marked
 tables of DOCS/dataset-format.md and DOCS/plants.md. Without a measurement it only rewrites them.
 Run from a clone: DOCS is its docs/ folder by default."""

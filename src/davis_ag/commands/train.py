@@ -55,7 +55,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--arch",
         choices=["paper", "nature", "pooled"],
         default="paper",
-        help="network: paper (section V-B, default), nature (SB3's NatureCNN) or pooled (fast smoke tests)",
+        help="network: paper (section V-C, default), nature (SB3's NatureCNN) or pooled (fast smoke tests)",
     )
     parser.add_argument(
         "--a2c-settings",

@@ -1,6 +1,6 @@
 """A labelled image pool in YOLO or COCO layout, and the paper's random train/test splits of it.
 
-Section VI-B draws three random splits of the real strawberry set, each 654 training and 159
+Section VI-A draws three random splits of the real strawberry set, each 654 training and 159
 test images. :func:`load_pool` reads any set a user points to:
 
 - YOLO: a data YAML (every image its ``train``/``val``/``test`` entries list, folders or .txt
@@ -22,7 +22,7 @@ import numpy as np
 from davis_ag.atomic_files import write_text_atomic
 from davis_ag.errors import UserError, yaml_problem
 
-#: Section VI-B's split sizes (Table 5).
+#: Section VI-A's split sizes (Table 5).
 PAPER_TRAIN, PAPER_TEST = 654, 159
 _IMAGE_SUFFIXES = {".jpg", ".jpeg", ".png", ".bmp", ".webp", ".tif", ".tiff"}
 

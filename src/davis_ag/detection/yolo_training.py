@@ -17,7 +17,7 @@ import torch
 
 from davis_ag.detection.offline import prepare_ultralytics
 
-#: The detector of section VI-B, built from its YAML.
+#: The detector of section VI-A, built from its YAML.
 MODEL_YAML = "yolov5n.yaml"
 
 

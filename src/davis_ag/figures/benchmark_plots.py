@@ -16,7 +16,7 @@ from davis_ag.figures.canvas import FORMATS, Plotted, new_figure, save_formats
 from davis_ag.figures.scene_numbers import box_oers
 from davis_ag.scene.specs import MP_ACTIONS, SP_ACTIONS
 
-#: Section V-C: episodes start on a target below this OER.
+#: Section V-D: episodes start on a target below this OER.
 START_OER = 0.4
 #: Fig. 4b's bins: twenty of 0.05 over [0, 1].
 OER_BINS = np.linspace(0.0, 1.0, 21)

@@ -17,7 +17,7 @@ from davis_ag.errors import UserError
 from davis_ag.figures.scene_numbers import box_oers, visible_fractions
 from davis_ag.scene.specs import CROPS, PAPER_TABLE3, SCENARIOS, parse_group_name
 
-#: Where the OER distribution is summarised (section V-C starts episodes below 0.4).
+#: Where the OER distribution is summarised (section V-D starts episodes below 0.4).
 OER_EDGES = np.linspace(0.0, 1.0, 11)
 
 

@@ -335,7 +335,7 @@ class DatasetFile(_Model):
 
 
 class SplitsFile(_Model):
-    """``splits.json``: the train/test split by scene (section V-C); ``seed`` where we drew it."""
+    """``splits.json``: the train/test split by scene (section V-D); ``seed`` where we drew it."""
 
     model_config = ConfigDict(extra="ignore", frozen=True)
     seed: Seed | None = None

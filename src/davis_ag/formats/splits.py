@@ -1,4 +1,4 @@
-"""The one train/test split rule (section V-C: 70 % of each group's scenes train, 30 % test).
+"""The one train/test split rule (section V-D: 70 % of each group's scenes train, 30 % test).
 
 The generator writes it into ``splits.json``; a dataset without one (the original download) is
 split by the same rule with the dataset seed of its ``dataset.json``, else 0, so the benchmark,
@@ -20,7 +20,7 @@ from davis_ag.formats.layout import DATASET_FILE
 from davis_ag.scene.specs import CROPS, SCENARIOS, parse_group_name
 from davis_ag.seeds import SPLIT_STREAM, stream_rng
 
-#: Share of each group's scenes in the training split (section V-C).
+#: Share of each group's scenes in the training split (section V-D).
 TRAIN_FRACTION = 0.7
 
 

@@ -3,7 +3,7 @@
 - ``dataset.json`` records what every scene of the folder shares (dataset seed, image size,
   field of view, each group's viewpoint grid); a run checks it before touching anything, so one
   folder never mixes scenes made with different settings.
-- ``splits.json`` is the 70/30 train/test split by scene of section V-C,
+- ``splits.json`` is the 70/30 train/test split by scene of section V-D,
   ``{"seed": int, "train": [scene ids], "test": [scene ids]}``, drawn by
   :mod:`davis_ag.formats.splits` from the dataset seed; it depends only on the seed and the scenes
   on disk, so a resumed run writes the same one.

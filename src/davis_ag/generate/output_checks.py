@@ -83,6 +83,27 @@ def check_scene_slot(root: Path, request: SceneRequest) -> bool:
     return True
 
 
+def check_drawn_like_the_rest(root: Path, request: SceneRequest, finished: list[str]) -> None:
+    """Refuse a run that would add a scene drawn otherwise than the folder's finished ones.
+
+    One finished scene stands for all: every run checks its scenes against them, so a folder's
+    scenes agree (reading every scene.json of a large dataset would take minutes).
+
+    Args:
+        root: The dataset folder.
+        request: A scene this run will make.
+        finished: Ids of the folder's finished scenes.
+
+    Raises:
+        UserError: as :func:`check_scene_slot`.
+    """
+    for scene_id in finished:
+        record = read_scene_record(root / scene_id)
+        if record is not None:
+            _check_drawn_alike(root / scene_id, record, request)
+            return
+
+
 def _check_drawn_alike(scene_dir: Path, record: SceneFile, request: SceneRequest) -> None:
     """What dataset.json does not hold but each scene.json does: a resumed run must not add scenes
     drawn otherwise beside the finished ones (a depth-less scene among scenes with depth stops

@@ -34,12 +34,13 @@ from davis_ag.formats.outputs import OutputLock
 from davis_ag.generate.dataset_files import (
     DATASET_FILE,
     SPLITS_FILE,
+    complete_scenes,
     dataset_settings,
     reconcile_settings,
     write_splits,
 )
 from davis_ag.generate.one_scene import SceneRequest, generate_scene
-from davis_ag.generate.output_checks import check_output_root, check_scene_slot
+from davis_ag.generate.output_checks import check_drawn_like_the_rest, check_output_root, check_scene_slot
 from davis_ag.generate.run_progress import (  # noqa: F401
     DEFAULT_MAX_RETRIES,
     Progress,
@@ -115,6 +116,8 @@ def run_dataset(requests: Sequence[SceneRequest], root: Path, options: RunOption
                 report.skipped.append(request.folder)
             else:
                 todo.append(request)
+        if todo:  # scenes outside this run's list (--first, --only, another group) count too
+            check_drawn_like_the_rest(root, todo[0], complete_scenes(root))
         write_json_atomic(root / DATASET_FILE, settings)
         progress = Progress(todo, options.progress)
         if report.skipped:

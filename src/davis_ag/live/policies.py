@@ -2,7 +2,7 @@
 look-ahead. Trained models are :class:`davis_ag.benchmark.policies.ModelPolicy`, and every policy
 is scored by :func:`davis_ag.benchmark.evaluation.evaluate_policies`, as on the grid.
 
-Section IV-B's heuristics draw random grid moves from a set (LRD: left/right/done, UDD:
+Section V-B's heuristics draw random grid moves from a set (LRD: left/right/done, UDD:
 up/down/done, Rand: all). In continuous space "left or right" becomes a random sideways move of
 random length, "up or down" a random climb, and Rand a uniform action; ``done`` has no
 counterpart (a zero action stands still). Greedy has no grid counterpart: at each step it tries

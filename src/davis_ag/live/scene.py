@@ -40,7 +40,7 @@ class LiveView:
         segmentation: (height, width) uint8, fruit id per pixel for boxed fruit, 255 elsewhere.
         boxes: ``[xmin, ymin, width, height, fruit_id, 0]`` per fruit above the threshold.
         visible_pixels: Visible pixels of each boxed fruit.
-        oer: Object exposure rate (eq. 1, section IV-A) of each boxed fruit.
+        oer: Object exposure rate (eq. 1, section V-A) of each boxed fruit.
         visible_fraction: Visible over unoccluded pixels of each boxed fruit (None when not asked).
         depth: (height, width) float32, metres along the optical axis, 0 where nothing is hit (None
             when not asked).

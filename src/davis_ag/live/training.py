@@ -4,7 +4,7 @@ PPO, not A2C: the action is continuous, and PPO is SB3's on-policy method for it
 well on short runs; SAC (off-policy, replay buffer) would keep every 224x224x4 observation in
 memory. Hyperparameters are SB3's PPO defaults except ``n_steps`` and ``batch_size``, shortened
 so that an update comes every few dozen episodes (tau is 3 or 5 steps). The network is the
-paper's (section V-B) or the pooled one for quick runs (:mod:`davis_ag.benchmark.networks`).
+paper's (section V-C) or the pooled one for quick runs (:mod:`davis_ag.benchmark.networks`).
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Target visibility maximisation with a continuous camera pose (``davis_ag/TVMContinuous-v0``).
 
-The task is TVM-v0's (section IV-A): start on a view of a target fruit with OER < 0.4, move for
+The task is TVM-v0's (section V-A): start on a view of a target fruit with OER < 0.4, move for
 ``tau`` steps (3 SP, 5 MP), and earn ``max(OER_tau - OER_0, 0) ** 2`` at the end. What changes
 is the camera: instead of stepping between the dataset's grid views, the agent moves anywhere,
 and every observation is drawn live from the regrown scene (:mod:`davis_ag.live.scene`).
@@ -17,10 +17,10 @@ so it needs a scene of ours (one with a scene.json to regrow from) and an OpenGL
   always looks at the plant, as the SP grid's views do.
 - Slip (section III-B): a move with a horizontal part lands off by Gaussian noise of 2.5 cm on x
   and y; turning and climbing in place do not slip. Slip draws from ``self.np_random`` only.
-- Refused moves (the agent stays, the step still counts), as section V-C refuses grid moves: the
+- Refused moves (the agent stays, the step still counts), as section V-D refuses grid moves: the
   new position leaves the scenario's grid area or altitude range; the straight path comes within
   the crop's exclusion distance of a stem (section III-C: 0.75 m strawberry, 1 m others), the
-  collision rule; or the target has no box from the new pose (section V-C).
+  collision rule; or the target has no box from the new pose (section V-D).
 - Observation: ``(224, 224, 4)`` uint8, drawn directly at that size by a square camera with the
   scene's vertical field of view (the dataset's 16:9 frames cover a wider horizontal angle), plus
   the target's box as a fourth channel, 255 inside and 0 elsewhere (TVM-v0's convention).

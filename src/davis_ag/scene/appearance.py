@@ -1,6 +1,6 @@
 """A scene's appearance: the paper's (one kind of sky, soil and exposure) or randomised per scene.
 
-For sim-to-real work (section VI-B of the paper) synthetic images usually need varied light and
+For sim-to-real work (section VI-A of the paper) synthetic images usually need varied light and
 surfaces. ``random`` draws, per scene and from the scene's seed alone (a stream of its own, so
 the plants, the grid and the paper's sun draws are the same as under ``paper``):
 

@@ -100,7 +100,7 @@ class CropSpec:
         return max(1, round(self.min_fruit_pixels * width * height / PAPER_PIXELS))
 
 
-# Why the grids differ by crop. Table 2 gives 3 x 3 m (SP) and 7 x 3 m (MP) grids, but Table 3's
+# Why the grids differ by crop. Section III-B gives 3 x 3 m (SP) and 7 x 3 m (MP) grids, but Table 3's
 # images per scene are exact (SP strawberry 285, tomato and vine 348; MP strawberry 1,128, tomato
 # and vine 1,800). On the staggered lattice of view_grid, tomato and vine fit 3 x 3 m (13 x 13
 # positions, 116 kept x 3 altitudes) and 7 x 3 m with three plants 2 m apart (15 x 7, 75 kept x 24
@@ -234,7 +234,7 @@ class ScenarioSpec:
         altitude_levels: Which of the crop's three altitudes are used (indices, low to high).
         headings: Camera headings per position (1 means: always aimed at the plant).
         actions: The pointer keys every view carries.
-        tau: Steps per episode in the benchmark (section V-C).
+        tau: Steps per episode in the benchmark (section V-D).
     """
 
     name: str
@@ -303,7 +303,7 @@ def scenario_spec(name: str, crop: CropSpec | None = None) -> ScenarioSpec:
     Args:
         name: The scenario's name.
         crop: When given, the grid is that crop's (``sp_extent`` / ``mp_extent``), which gives
-            Table 3's images per scene; without it, Table 2's nominal 3 x 3 m / 7 x 3 m.
+            Table 3's images per scene; without it, section III-B's nominal 3 x 3 m / 7 x 3 m.
 
     Returns:
         Its :class:`ScenarioSpec`.

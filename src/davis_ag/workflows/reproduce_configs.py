@@ -21,7 +21,7 @@ class ReproduceConfig:
         name: ``small``, ``medium`` or ``paper-scale``.
         size: Image width and height.
         sp_scenes, mp_scenes: SP strawberry and MP vine scenes.
-        mp_extent: MP grid extent (x, y) in metres; ``None`` keeps Table 2's 7 x 3 m.
+        mp_extent: MP grid extent (x, y) in metres; ``None`` keeps section III-B's 7 x 3 m.
         sp_timesteps, mp_timesteps: Environment steps per scenario of each learner.
         n_envs: Parallel environments of each learner.
         episodes, sessions: Evaluation protocol (200 x 3 in the paper).
@@ -63,7 +63,7 @@ class ReproduceConfig:
 
 #: ``small``: under an hour of stages on a 2-core CPU machine without GPU;
 #: a 3 x 2 m MP grid and 10 % / 5 % of the paper's A2C steps: not comparable with Table 4.
-#: ``medium``: the paper's grids (SP strawberry's 2.5 x 2.5 m, Table 2's 7 x 3 m MP) and protocol (300K A2C steps,
+#: ``medium``: the paper's grids (SP strawberry's 2.5 x 2.5 m, section III-B's 7 x 3 m MP) and protocol (300K A2C steps,
 #: 3 sessions of 200 episodes) on 10 SP strawberry and 10 MP vine scenes at 640x360 (the policy
 #: sees 224x224 either way; the 70/30 split leaves 3 test scenes of each), a few hours on such a
 #: machine, resumable across sittings.

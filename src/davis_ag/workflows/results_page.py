@@ -112,7 +112,7 @@ def _notes(config: Any, state: dict[str, Any], out: Path | None) -> list[str]:
         )
         count = f" ({protocol['starts']} eligible starts)" if "starts" in protocol else ""
         notes.append(
-            f"{scenario.upper()} episode starts{count}: {how}. Eligible (section V-C): a boxed target "
+            f"{scenario.upper()} episode starts{count}: {how}. Eligible (section V-D): a boxed target "
             "with OER < 0.4 and at least the crop's pixel threshold; reward max(OER_end - OER_0, 0)^2 "
             "at the end."
         )
@@ -168,7 +168,7 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
     mp_grid = (
         f"{config.mp_extent[0]:g} x {config.mp_extent[1]:g} m around the middle vine"
         if config.mp_extent
-        else f"Table 2's 7 x 3 m, {mp_views} views each"
+        else f"section III-B's 7 x 3 m, {mp_views} views each"
     )
     lines = [
         "# Table 4 reproduction",
@@ -181,7 +181,7 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
         f"{sp_extent} m grid, {sp_views} views each, as Table 3 counts them) and {config.mp_scenes} MP vine scene(s) (grid {mp_grid}, 0.5 m "
         f"step, 12 headings, 2 altitudes) at {config.size[0]}x{config.size[1]}, dataset seed "
         f"{config.seed}; box thresholds scaled by image area; A2C (Stable-Baselines3, the paper's "
-        f"network of section V-B, {config.n_envs} environments; its settings under each scenario) for {config.sp_timesteps:,} (SP) and "
+        f"network of section V-C, {config.n_envs} environments; its settings under each scenario) for {config.sp_timesteps:,} (SP) and "
         f"{config.mp_timesteps:,} (MP) environment steps"
         + (
             "; PPO beside it (RL Baselines3 Zoo's Atari settings, the same network, steps, seed, train split and keep-best-train rule)"

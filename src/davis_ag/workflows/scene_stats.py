@@ -1,5 +1,5 @@
 """``davis-ag scene-stats``: measure our scenes against the paper (Table 3's images per scene, fruit
-per plant, the Fig. 2-3 and section V-C findings, the moves TVM-v0 refuses), each measurement saved
+per plant, the Fig. 2-3 and section V-D findings, the moves TVM-v0 refuses), each measurement saved
 to its own JSON file under ``docs/data/`` so that a slow one is not redone when another is refreshed.
 
 - ``views``: images per scene for every crop and scenario, beside Table 3's (instant).
@@ -7,7 +7,7 @@ to its own JSON file under ``docs/data/`` so that a slow one is not redone when 
   single plants per crop, grown as ``davis-ag generate`` grows them (scene seeds of dataset seed 0,
   indices 0..N-1).
 - ``findings --count N --size WxH [--step 0.5]``: N single-plant strawberry scenes generated at
-  WxH (dataset seed 0), and the paper's section IV and V-C findings measured on them: visible
+  WxH (dataset seed 0), and the paper's section IV and V-D findings measured on them: visible
   fruit per position (fruit that Helios's Synthetic Annotation plug-in would box:
   ``specs.SEEABLE_FRUIT_PIXELS``), whether any view sees every fruit, how often changing altitude
   at a fixed position loses or gains fruit (Fig. 3), and the share of the published boxes (the

@@ -130,7 +130,7 @@ def findings_table(docs: Path) -> list[str]:
 
 
 def findings_lines(data: dict) -> list[str]:
-    """Markdown: the section IV and V-C findings measured on generated strawberry scenes of one size."""
+    """Markdown: the section IV and V-D findings measured on generated strawberry scenes of one size."""
     scenes = data["scenes"]
     oer = np.concatenate([s["box_oer"] for s in scenes])
     lines = [
@@ -141,7 +141,7 @@ def findings_lines(data: dict) -> list[str]:
         "pixels (both scaled with the image area); "
         f"{data['machine']}. Section IV: one plant with 24 fruit; visible fruit from fewer than 5 "
         "to 16 or more across positions; no view sees all 24; Fig. 3: changing altitude at a "
-        "position both loses and gains fruit. Section V-C: 4 % of boxes have OER < 0.4.",
+        "position both loses and gains fruit. Section V-D: 4 % of boxes have OER < 0.4.",
         "",
         "| scene | fruit | visible per view: min / median / max | views < 5 | views >= 16 | "
         "views seeing all | going up loses / gains fruit (of pairs) | boxes | OER < 0.4 |",

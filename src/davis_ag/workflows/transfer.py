@@ -1,4 +1,4 @@
-"""Section VI-B, Table 5: does pre-training on DAVIS-Ag help a detector on real images?
+"""Section VI-A, Table 5: does pre-training on DAVIS-Ag help a detector on real images?
 
 Stages (each resumable: a finished training run's ``done.json`` and a split's scores are kept):
 
@@ -101,7 +101,7 @@ def run_transfer(config: TransferConfig, say: Callable[[str], None] = print) -> 
             out / "pretrain-data" / "data.yaml", out / "runs" / "pretrain", config.pretrain_budget, config.seed
         )
     results: dict[str, Any] = {
-        "what": "Table 5 (section VI-B): YOLOv5n, Real-Only vs DAVIS-Ag -> Real",
+        "what": "Table 5 (section VI-A): YOLOv5n, Real-Only vs DAVIS-Ag -> Real",
         "real_set": config.real_label,
         "config": _jsonable(config),
         "pretrain_images": counts,
@@ -178,7 +178,7 @@ def write_results_md(results: dict[str, Any], path: Path, how: str = "") -> Path
     pre, bud = cfg["pretrain_budget"], cfg["budget"]
     wall = results["wall_s"]
     lines = [
-        "# Sim-to-real transfer (Table 5, section VI-B)",
+        "# Sim-to-real transfer (Table 5, section VI-A)",
         "",
         "Written by `davis-ag transfer --results`; every number below was measured by that run.",
         "",
