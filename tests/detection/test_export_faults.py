@@ -150,3 +150,31 @@ def test_a_full_disk_leaves_no_half_image_under_its_name(
     for image in (out / "images").rglob("*"):
         assert image.is_dir() or Image.open(image).load() is not None  # none half-written
     assert not list(out.rglob(".*.tmp"))
+
+
+def test_an_export_is_never_two_exports_mixed(
+    pristine: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--force refreshed a finished export in place, so the images of another dataset (or split)
+    stayed beside the new ones, and a stopped export was carried on by any export into the
+    folder: one scene id could land in train and in test."""
+    other = write_tiny_dataset(tmp_path / "other", "sp", "strawberry", scenes=3, size=(64, 48), seed=5)
+    out = tmp_path / "yolo"
+    assert export(capsys, "yolo", str(other), str(out))[0] == 0
+    three = sorted(p.name for p in out.rglob("*.jpeg"))
+    assert export(capsys, "yolo", str(pristine), str(out), "--force")[0] == 0
+    two = sorted(p.name for p in out.rglob("*.jpeg"))
+    assert len(two) < len(three)  # the other dataset's images are gone, not kept beside
+    fresh = tmp_path / "fresh"
+    assert export(capsys, "yolo", str(pristine), str(fresh))[0] == 0
+    assert two == sorted(p.name for p in fresh.rglob("*.jpeg"))
+    # A stopped export is carried on by the same export only.
+    from davis_ag.commands.export import export_settings
+
+    stopped = export_settings(cli.build_parser().parse_args(["export", "yolo", str(other), str(out)]))
+    (out / ".davis_ag-export-unfinished").write_text(json.dumps(stopped))  # as a killed run leaves it
+    code, _, err = export(capsys, "yolo", str(pristine), str(out))
+    assert code == 2 and "unfinished export of another dataset" in err and "--force" in err
+    assert export(capsys, "yolo", str(other), str(out), "--split", "test")[0] == 2
+    assert export(capsys, "yolo", str(pristine), str(out), "--force")[0] == 0
+    assert not (out / ".davis_ag-export-unfinished").exists()

@@ -9,6 +9,7 @@ from pathlib import Path
 
 from davis_ag.commands import arguments
 from davis_ag.errors import UserError
+from davis_ag.atomic_files import write_json_atomic
 from davis_ag.formats.outputs import LOCK_FILE, claim_output
 
 HELP = "write a dataset as COCO (RLE masks) or YOLO (ultralytics) detection data, or point clouds"
@@ -20,7 +21,7 @@ DESCRIPTION = (
     "the depth images, with colour, organ class and fruit id."
 )
 
-#: What an export folder may already hold (a previous export, which is refreshed in place).
+#: What an export folder may already hold (a previous export: carried on when unfinished, replaced with --force).
 _OURS = {"coco": {"annotations"}, "yolo": {"images", "labels", "data.yaml"}, "pointcloud": set()}
 #: Marks an export that has not finished: the same command carries on without --force.
 UNFINISHED = ".davis_ag-export-unfinished"
@@ -121,12 +122,66 @@ def run(args: argparse.Namespace) -> int:
     if args.format != "pointcloud":
         dataset_splits(dataset)
     check_out(args.out, args.format)
-    unfinished = (args.out / UNFINISHED).exists()  # a stopped export: the same command carries on
+    marker, wanted = args.out / UNFINISHED, export_settings(args)
+    unfinished = marker.exists()  # a stopped export: the same command carries on
+    if unfinished and not args.force:
+        check_same_export(marker, wanted)
     with claim_output(args.out, force=args.force or unfinished, folder=True, temporaries=LEFT_BY_A_KILL):
-        (args.out / UNFINISHED).touch()
+        if args.force:  # replaced, not refreshed: nothing of the old export stays beside the new one
+            clear_export(args.out)
+        write_json_atomic(marker, wanted)
         code = run_point_clouds(args) if args.format == "pointcloud" else _export(args)
-        (args.out / UNFINISHED).unlink()
+        marker.unlink()
     return code
+
+
+def export_settings(args: argparse.Namespace) -> dict[str, object]:
+    """What an export is of: the dataset (as the file system takes its path) and every option."""
+    from davis_ag.formats.outputs import resolved
+
+    chosen = {
+        key: value if isinstance(value, (bool, int, float, type(None))) else str(value)
+        for key, value in sorted(vars(args).items())
+        if key not in ("out", "force", "dir") and not callable(value)
+    }
+    return {"dir": str(resolved(args.dir)), **chosen}
+
+
+def check_same_export(marker: Path, wanted: dict[str, object]) -> None:
+    """Refuse to carry on a stopped export with another dataset or options: the two would mix.
+
+    Raises:
+        UserError: naming what differs and both ways on.
+    """
+    import json
+
+    try:
+        recorded = json.loads(marker.read_text())
+    except (OSError, ValueError):
+        recorded = None
+    if not isinstance(recorded, dict):  # an older run's empty marker: taken as this export's
+        return
+    differ = [k for k in ("dir", *sorted(set(recorded) | set(wanted))) if recorded.get(k) != wanted.get(k)]
+    if differ:
+        key = differ[0]
+        raise UserError(
+            f"{marker.parent} holds an unfinished export of another {'dataset' if key == 'dir' else key} "
+            f"({recorded.get(key)} against {wanted.get(key)}): run that export again to finish it, "
+            "or give --force to start this one over"
+        )
+
+
+def clear_export(out: Path) -> None:
+    """Remove a previous export's files (:func:`check_out` found nothing else there)."""
+    import shutil
+
+    for entry in out.iterdir():
+        if entry.name == LOCK_FILE:
+            continue
+        if entry.is_dir() and not entry.is_symlink():
+            shutil.rmtree(entry)
+        else:
+            entry.unlink()
 
 
 def _export(args: argparse.Namespace) -> int:
