@@ -75,9 +75,14 @@ def test_transfer_runs_end_to_end_offline(
     report = (tmp_path / "results.md").read_text()
     assert "stand-in" in report and "0.943" in report  # the paper's Table 5 sits beside ours, named
     assert results["paper_table5"] == PAPER_TABLE5
-    # A second run reuses every finished split.
-    assert main(argv) == 0
+    # A second run reuses every finished split (and replaces the report only with --force).
+    assert main(argv) == 2 and "--results" in capsys.readouterr().err
+    assert main([*argv, "--force"]) == 0
     assert json.loads((out / "transfer.json").read_text())["splits"] == results["splits"]
+    # A run of other settings would report the folder's scores as its own: refused.
+    assert main([*argv[:-2], "--seed", "1"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "holds a transfer run of other settings (seed: 0 against 1)" in err and "\n" not in err
 
 
 def test_transfer_with_a_missing_real_set_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:

@@ -63,6 +63,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="MD",
         help="also write a Markdown report (e.g. docs/transfer/results.md)",
     )
+    parser.add_argument("--force", action="store_true", help="replace an existing --results report")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -70,14 +71,13 @@ def run(args: argparse.Namespace) -> int:
     from davis_ag.detection.yolo_training import Budget
     from davis_ag.workflows.transfer import TransferConfig, run_transfer, table5_markdown, write_results_md
 
-    from davis_ag.formats.outputs import check_outside_datasets
+    from contextlib import nullcontext
+
+    from davis_ag.formats.outputs import check_outside_datasets, claim_output
 
     # Before any export or training: the work folder and the report never land in a dataset.
     check_outside_datasets(args.out)
     arguments.prove_writable_folder(args.out)
-    if args.results:
-        check_outside_datasets(args.results, "--results")
-        arguments.prove_writable_file(args.results, "--results")
     if args.imgsz < 32 or args.imgsz % 32:
         raise UserError(f"--imgsz must be a multiple of 32 (YOLO's stride), at least 32; got {args.imgsz}")
     budget = Budget(args.epochs, args.imgsz, args.batch, args.device, args.workers)
@@ -94,11 +94,17 @@ def run(args: argparse.Namespace) -> int:
         pretrain_budget=Budget(args.pretrain_epochs, args.imgsz, args.batch, args.device, args.workers),
         budget=budget,
     )
-    results = run_transfer(config)
-    print(table5_markdown(results))
-    print(f"wrote {args.out / 'transfer.json'} ({results['wall_s']['total']:.0f} s)")
-    if args.results:
-        from davis_ag.provenance import machine_description
+    report = (
+        claim_output(args.results, force=args.force, flag="--results", reads=[(args.real, "--real")])
+        if args.results
+        else nullcontext()
+    )
+    with report:  # the output rule, before hours of training
+        results = run_transfer(config)
+        print(table5_markdown(results))
+        print(f"wrote {args.out / 'transfer.json'} ({results['wall_s']['total']:.0f} s)")
+        if args.results:
+            from davis_ag.provenance import machine_description
 
-        print(f"wrote {write_results_md(results, args.results, machine_description())}")
+            print(f"wrote {write_results_md(results, args.results, machine_description())}")
     return 0

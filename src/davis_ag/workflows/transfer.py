@@ -1,6 +1,7 @@
 """Section VI-A, Table 5: does pre-training on DAVIS-Ag help a detector on real images?
 
-Stages (each resumable: a finished training run's ``done.json`` and a split's scores are kept):
+Stages (each resumable: a finished training run's ``done.json`` and a split's scores are kept;
+the work folder records the settings, ``transfer-config.json``, and refuses a run of others):
 
 1. export the DAVIS-Ag dataset to the ultralytics layout (its train split trains, its test split
    validates) and pre-train YOLOv5n on it (``pretrain`` budget);
@@ -72,6 +73,39 @@ def _jsonable(config: TransferConfig) -> dict[str, Any]:
     return {k: str(v) if isinstance(v, Path) else v for k, v in data.items()}
 
 
+#: The work folder's record of what its runs were made with.
+WORK_RECORD = "transfer-config.json"
+
+
+def check_work_folder(config: TransferConfig) -> None:
+    """Hold a work folder to one experiment: its finished runs and scores are reused, so a run of
+    other settings (another pre-training set, real set, budget or seed) would report them as its own.
+
+    Raises:
+        UserError: when the folder holds a run of other settings.
+    """
+    wanted = {k: v for k, v in _jsonable(config).items() if k not in ("out", "real_label")}
+    wanted["pretrain"], wanted["real"] = str(Path(config.pretrain).resolve()), str(Path(config.real).resolve())
+    record = config.out / WORK_RECORD
+    try:
+        made = json.loads(record.read_text()) if record.is_file() else None
+    except (OSError, ValueError):
+        made = None
+    if made is None:
+        if any((config.out / name).exists() for name in ("runs", "split1", "transfer.json")):
+            raise UserError(
+                f"{config.out} holds transfer runs of unrecorded settings: give another --out, or move it away"
+            )
+        write_json_atomic(record, wanted)
+        return
+    differ = [key for key in wanted if made.get(key) != wanted[key]]
+    if differ:
+        raise UserError(
+            f"{config.out} holds a transfer run of other settings ({differ[0]}: {made.get(differ[0])} against "
+            f"{wanted[differ[0]]}), whose runs and scores this one would reuse: give another --out, or move it away"
+        )
+
+
 def run_transfer(config: TransferConfig, say: Callable[[str], None] = print) -> dict[str, Any]:
     """Run the experiment (see the module docstring); returns what ``transfer.json`` holds.
 
@@ -90,6 +124,7 @@ def run_transfer(config: TransferConfig, say: Callable[[str], None] = print) -> 
             f"the real set has {len(pool.items)} images: splits of {n_train} train / {n_test} test "
             f"(the paper's {config.train_size}/{config.test_size} proportions)"
         )
+    check_work_folder(config)  # once the inputs are known to be usable
     with timer.stage("export DAVIS-Ag"):
         say(f"exporting {config.pretrain} for pre-training")
         counts = export_yolo(config.pretrain, out / "pretrain-data", "detect")
