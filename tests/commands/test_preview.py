@@ -29,5 +29,9 @@ def test_preview_draws_the_view_generate_writes_with_its_appearance_and_altitude
         assert np.array_equal(previewed, written)  # the same pixels, encoded alike
     plain = tmp_path / "plain"
     assert cli.main(["preview", "--views", "5", "--size", "96x54", "--out", str(plain)]) == 0
+    # The output rule: earlier pictures are replaced only with --force, never written into a dataset.
+    assert cli.main(["preview", "--views", "5", "--size", "96x54", "--out", str(plain)]) == 2
+    assert cli.main(["preview", "--views", "5", "--size", "96x54", "--out", str(plain), "--force"]) == 0
+    assert cli.main(["preview", "--views", "5", "--size", "96x54", "--out", str(scene_dir)]) == 2
     paper = np.asarray(Image.open(plain / "strawberry-sp-000-0005.jpeg")).astype(np.int64)
     assert np.abs(paper - np.asarray(Image.open(tmp_path / "p" / "strawberry-sp-000-0005.jpeg"))).mean() > 8

@@ -14,6 +14,7 @@ from PIL import Image, ImageDraw
 from davis_ag.atomic_files import atomic_output
 from davis_ag.commands import arguments
 from davis_ag.errors import UserError
+from davis_ag.formats.outputs import check_outside_datasets, claim_output
 from davis_ag.formats.layout import IMAGE_SUFFIX, JPEG_QUALITY, view_name, view_stem
 from davis_ag.generate.one_scene import SceneRequest, grow_scene
 from davis_ag.generate.run_progress import count_views
@@ -21,7 +22,14 @@ from davis_ag.labels.fruit_labels import fruit_lookup, label_view, visible_fract
 from davis_ag.render.backends import DEFAULT_RENDERER, open_renderer, resolve_look
 from davis_ag.scene.appearance import DEFAULT_APPEARANCE
 from davis_ag.scene.camera import Camera
-from davis_ag.scene.specs import DEFAULT_PLANTS, crop_spec, scenario_spec, with_strawberry_altitudes
+from davis_ag.scene.specs import (
+    DEFAULT_PLANTS,
+    CropSpec,
+    ScenarioSpec,
+    crop_spec,
+    scenario_spec,
+    with_strawberry_altitudes,
+)
 
 HELP = "render a few views of one scene with boxes drawn"
 DESCRIPTION = __doc__
@@ -39,6 +47,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--size", type=arguments.image_size, default=(1280, 720), help="image size (default 1280x720)")
     arguments.add_renderer_flags(parser)
     parser.add_argument("--out", type=arguments.path, required=True, help="folder for the pictures")
+    parser.add_argument("--force", action="store_true", help="replace pictures an earlier preview wrote")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -52,7 +61,24 @@ def run(args: argparse.Namespace) -> int:
     # Every check before the plant grows (a minute for a vine): the view count needs only the
     # nominal grid, which slip does not change.
     _check_views(numbers, count_views(scenario, crop))
+    check_outside_datasets(args.out)
     arguments.prove_writable_folder(args.out)
+    stems = [f"{crop.name}-{scenario.name}-{args.index:03d}-{view_stem(view_name(n))}" for n in numbers]
+    pictures = [args.out / f"{stem}{suffix}{IMAGE_SUFFIX}" for stem in stems for suffix in ("", "-boxes")]
+    with claim_output(pictures[0], force=args.force, also=[(p, "--out") for p in pictures[1:]]):  # the output rule
+        return _draw(args, scenario, crop, numbers, stems, renderer_name, look)
+
+
+def _draw(
+    args: argparse.Namespace,
+    scenario: ScenarioSpec,
+    crop: CropSpec,
+    numbers: list[int],
+    stems: list[str],
+    renderer_name: str,
+    look: str,
+) -> int:
+    """Grow the scene and write each chosen view, plain and with its boxes, into the claimed files."""
     request = SceneRequest(
         scenario,
         crop,
@@ -77,7 +103,7 @@ def run(args: argparse.Namespace) -> int:
             colour, primitive_ids, _ = renderer.render(view, depth=False)
             labels = label_view(primitive_ids, lookup, request.min_fruit_pixels)
             fractions = visible_fractions(request.camera, view, labels, polygons)
-            stem = f"{crop.name}-{scenario.name}-{args.index:03d}-{view_stem(view_name(number))}"
+            stem = stems[numbers.index(number)]
             with atomic_output(args.out / f"{stem}{IMAGE_SUFFIX}") as handle:
                 Image.fromarray(colour).save(handle, format="JPEG", quality=JPEG_QUALITY)
             boxed = Image.fromarray(colour)
