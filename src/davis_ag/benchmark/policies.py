@@ -247,7 +247,7 @@ class ModelPolicy:
         #: The scenes it was trained on, where its training record says (``davis-ag train``'s).
         self.trained_on: list[str] | None = None
         if isinstance(model, (str, os.PathLike)):
-            from davis_ag.benchmark.training import recorded_train_scenes
+            from davis_ag.benchmark.training_record import recorded_train_scenes
 
             self.trained_on = recorded_train_scenes(model)
             model = load_model(model, device)

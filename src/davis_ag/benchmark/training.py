@@ -13,7 +13,6 @@ to an uninterrupted one.
 
 from __future__ import annotations
 
-import json
 import os
 from pathlib import Path
 from typing import Any
@@ -38,6 +37,7 @@ from davis_ag.benchmark.networks import ARCHITECTURES
 from davis_ag.benchmark.progress import LearningCurve, TrainingProgress
 from davis_ag.benchmark.selection import KeepBestOnTrain, check_keep, snapshot_path
 from davis_ag.benchmark.splits import select_scenes
+from davis_ag.benchmark.training_record import model_path, training_record_path
 from davis_ag.benchmark.tvm import as_dataset
 from davis_ag.errors import MachineError, UserError
 from davis_ag.formats.models import check_seed
@@ -82,34 +82,11 @@ def make_vec_tvm(
     return make_vec_env(TVMEnv, n_envs=n_envs, seed=seed, env_kwargs=kwargs)
 
 
-def model_path(out_path: str | os.PathLike[str]) -> Path:
-    """The ``.zip`` SB3 writes for ``out_path``."""
-    out = Path(out_path)
-    return out if out.suffix == ".zip" else out.with_name(out.name + ".zip")
-
-
 def checkpoint_paths(out_path: str | os.PathLike[str]) -> tuple[Path, Path]:
     """The checkpoint model and its settings file for a training run saving to ``out_path``."""
     final = model_path(out_path)
     stem = final.with_suffix("")
     return stem.with_name(stem.name + ".checkpoint.zip"), stem.with_name(stem.name + ".checkpoint.json")
-
-
-def training_record_path(out_path: str | os.PathLike[str]) -> Path:
-    """``NAME.training.json`` beside the model ``NAME.zip``: settings, sittings, steps/s."""
-    stem = model_path(out_path).with_suffix("")
-    return stem.with_name(stem.name + ".training.json")
-
-
-def recorded_train_scenes(out_path: str | os.PathLike[str]) -> list[str] | None:
-    """The train scenes a saved model's training record lists (None: no record, or one from before
-    they were recorded)."""
-    try:
-        record = json.loads(training_record_path(out_path).read_text())
-    except (OSError, ValueError):
-        return None
-    scenes = record.get("train_scenes") if isinstance(record, dict) else None
-    return [str(s) for s in scenes] if isinstance(scenes, list) else None
 
 
 def train_a2c(dataset: Any, scenario: str, **kwargs: Any) -> Path:

@@ -13,8 +13,8 @@ so it needs a scene of ours (one with a scene.json to regrow from) and an OpenGL
   the scene's grid step) and ``max_climb`` (default half the span of the scene's altitudes); with
   ``aim="free"`` (MP default) two more, ``(dyaw, dpitch)``, scaled by ``max_turn`` degrees
   (default the scene grid's turn between headings: 30 on the MP grid's 12). Defaults follow each
-  scene's own grid as scene.json records it (reduced grids, crops of other altitudes). With ``aim="plant"`` (SP default) the camera
-  always looks at the plant, as the SP grid's views do.
+  scene's own grid as scene.json records it (reduced grids, crops of other altitudes). With
+  ``aim="plant"`` (SP default) the camera always looks at the plant, as the SP grid's views do.
 - Slip (section III-B): a move with a horizontal part lands off by Gaussian noise of 2.5 cm on x
   and y; turning and climbing in place do not slip. Slip draws from ``self.np_random`` only.
 - Refused moves (the agent stays, the step still counts), as section V-D refuses grid moves: the
@@ -49,6 +49,7 @@ from davis_ag.benchmark.cache import OBS_SIZE
 from davis_ag.benchmark.tvm import MAX_START_OER, can_start, episode_reward
 from davis_ag.errors import UserError
 from davis_ag.formats.layout import ANNOTATIONS, SCENE_METADATA
+from davis_ag.live.reopen import SceneSettings
 from davis_ag.live.scene import LiveScene, LiveView, open_live_scene
 from davis_ag.scene.specs import SLIP_SIGMA, scenario_spec
 from davis_ag.scene.view_grid import Viewpoint, excluded
@@ -316,7 +317,7 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         }
 
     @property
-    def _grid(self):
+    def _grid(self) -> SceneSettings:
         """The current scene's settings (the first scene's before any reset)."""
         return self.scenes[max(self._scene, 0)].settings
 

@@ -96,7 +96,7 @@ def _split_unchanged(model: Path, root: Path, scenario: str, crop: str) -> bool:
     """Whether a finished model was trained on today's train split (a group that grew moves
     scenes between the splits); a model from before the scenes were recorded is taken as it is."""
     from davis_ag.benchmark.splits import select_scenes
-    from davis_ag.benchmark.training import recorded_train_scenes
+    from davis_ag.benchmark.training_record import recorded_train_scenes
     from davis_ag.benchmark.tvm import as_dataset
 
     trained_on = recorded_train_scenes(model)
