@@ -13,7 +13,22 @@ Streams are NumPy ``SeedSequence`` keys, so two streams never share draws howeve
   ``[lighting's noise seed, OFF_GRID_STREAM, digest of the pose]`` for a pose off the grid (a live
   scene's free camera): the same pose always gets the same noise (:func:`view_noise_seed`);
 - evaluation session ``s``: ``[seed, s]`` for the environment's resets and ``[seed, s, AGENT_STREAM]``
-  for the agent's own draws (:mod:`davis_ag.benchmark.evaluation`).
+  for the agent's own draws (:mod:`davis_ag.benchmark.evaluation`);
+- a training run's environment ``i``: ``[seed, TRAIN_ENV_STREAM, i]`` (:func:`training_env_seed`;
+  runs begun before it, and their resumptions, seed ``seed + i`` as SB3 does, under which
+  environment 1 of seed 0 replays environment 0 of seed 1); the learner itself is seeded with
+  the run's seed (SB3: torch, NumPy, Python), and the snapshot scoring plays fixed episodes
+  (:data:`davis_ag.benchmark.selection.SELECT_SEED`) under a forked torch state;
+- the paired bootstrap: ``default_rng(seed)`` of the evaluation (:mod:`davis_ag.benchmark.paired`);
+  the transfer experiment's split ``k``: ``seed + k``, its appearance shift: ``[seed, image]``.
+
+Known coincidences, kept because changing them would change datasets already made: NumPy's
+``SeedSequence`` ignores trailing zeros and a key is a prefix of longer ones only in name, so a few
+keys meet: scene 001's key ``[dataset seed, scenario, crop, 1]`` is the split's, view 2's noise
+key is the appearance's, view 0's is ``default_rng(scene seed)``'s and session 0's resets are the
+bootstrap's. Each pair feeds different generators or hashes (a scene seed is one word of its
+sequence, the split draws a permutation; the noise is hashed again in the shaders), so no draw is
+shared; a new stream must not add to them.
 
 A new stream takes a new number here, never an old one.
 """
@@ -33,6 +48,9 @@ APPEARANCE_STREAM = 2
 AGENT_STREAM = 1
 #: Noise of a pose off the grid, after the noise seed; larger than any grid's view index.
 OFF_GRID_STREAM = 2**32 - 1
+#: A training run's environments, after its seed (then the environment's index); beyond any
+#: evaluation session's number, whose keys ``[seed, session, ...]`` share the first place.
+TRAIN_ENV_STREAM = 2**32 - 2
 
 
 def derived_seed(*keys: int) -> int:
@@ -59,3 +77,8 @@ def view_noise_seed(noise_seed: int, index: int, pose: Sequence[float]) -> int:
     rounded = np.round(np.asarray(pose, dtype=np.float64), 6) + 0.0  # + 0.0: -0.0 and 0.0 alike
     digest = int.from_bytes(hashlib.sha256(rounded.tobytes()).digest()[:8], "little")
     return derived_seed(noise_seed, OFF_GRID_STREAM, digest)
+
+
+def training_env_seed(seed: int, index: int) -> int:
+    """The seed of environment ``index`` of a training run of ``seed`` (``[seed, TRAIN_ENV_STREAM, index]``)."""
+    return derived_seed(seed, TRAIN_ENV_STREAM, index)

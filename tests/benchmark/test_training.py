@@ -114,7 +114,8 @@ def test_a_checkpoint_from_before_datasets_were_recorded_still_resumes(
         )
     settings_file = checkpoint_paths(out)[1]
     saved = json.loads(settings_file.read_text())
-    settings_file.write_text(json.dumps({**saved, "dataset": "/"}))  # as earlier versions wrote it
+    older = {k: v for k, v in saved.items() if k != "env_seeds"}
+    settings_file.write_text(json.dumps({**older, "dataset": "/"}))  # as earlier versions wrote it
     train_a2c(
         root,
         "sp",
@@ -124,6 +125,8 @@ def test_a_checkpoint_from_before_datasets_were_recorded_still_resumes(
         **TINY_RUN,
     )
     assert "resuming" in capsys.readouterr().out
+    # It went on as it began: its environments seeded seed + i, as the record says.
+    assert json.loads(training_record_path(out).read_text())["env_seeds"] == "seed+i"
 
 
 def test_a_model_is_never_scored_on_the_scenes_it_learnt_from(
@@ -157,6 +160,25 @@ def test_a_model_is_never_scored_on_the_scenes_it_learnt_from(
     )
     with pytest.raises(UserError, match="trained on 1 of the 2 test scenes .*Single-Strawberry/000.*train it again"):
         evaluate([ModelPolicy(out)], root, "sp", sessions=1, episodes=2)
+
+
+def test_runs_of_different_seeds_share_no_episode_stream(tmp_path: Path) -> None:
+    """SB3 seeds environment i with seed + i, so environment 1 of a seed-0 run replayed the starts
+    of environment 0 of a seed-1 run: runs meant as independent seeds shared 7 of 8 streams."""
+    from davis_ag.benchmark.training import make_vec_tvm
+
+    root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2)
+
+    def states(seed: int, scheme: str) -> list[dict]:
+        env = make_vec_tvm(root, "sp", 3, seed, "all", env_seeds=scheme)
+        env.reset()
+        return [each.unwrapped.np_random.bit_generator.state for each in env.envs]
+
+    old = {seed: states(seed, "seed+i") for seed in (0, 1)}
+    assert old[0][1] == old[1][0]  # the overlap, kept for runs begun before the streams
+    new = {seed: states(seed, "streams") for seed in (0, 1)}
+    assert not any(a == b for a in new[0] for b in new[1])
+    assert new[0] == states(0, "streams")  # and each run as reproducible as before
 
 
 def test_other_settings_never_resume_a_checkpoint(

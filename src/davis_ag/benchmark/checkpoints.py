@@ -25,9 +25,11 @@ from davis_ag.errors import UserError, stops_held
 from davis_ag.provenance import code_version
 
 
-def resumable(settings_file: Path, model_file: Path, settings: dict[str, Any]) -> tuple[int, list, list, list] | None:
-    """Steps done, sittings, learning curve and snapshot scores so far of a checkpoint of a run
-    with the same settings, else None."""
+def resumable(
+    settings_file: Path, model_file: Path, settings: dict[str, Any]
+) -> tuple[int, list, list, list, str] | None:
+    """Steps done, sittings, learning curve, snapshot scores so far and the environments' seeding
+    (``env_seeds``) of a checkpoint of a run with the same settings, else None."""
     try:
         saved = json.loads(settings_file.read_text())
     except (OSError, ValueError):
@@ -45,18 +47,22 @@ def resumable(settings_file: Path, model_file: Path, settings: dict[str, Any]) -
     saved.setdefault("keep", "last")  # and kept the last snapshot
     # Checkpoints from before the train scenes were recorded are taken for the split as it is.
     saved.setdefault("train_scenes", settings.get("train_scenes"))
+    # ... and from before the seed streams seeded environment i with seed + i: resumed so.
+    env_seeds = saved.pop("env_seeds", "seed+i")
+    wanted = {k: v for k, v in settings.items() if k != "env_seeds"}
     if saved.get("dataset") == "/":
         # Checkpoints before this version recorded Path.root ("/") for any dataset given as a
         # path; they are taken as they were then, for whatever dataset the run names.
         saved["dataset"] = settings["dataset"]
-    if saved != settings or not isinstance(done, int) or not isinstance(sittings, list):
+    if saved != wanted or not isinstance(done, int) or not isinstance(sittings, list):
         return None
-    return done, sittings, curve if isinstance(curve, list) else [], scores if isinstance(scores, list) else []
+    curve, scores = curve if isinstance(curve, list) else [], scores if isinstance(scores, list) else []
+    return done, sittings, curve, scores, str(env_seeds)
 
 
 def check_checkpoint(
     settings_file: Path, model_file: Path, settings: dict[str, Any], force: bool
-) -> tuple[int, list, list, list] | None:
+) -> tuple[int, list, list, list, str] | None:
     """What to resume from a checkpoint beside the output, by the output rule: the same run's is
     resumed; one of another run, or a damaged one, is discarded only with ``force``.
 

@@ -66,7 +66,10 @@ def train_split_score(
 
     agent = ModelPolicy(model, deterministic=DETERMINISTIC_PLAY)
     resets, draws = episode_seeds(seed, 0, episodes)
-    with torch.random.fork_rng(devices=[]):
+    # The agent seeds torch on every device; on a GPU the training run samples its actions from
+    # that device's generator, so it is saved and restored too, not only the CPU's.
+    device = getattr(model, "device", torch.device("cpu"))
+    with torch.random.fork_rng(devices=[device] if device.type == "cuda" else []):
         records = [run_episode(env, agent, r, d) for r, d in zip(resets, draws)]
     return {key: round(float(np.mean([r[key] for r in records])), 6) for key in ("oer_tau", "reward", "length")}
 

@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 import torch
+from stable_baselines3.common.vec_env import DummyVecEnv
 
 from davis_ag.atomic_files import (
     prove_writable_file,
@@ -41,6 +42,7 @@ from davis_ag.benchmark.training_record import model_path, training_record_path
 from davis_ag.benchmark.tvm import as_dataset
 from davis_ag.errors import MachineError, UserError
 from davis_ag.formats.models import check_seed
+from davis_ag.seeds import training_env_seed
 
 #: Steps between checkpoints by default: about a minute of training on a 2-core CPU.
 CHECKPOINT_EVERY = 10_000
@@ -59,6 +61,7 @@ def make_vec_tvm(
     split: str = "train",
     crop: str | None = None,
     cache_dir: str | os.PathLike[str] | None = None,
+    env_seeds: str = "streams",
 ) -> Any:
     """``n_envs`` TVM environments in one SB3 ``DummyVecEnv`` (each wrapped in ``Monitor``).
 
@@ -69,8 +72,12 @@ def make_vec_tvm(
         dataset: Dataset root or opened dataset.
         scenario: ``sp`` or ``mp``.
         n_envs: Number of environments.
-        seed: Environment ``i`` is seeded with ``seed + i``.
+        seed: The run's seed.
         split, crop, cache_dir: As for :class:`davis_ag.benchmark.TVMEnv`.
+        env_seeds: ``streams``: environment ``i`` is seeded with
+            :func:`~davis_ag.seeds.training_env_seed` ``(seed, i)``, so runs of different seeds
+            share no episode stream; ``seed+i`` (runs from before, resumed as they began):
+            SB3's ``seed + i``, under which environment 1 of seed 0 replays environment 0 of seed 1.
 
     Returns:
         The vectorised environment.
@@ -79,7 +86,20 @@ def make_vec_tvm(
 
     opened = as_dataset(dataset)
     kwargs = {"dataset": opened, "scenario": scenario, "split": split, "crop": crop, "cache_dir": cache_dir}
-    return make_vec_env(TVMEnv, n_envs=n_envs, seed=seed, env_kwargs=kwargs)
+    chosen = DummyVecEnv if env_seeds == "seed+i" else StreamSeededVecEnv
+    return make_vec_env(TVMEnv, n_envs=n_envs, seed=seed, env_kwargs=kwargs, vec_env_cls=chosen)
+
+
+class StreamSeededVecEnv(DummyVecEnv):
+    """SB3's ``DummyVecEnv`` seeding environment ``i`` from ``[seed, TRAIN_ENV_STREAM, i]``
+    (:func:`~davis_ag.seeds.training_env_seed`) instead of ``seed + i``; SB3 seeds it when the
+    vector is made and again when the learner is (``set_random_seed``), each time alike."""
+
+    def seed(self, seed: int | None = None) -> list[int | None]:
+        if seed is None:
+            return list(super().seed(None))
+        self._seeds = [training_env_seed(seed, i) for i in range(self.num_envs)]
+        return list(self._seeds)
 
 
 def checkpoint_paths(out_path: str | os.PathLike[str]) -> tuple[Path, Path]:
@@ -198,16 +218,19 @@ def train_agent(
         "a2c_settings" if algo == "a2c" else "sb3_settings": chosen,
         "start_rule": "pairs",
         "keep": keep,
+        "env_seeds": "streams",
     }
     opened = as_dataset(dataset)
     # What it learns from: evaluation refuses to score it on any of these (a split that changed
     # since, as scenes were added), and a checkpoint of another split is not resumed.
     settings["train_scenes"] = sorted(s.id for s in select_scenes(opened, scenario, "train", crop))
     resumed = check_checkpoint(settings_file, model_file, settings, force)
-    env = make_vec_tvm(opened, scenario, n_envs, seed, "train", crop, cache_dir)
     scores: list[dict[str, Any]] = []
+    if resumed is not None:  # seeded as it began (a checkpoint from before the streams: seed + i)
+        settings["env_seeds"] = resumed[4]
+    env = make_vec_tvm(opened, scenario, n_envs, seed, "train", crop, cache_dir, settings["env_seeds"])
     if resumed is not None:
-        done, earlier, points, scores = resumed
+        done, earlier, points, scores, _ = resumed
         model = load_checkpoint(algorithm, model_file, env, device)
         print(f"resuming {final.name} from its checkpoint at {done} of {total_timesteps} steps", flush=True)
     else:
