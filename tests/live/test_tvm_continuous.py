@@ -77,6 +77,15 @@ def test_a_full_action_follows_each_scene_s_own_grid(live_scene_dir: Path) -> No
         assert (given.max_move, given.max_climb, given.max_turn) == (0.3, 0.1, 10.0)
 
 
+def test_reset_options_choose_the_scene_or_are_refused(env: TVMContinuousEnv) -> None:
+    """{"scene": i} without a pose was ignored (a random scene was drawn); unknown keys too."""
+    _, info = env.reset(seed=1, options={"scene": 0})
+    assert info["scene"] == env.scenes[0].settings.metadata.scene
+    for bad in ({"scene": 5}, {"scene": "0"}, {"target_fruit": 3}):
+        with pytest.raises(UserError, match="reset options"):
+            env.reset(seed=1, options=bad)
+
+
 def test_a_seed_fixes_the_start_and_the_slip(env: TVMContinuousEnv) -> None:
     def episode(seed: int) -> tuple[np.ndarray, list]:
         obs, info = env.reset(seed=seed)

@@ -228,16 +228,25 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         Args:
             seed: Reseeds ``self.np_random``, the only source of randomness.
             options: ``{"pose": [x, y, z, yaw, pitch], "target": fruit_id, "scene": index}`` forces
-                a start (the target must have a box there).
+                a start (the target must have a box there); ``{"scene": index}`` alone draws the
+                start in that scene.
 
         Returns:
             The first observation and the info dict.
         """
         super().reset(seed=seed)
         rng = self.np_random
-        if options and "pose" in options:
+        options = dict(options or {})
+        unknown = sorted(set(options) - {"pose", "target", "scene"})
+        scene = options.get("scene", 0)
+        if unknown or not isinstance(scene, (int, np.integer)) or not 0 <= scene < len(self.scenes):
+            raise UserError(
+                f"reset options {options}: give a scene index below {len(self.scenes)}, a pose and a target"
+                + (f" (not {', '.join(unknown)})" if unknown else "")
+            )
+        if "pose" in options:
             self._scene = int(options.get("scene", 0))
-            if not 0 <= self._scene < len(self.scenes) or len(options["pose"]) != 5:
+            if len(options["pose"]) != 5:
                 raise UserError(
                     f"start {options}: give a scene index below {len(self.scenes)} and a pose [x, y, z, yaw, pitch]"
                 )
@@ -248,7 +257,7 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
             if self._labels.box(self._target) is None:
                 raise UserError(f"fruit {self._target} has no box from pose {options['pose']}")
         else:
-            self._scene = int(rng.integers(len(self.scenes)))
+            self._scene = int(options["scene"]) if "scene" in options else int(rng.integers(len(self.scenes)))
             self._start(rng)
         self._t, self._refused, self._over = 0, "", False
         self._oer_0 = self.oer
