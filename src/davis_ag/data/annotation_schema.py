@@ -84,6 +84,8 @@ def normalise_view_name(name: str | int) -> str:
         return ""
     if "/" in name or "\\" in name:
         raise ValueError(f"image name {name!r} must not contain a folder")
+    if not name.isprintable():
+        raise ValueError(f"image name {name!r} holds a control character")
     for suffix in _IMAGE_SUFFIXES:
         if name.lower().endswith(suffix):
             name = name[: -len(suffix)]
@@ -215,6 +217,7 @@ def exposure_rate(mask: np.ndarray, box: Box) -> float:
     """
     if box.area <= 0:
         return 0.0
+    # Clamped at 0 both ends: a negative end would count from the image's far edge.
     y0, x0 = max(box.ymin, 0), max(box.xmin, 0)
-    window = mask[y0 : box.ymax + 1, x0 : box.xmax + 1]
+    window = mask[y0 : max(box.ymax + 1, 0), x0 : max(box.xmax + 1, 0)]
     return float(np.count_nonzero(window == box.fruit_id)) / box.area

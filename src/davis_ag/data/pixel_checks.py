@@ -130,9 +130,15 @@ def depth_problems(
         problems.append("holds no surface at all (every pixel 0)")
     elif int(depth[hit].min()) < DEPTH_NEAR_MM:
         problems.append(f"holds a surface {int(depth[hit].min())} mm from the camera, nearer than any renderer draws")
-    if mask is None or metadata is None or record.pose is None or mask.shape != depth.shape:
+    # Against the pose and the fruit's centres only where those are whole (a short pose or a
+    # centre without three numbers is reported by the schema checks; a mask holds ids 0-254).
+    if mask is None or metadata is None or record.pose is None or len(record.pose) < 5 or mask.shape != depth.shape:
         return problems
-    fruits = {f.id: f for f in metadata.fruits if f.center is not None}
+    fruits = {
+        f.id: f
+        for f in metadata.fruits
+        if f.id is not None and 0 <= f.id < NO_FRUIT and f.center is not None and len(f.center) == 3
+    }
     x, y, z, yaw, pitch = (float(v) for v in record.pose[:5])
     forward = np.array(
         [

@@ -5,12 +5,11 @@ not be read because it resolves outside the dataset.
 
 from __future__ import annotations
 
-import json
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from davis_ag.data.safe_read import check_inside
+from davis_ag.data.safe_read import check_inside, parse_json
 from davis_ag.errors import UserError
 
 
@@ -61,12 +60,12 @@ def plural(n: int, word: str) -> str:
 
 
 def read_json_file(path: Path) -> tuple[object, str | None]:
+    """A JSON file's value, or None and why it cannot be read (:func:`~davis_ag.data.safe_read.parse_json`)."""
     try:
-        return json.loads(path.read_text(encoding="utf-8")), None
-    except json.JSONDecodeError as error:
-        return None, f"not valid JSON (line {error.lineno} column {error.colno}: {error.msg})"
+        text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as error:
         return None, f"cannot read ({error})"
+    return parse_json(text)
 
 
 def outside_reason(path: Path, root: Path | None) -> str | None:

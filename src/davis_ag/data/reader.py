@@ -73,7 +73,7 @@ class NotFoundError(UserError, KeyError):
 
 def _view_order(name: str) -> tuple[int, str]:
     stem = view_stem(name)
-    return (int(stem), name) if stem.isdigit() else (1 << 62, name)
+    return (int(stem), name) if stem.isascii() and stem.isdigit() else (1 << 62, name)
 
 
 @dataclass(eq=False)

@@ -14,6 +14,30 @@ import numpy as np
 from davis_ag.errors import UserError
 
 
+def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    """An object's keys, each once: a view named twice would be read as its last copy unseen."""
+    made: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in made:
+            raise ValueError(f"key {key!r} appears twice in one object")
+        made[key] = value
+    return made
+
+
+def parse_json(text: str) -> tuple[Any, str | None]:
+    """Parse a dataset's JSON text strictly: the value, or None and why it is not sound JSON of
+    ours (a syntax error with its place, a key given twice, a number of more digits than Python
+    reads, nesting too deep)."""
+    try:
+        return json.loads(text, object_pairs_hook=_unique_keys), None
+    except json.JSONDecodeError as error:
+        return None, f"not valid JSON (line {error.lineno} column {error.colno}: {error.msg})"
+    except ValueError as error:
+        return None, f"not sound JSON ({error})"
+    except RecursionError:
+        return None, "nested too deeply to be ours"
+
+
 def read_json(path: Path, what: str) -> Any:
     """Load a JSON file, turning every failure into one :class:`UserError` line."""
     try:
@@ -22,15 +46,10 @@ def read_json(path: Path, what: str) -> Any:
         raise UserError(f"{path}: cannot read {what} ({error.strerror or error}); check the file") from None
     except UnicodeDecodeError:
         raise UserError(f"{path}: {what} is not UTF-8 text; re-download or regenerate it") from None
-    try:
-        return json.loads(text)
-    except json.JSONDecodeError as error:
-        raise UserError(
-            f"{path}: {what} is not valid JSON (line {error.lineno} column {error.colno}: "
-            f"{error.msg}); re-download or regenerate it"
-        ) from None
-    except RecursionError:
-        raise UserError(f"{path}: {what} is nested too deeply to be ours; re-download or regenerate it") from None
+    data, problem = parse_json(text)
+    if problem is not None:
+        raise UserError(f"{path}: {what} is {problem}; re-download or regenerate it")
+    return data
 
 
 def check_inside(path: Path, root: Path | None) -> Path:
@@ -53,7 +72,7 @@ def check_inside(path: Path, root: Path | None) -> Path:
         return path
     try:
         resolved, inside = path.resolve(), root.resolve()
-    except (OSError, RuntimeError) as error:  # a symlink loop
+    except (OSError, RuntimeError, ValueError) as error:  # a symlink loop, a NUL in a name
         raise UserError(f"{path}: cannot resolve ({error}); replace the link by the file") from None
     if resolved != inside and not resolved.is_relative_to(inside):
         raise UserError(
@@ -77,7 +96,7 @@ def load_pixels(path: Path, mode: str | None) -> np.ndarray:
             pixels = np.asarray(im)
     except FileNotFoundError:
         raise UserError(f"{path}: image file missing; re-download or regenerate the scene") from None
-    except (OSError, UnidentifiedImageError, ValueError) as error:
+    except (OSError, UnidentifiedImageError, ValueError, Image.DecompressionBombError) as error:
         raise UserError(f"{path}: cannot decode ({error}); re-download or regenerate the scene") from None
     if mode is None:
         # A mask saved as RGB still carries the id in every channel; keep one.

@@ -192,14 +192,16 @@ def _check_pixels(
         elif size is not None and mask is not None:
             for problem in mask_problems(record, mask, size, tolerance):
                 flag(mask_path, problem)
-    depth = view_file(scene.path, record.name, "depth")
-    if depth.is_file():
-        for problem in depth_problems(record, depth, mask, metadata):
-            flag(depth, problem)
-    classes = view_file(scene.path, record.name, "classes")
-    if classes.is_file() and not outside_reason(classes, scene.root):
-        for problem in class_problems(classes, mask):
-            flag(classes, problem)
+    for kind, check in (
+        ("depth", lambda path: depth_problems(record, path, mask, metadata)),
+        ("classes", lambda path: class_problems(path, mask)),
+    ):
+        path = view_file(scene.path, record.name, kind)
+        if not path.is_file():
+            continue
+        outside = outside_reason(path, scene.root)  # a link out of the dataset is never decoded
+        for problem in [outside] if outside else check(path):
+            flag(path, problem)
 
 
 def _name_or_key(key: str) -> str:

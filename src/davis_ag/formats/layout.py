@@ -65,7 +65,7 @@ def view_stem(name: str) -> str:
 def view_number(name: str) -> int | None:
     """``"0001.jpeg"`` -> 1; None for a name that is no number (the original download may have some)."""
     stem = view_stem(name)
-    return int(stem) if stem.isdigit() else None
+    return int(stem) if stem.isascii() and stem.isdigit() else None  # not '²', which isdigit() takes
 
 
 def published_pointers(grid: ViewGrid, index: int) -> dict[str, str]:

@@ -65,8 +65,19 @@ def split_scenes(scene_ids: Iterable[str], seed: int) -> dict[str, list[str]]:
 
 def recorded_seed(root: str | Path) -> int:
     """The dataset seed ``<root>/dataset.json`` records, 0 without a readable one (the original
-    download has none)."""
+    download has none).
+
+    Raises:
+        UserError: when dataset.json records a seed that is no dataset seed (negative, a fraction,
+            too large): the split drawn from it would be another one.
+    """
+    from davis_ag.formats.models import check_seed
+
+    path = Path(root) / DATASET_FILE
     try:
-        return int(json.loads((Path(root) / DATASET_FILE).read_text())["seed"])
-    except (OSError, ValueError, KeyError, TypeError):
+        data = json.loads(path.read_text())
+    except (OSError, ValueError, RecursionError):
         return 0
+    if not isinstance(data, dict) or "seed" not in data:
+        return 0
+    return check_seed(data["seed"], f"{path}: seed")

@@ -150,7 +150,7 @@ def _normalise_scene_id(text: str) -> str:
     """``single-strawberry/3`` and ``Single-Strawberry/003/`` both become ``Single-Strawberry/003``."""
     group, _, index = text.strip().strip("/").replace("\\", "/").partition("/")
     titled = "-".join(part.capitalize() for part in group.split("-"))
-    if index.isdigit():
+    if index.isascii() and index.isdigit():
         return f"{titled}/{int(index):03d}"
     return titled if not index else f"{titled}/{index}"
 

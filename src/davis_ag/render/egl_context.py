@@ -68,7 +68,7 @@ def create_context():
     from davis_ag.errors import UserError
 
     device = os.environ.get(EGL_DEVICE_VARIABLE, "").strip()
-    if device and not device.isdigit():
+    if device and not (device.isascii() and device.isdigit()):
         raise UserError(f"{EGL_DEVICE_VARIABLE}={device!r}: give the number of an EGL device (0, 1, ...)")
     options = {"device_index": int(device)} if device else {}
     try:

@@ -196,7 +196,7 @@ def disk_needed(
 def _among_first(folder: str, group: str, n: int) -> bool:
     """Whether a scene folder is one of a run's ``n`` scenes of ``group`` (``GROUP/000`` to ``n - 1``)."""
     name, _, index = folder.partition("/")
-    return name == group and index.isdigit() and int(index) < n
+    return name == group and index.isascii() and index.isdigit() and int(index) < n
 
 
 def check_disk(
