@@ -180,6 +180,45 @@ def test_a_view_cut_short_and_those_after_it_are_drawn_again(
     same_scene(generated[1], scene_dir)
 
 
+def test_a_journal_with_a_gap_keeps_only_the_views_before_it(
+    generated: tuple[Path, Path, dict], tmp_path: Path
+) -> None:
+    """A stop while a view's files were awaited dropped that view from the queue unjournalled and
+    journalled the views after it; the resumed scene drew it last, out of order."""
+
+    def stop_after_9(done: int, total: int) -> None:
+        if done == 9:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        generate_scene(REQUEST, tmp_path, on_view=stop_after_9)
+    journal = tmp_path / "Single-Strawberry" / ".000.partial" / "views.jsonl"
+    lines = journal.read_text().splitlines()
+    journal.write_text("\n".join(lines[:2] + lines[3:]) + "\n")  # view 0003 missing, 0004... follow
+    scene_dir, _ = generate_scene(REQUEST, tmp_path)
+    assert json.loads((scene_dir / "scene.json").read_text())["timing_s"]["views_from_an_earlier_run"] == 2
+    same_scene(generated[1], scene_dir)  # annotations.json's keys in the uninterrupted order too
+
+
+def test_a_stop_while_the_scene_is_published_keeps_every_view(
+    generated: tuple[Path, Path, dict], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The journal was removed before annotations.json and scene.json were written: a kill in
+    between left a folder with no key, and the next run drew the whole scene again."""
+    import davis_ag.generate.scene_writer as scene_writer
+
+    def killed_at_publish(*args: object, **kwargs: object) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(scene_writer, "_fsync_dir", killed_at_publish)  # after the JSON, before the rename
+    with pytest.raises(KeyboardInterrupt):
+        generate_scene(REQUEST, tmp_path)
+    monkeypatch.undo()
+    scene_dir, _ = generate_scene(REQUEST, tmp_path)
+    assert json.loads((scene_dir / "scene.json").read_text())["timing_s"]["views_from_an_earlier_run"] == VIEWS
+    same_scene(generated[1], scene_dir)
+
+
 def test_a_partial_scene_of_another_request_is_cleared(generated: tuple[Path, Path, dict], tmp_path: Path) -> None:
     partial = tmp_path / "Single-Strawberry" / ".000.partial"
     (partial / "images").mkdir(parents=True)

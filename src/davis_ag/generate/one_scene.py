@@ -211,7 +211,7 @@ def draw_scene(
     class_of_id = np.concatenate([[SKY], model.organ_of_uuid()]).astype(np.uint8) if request.classes else None
     camera = request.camera
     scene_dir = root / request.folder
-    writer = SceneWriter(scene_dir, resume_key(request, viewpoints))
+    writer = SceneWriter(scene_dir, resume_key(request, viewpoints), [view_name(v.number) for v in viewpoints])
     # Views a crashed run of this same request left on disk are kept, not drawn again.
     visible: dict[str, dict[str, float]] = {name: record["extras"]["visible"] for name, record in writer.done.items()}
     try:

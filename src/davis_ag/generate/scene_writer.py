@@ -9,7 +9,7 @@ per view whose files are all on disk, with its annotations entry and extras. A r
 the folder of the same request (``resume_key``: the request and the code version) draws only the
 views the journal lacks; generation is deterministic (same seed, same plants, same draws), so
 the finished scene is the one an uninterrupted run writes. Any other folder is cleared. The
-journal and key are removed before the scene is published.
+journal and key are removed just before the scene is published, after its last file.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from davis_ag.atomic_files import write_json_atomic
+from davis_ag.atomic_files import write_bytes_atomic, write_json_atomic
 from davis_ag.formats.layout import ANNOTATIONS, IMAGES, SCENE_METADATA, view_file_name, write_view_files
 from davis_ag.formats.scene_file import SceneFile
 
@@ -44,11 +44,15 @@ class SceneWriter:
     overlaps with drawing the next view.
     """
 
-    def __init__(self, scene_dir: Path, resume_key: dict[str, Any] | None = None) -> None:
+    def __init__(
+        self, scene_dir: Path, resume_key: dict[str, Any] | None = None, order: list[str] | None = None
+    ) -> None:
         """Args:
         scene_dir: Where the finished scene will be.
         resume_key: What the scene is made from (JSON-ready); a hidden folder left with the
             same key is resumed (:attr:`done`), any other is cleared. None: never resume.
+        order: The view names in the order they are drawn: a resumed journal is kept only as
+            far as it follows it (None: as far as its lines are whole).
         """
         # Absolute from the start: pyhelios changes the process's working directory while a
         # Visualizer or PlantArchitecture is built or destroyed, and our encoder threads may
@@ -60,7 +64,7 @@ class SceneWriter:
         self.done: dict[str, dict[str, Any]] = {}
         if self.tmp_dir.exists():  # left by a run that crashed mid-scene
             if resume_key is not None and _read_key(self.tmp_dir) == resume_key:
-                self.done = _read_journal(self.tmp_dir)
+                self.done = _read_journal(self.tmp_dir, order)
             else:
                 shutil.rmtree(self.tmp_dir)
         (self.tmp_dir / IMAGES).mkdir(parents=True, exist_ok=True)
@@ -68,7 +72,7 @@ class SceneWriter:
             write_json_atomic(self.tmp_dir / RESUME_KEY, resume_key)
             # Rewritten with only the views kept, so a torn last line does not stay in the middle.
             lines = "".join(json.dumps(record) + "\n" for record in self.done.values())
-            (self.tmp_dir / JOURNAL).write_text(lines)
+            write_bytes_atomic(self.tmp_dir / JOURNAL, lines.encode())
         self.annotations: dict[str, dict] = {name: record["entry"] for name, record in self.done.items()}
         self._journal = open(self.tmp_dir / JOURNAL, "a") if resume_key is not None else None
         self._pool = ThreadPoolExecutor(max_workers=2)
@@ -126,14 +130,19 @@ class SceneWriter:
             self._drain(keep=4)
 
     def _drain(self, keep: int = 0) -> None:
-        """Wait for the oldest views' files, then journal those views, in order."""
+        """Wait for the oldest views' files, then journal those views, in order.
+
+        A view leaves the queue only once journalled: a stop (Ctrl-C) while its files are awaited
+        leaves it queued, so the journal never skips a view that a later line then follows.
+        """
         while len(self._pending) > keep:
-            _, files, record = self._pending.pop(0)
+            _, files, record = self._pending[0]
             for future in files:
                 future.result()
             if self._journal is not None:
                 self._journal.write(json.dumps(record) + "\n")
                 self._journal.flush()
+            self._pending.pop(0)
 
     def wait(self) -> None:
         """Block until every queued image is on disk (call before a renderer is closed)."""
@@ -149,11 +158,12 @@ class SceneWriter:
         self._pool.shutdown()
         if self._journal is not None:
             self._journal.close()
-        (self.tmp_dir / JOURNAL).unlink(missing_ok=True)  # not part of the published layout
-        (self.tmp_dir / RESUME_KEY).unlink(missing_ok=True)
         write_json_atomic(self.tmp_dir / ANNOTATIONS, self.annotations)
         write_json_atomic(self.tmp_dir / SCENE_METADATA, scene_metadata.as_written())
         _fsync_dir(self.tmp_dir / IMAGES)
+        # Last before the rename: a run killed before it resumes from the journal, every view kept.
+        (self.tmp_dir / JOURNAL).unlink(missing_ok=True)  # not part of the published layout
+        (self.tmp_dir / RESUME_KEY).unlink(missing_ok=True)
         os.replace(self.tmp_dir, self.scene_dir)
         _fsync_dir(self.scene_dir.parent)
         return self.scene_dir
@@ -188,8 +198,9 @@ def _read_key(folder: Path) -> Any:
         return None
 
 
-def _read_journal(folder: Path) -> dict[str, dict[str, Any]]:
-    """The journalled views, in order, up to the first one torn or with a file not whole.
+def _read_journal(folder: Path, order: list[str] | None = None) -> dict[str, dict[str, Any]]:
+    """The journalled views, in order, up to the first one torn, with a file not whole, or out of
+    ``order``.
 
     Stopping there keeps the views a prefix of the scene's, so annotations.json comes out in the
     same order as an uninterrupted run's. A torn last line is what a crash mid-write leaves; a
@@ -201,10 +212,12 @@ def _read_journal(folder: Path) -> dict[str, dict[str, Any]]:
         lines = (folder / JOURNAL).read_text().splitlines()
     except OSError:
         return done
-    for line in lines:
+    for index, line in enumerate(lines):
         try:
             record = json.loads(line)
         except ValueError:
+            break
+        if order is not None and (index >= len(order) or record.get("name") != order[index]):
             break
         if not all(_whole(folder / IMAGES / name) for name in record["files"]):
             break
