@@ -310,3 +310,36 @@ def test_a_full_disk_midway_leaves_no_half_scene_and_the_next_run_redoes_it(
     assert report.made == ["Single-Strawberry/000"]
     scene = {k: v for k, v in digest(root).items() if k.startswith("Single-Strawberry/000/")}
     assert scene == {k: v for k, v in digest(reference).items() if k.startswith("Single-Strawberry/000/")}
+
+
+def _exits_at_once() -> None:
+    time.sleep(0.3)
+    os._exit(3)
+
+
+def _runs_long() -> int:
+    time.sleep(30)
+    return 0
+
+
+def test_only_the_process_that_died_spends_a_try() -> None:
+    """When one worker dies the pool ends every other with SIGTERM and fails all their scenes:
+    each was charged a try, so one scene that kept crashing failed every scene beside it."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor, wait
+    from concurrent.futures.process import BrokenProcessPool
+
+    from davis_ag.generate.pool_executor import _died_on_their_own
+
+    pool = ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("spawn"))  # as generate does
+    try:
+        crashing, healthy = pool.submit(_exits_at_once), pool.submit(_runs_long)
+        pids = set(pool._processes)
+        wait([crashing, healthy], timeout=20)
+        for future in (crashing, healthy):
+            with pytest.raises(BrokenProcessPool):
+                future.result()
+        culprits = _died_on_their_own(pool)
+        assert len(culprits) == 1 and culprits < pids  # the one that exited, not the one the pool ended
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)

@@ -52,14 +52,16 @@ def run_on_pool(
         report: Filled with the scenes made and failed.
 
     A scene whose process died (the pool breaks) is tried again on a fresh pool, up to
-    ``options.max_retries`` times; scenes that were only queued do not count a try.
+    ``options.max_retries`` times; scenes that were only queued, or whose process the pool ended
+    because another one died, do not count a try.
     """
     # spawn, not fork: a forked child would share the parent's state of native libraries.
     context = multiprocessing.get_context("spawn")
     tries: dict[str, int] = {}
     pending = list(todo)
     while pending:
-        started: set[str] = set()
+        started: dict[str, int | None] = {}  # scene -> the pid of the process drawing it
+        culprits: set[int] | None = None  # processes that died on their own, once the pool broke
         # A fresh queue per pool: a process killed while writing may leave a queue's lock held.
         events = context.Queue()
         pool = ProcessPoolExecutor(
@@ -82,7 +84,11 @@ def run_on_pool(
                     try:
                         stats = future.result()
                     except BrokenProcessPool as error:
-                        if request.folder not in started:  # only queued: no try spent
+                        if culprits is None:
+                            culprits = _died_on_their_own(pool)
+                        pid = started.get(request.folder)
+                        if request.folder not in started or (culprits and pid not in culprits):
+                            # Only queued, or ended by the pool because a sibling died: no try spent.
                             pending.append(request)
                         elif tries.setdefault(request.folder, 0) < options.max_retries:
                             tries[request.folder] += 1
@@ -114,15 +120,29 @@ def run_on_pool(
             events.join_thread()
 
 
-def _drain(events: Any, progress: Progress, started: set[str]) -> None:
+def _drain(events: Any, progress: Progress, started: dict[str, int | None]) -> None:
     while True:
         try:
             event = events.get_nowait()
         except Exception:  # queue.Empty, or the queue of a dead pool
             return
         if event[0] == "start":
-            started.add(event[1])
+            started[event[1]] = event[2] if len(event) > 2 else None
         progress.event(event)
+
+
+def _died_on_their_own(pool: ProcessPoolExecutor) -> set[int]:
+    """The pids of a broken pool's processes that ended by themselves (killed for memory, a
+    crash), not by the SIGTERM the pool then sends every other worker: only their scenes spend
+    a try. Empty when none can be told apart (every scene running then spends one, as before)."""
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    for process in processes:
+        process.join(5)
+    return {
+        process.pid
+        for process in processes
+        if process.pid is not None and process.exitcode not in (None, -signal.SIGTERM)
+    }
 
 
 _EVENTS: Any = None
@@ -155,7 +175,7 @@ def die_with_parent(parent: int) -> None:
 def _pool_scene(request: SceneRequest, root: str) -> dict:
     """Make one scene in a pool process, reporting progress on the event queue."""
     scene = request.folder
-    _EVENTS.put(("start", scene))
+    _EVENTS.put(("start", scene, os.getpid()))
     last = [0.0]
 
     def on_view(done: int, total: int) -> None:

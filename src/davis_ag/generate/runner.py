@@ -138,6 +138,14 @@ def run_dataset(requests: Sequence[SceneRequest], root: Path, options: RunOption
                 run_on_pool(todo, root, pool, progress, report)
         finally:
             progress.close()
+        # A scene made where this machine cannot see it (Ray workers without the shared folder
+        # --out must be) would be left out of splits.json while the run said it was made.
+        unseen = sorted(set(report.made) - set(complete_scenes(root)))
+        if unseen:
+            raise UserError(
+                f"{len(unseen)} scene(s) were made where {root} cannot see them ({unseen[0]}, ...): "
+                "--out must be a folder every Ray worker shares with this machine"
+            )
         if report.failed:
             first, message = next(iter(report.failed.items()))
             # Exit status 1 when the machine failed every one of them (a full disk), 2 otherwise.
