@@ -5,6 +5,7 @@ numbers behind each figure recomputed here from the raw files: annotations.json 
 from __future__ import annotations
 
 import json
+import shutil
 from pathlib import Path
 from typing import Any
 
@@ -232,6 +233,12 @@ def test_stats_table3_and_fruit(real_root: Path, tmp_path: Path, capsys: pytest.
         (["plot", "oer", "ROOT", "--formats", "gif", "--out", "X"], "--formats"),
         (["plot", "actions", "--results", "OLD", "--out", "X"], "rerun"),
         (["stats", "NOWHERE"], "no such folder"),
+        # Continuous results (actions are numbers), a file without policies, a loop of up moves:
+        # a traceback twice and a figure that never finished.
+        (["plot", "actions", "--results", "CONTINUOUS", "--out", "X"], "not grid moves"),
+        (["plot", "episode", "ROOT", "--results", "CONTINUOUS", "--out", "X"], "not grid moves"),
+        (["plot", "episode", "ROOT", "--results", "EMPTY", "--out", "X"], "holds no policies"),
+        (["plot", "altitude", "LOOP", "--out", "X"], "come back to"),
     ],
 )
 def test_bad_input_is_one_line(
@@ -239,7 +246,36 @@ def test_bad_input_is_one_line(
 ) -> None:
     old = tmp_path / "old.json"  # results written before per-episode records existed
     old.write_text(json.dumps({"protocol": {"scenario": "sp"}, "policies": {"LRD": {"oer_tau": {}}}}))
-    swap = {"ROOT": str(real_root), "X": str(tmp_path / "x"), "OLD": str(old), "NOWHERE": str(tmp_path / "no")}
+    continuous = tmp_path / "continuous.json"
+    episode = {"scene": "Single-Strawberry/000", "actions": [[0.5, -0.2, 0.1]], "views": [], "target": 1}
+    continuous.write_text(
+        json.dumps(
+            {
+                "protocol": {"scenario": "sp", "environment": "davis_ag/TVMContinuous-v0"},
+                "policies": {"Rand": {"oer_tau": {}, "episodes": [episode]}},
+            }
+        )
+    )
+    empty = tmp_path / "empty.json"
+    empty.write_text(json.dumps({"protocol": {"scenario": "sp"}, "policies": {}}))
+    loop = tmp_path / "loop"
+    if "LOOP" in args:  # a copy whose top view's up move leads back to the bottom of its column
+        shutil.copytree(real_root, loop)
+        path = loop / "Single-Strawberry" / "000" / "annotations.json"
+        doc = json.loads(path.read_text())
+        top = next(n for n, e in doc.items() if not e.get("up") and e.get("down"))
+        bottom = doc[doc[top]["down"]]["down"] or doc[top]["down"]
+        doc[top]["up"] = bottom
+        path.write_text(json.dumps(doc))
+    swap = {
+        "ROOT": str(real_root),
+        "X": str(tmp_path / "x"),
+        "OLD": str(old),
+        "NOWHERE": str(tmp_path / "no"),
+        "CONTINUOUS": str(continuous),
+        "EMPTY": str(empty),
+        "LOOP": str(loop),
+    }
     assert cli.main([swap.get(a, a) for a in args]) == 2
     err = capsys.readouterr().err.strip()
     assert words in err and "\n" not in err and err.startswith("davis-ag")

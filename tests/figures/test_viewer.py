@@ -124,8 +124,43 @@ def test_no_path_reaches_outside_the_dataset(served: tuple[Path, int], tmp_path:
     ]
     for path in crafted:
         status, body = _get(port, path)
-        assert status == 404, path
+        assert status == (403 if path.startswith("http://127.0.0.1/") else 404), path  # no port in its Host
         assert b"SECRET" not in body and b"root:" not in body, path
+
+
+def test_a_linked_images_folder_serves_nothing_from_outside(served: tuple[Path, int], tmp_path: Path) -> None:
+    """The file only had to lie in the folder the link points to."""
+    root, port = served
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    (outside / "0001.jpeg").write_bytes(b"SECRET")
+    images = root / "Single-Strawberry/000/images"
+    shutil.move(images, tmp_path / "kept")
+    images.symlink_to(outside)
+    status, body = _get(port, "/image/Single-Strawberry/000/0001.jpeg")
+    assert status == 404 and b"SECRET" not in body
+
+
+def _get_with(port: int, target: str, host: str | None = None) -> int:
+    connection = http.client.HTTPConnection("127.0.0.1", port, timeout=10)
+    connection.putrequest("GET", target, skip_host=host is not None, skip_accept_encoding=True)
+    if host is not None:
+        connection.putheader("Host", host)
+    connection.endheaders()
+    status = connection.getresponse().status
+    connection.close()
+    return status
+
+
+def test_odd_requests_get_an_answer_and_other_hosts_none(served: tuple[Path, int]) -> None:
+    """ "GET *" and a bare query ended in an IndexError with no reply; a page of another site whose
+    name resolves to 127.0.0.1 (DNS rebinding) could read the dataset through the browser."""
+    _, port = served
+    assert _get_with(port, "*") == 400 and _get_with(port, "?x=1") == 400
+    assert _get_with(port, "/api/scenes", host="attacker.example") == 403
+    assert _get_with(port, "/api/scenes", host=f"attacker.example:{port}") == 403
+    assert _get_with(port, "/api/scenes", host=f"localhost:{port}") == 200
+    assert _get(port, "/api/scenes")[0] == 200  # still serving
 
 
 def test_view_command_refuses_a_bad_port(served: tuple[Path, int], capsys: pytest.CaptureFixture[str]) -> None:

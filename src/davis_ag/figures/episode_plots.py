@@ -144,6 +144,8 @@ def plot_episode(
         fontsize=9,
     )
     figure.tight_layout()
+    # Room under the map for its legend's two rows, which tight_layout leaves out (they ran off the foot).
+    figure.subplots_adjust(bottom=max(figure.subplotpars.bottom, 0.75 / figure.get_figheight()))
     paths = save_formats(figure, out, formats)
     return Plotted(
         paths,

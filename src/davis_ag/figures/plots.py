@@ -62,11 +62,26 @@ class PlotRequest:
 
 
 def _results(path: Path) -> dict[str, Any]:
+    """Grid results a figure of moves can draw.
+
+    Raises:
+        UserError: for a file that is not evaluation results, holds no policy, or records the
+            continuous environment's actions (numbers, not grid moves).
+    """
+    from davis_ag.figures.benchmark_plots import policy_names
+
     data = read_json(path, "evaluation results")
     if not isinstance(data, dict) or not isinstance(data.get("policies"), dict):
         raise UserError(
             f'{path}: not `davis-ag evaluate` results (no "policies"); give the JSON '
             "that `davis-ag evaluate --out` wrote"
+        )
+    policy_names(data, str(path))
+    environment = (data.get("protocol") or {}).get("environment") if isinstance(data.get("protocol"), dict) else None
+    if environment not in (None, "davis_ag/TVM-v0"):
+        raise UserError(
+            f"{path}: results of {environment}, whose actions are numbers, not grid moves; these "
+            "figures draw TVM-v0 results (evaluate without --env continuous)"
         )
     return data
 
@@ -90,7 +105,7 @@ def _episode(request: PlotRequest) -> Plotted:
             "VIEW --actions A,B,... (an episode to walk)"
         )
     results = _results(request.results)
-    policy = request.policy or next(iter(results["policies"]))
+    policy = request.policy or next(iter(results["policies"]))  # _results found at least one
     scene_id, path, actions, target = episode_from_results(results, policy, request.episode, str(request.results))
     root = request.dataset or Path(str(results.get("protocol", {}).get("dataset", "")))
     if not str(root):

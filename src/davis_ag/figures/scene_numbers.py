@@ -134,7 +134,14 @@ def altitude_columns(scene: Scene) -> list[dict[int, set[int]]]:
             continue  # not the lowest view of its column
         column: dict[int, set[int]] = {}
         current: View | None = view
+        climbed: set[str] = set()
         while current is not None and current.pose is not None:
+            if current.name in climbed:  # "up" pointers that lead back down: no column to draw
+                raise UserError(
+                    f"{scene.annotations_path}: the up moves from {view.name} come back to {current.name}; "
+                    "fix its pointers (up must climb) or regenerate the scene"
+                )
+            climbed.add(current.name)
             column[level_of[round(current.pose[2], 2)]] = {b.fruit_id for b in current.boxes}
             current = current.next("up")
         if len(column) > 1:

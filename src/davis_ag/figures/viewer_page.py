@@ -194,7 +194,7 @@ function drawMap() {
     if (seen.has(key)) continue;
     seen.add(key);
     html += "<circle class='spot' data-view='" + esc(name) + "' cx='" + X(v.pose[0]) + "' cy='" + Y(v.pose[1]) +
-      "' r='5' fill='#9ab' stroke='#345' style='cursor:pointer'><title>" + name + "</title></circle>";
+      "' r='5' fill='#9ab' stroke='#345' style='cursor:pointer'><title>" + esc(name) + "</title></circle>";
   }
   // Marks drawn over the spots let clicks through, so a spot under the path can still be clicked.
   for (const p of plants) html += "<text pointer-events='none' x='" + (X(p[0]) - 5) + "' y='" + (Y(p[1]) + 5) + "' font-size='16'>&#x2715;</text>";

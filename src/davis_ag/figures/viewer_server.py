@@ -161,15 +161,16 @@ class Viewer:
 
     def file(self, scene: Scene, name: str) -> Path | None:
         """The scene's ``images/<name>`` when the name is allowed and the file, symlinks
-        followed, really lies in that folder; else ``None``."""
+        followed, really lies in that folder and in the dataset (a linked images folder or
+        scene folder does not take the server out of it); else ``None``."""
         if not FILE_NAME.fullmatch(name):
             return None
-        folder = (scene.path / IMAGES).resolve()
         try:
+            folder, root = (scene.path / IMAGES).resolve(), Path(self.dataset.root).resolve()
             real = (folder / name).resolve(strict=True)
         except (OSError, RuntimeError):
             return None
-        if real.parent != folder or not real.is_file():
+        if real.parent != folder or not real.is_relative_to(root) or not real.is_file():
             return None
         return real
 
@@ -203,7 +204,14 @@ def make_handler(viewer: Viewer, page: bytes) -> type[BaseHTTPRequestHandler]:
             self._send(HTTPStatus.NOT_FOUND, why.encode(), "text/plain; charset=utf-8")
 
         def do_GET(self) -> None:  # noqa: N802 (http.server's name)
+            # Only pages that asked for this address: a site rebinding its name to 127.0.0.1
+            # sends its own Host, and would otherwise read the dataset through the browser.
+            port = self.server.server_address[1]
+            if self.headers.get("Host", "") not in (f"{HOST}:{port}", f"localhost:{port}"):
+                return self._send(HTTPStatus.FORBIDDEN, b"wrong host", "text/plain; charset=utf-8")
             url = urlsplit(self.path)
+            if not url.path.startswith("/"):  # "GET *" or a bare query
+                return self._send(HTTPStatus.BAD_REQUEST, b"bad request", "text/plain; charset=utf-8")
             # Split first, then decode each segment: an encoded "/" never makes a new segment.
             parts = [unquote(p) for p in url.path.split("/")[1:]]
             try:
@@ -212,6 +220,9 @@ def make_handler(viewer: Viewer, page: bytes) -> type[BaseHTTPRequestHandler]:
                 self._send(HTTPStatus.INTERNAL_SERVER_ERROR, str(error).encode(), "text/plain; charset=utf-8")
             except (BrokenPipeError, ConnectionResetError):
                 pass
+            except Exception as error:  # noqa: BLE001 - one request's bug must not end the viewer
+                message = f"{type(error).__name__}: {error}".encode()
+                self._send(HTTPStatus.INTERNAL_SERVER_ERROR, message, "text/plain; charset=utf-8")
 
         def _route(self, parts: list[str], query: dict[str, list[str]]) -> None:
             head, rest = parts[0], parts[1:]
