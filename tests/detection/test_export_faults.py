@@ -178,3 +178,27 @@ def test_an_export_is_never_two_exports_mixed(
     assert export(capsys, "yolo", str(other), str(out), "--split", "test")[0] == 2
     assert export(capsys, "yolo", str(pristine), str(out), "--force")[0] == 0
     assert not (out / ".davis_ag-export-unfinished").exists()
+
+
+def test_a_segment_export_needs_every_mask(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A view without its _seg.png got box lines among the polygon lines: the export said it was
+    done, and ultralytics refused to load it ("equal numbers of boxes and segments")."""
+    from layout_factory import write_original_style_dataset
+
+    data = write_original_style_dataset(tmp_path / "orig", scenes=2, missing_mask=True)
+    code, _, err = export(capsys, "yolo", str(data), str(tmp_path / "seg"), "--task", "segment")
+    assert code == 2 and "_seg.png: missing, and --task segment needs every view's instance mask" in err
+    assert export(capsys, "yolo", str(data), str(tmp_path / "boxes"))[0] == 0  # boxes need no mask
+
+
+@pytest.mark.parametrize("fmt", ["coco", "yolo"])
+def test_a_scene_in_both_splits_is_never_exported_to_both(
+    fmt: str, data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    splits = data / "splits.json"
+    doc = json.loads(splits.read_text())
+    doc["test"] = sorted({*doc["test"], doc["train"][0]})
+    splits.write_text(json.dumps(doc))
+    code, _, err = export(capsys, fmt, str(data), str(tmp_path / "out"))
+    assert code == 2 and "in both train and test" in err
+    assert not (tmp_path / "out").exists()

@@ -115,12 +115,12 @@ def check_out(out: Path, fmt: str) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Export ``args.dir`` to ``args.out``; prints the counts per split."""
-    from davis_ag.benchmark.splits import dataset_splits
     from davis_ag.data.reader import open_dataset
+    from davis_ag.detection.instances import check_export_splits
 
     dataset = open_dataset(args.dir)  # a bad DIR, or a split that lost a scene, before anything is created
     if args.format != "pointcloud":
-        dataset_splits(dataset)
+        check_export_splits(dataset)
     check_out(args.out, args.format)
     marker, wanted = args.out / UNFINISHED, export_settings(args)
     unfinished = marker.exists()  # a stopped export: the same command carries on

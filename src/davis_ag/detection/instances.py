@@ -39,6 +39,23 @@ def category_id(crop: str | None) -> int:
     return CATEGORIES.index(crop) + 1
 
 
+def check_export_splits(dataset: Dataset) -> dict[str, set[str]]:
+    """The scene ids of each split, after refusing a split an export must not follow.
+
+    Raises:
+        UserError: when a scene is in both splits (its test images would train).
+    """
+    splits = dataset_splits(dataset)
+    keep = {split: set(splits[split]) for split in EXPORT_SPLITS}
+    both = sorted(keep["train"] & keep["test"])
+    if both:
+        raise UserError(
+            f"{dataset.root}: splits.json lists {len(both)} scene(s) in both train and test (e.g. {both[0]}); "
+            "fix it, or regenerate it (`davis-ag validate` names every one)"
+        )
+    return keep
+
+
 def scenes_by_split(dataset: Dataset) -> dict[str, list[Scene]]:
     """The dataset's scenes per split.
 
@@ -48,9 +65,11 @@ def scenes_by_split(dataset: Dataset) -> dict[str, list[Scene]]:
 
     Returns:
         ``{"train": [...], "test": [...]}``, each sorted by scene id.
+
+    Raises:
+        UserError: as :func:`check_export_splits`.
     """
-    splits = dataset_splits(dataset)
-    keep = {split: set(splits[split]) for split in EXPORT_SPLITS}
+    keep = check_export_splits(dataset)
     on_disk = {s.id for s in dataset.scenes}
     listed = keep["train"] | keep["test"]
     unlisted = sorted(on_disk - listed)

@@ -60,12 +60,36 @@ def mask_polygon(mask: np.ndarray) -> np.ndarray:
     return np.concatenate(joined).astype(float)
 
 
+def outline_pieces(mask: np.ndarray) -> list[np.ndarray]:
+    """Each connected part of a bool mask as its own closed outline, ``K x 2`` (x, y), largest first;
+    parts of fewer than three outline points (specks of a pixel or two) are left out.
+
+    For organ classes, which fall into hundreds of parts (every stem): joined into one polygon,
+    the seams between them fill in as a fan when the polygon is drawn.
+    """
+    import cv2
+
+    contours, _ = cv2.findContours(mask.astype(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+    pieces = [c.reshape(-1, 2) for c in sorted(contours, key=cv2.contourArea, reverse=True)]
+    return [piece.astype(float) for piece in pieces if len(piece) >= 3]
+
+
 def label_lines(item: LabelledView, task: str) -> list[str]:
-    """The YOLO label lines of one view (see the module docstring)."""
+    """The YOLO label lines of one view (see the module docstring).
+
+    Raises:
+        UserError: for ``segment`` on a view without an instance mask (a box line among polygon
+            lines makes the file one ultralytics refuses to load).
+    """
     w, h = float(item.width), float(item.height)
     lines = []
     for inst in item.instances:
         cls = inst.category - 1
+        if task == "segment" and inst.mask is None:
+            raise UserError(
+                f"{item.view.mask_path}: missing, and --task segment needs every view's instance mask; "
+                "export with --task detect, or regenerate the scene"
+            )
         if task == "segment" and inst.mask is not None and inst.mask.any():
             points = mask_polygon(inst.mask)
             # Pixel centres: the outline through them covers exactly the mask's pixels when filled.
@@ -80,13 +104,15 @@ def label_lines(item: LabelledView, task: str) -> list[str]:
 
 
 def organ_lines(item: LabelledView) -> list[str]:
-    """One segment line per organ class present in the view (see
-    :mod:`davis_ag.detection.organ_export`); none without a class image."""
+    """One segment line per connected part of each organ class in the view (see
+    :mod:`davis_ag.detection.organ_export`); none without a class image. A part's holes are not
+    drawn (YOLO polygons have none): the soil's outline covers the plant's foot, and ultralytics'
+    overlapping masks (the default) lay the smaller parts over it."""
     w, h = float(item.width), float(item.height)
     return [
-        f"{yolo_organ_class(value)} "
-        + " ".join(f"{(x + 0.5) / w:.6f} {(y + 0.5) / h:.6f}" for x, y in mask_polygon(mask))
+        f"{yolo_organ_class(value)} " + " ".join(f"{(x + 0.5) / w:.6f} {(y + 0.5) / h:.6f}" for x, y in piece)
         for value, mask in organ_masks(item.view)
+        for piece in outline_pieces(mask)
     ]
 
 
