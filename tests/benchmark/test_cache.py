@@ -123,6 +123,13 @@ def test_a_cache_dir_on_a_dataset_leaves_its_scenes_alone(
     cache_module._OPEN.clear()  # as a new process finds it
     TVMEnv(root, "sp", "all", cache_dir=tmp_path / "caches")
     assert json.loads(meta.read_text())["fingerprint"] != "old"
+    # ... and a damaged one (meta.json cut short) too, in the dataset's own cache folder.
+    TVMEnv(root, "sp", "all")
+    own = root / CACHE_FOLDER / "Single-Strawberry/000" / "meta.json"
+    own.write_text(own.read_text()[:10])
+    cache_module._OPEN.clear()
+    TVMEnv(root, "sp", "all")
+    assert json.loads(own.read_text())["fingerprint"]
 
 
 def test_steps_never_decode(root: Path, monkeypatch: pytest.MonkeyPatch) -> None:

@@ -160,6 +160,17 @@ def test_a_model_is_never_scored_on_the_scenes_it_learnt_from(
     )
     with pytest.raises(UserError, match="trained on 1 of the 2 test scenes .*Single-Strawberry/000.*train it again"):
         evaluate([ModelPolicy(out)], root, "sp", sessions=1, episodes=2)
+    # A checkpoint of one split is not resumed on another.
+    original = {"train": ["Single-Strawberry/000"], "test": ["Single-Strawberry/001"]}
+    splits.write_text(json.dumps({**json.loads(splits.read_text()), **original}))
+    with pytest.raises(KeyboardInterrupt):
+        train_a2c(
+            root, "sp", total_timesteps=100, seed=1, out_path=tmp_path / "b.zip", **TINY_RUN, callback=KillAfter(50)
+        )
+    swapped = {"train": ["Single-Strawberry/001"], "test": ["Single-Strawberry/000"]}
+    splits.write_text(json.dumps({**json.loads(splits.read_text()), **swapped}))
+    with pytest.raises(UserError, match="another train split"):
+        train_a2c(root, "sp", total_timesteps=100, seed=1, out_path=tmp_path / "b.zip", **TINY_RUN)
 
 
 def test_runs_of_different_seeds_share_no_episode_stream(tmp_path: Path) -> None:

@@ -188,6 +188,7 @@ def test_a_segment_export_needs_every_mask(tmp_path: Path, capsys: pytest.Captur
     data = write_original_style_dataset(tmp_path / "orig", scenes=2, missing_mask=True)
     code, _, err = export(capsys, "yolo", str(data), str(tmp_path / "seg"), "--task", "segment")
     assert code == 2 and "_seg.png: missing, and --task segment needs every view's instance mask" in err
+    assert not (tmp_path / "seg").exists()  # refused before anything is made: no stopped export to trip on
     assert export(capsys, "yolo", str(data), str(tmp_path / "boxes"))[0] == 0  # boxes need no mask
 
 

@@ -81,7 +81,7 @@ def test_reset_options_choose_the_scene_or_are_refused(env: TVMContinuousEnv) ->
     """{"scene": i} without a pose was ignored (a random scene was drawn); unknown keys too."""
     _, info = env.reset(seed=1, options={"scene": 0})
     assert info["scene"] == env.scenes[0].settings.metadata.scene
-    for bad in ({"scene": 5}, {"scene": "0"}, {"target_fruit": 3}):
+    for bad in ({"scene": 5}, {"scene": "0"}, {"target_fruit": 3}, {"target": 3}):
         with pytest.raises(UserError, match="reset options"):
             env.reset(seed=1, options=bad)
 

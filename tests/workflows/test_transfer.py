@@ -79,6 +79,9 @@ def test_transfer_runs_end_to_end_offline(
     assert main(argv) == 2 and "--results" in capsys.readouterr().err
     assert main([*argv, "--force"]) == 0
     assert json.loads((out / "transfer.json").read_text())["splits"] == results["splits"]
+    # A folder from before the settings were recorded takes them from its transfer.json.
+    (out / "transfer-config.json").unlink()
+    assert main([*argv, "--force"]) == 0 and (out / "transfer-config.json").is_file()
     # A run of other settings would report the folder's scores as its own: refused.
     assert main([*argv[:-2], "--seed", "1"]) == 2
     err = capsys.readouterr().err.strip()

@@ -348,17 +348,17 @@ _CACHE_FILES = frozenset({"meta.json", "tables.npz", "images.npy"})
 
 
 def _replaceable(folder: Path) -> bool:
-    """Whether an existing folder is a cache of ours (of another version or scene state), the
-    only thing a rebuild may delete: a ``--cache-dir`` pointed at a dataset would otherwise
-    replace its scene folders."""
+    """Whether an existing folder may be deleted as a cache of ours (stale or damaged): a real
+    folder holding nothing but a cache's own file names, none a link. Decided on the names alone
+    (nothing is read): a scene folder, which a ``--cache-dir`` pointed at a dataset would
+    otherwise replace, always holds ``annotations.json`` and ``images/``."""
     if folder.is_symlink() or not folder.is_dir():
         return False
     try:
-        names = {p.name for p in folder.iterdir()}
-        meta = json.loads((folder / "meta.json").read_text())
-    except (OSError, ValueError):
+        entries = list(folder.iterdir())
+    except OSError:
         return False
-    return names <= _CACHE_FILES and isinstance(meta, dict) and "fingerprint" in meta
+    return all(entry.name in _CACHE_FILES and not entry.is_symlink() for entry in entries)
 
 
 def load_scene_cache(scene: Any, root: Path, cache_dir: str | os.PathLike[str] | None = None) -> SceneCache:

@@ -107,7 +107,7 @@ def _checkpoint_problem(settings_file: Path, model_file: Path, settings: dict[st
         if key == "train_scenes"
         else f"{key} {saved.get(key)!r}, not {settings[key]!r}"
         for key in settings
-        if key in saved and saved[key] != settings[key] and key != "dataset"
+        if key in saved and saved[key] != settings[key] and key not in ("dataset", "env_seeds")  # never blocks
     ]
     differ += ["another dataset"] if saved.get("dataset") not in (settings["dataset"], "/", None) else []
     return f"it is the checkpoint of another run ({'; '.join(differ[:3]) or 'older settings'}), which this one cannot resume"

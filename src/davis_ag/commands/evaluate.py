@@ -107,8 +107,16 @@ def run(args: argparse.Namespace) -> int:
     check_figure_path(plot, "--plot")  # before the episodes, not after
     if args.cache_dir is not None:
         arguments.prove_writable_folder(args.cache_dir, "--cache-dir")
-    with claim_output(out, force=args.force, also=[(plot, "--plot")]):  # the output rule
+    # A policy's file (a model, a module) is an input: never replaced by the results or the chart.
+    reads = [(path, "--policy") for spec in specs for path in _spec_files(spec)]
+    with claim_output(out, force=args.force, also=[(plot, "--plot")], reads=reads):  # the output rule
         return _evaluate(args, names, specs, out, plot)
+
+
+def _spec_files(spec: str) -> list[Path]:
+    """The file a ``--policy`` SPEC reads, where it names one (``model.zip``, ``mine.py:act``)."""
+    candidates = [spec, spec.rsplit(":", 1)[0]] if ":" in spec else [spec]
+    return [Path(c) for c in candidates if Path(c).expanduser().is_file()][:1]
 
 
 def _evaluate(args: argparse.Namespace, names: list[str], specs: list[str], out: Path, plot: Path) -> int:

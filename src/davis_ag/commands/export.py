@@ -121,6 +121,13 @@ def run(args: argparse.Namespace) -> int:
     dataset = open_dataset(args.dir)  # a bad DIR, or a split that lost a scene, before anything is created
     if args.format != "pointcloud":
         check_export_splits(dataset)
+    if args.format == "yolo" and args.task == "segment":  # polygons need masks: refused before anything is made
+        lacking = next((v for s in dataset.scenes for v in s if not v.mask_path.is_file()), None)
+        if lacking is not None:
+            raise UserError(
+                f"{lacking.mask_path}: missing, and --task segment needs every view's instance mask; "
+                "export with --task detect, or regenerate the scene"
+            )
     check_out(args.out, args.format)
     marker, wanted = args.out / UNFINISHED, export_settings(args)
     unfinished = marker.exists()  # a stopped export: the same command carries on

@@ -69,7 +69,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run the experiment and print the Table-5-style table."""
     from davis_ag.detection.yolo_training import Budget
-    from davis_ag.workflows.transfer import TransferConfig, run_transfer, table5_markdown, write_results_md
+    from davis_ag.workflows.transfer import (
+        WORK_RECORD,
+        TransferConfig,
+        run_transfer,
+        table5_markdown,
+        write_results_md,
+    )
 
     from contextlib import nullcontext
 
@@ -95,7 +101,12 @@ def run(args: argparse.Namespace) -> int:
         budget=budget,
     )
     report = (
-        claim_output(args.results, force=args.force, flag="--results", reads=[(args.real, "--real")])
+        claim_output(  # never over the real set, nor the work folder's own records
+            args.results,
+            force=args.force,
+            flag="--results",
+            reads=[(args.real, "--real"), (args.out / "transfer.json", "OUT's"), (args.out / WORK_RECORD, "OUT's")],
+        )
         if args.results
         else nullcontext()
     )

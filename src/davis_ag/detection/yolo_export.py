@@ -85,12 +85,14 @@ def label_lines(item: LabelledView, task: str) -> list[str]:
     lines = []
     for inst in item.instances:
         cls = inst.category - 1
-        if task == "segment" and inst.mask is None:
+        if task == "segment" and (inst.mask is None or not inst.mask.any()):
+            what = "missing" if inst.mask is None else f"holds no pixel of fruit {inst.box.fruit_id}, which has a box"
             raise UserError(
-                f"{item.view.mask_path}: missing, and --task segment needs every view's instance mask; "
-                "export with --task detect, or regenerate the scene"
+                f"{item.view.mask_path}: {what}, and --task segment needs every box's mask (a box line among "
+                "polygons is a file ultralytics refuses); export with --task detect (and --force over this "
+                "unfinished export), or regenerate the scene"
             )
-        if task == "segment" and inst.mask is not None and inst.mask.any():
+        if task == "segment":
             points = mask_polygon(inst.mask)
             # Pixel centres: the outline through them covers exactly the mask's pixels when filled.
             coords = " ".join(f"{(x + 0.5) / w:.6f} {(y + 0.5) / h:.6f}" for x, y in points)

@@ -209,9 +209,9 @@ def paper_figures(
             skipped[kind] = "no evaluation results"
             continue
         request = PlotRequest(kind, out_dir / kind, dataset=root, results=results, formats=formats)
-        if kind == "episode" and results is not None:
-            request.policy, request.episode = _telling_episode(_results(results))
         try:
+            if kind == "episode" and results is not None:
+                request.policy, request.episode = _telling_episode(_results(results))
             drawn[kind] = make_plot(request)
         except UserError as error:
             skipped[kind] = str(error)

@@ -110,7 +110,7 @@ LOG_INTERVAL_S = 60.0
 class Progress:
     """A scenes bar and a views bar (with the time left), fed by events from any executor.
 
-    Events are tuples ``("start", scene_id)`` and ``("view", scene_id, done, total)``. When
+    Events are tuples ``("start", scene_id[, pid])`` and ``("view", scene_id, done, total)``. When
     stderr is not a terminal there are no bars (a bar redrawn per view floods a log): a line per
     finished scene, and one every :data:`LOG_INTERVAL_S` seconds with the views done and the
     time left.

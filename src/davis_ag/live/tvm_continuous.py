@@ -239,7 +239,8 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         options = dict(options or {})
         unknown = sorted(set(options) - {"pose", "target", "scene"})
         scene = options.get("scene", 0)
-        if unknown or not isinstance(scene, (int, np.integer)) or not 0 <= scene < len(self.scenes):
+        alone = "target" in options and "pose" not in options  # a target is chosen with its pose
+        if unknown or alone or not isinstance(scene, (int, np.integer)) or not 0 <= scene < len(self.scenes):
             raise UserError(
                 f"reset options {options}: give a scene index below {len(self.scenes)}, a pose and a target"
                 + (f" (not {', '.join(unknown)})" if unknown else "")

@@ -6,7 +6,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from davis_ag.atomic_files import write_marked_section
+from davis_ag.atomic_files import read_page, write_marked_section
 from davis_ag.generate.run_config import load_dataset_config
 from davis_ag.generate.run_progress import count_views
 
@@ -106,7 +106,7 @@ def write_continuous(result: dict, load: tuple[float, float], doc: Path | None) 
     if doc:
         write_marked_section(doc, "bench-continuous", continuous_table(result, load))
         page = doc.absolute().parent / "views-on-demand.md"
-        if page.is_file() and "<!-- continuous-rate:start -->" in page.read_text():
+        if page.is_file() and "<!-- continuous-rate:start -->" in read_page(page, "page"):
             write_marked_section(page, "continuous-rate", continuous_line(result))
 
 

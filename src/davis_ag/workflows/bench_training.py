@@ -17,7 +17,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from davis_ag.atomic_files import write_marked_section
+from davis_ag.atomic_files import read_page, write_marked_section
 
 SEED = 0
 #: Steps each learner is timed for: a whole number of every timed rollout (8 environments x 128
@@ -144,5 +144,5 @@ def write_training(result: dict[str, Any], load: tuple[float, float], doc: Path 
     if doc:
         write_marked_section(doc, "bench-training", training_table(result, load))
         page = doc.absolute().parent / "benchmark.md"
-        if page.is_file() and "<!-- ppo-rate:start -->" in page.read_text():
+        if page.is_file() and "<!-- ppo-rate:start -->" in read_page(page, "page"):
             write_marked_section(page, "ppo-rate", ppo_line(result))

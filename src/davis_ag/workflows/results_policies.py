@@ -53,7 +53,7 @@ def model_path(out: Path, group: str, learner: str = "A2C") -> Path:
 def training_record(out: Path | None, group: str, learner: str = "A2C") -> dict[str, Any]:
     """A run's training record of a learner (A2C by default) for a group; {} without a run
     folder or a record."""
-    from davis_ag.benchmark.training import training_record_path
+    from davis_ag.benchmark.training_record import training_record_path
 
     return load_json_object(training_record_path(model_path(out, group, learner))) if out else {}
 

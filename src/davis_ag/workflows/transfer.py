@@ -77,22 +77,40 @@ def _jsonable(config: TransferConfig) -> dict[str, Any]:
 WORK_RECORD = "transfer-config.json"
 
 
+def _settings(config: dict[str, Any]) -> dict[str, Any]:
+    """What a work folder's runs depend on, from a config as ``transfer.json`` records it: not the
+    folder, the label, or where and how fast the runs train (``device``, data-loading ``workers``)."""
+    kept = {k: v for k, v in config.items() if k not in ("out", "real_label")}
+    for key in ("pretrain", "real"):
+        kept[key] = str(Path(str(kept.get(key))).resolve())
+    for key in ("budget", "pretrain_budget"):
+        if isinstance(kept.get(key), dict):
+            kept[key] = {k: v for k, v in kept[key].items() if k not in ("device", "workers")}
+    return kept
+
+
 def check_work_folder(config: TransferConfig) -> None:
     """Hold a work folder to one experiment: its finished runs and scores are reused, so a run of
     other settings (another pre-training set, real set, budget or seed) would report them as its own.
 
+    A folder from before the record took its settings from its ``transfer.json``, when there is one.
+
     Raises:
-        UserError: when the folder holds a run of other settings.
+        UserError: when the folder holds a run of other settings, or runs whose settings it never recorded.
     """
-    wanted = {k: v for k, v in _jsonable(config).items() if k not in ("out", "real_label")}
-    wanted["pretrain"], wanted["real"] = str(Path(config.pretrain).resolve()), str(Path(config.real).resolve())
+    wanted = _settings(_jsonable(config))
     record = config.out / WORK_RECORD
-    try:
-        made = json.loads(record.read_text()) if record.is_file() else None
-    except (OSError, ValueError):
-        made = None
+    made: Any = None
+    for source in (record, config.out / "transfer.json"):
+        try:
+            found = json.loads(source.read_text()) if source.is_file() else None
+        except (OSError, ValueError):
+            found = None
+        if isinstance(found, dict):
+            made = found if source == record else _settings(found.get("config") or {})
+            break
     if made is None:
-        if any((config.out / name).exists() for name in ("runs", "split1", "transfer.json")):
+        if any((config.out / name).exists() for name in ("runs", "split1")):
             raise UserError(
                 f"{config.out} holds transfer runs of unrecorded settings: give another --out, or move it away"
             )
@@ -104,6 +122,7 @@ def check_work_folder(config: TransferConfig) -> None:
             f"{config.out} holds a transfer run of other settings ({differ[0]}: {made.get(differ[0])} against "
             f"{wanted[differ[0]]}), whose runs and scores this one would reuse: give another --out, or move it away"
         )
+    write_json_atomic(record, wanted)
 
 
 def run_transfer(config: TransferConfig, say: Callable[[str], None] = print) -> dict[str, Any]:
