@@ -333,8 +333,14 @@ def test_only_the_process_that_died_spends_a_try() -> None:
 
     pool = ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("spawn"))  # as generate does
     try:
-        crashing, healthy = pool.submit(_exits_at_once), pool.submit(_runs_long)
+        # Start both workers first. The pool adds a worker to the set it watches only after it
+        # wakes its manager thread, so a worker that dies in its first milliseconds can go
+        # unseen until the next result arrives (CPython 3.11): the healthy scene would then
+        # finish before the pool breaks, and this test would measure that race, not our rule.
+        wait([pool.submit(time.sleep, 0.5) for _ in range(2)], timeout=60)
         pids = set(pool._processes)
+        assert len(pids) == 2
+        crashing, healthy = pool.submit(_exits_at_once), pool.submit(_runs_long)
         wait([crashing, healthy], timeout=20)
         for future in (crashing, healthy):
             with pytest.raises(BrokenProcessPool):
