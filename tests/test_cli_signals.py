@@ -32,12 +32,17 @@ def stop_when(process: subprocess.Popen, ready: callable, number: int, limit: fl
     """Send ``number`` to ``process`` once ``ready()`` holds; its exit status and stderr's lines
     that are no progress bar."""
     deadline = time.monotonic() + limit
-    while not ready():
-        assert process.poll() is None, process.communicate()
-        assert time.monotonic() < deadline, "the command never got going"
-        time.sleep(0.1)
-    os.kill(process.pid, number)
-    _, err = process.communicate(timeout=60)
+    try:
+        while not ready():
+            assert process.poll() is None, process.communicate()
+            assert time.monotonic() < deadline, "the command never got going"
+            time.sleep(0.1)
+        os.kill(process.pid, number)
+        _, err = process.communicate(timeout=60)
+    finally:
+        if process.poll() is None:  # a failed check: never leave a long command eating the cores
+            process.kill()
+            process.communicate()
     lines = [line for line in err.replace("\r", "\n").splitlines() if line.strip() and "%|" not in line]
     return process.returncode, "\n".join(lines)
 

@@ -145,7 +145,7 @@ def test_a_second_run_on_one_output_is_refused(tmp_path: Path, data: Path, capsy
                 "from pathlib import Path\n"
                 "from davis_ag.formats.outputs import claim_output\n"
                 f"with claim_output(Path({str(model)!r})), claim_output(Path({str(export)!r}), folder=True):\n"
-                "    print('claimed', flush=True); time.sleep(60)\n"
+                "    print('claimed', flush=True); time.sleep(3600)\n"  # killed below
             ),
         ],
         stdout=subprocess.PIPE,

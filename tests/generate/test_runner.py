@@ -117,7 +117,7 @@ def test_a_second_run_on_the_same_folder_is_refused(
                 "import fcntl, os, sys, time\n"
                 f"fd = os.open({str(root / LOCK_FILE)!r}, os.O_RDWR | os.O_CREAT)\n"
                 "fcntl.flock(fd, fcntl.LOCK_EX); os.write(fd, str(os.getpid()).encode())\n"
-                "print('locked', flush=True); time.sleep(60)\n"
+                "print('locked', flush=True); time.sleep(3600)\n"  # killed below
             ),
         ],
         stdout=subprocess.PIPE,
@@ -199,14 +199,19 @@ def test_killed_pool_run_resumes_to_the_same_dataset(reference: Path, tiny_confi
     command = [*DAVIS_AG, "generate", "--config", str(tiny_config), "--out", str(root), "--workers", "2", "--quiet"]
     run = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 180
-    while not list(root.glob("Single-Strawberry/.*.partial/images/*_seg.png")):  # mid-scene
-        assert run.poll() is None, f"the run ended before it could be killed: {run.stderr.read()}"
-        assert time.monotonic() < deadline
-        time.sleep(0.01)
-    workers = _children(run.pid)
-    run.send_signal(signal.SIGKILL)
-    run.wait()
-    run.stderr.close()
+    try:
+        while True:
+            workers = _children(run.pid)  # before the look, so the kill follows it at once
+            if list(root.glob("Single-Strawberry/.*.partial/images/*_seg.png")):  # mid-scene
+                break
+            assert run.poll() is None, f"the run ended before it could be killed: {run.stderr.read()}"
+            assert time.monotonic() < deadline
+            time.sleep(0.01)
+        run.send_signal(signal.SIGKILL)
+    finally:
+        run.kill()
+        run.wait()
+        run.stderr.close()
     deadline = time.monotonic() + 20
     while any(_alive(pid) for pid in workers):  # the pool's processes die with the run: no orphan
         assert time.monotonic() < deadline, "worker processes outlived the killed run"  # keeps writing
@@ -233,15 +238,23 @@ def test_local_runs_never_import_ray() -> None:
 
 
 def test_ray_executor_makes_the_same_dataset(reference: Path, tiny_config: Path, tmp_path: Path) -> None:
+    """Ray starts its own local instance and leaves the command line's SIGTERM handler in place
+    (ray.init installs sys.exit(15), so a stopped run said nothing of what it kept, exit 15)."""
     ray = pytest.importorskip("ray")
-    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False, logging_level="error")
+
+    def ours(number: int, frame: object) -> None:
+        raise AssertionError("not called")
+
+    previous = signal.signal(signal.SIGTERM, ours)
     try:
         root = tmp_path / "data"
         options = RunOptions(executor="ray", cpus_per_scene=1, progress=False)
         report = run_dataset(load_dataset_config(tiny_config).requests(), root, options)
         assert sorted(report.made) == ["Single-Strawberry/000", "Single-Strawberry/001"]
+        assert signal.getsignal(signal.SIGTERM) is ours
     finally:
-        ray.shutdown()
+        signal.signal(signal.SIGTERM, previous)
+        ray.shutdown()  # a no-op when the run shut it down
     assert digest(root) == digest(reference)
 
 
@@ -337,8 +350,9 @@ def test_only_the_process_that_died_spends_a_try() -> None:
         # wakes its manager thread, so a worker that dies in its first milliseconds can go
         # unseen until the next result arrives (CPython 3.11): the healthy scene would then
         # finish before the pool breaks, and this test would measure that race, not our rule.
-        wait([pool.submit(time.sleep, 0.5) for _ in range(2)], timeout=60)
+        done, _ = wait([pool.submit(time.sleep, 0.5) for _ in range(2)], timeout=120)
         pids = set(pool._processes)
+        assert len(done) == 2
         assert len(pids) == 2
         crashing, healthy = pool.submit(_exits_at_once), pool.submit(_runs_long)
         wait([crashing, healthy], timeout=20)

@@ -8,6 +8,8 @@ there atomically, exactly as a local run does, and the driver keeps the folder's
 
 from __future__ import annotations
 
+import signal
+import threading
 import time
 from pathlib import Path
 from typing import Any, Sequence
@@ -96,8 +98,13 @@ def connect(address: str | None):
         ) from None
     if ray.is_initialized():
         return ray, False
+    # ray.init puts its own SIGTERM handler (sys.exit(15)) in place of the command line's, which
+    # turns a stop into Stopped: keep ours, so a stopped run says what it kept and exits 143.
+    handlers = {number: signal.getsignal(number) for number in (signal.SIGTERM, signal.SIGINT)}
     try:
-        ray.init(address=address, log_to_driver=False, logging_level="warning")
+        # Without --address, a new local instance (as docs/generating.md says), never the cluster
+        # that /tmp/ray/ray_current_cluster or RAY_ADDRESS happens to name: --address auto joins it.
+        ray.init(address=address or "local", log_to_driver=False, logging_level="warning")
     except Exception as error:  # ConnectionError, ValueError, RuntimeError depending on the address
         where = address or "a new local instance"
         reason = (str(error).splitlines() or [type(error).__name__])[0].rstrip(".")
@@ -105,6 +112,11 @@ def connect(address: str | None):
             f"cannot start or reach Ray at {where}: {reason}; "
             "start the cluster with `ray start --head` and pass --address auto or ray://HEAD:10001"
         ) from None
+    finally:
+        if threading.current_thread() is threading.main_thread():
+            for number, handler in handlers.items():
+                if handler is not None:  # None: set outside Python, nothing to put back
+                    signal.signal(number, handler)
     return ray, True
 
 
