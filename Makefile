@@ -38,7 +38,7 @@ bench: $(STAMP)
 	$(BIN)/davis-ag bench --out $(OUT)/bench.json --doc docs/performance.md
 
 reproduce: $(STAMP)
-	$(BIN)/davis-ag reproduce --out $(OUT)/reproduce --results docs/results.md
+	$(BIN)/davis-ag reproduce --out $(OUT)/reproduce
 
 clean:
 	rm -rf $(OUT) .pytest_cache

@@ -13,7 +13,7 @@ from davis_ag.workflows.reproduce_configs import CONFIGS
 
 
 def test_a_run_from_before_ppo_is_rewritten_without_claiming_ppo(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     # Issue 32: medium's state.json predates ReproduceConfig.learners; its page still renders, and
     # nothing on it says PPO ran, although the configuration now trains it.
@@ -32,7 +32,12 @@ def test_a_run_from_before_ppo_is_rewritten_without_claiming_ppo(
     }
     (tmp_path / "state.json").write_text(json.dumps(state))
     page = tmp_path / "results.md"
-    assert cli.main(["reproduce", "--out", str(tmp_path), "--rewrite-results", "--results", str(page)]) == 0
+    elsewhere = tmp_path / "clone"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)  # a clone, whose docs/results.md is the committed page
+    # Without --results the page lives with its run, never in the working folder's docs/.
+    assert cli.main(["reproduce", "--out", str(tmp_path), "--rewrite-results"]) == 0
+    assert not list(elsewhere.iterdir())
     text = page.read_text()
     assert "| A2C | .600 ± .010 |" in text and "| sp-strawberry: train A2C | 7200 |" in text
     assert "PPO" not in text

@@ -12,8 +12,8 @@ ALGORITHMS: tuple[str, ...] = ("a2c", "ppo", "dqn")
 #: PPO's and DQN's settings on top of Stable-Baselines3's defaults. PPO: RL Baselines3 Zoo's
 #: settings for Atari (``hyperparams/ppo.yml``, the zoo's set for a ``CnnPolicy`` on images with
 #: our 8 environments), not SB3's defaults, which are made for small vector observations: with
-#: 8 environments SB3's 2,048-step rollouts leave 300K steps 18 policy updates (the zoo's
-#: 128-step rollouts, 292), and its 10 epochs of 64-sample batches cost more per step than the
+#: 8 environments SB3's 2,048-step rollouts leave 300K steps 19 policy updates (the zoo's
+#: 128-step rollouts, 293: whole rollouts until the budget is reached), and its 10 epochs of 64-sample batches cost more per step than the
 #: zoo's 4 epochs of 256 (``make bench``'s training table, docs/performance.md). ``lin_X``: X falling
 #: linearly to 0 over the run (:func:`sb3_arguments`). DQN: SB3's replay
 #: buffer holds 1M transitions, which at 224x224x4 bytes per observation (twice: the next one

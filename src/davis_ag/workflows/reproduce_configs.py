@@ -63,7 +63,8 @@ class ReproduceConfig:
 
 #: ``small``: under an hour of stages on a 2-core CPU machine without GPU;
 #: a 3 x 2 m MP grid and 10 % / 5 % of the paper's A2C steps: not comparable with Table 4.
-#: ``medium``: the paper's grids (SP strawberry's 2.5 x 2.5 m, section III-B's 7 x 3 m MP) and protocol (300K A2C steps,
+#: ``medium``: the paper's grids (SP strawberry's 2.5 x 2.5 m, read from Table 3's 285 views, not
+#: section III-B's 3 x 3 m; section III-B's 7 x 3 m MP) and protocol (300K A2C steps,
 #: 3 sessions of 200 episodes) on 10 SP strawberry and 10 MP vine scenes at 640x360 (the policy
 #: sees 224x224 either way; the 70/30 split leaves 3 test scenes of each), a few hours on such a
 #: machine, resumable across sittings.
