@@ -235,13 +235,17 @@ def rescue_folder() -> Path:
     raise UserError("no folder is writable: neither ~/.cache nor the temporary folder")
 
 
-def write_or_rescue(path: str | os.PathLike[str], write: Callable[[Path], None], what: str) -> Path:
+def write_or_rescue(
+    path: str | os.PathLike[str], write: Callable[[Path], None], what: str, survivor: Callable[[], str] | None = None
+) -> Path:
     """Write a result that took long to make; when its path fails, keep it elsewhere and say so.
 
     Args:
         path: Where the result should go.
         write: Writes the result to the path it is given (atomically, ideally).
         what: What the result is, for the message (e.g. "the trained model").
+        survivor: When neither place takes it, what survives of the work and how to go on (e.g.
+            a training run's last checkpoint); by default, that the result is lost.
 
     Returns:
         ``path`` when written there.
@@ -259,8 +263,8 @@ def write_or_rescue(path: str | os.PathLike[str], write: Callable[[Path], None],
     try:
         write(kept)
     except OSError as error:
+        left = survivor() if survivor is not None else f"{what} is lost; free space and run again"
         raise MachineError(
-            f"cannot write {what} to {target} ({reason}) nor to {kept} "
-            f"({error.strerror or error}): {what} is lost; free space and run again"
+            f"cannot write {what} to {target} ({reason}) nor to {kept} ({error.strerror or error}): {left}"
         ) from None
     raise MachineError(f"cannot write {what} to {target} ({reason}); it was kept in {kept}: move it where you want it")

@@ -17,7 +17,9 @@ Streams are NumPy ``SeedSequence`` keys, so two streams never share draws howeve
 - a training run's environment ``i``: ``[seed, TRAIN_ENV_STREAM, i]`` (:func:`training_env_seed`;
   runs begun before it, and their resumptions, seed ``seed + i`` as SB3 does, under which
   environment 1 of seed 0 replays environment 0 of seed 1); the learner itself is seeded with
-  the run's seed (SB3: torch, NumPy, Python), and the snapshot scoring plays fixed episodes
+  the run's seed (SB3: torch, NumPy, Python); a sitting resumed from the checkpoint at step ``k``
+  seeds all of these from ``[seed, TRAIN_RESUME_STREAM, k]`` instead (:func:`resumed_training_seed`),
+  so it does not replay the first sitting's episodes and draws; the snapshot scoring plays fixed episodes
   (:data:`davis_ag.benchmark.selection.SELECT_SEED`) under a forked torch state;
 - the paired bootstrap: ``default_rng(seed)`` of the evaluation (:mod:`davis_ag.benchmark.paired`);
   the transfer experiment's split ``k``: ``seed + k``, its appearance shift: ``[seed, image]``.
@@ -51,6 +53,8 @@ OFF_GRID_STREAM = 2**32 - 1
 #: A training run's environments, after its seed (then the environment's index); beyond any
 #: evaluation session's number, whose keys ``[seed, session, ...]`` share the first place.
 TRAIN_ENV_STREAM = 2**32 - 2
+#: A training sitting resumed from a checkpoint, after the run's seed (then the step it resumes at).
+TRAIN_RESUME_STREAM = 2**32 - 3
 
 
 def derived_seed(*keys: int) -> int:
@@ -77,6 +81,12 @@ def view_noise_seed(noise_seed: int, index: int, pose: Sequence[float]) -> int:
     rounded = np.round(np.asarray(pose, dtype=np.float64), 6) + 0.0  # + 0.0: -0.0 and 0.0 alike
     digest = int.from_bytes(hashlib.sha256(rounded.tobytes()).digest()[:8], "little")
     return derived_seed(noise_seed, OFF_GRID_STREAM, digest)
+
+
+def resumed_training_seed(seed: int, step: int) -> int:
+    """The seed of a training sitting of a run of ``seed`` resumed at ``step`` (``[seed,
+    TRAIN_RESUME_STREAM, step]``): the learner's and, through it, its environments'."""
+    return derived_seed(seed, TRAIN_RESUME_STREAM, step)
 
 
 def training_env_seed(seed: int, index: int) -> int:

@@ -69,3 +69,32 @@ def test_a_killed_run_resumes_with_the_best_it_had(tmp_path: Path, one_thread: N
 def test_an_unknown_keep_rule_is_refused(tmp_path: Path) -> None:
     with pytest.raises(UserError, match="unknown --keep 'best'"):
         check_keep("best")
+
+
+def test_a_stop_after_the_choice_but_before_the_record_keeps_the_choice(
+    tmp_path: Path, one_thread: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The kept snapshot was renamed into place before the training record and the checkpoint's
+    removal: a stop in between left no snapshot under its name, and the run resumed from the
+    checkpoint dropped every score and kept the checkpoint's model instead of the best."""
+    from davis_ag.benchmark import training
+
+    root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2)
+    out = tmp_path / "a2c.zip"
+    real = training.write_json_atomic
+
+    def stop_at_the_record(path: Path, data: object) -> None:
+        if path == training_record_path(out):
+            raise KeyboardInterrupt
+        real(path, data)
+
+    monkeypatch.setattr(training, "write_json_atomic", stop_at_the_record)
+    with pytest.raises(KeyboardInterrupt):
+        train_a2c(root, "sp", out_path=out, checkpoint_every=40, **KWARGS)
+    first = json.loads(checkpoint_paths(out)[1].read_text())["selection"]
+    monkeypatch.undo()
+    train_a2c(root, "sp", out_path=out, checkpoint_every=40, **KWARGS)
+    selection = json.loads(training_record_path(out).read_text())["selection"]
+    assert selection["scores"][: len(first)] == first  # none dropped
+    assert A2C.load(out, device="cpu").num_timesteps == selection["kept_step"]
+    assert _snapshots(tmp_path) == []

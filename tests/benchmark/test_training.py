@@ -6,16 +6,20 @@ import json
 import tempfile
 from pathlib import Path
 
+import numpy as np
 import pytest
+import torch
 from kill_callback import KillAfter
 from layout_factory import write_tiny_dataset
 from stable_baselines3 import A2C
+from stable_baselines3.common.callbacks import BaseCallback, CallbackList
 
 from davis_ag.benchmark.algorithms import A2C_SETTINGS
 from davis_ag.benchmark.selection import snapshot_path
 from davis_ag.benchmark.training import check_device, checkpoint_paths, train_a2c, training_record_path
 from davis_ag.errors import MachineError, UserError
 from davis_ag.provenance import code_version
+from davis_ag.seeds import resumed_training_seed
 
 #: The smallest real training run: two environments, the tiny network, a checkpoint every 20 steps.
 TINY_RUN = dict(n_envs=2, arch="pooled", device="cpu", checkpoint_every=20)
@@ -462,3 +466,50 @@ def test_a_stop_while_a_model_saves_waits_for_the_whole_file(tmp_path: Path) -> 
     with pytest.raises(Stopped):
         save_model(_SavesInTwoWrites(), path)
     assert path.read_bytes() == b"first half, second half"
+
+
+class _FirstObservation(BaseCallback):
+    """What a sitting starts from: its environments' first observations and torch's seed."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.seen: list[tuple] = []
+
+    def _on_training_start(self) -> None:
+        self.seen.append((self.model._last_obs.copy(), torch.initial_seed()))
+
+    def _on_step(self) -> bool:
+        return True
+
+
+def test_a_resumed_sitting_draws_its_own_episodes(tmp_path: Path, one_thread: None) -> None:
+    """SB3's load seeds everything with the run's seed, as at step 0: a resumed sitting replayed
+    the first one's episode starts and action draws. It draws from its own stream now."""
+    root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2)
+    kwargs = dict(total_timesteps=240, seed=1, out_path=tmp_path / "a2c", keep="last", **TINY_RUN)
+    first = _FirstObservation()
+    with pytest.raises(KeyboardInterrupt):
+        train_a2c(root, "sp", callback=CallbackList([first, KillAfter(130)]), **kwargs)
+    done = json.loads(checkpoint_paths(tmp_path / "a2c")[1].read_text())["timesteps_done"]
+    second = _FirstObservation()
+    train_a2c(root, "sp", callback=second, **kwargs)
+    (obs_1, torch_1), (obs_2, torch_2) = first.seen[0], second.seen[0]
+    assert torch_1 == 1 and torch_2 == resumed_training_seed(1, done)
+    assert not np.array_equal(obs_1, obs_2)  # other starts, not sitting 1's again
+
+
+def test_a_checkpoint_whose_record_lags_its_model_keeps_the_budget(tmp_path: Path, one_thread: None) -> None:
+    """A stop between the checkpoint's zip and its record left the record a checkpoint behind;
+    counting from it trained past the budget (the record said 260 of 240 steps)."""
+    root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2)
+    kwargs = dict(total_timesteps=240, seed=1, out_path=tmp_path / "a2c", keep="last", **TINY_RUN)
+    with pytest.raises(KeyboardInterrupt):
+        train_a2c(root, "sp", callback=KillAfter(130), **kwargs)
+    settings_file = checkpoint_paths(tmp_path / "a2c")[1]
+    saved = json.loads(settings_file.read_text())
+    done = saved["timesteps_done"]
+    settings_file.write_text(json.dumps({**saved, "timesteps_done": done - 20}))  # the zip is 20 steps ahead
+    path = train_a2c(root, "sp", **kwargs)
+    record = json.loads(training_record_path(path).read_text())
+    assert A2C.load(path, device="cpu").num_timesteps == 240 and record["timesteps"] == 240
+    assert [(s["from_step"], s["to_step"]) for s in record["sittings"]][-1] == (done, 240)

@@ -122,6 +122,12 @@ def test_ppo_trains_beside_a2c_resumes_a_killed_run_and_reuses_a_finished_one(
     made = model.stat().st_mtime_ns
     assert train_learner("ppo", sp_root, "sp", "strawberry", model, 128, config, **kwargs) is None
     assert model.stat().st_mtime_ns == made
+    # A run of another seed or number of environments does not reuse it: its page would state them.
+    config = replace(config, seed=2)
+    assert train_learner("ppo", sp_root, "sp", "strawberry", model, 128, config, **kwargs) is not None
+    record = json.loads(training_record_path(model).read_text())
+    assert record["seed"] == 2
+    assert train_learner("ppo", sp_root, "sp", "strawberry", model, 128, config, **kwargs) is None
     # A model trained on another train split (the group grew since) is trained anew, not reused.
     record_path = training_record_path(model)
     record_path.write_text(json.dumps({**record, "train_scenes": ["Single-Strawberry/001"]}))

@@ -20,7 +20,7 @@ from stable_baselines3.common.callbacks import BaseCallback
 from davis_ag.atomic_files import atomic_output, write_json_atomic
 from davis_ag.benchmark.algorithms import SB3_DEFAULT_SETTINGS
 from davis_ag.benchmark.progress import LearningCurve
-from davis_ag.benchmark.selection import KeepBestOnTrain
+from davis_ag.benchmark.selection import KeepBestOnTrain, last_multiple
 from davis_ag.errors import UserError, stops_held
 from davis_ag.provenance import code_version
 
@@ -178,14 +178,18 @@ class CheckpointEvery(BaseCallback):
         self._last = 0
 
     def _on_training_start(self) -> None:
-        self._last = self.model.num_timesteps
+        self._last = last_multiple(self.model.num_timesteps, self.every)
 
     def _on_step(self) -> bool:
+        return True
+
+    def _on_rollout_start(self) -> None:
+        # Between rollouts, after the last one's update: a checkpoint inside a rollout holds the
+        # model without it, and the resumed run would lose those steps' update but count them.
         if self.model.num_timesteps - self._last >= self.every:
-            self._last = self.model.num_timesteps
+            self._last = last_multiple(self.model.num_timesteps, self.every)
             with stops_held():  # the model and its settings file, both or neither, before a stop
                 self._save()
-        return True
 
     def _save(self) -> None:
         save_model(self.model, self.model_file)
@@ -194,8 +198,8 @@ class CheckpointEvery(BaseCallback):
             self.settings_file,
             {
                 **self.settings,
-                "timesteps_done": self._last,
-                "sittings": self.sittings.upto(self._last),
+                "timesteps_done": int(self.model.num_timesteps),
+                "sittings": self.sittings.upto(int(self.model.num_timesteps)),
                 "curve": self.curve.points,
                 "selection": scores,
             },

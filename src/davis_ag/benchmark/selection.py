@@ -16,6 +16,7 @@ best it had.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Any
 
@@ -110,13 +111,18 @@ class KeepBestOnTrain(BaseCallback):
         return max(self.scores, key=lambda s: (s["oer_tau"], -s["step"])) if self.scores else None
 
     def _on_training_start(self) -> None:
-        self._last = self.model.num_timesteps
+        # On the run's multiples of ``every``, whatever step a sitting resumes at.
+        self._last = last_multiple(self.model.num_timesteps, self.every)
 
     def _on_step(self) -> bool:
-        if self.every and self.model.num_timesteps - self._last >= self.every:
-            self._last = self.model.num_timesteps
-            self.score_now()
         return True
+
+    def _on_rollout_start(self) -> None:
+        # Between rollouts, after the update of the last one: the policy scored is the one that
+        # step count names (inside a rollout it would lack its last update).
+        if self.every and self.model.num_timesteps - self._last >= self.every:
+            self._last = last_multiple(self.model.num_timesteps, self.every)
+            self.score_now()
 
     def score_now(self) -> None:
         """Score the current policy; save it when it is the best so far."""
@@ -158,6 +164,25 @@ class KeepBestOnTrain(BaseCallback):
             "scores": self.scores,
             "kept_step": best["step"] if best else None,
         }
+
+
+def last_multiple(step: int, every: int) -> int:
+    """The last multiple of ``every`` at or before ``step`` (``step`` itself when ``every`` is 0)."""
+    return step - step % every if every else step
+
+
+def publish_snapshot(snapshot: Path, final: Path) -> None:
+    """Put the kept ``snapshot`` at ``final`` without copying it: a hard link, so the snapshot
+    keeps its own name until the run's records are written (pruned after), or a rename where the
+    file system has no links."""
+    link = final.with_name(f".{final.name}.{os.getpid()}.link")
+    try:
+        link.unlink(missing_ok=True)
+        os.link(snapshot, link)
+    except OSError:
+        os.replace(snapshot, final)
+        return
+    os.replace(link, final)
 
 
 def _play() -> str:

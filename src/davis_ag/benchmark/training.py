@@ -7,8 +7,10 @@ A 300K-step run on a CPU takes hours, so training saves a checkpoint every few t
 (model, optimiser state and step count in SB3's zip, beside a small JSON of the run's settings)
 and a run started again with the same settings continues from the last checkpoint instead of
 from scratch. What a resumed run does not restore: the environments' episodes in flight (they
-start anew) and the random streams, so a resumed run is a valid continuation, not bit-identical
-to an uninterrupted one.
+start anew) and the random streams, which it draws afresh from ``[seed, TRAIN_RESUME_STREAM,
+step]`` (:func:`davis_ag.seeds.resumed_training_seed`; SB3's load would reseed them as at step 0
+and replay the first sitting), so a resumed run is a valid continuation, reproducible from the
+steps its sittings begin at, not bit-identical to an uninterrupted one.
 """
 
 from __future__ import annotations
@@ -36,13 +38,13 @@ from davis_ag.benchmark.algorithms import (
 from davis_ag.benchmark.checkpoints import CheckpointEvery, Sittings, check_checkpoint, load_checkpoint, save_model
 from davis_ag.benchmark.networks import ARCHITECTURES
 from davis_ag.benchmark.progress import LearningCurve, TrainingProgress
-from davis_ag.benchmark.selection import KeepBestOnTrain, check_keep, snapshot_path
+from davis_ag.benchmark.selection import KeepBestOnTrain, check_keep, publish_snapshot, snapshot_path
 from davis_ag.benchmark.splits import select_scenes
 from davis_ag.benchmark.training_record import model_path, training_record_path
 from davis_ag.benchmark.tvm import as_dataset
 from davis_ag.errors import MachineError, UserError
 from davis_ag.formats.models import check_seed
-from davis_ag.seeds import training_env_seed
+from davis_ag.seeds import resumed_training_seed, training_env_seed
 
 #: Steps between checkpoints by default: about a minute of training on a 2-core CPU.
 CHECKPOINT_EVERY = 10_000
@@ -230,8 +232,14 @@ def train_agent(
         settings["env_seeds"] = resumed[4]
     env = make_vec_tvm(opened, scenario, n_envs, seed, "train", crop, cache_dir, settings["env_seeds"])
     if resumed is not None:
-        done, earlier, points, scores, _ = resumed
+        _, earlier, points, scores, _ = resumed
         model = load_checkpoint(algorithm, model_file, env, device)
+        # The model's own count: a stop between the checkpoint's zip and its record leaves the
+        # record a checkpoint behind, and counting from it would train past the budget.
+        done = int(model.num_timesteps)
+        # SB3's load seeds torch, NumPy, Python and the environments with the run's seed, as at
+        # step 0: every resumed sitting would replay the first one's episodes and draws.
+        model.set_random_seed(resumed_training_seed(seed, done))
         print(f"resuming {final.name} from its checkpoint at {done} of {total_timesteps} steps", flush=True)
     else:
         model = algorithm(
@@ -264,16 +272,31 @@ def train_agent(
             model.learn(
                 total_timesteps=total_timesteps - done, callback=callbacks or None, reset_num_timesteps=done == 0
             )
+        elif selection is not None:  # a checkpoint at the budget (older versions wrote one): nothing to learn
+            selection.init_callback(model)
         env.close()
         curve.flush(int(model.num_timesteps))
         extra: dict[str, Any] = {}
         if selection is None:
-            saved = write_or_rescue(final, lambda path: save_model(model, path), "the trained model")
+            saved = write_or_rescue(
+                final,
+                lambda path: save_model(model, path),
+                "the trained model",
+                # The last checkpoint survives a write that fails at both places (a full disk).
+                lambda: (
+                    f"the last checkpoint is kept in {model_file}: free the space and run the same "
+                    "command again to finish"
+                    if model_file.is_file()
+                    else "the trained model is lost; free space and run again"
+                ),
+            )
         else:
             selection.score_now()  # the last snapshot competes too
-            # A rename, not a copy: it needs no space, so a full disk cannot lose the best snapshot.
+            # A link, not a copy: it needs no space, so a full disk cannot lose the best snapshot;
+            # and the snapshot keeps its name until the record and checkpoint are done, so a
+            # stop in between resumes to the same choice instead of one of the checkpoint.
             saved = final
-            os.replace(snapshot_path(final, selection.best["step"]), final)
+            publish_snapshot(snapshot_path(final, selection.best["step"]), final)
             extra["selection"] = selection.record()
             print(
                 f"kept the snapshot at {selection.best['step']} steps (train-split OER_tau "
@@ -307,8 +330,6 @@ def what_survives(error: OSError, final: Path, selection: KeepBestOnTrain | None
     """The one line of a training run that a failure of the machine (a full disk) ended: what
     failed, and which finished model survives where (the final model, the best snapshot so far,
     or the last checkpoint), so nothing finished is lost or claimed where it is not."""
-    reason = f"{error.filename}: " if error.filename else ""
-    reason += error.strerror or str(error)
     best = selection.best if selection is not None else None
     if final.is_file() and (best is None or not snapshot_path(final, best["step"]).is_file()):
         kept = f"the trained model is saved in {final} (its training record is not)"
@@ -321,6 +342,7 @@ def what_survives(error: OSError, final: Path, selection: KeepBestOnTrain | None
         kept = f"the last checkpoint is kept in {model_file}"
     else:
         kept = "no snapshot was finished yet"
+    reason = (f"{error.filename}: " if error.filename else "") + (error.strerror or str(error))
     return f"training stopped: {reason}; {kept}: free the space and run the same command again to finish"
 
 

@@ -67,6 +67,7 @@ def train_learner(
         model.is_file()
         and all(made.get(k) == v for k, v in wanted.items())
         and _split_unchanged(model, root, scenario, crop)
+        and _made_as_configured(model, config, train_kwargs.get("arch", "paper"))
     ):
         return None
     network = "the paper's network" + (" as features extractor" if algo != "a2c" else "")
@@ -90,6 +91,16 @@ def train_learner(
     seconds = time.perf_counter() - start
     write_json_atomic(stamp, {**wanted, "seconds": seconds})
     return seconds
+
+
+def _made_as_configured(model: Path, config: Any, arch: str) -> bool:
+    """Whether a finished model's training record names the run's seed, number of environments
+    and network, which the page states for it; a model without a record is taken as it is."""
+    from davis_ag.benchmark.training_record import training_record_path
+
+    record = load_json_object(training_record_path(model))
+    wanted = {"seed": config.seed, "n_envs": config.n_envs, "arch": arch}
+    return all(record.get(key, value) == value for key, value in wanted.items())
 
 
 def _split_unchanged(model: Path, root: Path, scenario: str, crop: str) -> bool:
