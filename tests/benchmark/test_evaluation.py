@@ -236,3 +236,39 @@ def test_not_a_dataset(tmp_path: Path) -> None:
     )
     with pytest.raises(UserError, match="not a DAVIS-Ag dataset"):
         args.func(args)
+
+
+def test_the_table_says_when_a_policy_plays_one_action_or_episodes_replay_few_starts(sp_root: Path) -> None:
+    """A collapsed learner (one action throughout) reads like a method, and an interval over 100
+    episodes of a handful of starts reads like a sure gap; the table says both."""
+    from davis_ag.benchmark.agents import FixedActionAgent
+    from davis_ag.benchmark.results import as_results
+
+    results = evaluate_policies(TVMEnv(sp_root, "sp", "test"), [FixedActionAgent("left")], episodes=50, sessions=2)
+    table = format_table(results)
+    assert "note: always left played left only: a fixed action, not a method" in table
+    starts = as_results(results).protocol.starts
+    assert f"note: 100 episodes replay {starts} eligible starts" in table and starts < 50
+
+
+def test_a_policy_is_prepared_once_for_all_its_episodes(sp_root: Path) -> None:
+    """The Policy protocol promises one ``prepare(env)`` before any episode; it ran before each."""
+
+    class Counting:
+        name = "counting"
+
+        def __init__(self) -> None:
+            self.prepared = 0
+
+        def prepare(self, env: object) -> None:
+            self.prepared += 1
+
+        def reset(self, seed: int | None = None) -> None:
+            pass
+
+        def act(self, observation: np.ndarray, info: dict) -> str:
+            return "done"
+
+    policy = Counting()
+    evaluate_policies(TVMEnv(sp_root, "sp", "test"), [policy], episodes=5, sessions=2)
+    assert policy.prepared == 1

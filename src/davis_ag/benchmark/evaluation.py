@@ -94,14 +94,17 @@ def _act(policy: Any, observation: Any, info: dict[str, Any]) -> Any:
         ) from None
 
 
-def run_episode(env: Any, policy: Any, reset_seed: int, policy_seed: int | None = None) -> dict[str, Any]:
+def run_episode(
+    env: Any, policy: Any, reset_seed: int, policy_seed: int | None = None, prepared: bool = False
+) -> dict[str, Any]:
     """Play one episode.
 
     Args:
         env: A TVM-v0 or TVMContinuous-v0 environment (wrapped or not).
-        policy: The policy (its ``prepare(env)`` is called first).
+        policy: The policy (its ``prepare(env)`` is called first unless ``prepared``).
         reset_seed: Seed of ``env.reset``; fixes the scene, start and target.
         policy_seed: Seed of the policy's own randomness.
+        prepared: Whether the caller has called ``prepare(env)`` already (once for many episodes).
 
     Returns:
         ``{"oer_0", "oer_tau", "reward", "length", "scene", "target_fruit", "path", "actions"}``,
@@ -110,7 +113,8 @@ def run_episode(env: Any, policy: Any, reset_seed: int, policy_seed: int | None 
     Raises:
         UserError: when the policy answers with something that is not an action here.
     """
-    prepare(policy, env)
+    if not prepared:
+        prepare(policy, env)
     obs, info = env.reset(seed=reset_seed)
     policy.reset(policy_seed)
     total, actions, refused = 0.0, [], 0
@@ -148,7 +152,8 @@ def run_episode(env: Any, policy: Any, reset_seed: int, policy_seed: int | None 
 def play_sessions(
     env: Any, policy: Any, keys: tuple[str, ...], seed: int, sessions: int, episodes: int
 ) -> tuple[dict[str, Any], list[dict[str, Any]]]:
-    """Play ``sessions`` x ``episodes`` seeded episodes (the same for every policy) and summarise.
+    """Play ``sessions`` x ``episodes`` seeded episodes (the same for every policy) and summarise;
+    the policy was prepared for ``env`` once before (the Policy protocol: not once per episode).
 
     Returns:
         Per key the mean, std and per-session values over sessions and the standard error of the
@@ -158,7 +163,7 @@ def play_sessions(
     records = []
     for session in range(sessions):
         env_seeds, policy_seeds = episode_seeds(seed, session, episodes)
-        runs = [run_episode(env, policy, r, a) for r, a in zip(env_seeds, policy_seeds)]
+        runs = [run_episode(env, policy, r, a, prepared=True) for r, a in zip(env_seeds, policy_seeds)]
         for key in per_session:
             per_session[key].append(float(np.mean([run[key] for run in runs])))
         records.extend({"session": session, **run} for run in runs)
@@ -329,7 +334,30 @@ def format_table(results: EvaluationResults | dict[str, Any]) -> str:
         lines.append(
             f"{BEST_FIXED}: always {policies[BEST_FIXED].action}, the best single action by exact OER_tau on this split"
         )
+    lines.extend(_warnings(results))
     return "\n".join(lines)
+
+
+def _warnings(results: EvaluationResults) -> list[str]:
+    """What a reader could mistake in the table: a policy that plays one action only (a collapsed
+    learner looks like a method), and episodes that replay a few starts (the interval over
+    episodes is then sure of those starts, not of the method)."""
+    notes = []
+    for name, policy in results.policies.items():
+        played = {action: n for action, n in (policy.action_counts or {}).items() if n}
+        if name != BEST_FIXED and len(played) == 1:
+            notes.append(
+                f"note: {name} played {next(iter(played))} only: a fixed action, not a method; see {BEST_FIXED}"
+            )
+    protocol = results.protocol
+    # Section V-D's 3 x 200 episodes draw each start about once on a test split of Table 3's size.
+    if protocol.starts is not None and 2 * protocol.starts < protocol.episodes * protocol.sessions:
+        notes.append(
+            f"note: {protocol.sessions * protocol.episodes} episodes replay {protocol.starts} eligible starts: "
+            "the intervals say how sure the means are over these starts, not over other scenes; "
+            "a larger test split tells methods apart"
+        )
+    return notes
 
 
 def write_json(results: EvaluationResults | dict[str, Any], path: str | os.PathLike[str]) -> Path:

@@ -71,7 +71,7 @@ def train_split_score(
     # that device's generator, so it is saved and restored too, not only the CPU's.
     device = getattr(model, "device", torch.device("cpu"))
     with torch.random.fork_rng(devices=[device] if device.type == "cuda" else []):
-        records = [run_episode(env, agent, r, d) for r, d in zip(resets, draws)]
+        records = [run_episode(env, agent, r, d, prepared=i > 0) for i, (r, d) in enumerate(zip(resets, draws))]
     return {key: round(float(np.mean([r[key] for r in records])), 6) for key in ("oer_tau", "reward", "length")}
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import Any
 
 from davis_ag.atomic_files import write_or_rescue
 from davis_ag.commands import arguments
@@ -38,7 +39,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--policy",
-        action="append",
+        action=_AddPolicy,
         default=[],
         metavar="SPEC",
         help="a method to score beside the baselines (repeatable): MODEL.zip (any Stable-Baselines3 "
@@ -54,10 +55,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--name",
-        action="append",
-        default=[],
+        action=_NamePolicy,
+        default=None,
         metavar="NAME",
-        help="row name of the --policy given in the same position (repeatable)",
+        help="row name of the --policy given just before it (repeatable)",
     )
     parser.add_argument(
         "--env",
@@ -88,6 +89,32 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--force", action="store_true", help="replace an existing --out and --plot")
 
 
+class _AddPolicy(argparse.Action):
+    """``--policy SPEC``: one more method, not yet named (``policy_names`` keeps step with it)."""
+
+    def __call__(
+        self, parser: argparse.ArgumentParser, namespace: argparse.Namespace, value: Any, _: Any = None
+    ) -> None:
+        setattr(namespace, self.dest, [*(getattr(namespace, self.dest) or []), value])
+        namespace.policy_names = [*(getattr(namespace, "policy_names", None) or []), None]
+
+
+class _NamePolicy(argparse.Action):
+    """``--name NAME``: the row name of the ``--policy`` just before it, as the docs say; a name
+    with no policy before it, or a second name for one, is refused rather than put on another row."""
+
+    def __call__(
+        self, parser: argparse.ArgumentParser, namespace: argparse.Namespace, value: Any, _: Any = None
+    ) -> None:
+        names = list(getattr(namespace, "policy_names", None) or [])
+        if not names:
+            parser.error(f"--name {value}: give it after the --policy it names")
+        if names[-1] is not None:
+            parser.error(f"--name {value}: the --policy before it is already named {names[-1]!r}")
+        names[-1] = value
+        namespace.policy_names = names
+
+
 def run(args: argparse.Namespace) -> int:
     """Evaluate, print the table, write JSON and PNG."""
     allowed = CONTINUOUS_POLICIES if args.env == "continuous" else POLICIES
@@ -98,10 +125,6 @@ def run(args: argparse.Namespace) -> int:
             f"--policies {wrong[0]} is not a baseline of --env {args.env}: choose from {', '.join(allowed)}"
         )
     specs = args.policy or []
-    if len(args.name) > len(specs):
-        raise UserError(
-            f"{len(args.name)} --name for {len(specs)} --policy: give one --name after each --policy it names"
-        )
     out = arguments.prove_writable_file(args.out)
     plot = arguments.prove_writable_file(args.plot or out.with_suffix(".png"), "--plot")
     check_figure_path(plot, "--plot")  # before the episodes, not after
@@ -127,7 +150,7 @@ def _evaluate(args: argparse.Namespace, names: list[str], specs: list[str], out:
 
     policies = [
         policy_from_spec(spec, name, deterministic=args.deterministic)
-        for spec, name in zip(specs, args.name + [None] * len(specs))
+        for spec, name in zip(specs, getattr(args, "policy_names", None) or [None] * len(specs))
     ]
     results = evaluate(
         policies,

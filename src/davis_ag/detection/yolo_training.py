@@ -19,6 +19,34 @@ from davis_ag.detection.offline import prepare_ultralytics
 
 #: The detector of section VI-A, built from its YAML.
 MODEL_YAML = "yolov5n.yaml"
+#: Its finest detection grid, in input pixels: a box much smaller than a cell rarely holds the
+#: cell centre the anchor-free head assigns it to, so it teaches the detector nothing.
+FINEST_STRIDE = 8
+
+
+def median_box_side(export: Path, split: str, imgsz: int) -> float | None:
+    """The median side (square root of the area) of an export's boxes as the detector sees them,
+    in input pixels at ``imgsz`` (the longer image side scaled to it); None without boxes.
+
+    Args:
+        export: A YOLO export's folder (``images/<split>``, ``labels/<split>``).
+        split: ``train`` or ``test``.
+        imgsz: The training image size.
+    """
+    from PIL import Image
+
+    images = sorted((export / "images" / split).glob("*"))
+    if not images:
+        return None
+    with Image.open(images[0]) as first:
+        width, height = first.size  # an export's views share one size
+    scale = imgsz / max(width, height)
+    sides = [
+        (float(w) * width * float(h) * height) ** 0.5 * scale
+        for label in (export / "labels" / split).glob("*.txt")
+        for _, _, _, w, h in (line.split()[:5] for line in label.read_text().splitlines() if line.strip())
+    ]
+    return float(sorted(sides)[len(sides) // 2]) if sides else None
 
 
 @dataclass(frozen=True)

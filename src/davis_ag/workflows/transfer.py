@@ -25,7 +25,7 @@ from typing import Any
 from davis_ag.atomic_files import write_json_atomic, write_text_atomic
 from davis_ag.detection.real_sets import PAPER_TEST, PAPER_TRAIN, load_pool, split_sizes, write_split
 from davis_ag.detection.yolo_export import export_yolo
-from davis_ag.detection.yolo_training import Budget, evaluate, train
+from davis_ag.detection.yolo_training import FINEST_STRIDE, Budget, evaluate, median_box_side, train
 from davis_ag.errors import UserError
 from davis_ag.stage_timer import Timer
 
@@ -149,6 +149,13 @@ def run_transfer(config: TransferConfig, say: Callable[[str], None] = print) -> 
         counts = export_yolo(config.pretrain, out / "pretrain-data", "detect")
     if not counts["train"]["images"]:
         raise UserError(f"{config.pretrain}: its train split has no view; give a dataset with train scenes")
+    box_side = median_box_side(out / "pretrain-data", "train", config.pretrain_budget.imgsz)
+    if box_side is not None and box_side < FINEST_STRIDE:
+        say(
+            f"note: the pre-training boxes are a median {box_side:.1f} px at --imgsz "
+            f"{config.pretrain_budget.imgsz}, under YOLOv5n's {FINEST_STRIDE} px grid: few are learnt "
+            "from; larger images or a larger --imgsz give the detector something to learn"
+        )
     with timer.stage("pre-train"):
         say("pre-training YOLOv5n on DAVIS-Ag")
         pretrained = train(
@@ -159,6 +166,7 @@ def run_transfer(config: TransferConfig, say: Callable[[str], None] = print) -> 
         "real_set": config.real_label,
         "config": _jsonable(config),
         "pretrain_images": counts,
+        "pretrain_median_box_px": None if box_side is None else round(box_side, 1),
         "real_images": len(pool.items),
         "split_sizes": {"train": n_train, "test": n_test},
         "splits": [],
@@ -239,8 +247,13 @@ def write_results_md(results: dict[str, Any], path: Path, how: str = "") -> Path
         f"**Real set: {results['real_set']}.** "
         + ("These are stand-in numbers, not comparable to the paper's." if "stand-in" in results["real_set"] else ""),
         "",
-        f"- Pre-training: {cfg['pretrain']} ({results['pretrain_images']['train']['images']} train images); "
-        f"{pre['epochs']} epochs at {pre['imgsz']} px, batch {pre['batch']}, device {pre['device']}.",
+        f"- Pre-training: {cfg['pretrain']} ({results['pretrain_images']['train']['images']} train images"
+        + (
+            f", boxes a median {results['pretrain_median_box_px']} px as the detector sees them"
+            if results.get("pretrain_median_box_px") is not None
+            else ""
+        )
+        + f"); {pre['epochs']} epochs at {pre['imgsz']} px, batch {pre['batch']}, device {pre['device']}.",
         f"- Real set: {results['real_images']} images, {len(results['splits'])} random splits of "
         f"{results['split_sizes']['train']} train / {results['split_sizes']['test']} test; "
         f"every run {bud['epochs']} epochs at {bud['imgsz']} px, batch {bud['batch']}; last-epoch weights scored.",
