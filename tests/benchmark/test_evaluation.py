@@ -249,6 +249,9 @@ def test_the_table_says_when_a_policy_plays_one_action_or_episodes_replay_few_st
     assert "note: always left played left only: a fixed action, not a method" in table
     starts = as_results(results).protocol.starts
     assert f"note: 100 episodes replay {starts} eligible starts" in table and starts < 50
+    assert "note: one session" not in table
+    one = format_table(evaluate_policies(TVMEnv(sp_root, "sp", "test"), [FixedActionAgent("left")], 5, sessions=1))
+    assert "note: one session, so every ± (the spread of session means) is 0" in one
 
 
 def test_a_policy_is_prepared_once_for_all_its_episodes(sp_root: Path) -> None:

@@ -350,6 +350,8 @@ def _warnings(results: EvaluationResults) -> list[str]:
                 f"note: {name} played {next(iter(played))} only: a fixed action, not a method; see {BEST_FIXED}"
             )
     protocol = results.protocol
+    if protocol.sessions == 1:
+        notes.append("note: one session, so every ± (the spread of session means) is 0; section V-D plays 3")
     # Section V-D's 3 x 200 episodes draw each start about once on a test split of Table 3's size.
     if protocol.starts is not None and 2 * protocol.starts < protocol.episodes * protocol.sessions:
         notes.append(
