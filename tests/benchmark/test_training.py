@@ -41,6 +41,10 @@ def test_a_killed_run_resumes_from_its_checkpoint(
     model_file, settings_file = checkpoint_paths(out)
     saved = json.loads(settings_file.read_text())
     assert 80 <= saved["timesteps_done"] <= 130 and model_file.is_file()
+    # Taken between rollouts, after the last one's update: inside a rollout it lacked that update,
+    # which the resumed run never made though it counted the steps.
+    checkpoint = A2C.load(model_file, device="cpu")
+    assert checkpoint._n_updates * checkpoint.n_steps * checkpoint.n_envs == saved["timesteps_done"]
     assert not (tmp_path / "models" / "a2c.zip").exists()  # no final model from a killed run
 
     path = train_a2c(root, "sp", **kwargs)
@@ -512,4 +516,4 @@ def test_a_checkpoint_whose_record_lags_its_model_keeps_the_budget(tmp_path: Pat
     path = train_a2c(root, "sp", **kwargs)
     record = json.loads(training_record_path(path).read_text())
     assert A2C.load(path, device="cpu").num_timesteps == 240 and record["timesteps"] == 240
-    assert [(s["from_step"], s["to_step"]) for s in record["sittings"]][-1] == (done, 240)
+    assert [(s["from_step"], s["to_step"]) for s in record["sittings"]] == [(0, done), (done, 240)]  # no gap

@@ -24,7 +24,7 @@ import numpy as np
 import torch
 from stable_baselines3.common.callbacks import BaseCallback
 
-from davis_ag.errors import UserError
+from davis_ag.errors import UserError, stops_held
 
 #: What a training run keeps: ``best-train`` (default) or ``last``.
 KEEP_RULES: tuple[str, ...] = ("best-train", "last")
@@ -175,14 +175,17 @@ def publish_snapshot(snapshot: Path, final: Path) -> None:
     """Put the kept ``snapshot`` at ``final`` without copying it: a hard link, so the snapshot
     keeps its own name until the run's records are written (pruned after), or a rename where the
     file system has no links."""
-    link = final.with_name(f".{final.name}.{os.getpid()}.link")
-    try:
-        link.unlink(missing_ok=True)
-        os.link(snapshot, link)
-    except OSError:
-        os.replace(snapshot, final)
-        return
-    os.replace(link, final)
+    if final.exists() and os.path.samefile(snapshot, final):
+        return  # published before (a run stopped before its record): renaming onto itself keeps the link
+    link = final.with_name(f".{final.name}.link")  # one name: a stop between the two steps leaves it for the next
+    with stops_held():
+        try:
+            link.unlink(missing_ok=True)
+            os.link(snapshot, link)
+        except OSError:
+            os.replace(snapshot, final)
+            return
+        os.replace(link, final)
 
 
 def _play() -> str:

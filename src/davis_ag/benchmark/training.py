@@ -237,6 +237,8 @@ def train_agent(
         # The model's own count: a stop between the checkpoint's zip and its record leaves the
         # record a checkpoint behind, and counting from it would train past the budget.
         done = int(model.num_timesteps)
+        if earlier and earlier[-1].get("to_step") != done:  # that sitting made the model's steps
+            earlier = [*earlier[:-1], {**earlier[-1], "to_step": done}]
         # SB3's load seeds torch, NumPy, Python and the environments with the run's seed, as at
         # step 0: every resumed sitting would replay the first one's episodes and draws.
         model.set_random_seed(resumed_training_seed(seed, done))
@@ -293,8 +295,9 @@ def train_agent(
         else:
             selection.score_now()  # the last snapshot competes too
             # A link, not a copy: it needs no space, so a full disk cannot lose the best snapshot;
-            # and the snapshot keeps its name until the record and checkpoint are done, so a
-            # stop in between resumes to the same choice instead of one of the checkpoint.
+            # and the snapshot keeps its name until the record and checkpoint are done, so a run
+            # stopped in between resumes with every score and snapshot it had (it then trains
+            # from its last checkpoint to the budget again, and the last score is redrawn).
             saved = final
             publish_snapshot(snapshot_path(final, selection.best["step"]), final)
             extra["selection"] = selection.record()

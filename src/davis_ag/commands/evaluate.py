@@ -48,7 +48,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--model",
-        action="append",
+        action=_AddPolicy,
         dest="policy",
         metavar="MODEL.zip",
         help="the same as --policy (kept for earlier scripts)",
@@ -150,7 +150,7 @@ def _evaluate(args: argparse.Namespace, names: list[str], specs: list[str], out:
 
     policies = [
         policy_from_spec(spec, name, deterministic=args.deterministic)
-        for spec, name in zip(specs, getattr(args, "policy_names", None) or [None] * len(specs))
+        for spec, name in zip(specs, getattr(args, "policy_names", None) or [None] * len(specs), strict=True)
     ]
     results = evaluate(
         policies,
