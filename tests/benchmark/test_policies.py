@@ -26,6 +26,18 @@ class Wiggle:
         self.rng = np.random.default_rng(seed)
     def act(self, observation, info):
         return int(self.rng.integers(2))
+
+class NoReset:
+    def act(self, observation, info):
+        return 0
+
+class NeedsArgs:
+    def __init__(self, size):
+        self.size = size
+    def reset(self, seed=None):
+        pass
+    def act(self, observation, info):
+        return 0
 """
 
 
@@ -65,6 +77,8 @@ def test_every_spec_form_plays(sp_root: Path, policy_file: Path, monkeypatch: py
         ("{file}:missing", "has no 'missing'"),
         ("{file}", "name the function or class too"),
         ("/nonexistent/model.zip", "no such model file"),
+        ("{file}:NoReset", r"^--policy .*:NoReset: NoReset has act but no reset\(seed\) method"),
+        ("{file}:NeedsArgs", r"^--policy .*:NeedsArgs: class NeedsArgs cannot be made without arguments"),
     ],
 )
 def test_bad_specs_get_one_line(spec: str, message: str, policy_file: Path) -> None:

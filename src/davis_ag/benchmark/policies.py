@@ -160,8 +160,8 @@ def as_policy(thing: Any, name: str | None = None) -> Any:
             thing = thing()
         except TypeError as error:
             raise UserError(
-                f"class {thing.__name__} cannot be made without arguments ({error}): give an "
-                "object or a function instead"
+                f"class {thing.__name__} cannot be made without arguments ({error}): give it "
+                "defaults, or name an object of it or a function in the file instead"
             ) from None
     if callable(getattr(thing, "act", None)):
         if not callable(getattr(thing, "reset", None)):
@@ -301,7 +301,7 @@ class ModelPolicy:
                 raise UserError(
                     f"{self.name}: trained on {len(seen)} of the {len(described['scenes'])} test scenes "
                     f"({seen[0]}{', ...' if len(seen) > 1 else ''}): the split changed after it was trained "
-                    "(scenes added or removed); train it again on this dataset"
+                    "(scenes added or removed, or splits.json edited); train it again on this dataset"
                 )
 
     def act(self, observation: np.ndarray, info: dict[str, Any]) -> Any:
@@ -380,6 +380,9 @@ def policy_from_spec(spec: str, name: str | None = None, deterministic: bool = D
             thing = getattr(module, attr)
         except AttributeError:
             raise UserError(f"--policy {spec}: {target} has no {attr!r}") from None
-        policy = as_policy(thing, name)
+        try:
+            policy = as_policy(thing, name)
+        except UserError as error:  # which --policy it was, as every other refusal of one says
+            raise UserError(f"--policy {spec}: {error}") from None
     policy.source = text
     return policy
