@@ -78,7 +78,11 @@ def test_transfer_runs_end_to_end_offline(
     # A second run reuses every finished split (and replaces the report only with --force).
     assert main(argv) == 2 and "--results" in capsys.readouterr().err
     assert main([*argv, "--force"]) == 0
-    assert json.loads((out / "transfer.json").read_text())["splits"] == results["splits"]
+    again = json.loads((out / "transfer.json").read_text())
+    assert again["splits"] == results["splits"]
+    # ... and keeps the times its first sitting measured (it wrote 0 s for every reused stage).
+    for stage in ("pre-train", "split 1", "split 2"):
+        assert again["wall_s"][stage] == results["wall_s"][stage] > 0
     # A folder from before the settings were recorded takes them from its transfer.json.
     (out / "transfer-config.json").unlink()
     assert main([*argv, "--force"]) == 0 and (out / "transfer-config.json").is_file()

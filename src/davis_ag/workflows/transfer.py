@@ -156,6 +156,10 @@ def run_transfer(config: TransferConfig, say: Callable[[str], None] = print) -> 
             f"{config.pretrain_budget.imgsz}, under YOLOv5n's {FINEST_STRIDE} px grid: few are learnt "
             "from; larger images or a larger --imgsz give the detector something to learn"
         )
+    # A stage finished by an earlier sitting is reused: its time is the one that sitting measured.
+    earlier = _earlier_wall_times(out / "transfer.json")
+    if (out / "runs" / "pretrain" / "done.json").is_file():
+        timer.notes["pre-train"] = "reused"
     with timer.stage("pre-train"):
         say("pre-training YOLOv5n on DAVIS-Ag")
         pretrained = train(
@@ -195,12 +199,30 @@ def run_transfer(config: TransferConfig, say: Callable[[str], None] = print) -> 
                 scores[arm] = evaluate(weights, data_yaml, config.budget)
             write_json_atomic(scores_path, scores)
             results["splits"].append(scores)
-    results["wall_s"] = {
-        **{name: round(s, 1) for name, s in timer.stages.items()},
-        "total": round(time.perf_counter() - started, 1),
-    }
+    stages = {name: round(s, 1) for name, s in timer.stages.items()}
+    reused = {name for name, note in timer.notes.items() if note == "reused"}
+    if reused and all(name in earlier for name in reused):
+        stages = {**stages, **{name: earlier[name] for name in reused}}
+        total = round(sum(stages.values()), 1)  # the sittings' work, not this sitting's wait
+    else:
+        total = round(time.perf_counter() - started, 1)
+    results["wall_s"] = {**stages, "total": total}
     write_json_atomic(out / "transfer.json", results)
     return results
+
+
+def _earlier_wall_times(path: Path) -> dict[str, float]:
+    """The stage times an earlier sitting of this work folder recorded in ``transfer.json``
+    (the work folder's settings are checked to be the same before this is read); {} without."""
+    try:
+        wall = json.loads(path.read_text()).get("wall_s", {})
+    except (OSError, ValueError, AttributeError):
+        return {}
+    return (
+        {k: float(v) for k, v in wall.items() if k != "total" and isinstance(v, (int, float))}
+        if isinstance(wall, dict)
+        else {}
+    )
 
 
 def table5_markdown(results: dict[str, Any]) -> str:
