@@ -83,6 +83,7 @@ def test_transfer_runs_end_to_end_offline(
     # ... and keeps the times its first sitting measured (it wrote 0 s for every reused stage).
     for stage in ("pre-train", "split 1", "split 2"):
         assert again["wall_s"][stage] == results["wall_s"][stage] > 0
+    assert list(again["wall_s"]) == list(results["wall_s"])  # in the order the stages ran
     # A folder from before the settings were recorded takes them from its transfer.json.
     (out / "transfer-config.json").unlink()
     assert main([*argv, "--force"]) == 0 and (out / "transfer-config.json").is_file()
