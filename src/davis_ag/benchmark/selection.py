@@ -63,15 +63,16 @@ def train_split_score(
         ``{"oer_tau", "reward", "length"}``, means over the episodes.
     """
     from davis_ag.benchmark.evaluation import episode_seeds, run_episode
-    from davis_ag.benchmark.policies import DETERMINISTIC_PLAY, ModelPolicy
+    from davis_ag.benchmark.policies import DETERMINISTIC_PLAY, ModelPolicy, prepare
 
     agent = ModelPolicy(model, deterministic=DETERMINISTIC_PLAY)
+    prepare(agent, env)  # once for all the episodes
     resets, draws = episode_seeds(seed, 0, episodes)
     # The agent seeds torch on every device; on a GPU the training run samples its actions from
     # that device's generator, so it is saved and restored too, not only the CPU's.
     device = getattr(model, "device", torch.device("cpu"))
     with torch.random.fork_rng(devices=[device] if device.type == "cuda" else []):
-        records = [run_episode(env, agent, r, d, prepared=i > 0) for i, (r, d) in enumerate(zip(resets, draws))]
+        records = [run_episode(env, agent, r, d, prepared=True) for r, d in zip(resets, draws)]
     return {key: round(float(np.mean([r[key] for r in records])), 6) for key in ("oer_tau", "reward", "length")}
 
 

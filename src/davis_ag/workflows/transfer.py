@@ -180,11 +180,13 @@ def run_transfer(config: TransferConfig, say: Callable[[str], None] = print) -> 
         seed = config.seed + k
         split_dir = out / f"split{k + 1}"
         scores_path = split_dir / "scores.json"
-        if scores_path.is_file():
-            results["splits"].append(json.loads(scores_path.read_text()))
+        reused_split = scores_path.is_file()
+        if reused_split:
             timer.notes[f"split {k + 1}"] = "reused"
-            continue
-        with timer.stage(f"split {k + 1}"):
+        with timer.stage(f"split {k + 1}"):  # a reused split too, so every stage keeps its place
+            if reused_split:
+                results["splits"].append(json.loads(scores_path.read_text()))
+                continue
             data_yaml = write_split(pool, split_dir / "data", seed, n_train, n_test)
             scores: dict[str, Any] = {"split": k + 1, "seed": seed}
             for arm, title in ARMS:
@@ -202,9 +204,7 @@ def run_transfer(config: TransferConfig, say: Callable[[str], None] = print) -> 
     stages = {name: round(s, 1) for name, s in timer.stages.items()}
     reused = {name for name, note in timer.notes.items() if note == "reused"}
     if reused and all(name in earlier for name in reused):
-        measured = {**stages, **{name: earlier[name] for name in reused}}
-        order = ["export DAVIS-Ag", "pre-train", *(f"split {k + 1}" for k in range(config.splits))]
-        stages = {name: measured[name] for name in order if name in measured}  # in the order they run
+        stages = {name: earlier[name] if name in reused else s for name, s in stages.items()}
         total = round(sum(stages.values()), 1)  # the sittings' work, not this sitting's wait
     else:
         total = round(time.perf_counter() - started, 1)
