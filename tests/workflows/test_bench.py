@@ -105,3 +105,58 @@ def test_every_path_of_the_bench_runs_on_a_small_scene(tmp_path: Path) -> None:
     assert all(seconds > 0 for seconds in result["seconds_per_view"].values())
     written = {p.name for p in (tmp_path / "strawberry-documented").iterdir()}
     assert {"0001.jpeg", "0003.jpeg"} <= written and any(name.endswith(".json") for name in written)
+
+
+def test_a_gpu_machines_rates_go_to_the_gpu_sections_and_leave_the_2_core_machines(tmp_path: Path) -> None:
+    """``make bench`` on a GPU machine writes the page's ``-gpu`` sections; the 2-core machine's
+    tables, and the sentences other pages show of them, stay as they were."""
+    from davis_ag.workflows.bench_report import write_continuous
+    from davis_ag.workflows.bench_training import LEARNERS, write_training
+
+    rows = {row: {"steps_per_second": 800.0, "over_reference": 1.0, "hours_300k": 0.1} for row, _, _ in LEARNERS}
+    training = {"steps": 2048, "seed": 0, "devices": ["cpu", "cuda"], "learners": rows}
+    continuous = {
+        "steps_per_second": 371.2,
+        "cpu_ms_per_step": 2.7,
+        "steps": 600,
+        "resets": 200,
+        "refused_share": 0.62,
+        "render_and_label_ms": 1.0,
+        "draws_per_step": 1.59,
+        "draws_per_reset": 2.93,
+        "open_and_first_reset_s": 0.77,
+        "target_min": 50.0,
+        "gl_renderer": "NVIDIA H200/PCIe/SSE2",
+        "triangles": 33576,
+        "triangles_drawn": 13570,
+    }
+    sections = ("bench-training", "bench-continuous", "bench-training-gpu", "bench-continuous-gpu")
+    performance = tmp_path / "performance.md"
+    performance.write_text("".join(f"<!-- {m}:start -->\nold {m}\n<!-- {m}:end -->\n" for m in sections))
+    (tmp_path / "benchmark.md").write_text("<!-- ppo-rate:start -->\nold\n<!-- ppo-rate:end -->\n")
+    (tmp_path / "views-on-demand.md").write_text("<!-- continuous-rate:start -->\nold\n<!-- continuous-rate:end -->\n")
+
+    write_training(training, (1.0, 1.0), performance, gpu_machine=True)
+    write_continuous(continuous, (1.0, 1.0), performance, gpu_machine=True)
+    page = performance.read_text()
+    assert "old bench-training\n" in page and "old bench-continuous\n" in page
+    assert "old bench-training-gpu" not in page and "old bench-continuous-gpu" not in page
+    assert "**371.2**" in page and "drawn by NVIDIA H200/PCIe/SSE2" in page and "**800.0**" in page
+    assert "old" in (tmp_path / "benchmark.md").read_text()
+    assert "old" in (tmp_path / "views-on-demand.md").read_text()
+
+
+def test_a_gpu_machine_asks_for_the_pages_gpu_section(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A page without the GPU section is refused before minutes of measuring, naming the marker."""
+    from davis_ag import cli
+    from davis_ag.workflows import bench_report
+
+    monkeypatch.setattr(bench_report, "is_gpu_machine", lambda: True)
+    page = tmp_path / "performance.md"
+    page.write_text("<!-- bench:start -->\n<!-- bench:end -->\n")
+    assert cli.main(["bench", "--out", str(tmp_path / "b.json"), "--doc", str(page)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "<!-- bench-gpu:start -->" in err and "\n" not in err
+    assert page.read_text() == "<!-- bench:start -->\n<!-- bench:end -->\n"

@@ -71,7 +71,7 @@ def run(args: argparse.Namespace) -> int:
     from davis_ag.workflows.bench import run as run_bench
     from davis_ag.workflows.bench import run_only
     from davis_ag.workflows.bench_training import write_training
-    from davis_ag.workflows.bench_report import table, write_continuous
+    from davis_ag.workflows.bench_report import doc_section, is_gpu_machine, table, write_continuous
 
     from davis_ag.atomic_files import prove_writable_folder, read_page
     from davis_ag.errors import UserError
@@ -81,28 +81,30 @@ def run(args: argparse.Namespace) -> int:
     prove_writable_folder(args.out.parent)
     if args.out.exists() and not _is_report(args.out):
         raise UserError(f"--out {args.out}: holds something other than an earlier bench report; give a new .json path")
-    if args.doc is not None and not (args.doc.is_file() and "<!-- bench:start -->" in read_page(args.doc, "--doc")):
-        raise UserError(
-            f"--doc {args.doc}: not a Markdown page with <!-- bench:start --> and <!-- bench:end --> "
-            "markers; give docs/performance.md or leave --doc out"
-        )
     if args.device != "cpu" and args.only != "training":
         raise UserError(f"--device {args.device} is for --only training: add --only training, or leave --device out")
+    # A GPU machine's numbers go to the page's GPU sections, beside the 2-core machine's.
+    gpu = args.doc is not None and is_gpu_machine()
+    marker = doc_section({"continuous": "bench-continuous", "training": "bench-training"}.get(args.only, "bench"), gpu)
+    if args.doc is not None and not (args.doc.is_file() and f"<!-- {marker}:start -->" in read_page(args.doc, "--doc")):
+        raise UserError(
+            f"--doc {args.doc}: not a Markdown page with <!-- {marker}:start --> and <!-- {marker}:end --> "
+            "markers; give docs/performance.md or leave --doc out"
+        )
     if args.only in ("continuous", "training"):
-        run_only(args.only, args.out, args.doc, ("cpu",) if args.device == "cpu" else ("cpu", args.device))
+        run_only(args.only, args.out, args.doc, ("cpu",) if args.device == "cpu" else ("cpu", args.device), gpu)
         print(f"written {args.out}" + (f" and {args.doc}" if args.doc else ""))
         return 0
     report = run_bench(args.out, args.crops, args.repeats, args.antialiasing)
     text = table(report)
     print(text)
     if args.doc:
-        write_marked_section(args.doc, "bench", text)
+        write_marked_section(args.doc, marker, text)
+        load = report["machine"]["load_average"]
         if "continuous_env" in report:
-            load = report["machine"]["load_average"]
-            write_continuous(report["continuous_env"], (load["start"][0], load["end"][0]), args.doc)
+            write_continuous(report["continuous_env"], (load["start"][0], load["end"][0]), args.doc, gpu)
         if "training" in report:
-            load = report["machine"]["load_average"]
-            write_training(report["training"], (load["start"][0], load["end"][0]), args.doc)
+            write_training(report["training"], (load["start"][0], load["end"][0]), args.doc, gpu)
         print(f"written {args.doc}")
     print(f"written {args.out}")
     return 0

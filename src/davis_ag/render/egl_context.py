@@ -79,3 +79,27 @@ def create_context():
             "system's EGL and GL libraries (Debian: libegl1 libgl1 libgl1-mesa-dri)"
             + (f", or choose another {EGL_DEVICE_VARIABLE}" if device else "")
         ) from None
+
+
+#: Words of ``GL_RENDERER`` that name a rasteriser running on the CPU (Mesa's llvmpipe and softpipe,
+#: Google's SwiftShader); any other renderer draws on a GPU.
+SOFTWARE_RASTERISERS = ("llvmpipe", "softpipe", "swiftshader")
+
+
+def renderer_name() -> str:
+    """``GL_RENDERER`` of the context our renderer draws in: ``llvmpipe (LLVM 15.0.6, 256 bits)`` on a
+    machine without a GPU, ``NVIDIA H200/PCIe/SSE2`` on one with NVIDIA's EGL driver.
+
+    Raises:
+        UserError: when no context can be opened (see :func:`create_context`).
+    """
+    context = create_context()
+    try:
+        return str(context.info["GL_RENDERER"])
+    finally:
+        context.release()
+
+
+def draws_on_gpu(renderer: str) -> bool:
+    """Whether a ``GL_RENDERER`` name is a GPU's (not one of :data:`SOFTWARE_RASTERISERS`)."""
+    return not any(word in renderer.lower() for word in SOFTWARE_RASTERISERS)

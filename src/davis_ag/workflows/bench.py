@@ -45,6 +45,7 @@ from davis_ag.errors import UserError
 from davis_ag.formats.layout import view_name, view_stem
 from davis_ag.generate.one_scene import SceneRequest, draw_scene, grow_scene
 from davis_ag.generate.run_progress import count_views
+from davis_ag.render.egl_context import renderer_name
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import CROPS, SCENARIOS
 from davis_ag.workflows.bench_report import (
@@ -320,15 +321,19 @@ def continuous_env_speed(scratch: Path, steps: int = 600) -> dict:
         "draws_per_reset": round(rate["draws_per_reset"], 2),
         "open_and_first_reset_s": round(setup_s, 2),
         "target_min": CONTINUOUS_TARGET,
+        "gl_renderer": renderer_name(),
         "triangles": int(env.scenes[0].assets.geometry.triangle_count),
         "triangles_drawn": int(merge_ground(env.scenes[0].assets.geometry).triangle_count),
     }
 
 
-def run_only(what: str, out: Path, doc: Path | None, devices: tuple[str, ...] = ("cpu",)) -> dict:
+def run_only(
+    what: str, out: Path, doc: Path | None, devices: tuple[str, ...] = ("cpu",), gpu_machine: bool = False
+) -> dict:
     """One measurement alone (``--only continuous``: TVMContinuous-v0's rate, about a minute;
     ``--only training``: the learners' training rates, about 8 minutes, on each of ``devices``):
-    JSON, the doc's section and the line another page shows of it."""
+    JSON, the doc's section (its GPU section on a ``gpu_machine``) and the line another page shows
+    of it."""
     measurements: dict[str, tuple[str, Any, Any, Any]] = {
         "continuous": ("continuous_env", continuous_env_speed, continuous_table, write_continuous),
         "training": ("training", partial(training_speed, devices=devices), training_table, write_training),
@@ -341,8 +346,15 @@ def run_only(what: str, out: Path, doc: Path | None, devices: tuple[str, ...] = 
     print(table_of(result, load))
     out.parent.mkdir(parents=True, exist_ok=True)
     write_json_atomic(out, {key: result})
-    write(result, load, doc)
+    write(result, load, doc, gpu_machine)
     return result
+
+
+def training_devices() -> tuple[str, ...]:
+    """The torch devices the whole bench times the learners on: the CPU, and CUDA where torch has it."""
+    import torch
+
+    return ("cpu", "cuda") if torch.cuda.is_available() else ("cpu",)
 
 
 def run(out: Path, crops: list[str], repeats: int, antialiasing: str = "fxaa") -> dict:
@@ -353,6 +365,7 @@ def run(out: Path, crops: list[str], repeats: int, antialiasing: str = "fxaa") -
             "cpus": os.cpu_count(),
             "platform": platform.platform(),
             "LP_NUM_THREADS": os.environ.get("LP_NUM_THREADS"),
+            "gl_renderer": renderer_name(),
         },
         "image_size": [CAMERA.width, CAMERA.height],
         "seed": SEED,
@@ -375,7 +388,8 @@ def run(out: Path, crops: list[str], repeats: int, antialiasing: str = "fxaa") -
             report["env_steps_per_second"] = env_speed(Path(scratch) / "strawberry-ours-0")
             report["continuous_env"] = continuous_env_speed(Path(scratch))
             report["pool"] = pool_gain(Path(scratch))
-            report["training"] = training_speed(Path(scratch))
+            # On a GPU machine each learner is timed on the CPU and then on the GPU.
+            report["training"] = training_speed(Path(scratch), devices=training_devices())
     for name in CROPS:  # a crop not measured this time: assume the slowest one measured
         for measured in (per_view, overhead, floor, grow):
             measured.setdefault(name, max(measured.values()))

@@ -73,6 +73,25 @@ def projection(
     }
 
 
+def doc_section(marker: str, gpu_machine: bool) -> str:
+    """The marker a measurement is written between: a GPU machine's go to the page's ``MARKER-gpu``
+    sections, beside the 2-core machine's, so ``make bench`` on either never replaces the other's."""
+    return f"{marker}-gpu" if gpu_machine else marker
+
+
+def is_gpu_machine() -> bool:
+    """Whether this machine trains or draws on a GPU (CUDA in torch, or a GPU's EGL driver)."""
+    import torch
+
+    from davis_ag.render.egl_context import draws_on_gpu, renderer_name
+
+    return torch.cuda.is_available() or draws_on_gpu(renderer_name())
+
+
+def _drawn_by(renderer: str | None) -> str:
+    return f", drawn by {renderer}" if renderer else ""
+
+
 def continuous_table(result: dict, load: tuple[float, float]) -> str:
     """The TVMContinuous-v0 rate as Markdown."""
     met = "meets" if result["steps_per_second"] >= result["target_min"] else "misses"
@@ -80,7 +99,7 @@ def continuous_table(result: dict, load: tuple[float, float]) -> str:
         f"224x224 observations, single-plant strawberry (seed {SEED}, scene 0, {result['triangles']:,} triangles, "
         f"{result['triangles_drawn']:,} with the soil merged), "
         f"uniformly random actions, resets included; load average {load[0]:.2f} at the start, "
-        f"{load[1]:.2f} at the end, {os.cpu_count()} CPUs.\n\n"
+        f"{load[1]:.2f} at the end, {os.cpu_count()} CPUs{_drawn_by(result.get('gl_renderer'))}.\n\n"
         "| steps timed | resets | refused moves | views drawn per step (per reset) | render + labels, ms | "
         "open + first reset, s | CPU ms/step | steps/s | target |\n"
         "|---|---|---|---|---|---|---|---|---|\n"
@@ -101,12 +120,13 @@ def continuous_line(result: dict) -> str:
     )
 
 
-def write_continuous(result: dict, load: tuple[float, float], doc: Path | None) -> None:
-    """Write the TVMContinuous-v0 rate into the doc and, beside it, docs/views-on-demand.md."""
+def write_continuous(result: dict, load: tuple[float, float], doc: Path | None, gpu_machine: bool = False) -> None:
+    """Write the TVMContinuous-v0 rate into the doc and, beside it, docs/views-on-demand.md (whose
+    sentence is the 2-core machine's: a GPU machine's rate goes to the doc's GPU section only)."""
     if doc:
-        write_marked_section(doc, "bench-continuous", continuous_table(result, load))
+        write_marked_section(doc, doc_section("bench-continuous", gpu_machine), continuous_table(result, load))
         page = doc.absolute().parent / "views-on-demand.md"
-        if page.is_file() and "<!-- continuous-rate:start -->" in read_page(page, "page"):
+        if not gpu_machine and page.is_file() and "<!-- continuous-rate:start -->" in read_page(page, "page"):
             write_marked_section(page, "continuous-rate", continuous_line(result))
 
 
@@ -117,7 +137,8 @@ def table(report: dict) -> str:
         f"seed {report['seed']}, scene 0 of each crop, "
         f"median of {max(c['repeats'] for c in report['crops'].values())} interleaved repetitions; load "
         f"average {report['machine']['load_average']['start'][0]} at the start, "
-        f"{report['machine']['load_average']['end'][0]} at the end, {report['machine']['cpus']} CPUs.",
+        f"{report['machine']['load_average']['end'][0]} at the end, {report['machine']['cpus']} CPUs"
+        f"{_drawn_by(report['machine'].get('gl_renderer'))}.",
         "",
         "| crop | primitives | views timed | ours s/view | documented s/view | floor s/view | "
         "documented / ours | target | ours / floor |",

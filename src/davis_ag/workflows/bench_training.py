@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from davis_ag.atomic_files import read_page, write_marked_section
+from davis_ag.workflows.bench_report import doc_section
 
 SEED = 0
 #: Steps each learner is timed for: a whole number of every timed rollout (8 environments x 128
@@ -139,10 +140,13 @@ def ppo_line(result: dict[str, Any]) -> str:
     )
 
 
-def write_training(result: dict[str, Any], load: tuple[float, float], doc: Path | None) -> None:
-    """Write the training rates into the doc and PPO's line into docs/benchmark.md beside it."""
+def write_training(
+    result: dict[str, Any], load: tuple[float, float], doc: Path | None, gpu_machine: bool = False
+) -> None:
+    """Write the training rates into the doc and PPO's line into docs/benchmark.md beside it (whose
+    sentence is the 2-core machine's: a GPU machine's rates go to the doc's GPU section only)."""
     if doc:
-        write_marked_section(doc, "bench-training", training_table(result, load))
+        write_marked_section(doc, doc_section("bench-training", gpu_machine), training_table(result, load))
         page = doc.absolute().parent / "benchmark.md"
-        if page.is_file() and "<!-- ppo-rate:start -->" in read_page(page, "page"):
+        if not gpu_machine and page.is_file() and "<!-- ppo-rate:start -->" in read_page(page, "page"):
             write_marked_section(page, "ppo-rate", ppo_line(result))
