@@ -132,3 +132,40 @@ def test_what_cannot_be_verified_is_refused_in_one_line_before_any_scene_is_made
     (tmp_path / "holds" / "Multi-Vine" / "000").mkdir(parents=True)
     with pytest.raises(UserError, match="already exists: make the scene again in another folder"):
         verify_scene(vine, tmp_path / "holds", progress=False)
+
+
+def test_scene_json_records_the_opengl_implementation_that_drew_it(dataset: Path) -> None:
+    from davis_ag.formats.scene_file import read_scene_file
+    from davis_ag.render.egl_context import renderer_name
+
+    generator = read_scene_file(dataset / "Single-Strawberry" / "002" / "scene.json").generator
+    assert generator is not None and generator.gl_renderer == renderer_name()
+
+
+def test_a_scene_drawn_by_another_opengl_implementation_says_so(copy: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A scene made on a GPU and verified on llvmpipe (or the other way): its pixels differ, and
+    the line says which implementations drew it and whether the labels came out the same."""
+    import json
+
+    scene = copy / "Single-Strawberry" / "002"
+    record = json.loads((scene / "scene.json").read_text())
+    record["generator"]["gl_renderer"] = "NVIDIA H200/PCIe/SSE2"  # as a lent GPU machine records it
+    (scene / "scene.json").write_text(json.dumps(record))
+    view = next((scene / "images").glob("*.jpeg"))  # its pixels, drawn by the GPU
+    view.write_bytes(view.read_bytes()[:-2] + b"\x00\xff\xd9")
+    assert main(["verify", str(scene)]) == 1
+    (line,) = capsys.readouterr().out.splitlines()
+    assert "1 of " in line and f"images/{view.name}" in line
+    assert "drawn by NVIDIA H200/PCIe/SSE2, drawn again by " in line and "annotations.json came out the same" in line
+
+    del record["generator"]["gl_renderer"]  # a scene made before the record: said so
+    (scene / "scene.json").write_text(json.dumps(record))
+    assert main(["verify", str(scene)]) == 1
+    assert "where the scene does not record what drew it" in capsys.readouterr().out
+
+
+def test_a_differing_scene_of_the_same_implementation_names_no_implementation() -> None:
+    from davis_ag.workflows.regenerate import Verdict
+
+    verdict = Verdict("Single-Strawberry/000", 4, ("images/0001.jpeg",), "a", "b", "llvmpipe", "llvmpipe")
+    assert "OpenGL" not in verdict.text() and "1 of 4 files differ" in verdict.text()

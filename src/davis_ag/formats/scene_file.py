@@ -41,6 +41,11 @@ class GeneratorRecord(_Record):
     version: str | None = Field(None, description="davis-ag's version and git commit")
     pyhelios3d: str | None = Field(None, description="the pyhelios3d version that grew the plants")
     python: str | None = None
+    gl_renderer: str | None = Field(
+        None,
+        description="GL_RENDERER of the OpenGL implementation that drew the views (llvmpipe: Mesa on the "
+        "CPU); another implementation draws other pixels from the same records",
+    )
 
 
 class CameraRecord(_Record):

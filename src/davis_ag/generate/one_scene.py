@@ -25,6 +25,7 @@ from davis_ag.errors import UserError
 from davis_ag.generate.scene_writer import SceneWriter
 from davis_ag.labels.fruit_labels import fruit_lookup, label_view, visible_fractions
 from davis_ag.render.backends import ANTIALIASING_DESCRIPTIONS, DEFAULT_RENDERER, open_renderer, resolve_look
+from davis_ag.render.egl_context import renderer_name
 from davis_ag.scene.appearance import draw_appearance, resolve_appearance
 from davis_ag.scene.build import build_scene
 from davis_ag.scene.camera import Camera
@@ -311,6 +312,8 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict, timing: di
             "version": code_version(),
             "pyhelios3d": pyhelios.__version__,
             "python": platform.python_version(),
+            # Pixels depend on the OpenGL implementation: `verify` on another one names both.
+            "gl_renderer": renderer_name(),
         },
         seed=request.seed,
         dataset_seed=request.dataset_seed,

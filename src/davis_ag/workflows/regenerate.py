@@ -19,12 +19,14 @@ from pathlib import Path
 from typing import Any
 
 from davis_ag.errors import UserError
-from davis_ag.formats.layout import SCENE_METADATA
+from davis_ag.formats.layout import ANNOTATIONS, SCENE_METADATA
 from davis_ag.formats.scene_file import read_scene_file
 from davis_ag.generate.one_scene import SceneRequest
 
 #: What ``scene.json`` records of the making rather than of the scene: left out of the comparison.
 MAKING = ("generator", "timing_s")
+#: What a verdict says of a version or a renderer the scene does not record (scenes made before it was).
+UNRECORDED = "unrecorded"
 
 
 @dataclass(frozen=True)
@@ -37,6 +39,9 @@ class Verdict:
         differing: The files (relative to the scene) whose bytes differ, or that only one side has.
         made_by: The code that made the scene on disk (its ``scene.json``).
         remade_by: The code that made it again.
+        drawn_by: The OpenGL implementation that drew the scene on disk (``GL_RENDERER``, as its
+            ``scene.json`` records it; ``unrecorded`` for scenes made before it was).
+        redrawn_by: The one that drew it again.
     """
 
     scene: str
@@ -44,6 +49,8 @@ class Verdict:
     differing: tuple[str, ...]
     made_by: str
     remade_by: str
+    drawn_by: str = UNRECORDED
+    redrawn_by: str = UNRECORDED
 
     @property
     def identical(self) -> bool:
@@ -61,7 +68,19 @@ class Verdict:
         shown = ", ".join(self.differing[:5]) + (
             f" and {len(self.differing) - 5} more" if len(self.differing) > 5 else ""
         )
-        return f"{self.scene}: {len(self.differing):,} of {self.files:,} files differ ({shown}; {versions})"
+        line = f"{self.scene}: {len(self.differing):,} of {self.files:,} files differ ({shown}; {versions})"
+        labels = f"{ANNOTATIONS} {'differs too' if ANNOTATIONS in self.differing else 'came out the same'}"
+        if self.drawn_by == UNRECORDED and self.redrawn_by != UNRECORDED:
+            line += (
+                f"; drawn again by {self.redrawn_by}, where the scene does not record what drew it: another "
+                f"OpenGL implementation draws other pixels ({labels})"
+            )
+        elif self.drawn_by != self.redrawn_by:
+            line += (
+                f"; drawn by {self.drawn_by}, drawn again by {self.redrawn_by}: another OpenGL implementation "
+                f"draws other pixels, so only the same one gives the same images ({labels})"
+            )
+        return line
 
 
 def scene_folder_of(path: str | os.PathLike[str]) -> Path:
@@ -137,9 +156,18 @@ def verify_scene(scene_dir: Path, work: Path | None = None, progress: bool = Tru
         root = Path(work) if work is not None else Path(temporary)
         run_dataset([request], root, RunOptions(workers=1, progress=progress))
         differing, files = compare_scenes(scene_dir, root / request.folder)
+        again = read_scene_file(root / request.folder / SCENE_METADATA).generator
     generator = read_scene_file(scene_dir / SCENE_METADATA).generator
-    made_by = (generator.version if generator else None) or "unrecorded"
-    return Verdict(request.folder, files, tuple(differing), made_by, code_version())
+    made_by = (generator.version if generator else None) or UNRECORDED
+    return Verdict(
+        request.folder,
+        files,
+        tuple(differing),
+        made_by,
+        code_version(),
+        (generator.gl_renderer if generator else None) or UNRECORDED,
+        (again.gl_renderer if again else None) or UNRECORDED,
+    )
 
 
 def compare_scenes(ours: Path, again: Path) -> tuple[list[str], int]:
