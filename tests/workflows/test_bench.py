@@ -146,17 +146,33 @@ def test_a_gpu_machines_rates_go_to_the_gpu_sections_and_leave_the_2_core_machin
     assert "old" in (tmp_path / "views-on-demand.md").read_text()
 
 
-def test_a_gpu_machine_asks_for_the_pages_gpu_section(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+@pytest.mark.parametrize(
+    ("only", "present", "missing"),
+    [
+        ("all", ["bench"], "bench-gpu"),
+        ("all", ["bench-gpu", "bench-training-gpu"], "bench-continuous-gpu"),  # every section it will write
+        ("continuous", ["bench-continuous", "bench-gpu"], "bench-continuous-gpu"),
+        ("training", ["bench-training", "bench-gpu"], "bench-training-gpu"),
+    ],
+)
+def test_a_gpu_machine_asks_for_the_pages_gpu_sections(
+    only: str,
+    present: list[str],
+    missing: str,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
 ) -> None:
-    """A page without the GPU section is refused before minutes of measuring, naming the marker."""
+    """A page without a GPU section the run would write is refused before minutes of measuring,
+    naming the marker, and left as it was."""
     from davis_ag import cli
     from davis_ag.workflows import bench_report
 
     monkeypatch.setattr(bench_report, "is_gpu_machine", lambda: True)
     page = tmp_path / "performance.md"
-    page.write_text("<!-- bench:start -->\n<!-- bench:end -->\n")
-    assert cli.main(["bench", "--out", str(tmp_path / "b.json"), "--doc", str(page)]) == 2
+    text = "".join(f"<!-- {m}:start -->\n<!-- {m}:end -->\n" for m in present)
+    page.write_text(text)
+    assert cli.main(["bench", "--only", only, "--out", str(tmp_path / "b.json"), "--doc", str(page)]) == 2
     err = capsys.readouterr().err.strip()
-    assert "<!-- bench-gpu:start -->" in err and "\n" not in err
-    assert page.read_text() == "<!-- bench:start -->\n<!-- bench:end -->\n"
+    assert f"<!-- {missing}:start -->" in err and "\n" not in err
+    assert page.read_text() == text

@@ -38,7 +38,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="our renderer's antialiasing (default fxaa)",
     )
     parser.add_argument(
-        "--doc", type=arguments.path, metavar="PAGE.md", help="write the tables into this Markdown file's bench section"
+        "--doc",
+        type=arguments.path,
+        metavar="PAGE.md",
+        help="write the tables into this Markdown file's bench sections (its -gpu ones on a GPU machine)",
     )
     parser.add_argument(
         "--only",
@@ -69,7 +72,7 @@ def run(args: argparse.Namespace) -> int:
     """Measure, print and write the report (and the doc's sections)."""
     from davis_ag.atomic_files import write_marked_section
     from davis_ag.workflows.bench import run as run_bench
-    from davis_ag.workflows.bench import run_only
+    from davis_ag.workflows.bench import run_only, training_devices
     from davis_ag.workflows.bench_training import write_training
     from davis_ag.workflows.bench_report import doc_section, is_gpu_machine, table, write_continuous
 
@@ -85,21 +88,28 @@ def run(args: argparse.Namespace) -> int:
         raise UserError(f"--device {args.device} is for --only training: add --only training, or leave --device out")
     # A GPU machine's numbers go to the page's GPU sections, beside the 2-core machine's.
     gpu = args.doc is not None and is_gpu_machine()
-    marker = doc_section({"continuous": "bench-continuous", "training": "bench-training"}.get(args.only, "bench"), gpu)
-    if args.doc is not None and not (args.doc.is_file() and f"<!-- {marker}:start -->" in read_page(args.doc, "--doc")):
+    sections = {"continuous": ["bench-continuous"], "training": ["bench-training"]}.get(args.only)
+    if sections is None:  # the whole bench: the view costs, and with strawberry the rates too
+        sections = ["bench", "bench-continuous", "bench-training"] if "strawberry" in args.crops else ["bench"]
+    markers = [doc_section(name, gpu) for name in sections]
+    page = read_page(args.doc, "--doc") if args.doc is not None and args.doc.is_file() else ""
+    missing = [m for m in markers if f"<!-- {m}:start -->" not in page or f"<!-- {m}:end -->" not in page]
+    if args.doc is not None and missing:
         raise UserError(
-            f"--doc {args.doc}: not a Markdown page with <!-- {marker}:start --> and <!-- {marker}:end --> "
+            f"--doc {args.doc}: not a Markdown page with <!-- {missing[0]}:start --> and <!-- {missing[0]}:end --> "
             "markers; give docs/performance.md or leave --doc out"
         )
     if args.only in ("continuous", "training"):
-        run_only(args.only, args.out, args.doc, ("cpu",) if args.device == "cpu" else ("cpu", args.device), gpu)
+        # A GPU machine's training table is always the CPU's beside the GPU's (where torch has CUDA).
+        devices = ("cpu", args.device) if args.device != "cpu" else (training_devices() if gpu else ("cpu",))
+        run_only(args.only, args.out, args.doc, devices, gpu)
         print(f"written {args.out}" + (f" and {args.doc}" if args.doc else ""))
         return 0
     report = run_bench(args.out, args.crops, args.repeats, args.antialiasing)
     text = table(report)
     print(text)
     if args.doc:
-        write_marked_section(args.doc, marker, text)
+        write_marked_section(args.doc, markers[0], text)
         load = report["machine"]["load_average"]
         if "continuous_env" in report:
             write_continuous(report["continuous_env"], (load["start"][0], load["end"][0]), args.doc, gpu)

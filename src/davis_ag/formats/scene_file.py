@@ -43,8 +43,9 @@ class GeneratorRecord(_Record):
     python: str | None = None
     gl_renderer: str | None = Field(
         None,
-        description="GL_RENDERER of the OpenGL implementation that drew the views (llvmpipe: Mesa on the "
-        "CPU); another implementation draws other pixels from the same records",
+        description="GL_RENDERER of the OpenGL implementation our renderer drew the views with (llvmpipe: "
+        "Mesa on the CPU; not recorded for Helios's renderer); another one draws other pixels from the "
+        "same records",
     )
 
 

@@ -313,7 +313,8 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict, timing: di
             "pyhelios3d": pyhelios.__version__,
             "python": platform.python_version(),
             # Pixels depend on the OpenGL implementation: `verify` on another one names both.
-            "gl_renderer": renderer_name(),
+            # (Helios's Visualizer opens its own display, which $DAVIS_AG_EGL_DEVICE does not choose.)
+            "gl_renderer": renderer_name() if request.renderer == "opengl" else None,
         },
         seed=request.seed,
         dataset_seed=request.dataset_seed,

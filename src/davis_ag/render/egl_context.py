@@ -86,15 +86,22 @@ def create_context():
 SOFTWARE_RASTERISERS = ("llvmpipe", "softpipe", "swiftshader")
 
 
-@functools.cache
 def renderer_name() -> str:
     """``GL_RENDERER`` of the context our renderer draws in: ``llvmpipe (LLVM 15.0.6, 256 bits)`` on a
     machine without a GPU, ``NVIDIA H200/PCIe/SSE2`` on one with NVIDIA's EGL driver (asked once per
-    process: the EGL display and device do not change in one).
+    ``$DAVIS_AG_EGL_DEVICE``, which chooses the device).
 
     Raises:
         UserError: when no context can be opened (see :func:`create_context`).
     """
+    import os
+
+    return _renderer_name(os.environ.get(EGL_DEVICE_VARIABLE, "").strip())
+
+
+@functools.cache
+def _renderer_name(device: str) -> str:
+    """:func:`renderer_name` for one value of ``$DAVIS_AG_EGL_DEVICE`` (read by :func:`create_context`)."""
     state = egl_current()  # another GL user's context (Helios's Visualizer) stays current
     context = create_context()
     try:

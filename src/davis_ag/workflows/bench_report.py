@@ -155,10 +155,12 @@ def table(report: dict) -> str:
             f"{spv['ours']:.3f} | {doc} | {spv['floor']:.3f} | {ratio} | {target} | {over} |"
         )
     p = report["paper_projection"]
+    # The projection runs POOL_SLOTS scene processes a machine: the default workers on 2 cores only.
+    workers = "the default workers" if report["machine"]["cpus"] == POOL_SLOTS else f"{POOL_SLOTS} scene processes"
     lines += [
         "",
         f"The `paper` preset ({p['images']:,} images, {p['scenes']} scenes): "
-        f"**{p['hours_one_machine']} h** on one machine like this one with the default workers "
+        f"**{p['hours_one_machine']} h** on one machine like this one with {workers} "
         f"(target <= {PAPER_HOURS_TARGET:.0f} h; {p['hours_one_machine_one_process']} h in one process), "
         f"{p[f'hours_{CLUSTER_MACHINES}_machines']} h on {CLUSTER_MACHINES} such machines with Ray. "
         f"Per-scene overhead (growing, renderer set-up), s: "

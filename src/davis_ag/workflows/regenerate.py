@@ -72,8 +72,8 @@ class Verdict:
         labels = f"{ANNOTATIONS} {'differs too' if ANNOTATIONS in self.differing else 'came out the same'}"
         if self.drawn_by == UNRECORDED and self.redrawn_by != UNRECORDED:
             line += (
-                f"; drawn again by {self.redrawn_by}, where the scene does not record what drew it: another "
-                f"OpenGL implementation draws other pixels ({labels})"
+                f"; drawn again by {self.redrawn_by}, where the scene does not record what drew it: if another "
+                f"OpenGL implementation drew it, its pixels differ ({labels})"
             )
         elif self.drawn_by != self.redrawn_by:
             line += (
