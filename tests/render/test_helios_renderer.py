@@ -10,6 +10,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from helios_reference import helios_reference
+
 from davis_ag.labels.fruit_labels import silhouette_pixels
 from davis_ag.render.helios import HeliosRenderer
 from davis_ag.scene.camera import Camera
@@ -96,6 +98,7 @@ def test_projection_inverts_the_pinhole_model(
     assert v == pytest.approx(CAMERA.height / 2 - CAMERA.fy * up, abs=1e-6)
 
 
+@helios_reference
 @pytest.mark.parametrize("view", VIEWS, ids=["level", "tilted"])
 def test_spheres_render_where_the_camera_model_projects_them(scene, view: Viewpoint) -> None:  # type: ignore[no-untyped-def]
     renderer, uuids, polygons = scene
@@ -115,6 +118,7 @@ def test_spheres_render_where_the_camera_model_projects_them(scene, view: Viewpo
         assert silhouette_pixels(CAMERA, view, polys) == pytest.approx(mask.sum(), abs=3)
 
 
+@helios_reference
 def test_id_pass_then_read_colour_equals_a_colour_draw(scene) -> None:  # type: ignore[no-untyped-def]
     renderer, _, _ = scene
     first, other = VIEWS

@@ -13,6 +13,8 @@ from collections.abc import Iterator
 import numpy as np
 import pytest
 
+from helios_reference import helios_reference
+
 from davis_ag.labels.fruit_labels import fruit_lookup, label_view
 from davis_ag.render.backends import open_renderer, resolve_look
 from davis_ag.scene.camera import Camera
@@ -49,6 +51,7 @@ def frames() -> Iterator[dict]:
     yield out
 
 
+@helios_reference
 def test_ids_match_helios(frames: dict) -> None:
     differ = sum(int((ours[1] != ref[1]).sum()) for ours, ref in zip(frames["opengl"], frames["helios"]))
     pixels = len(frames["views"]) * CAMERA.width * CAMERA.height
@@ -58,6 +61,7 @@ def test_ids_match_helios(frames: dict) -> None:
         assert (ours[1][0] == 0).all()  # the top row is sky
 
 
+@helios_reference
 def test_fruit_masks_and_boxes_match_helios(frames: dict) -> None:
     model = frames["model"]
     lookup = fruit_lookup({f.id: f.uuids for f in model.fruits}, model.uuid_count)
@@ -99,6 +103,7 @@ def test_depth_matches_helios_and_the_pinhole_model(frames: dict) -> None:
             assert along.min() - 1e-3 <= depth[pixels].min() and depth[pixels].max() <= along.max() + 1e-3
 
 
+@helios_reference
 def test_default_look_keeps_the_geometry(frames: dict) -> None:
     """The default look changes textures, not where things are: fruit are where Helios sees them."""
     model = frames["model"]
