@@ -111,7 +111,12 @@ def plot_scene_gaps(gaps: dict[str, dict[str, Any]], path: str | os.PathLike[str
 
     scenes = sorted({s["scene"] for gap in gaps.values() for s in gap["per_scene"]})
     x = {scene: i for i, scene in enumerate(scenes)}
-    fig, ax = plt.subplots(figsize=(max(6.0, 0.32 * len(scenes) + 2.5), 3.8))
+    width = max(6.0, 0.32 * len(scenes) + 2.5)
+    # Each learner's two legend entries take about 4.8 inches at this size: on a figure of few
+    # scenes they go two to a row, so none is cut at the figure's edge.
+    columns = 2 * len(gaps) if width >= 4.8 * len(gaps) else 2
+    rows = -(-2 * len(gaps) // columns)
+    fig, ax = plt.subplots(figsize=(width, 3.8 + 0.2 * (rows - 1)))
     ax.axhline(0.0, color="black", linewidth=0.8)
     spread = 0.18 * (len(gaps) > 1)  # learners side by side within a scene's slot
     for i, (learner, gap) in enumerate(gaps.items()):
@@ -137,8 +142,8 @@ def plot_scene_gaps(gaps: dict[str, dict[str, Any]], path: str | os.PathLike[str
     ax.set_xlabel(f"test scene ({scenes[0].split('/')[0]}/…)" if scenes else "test scene")
     ax.set_ylabel("OER_tau minus Best fixed action")
     ax.set_title(f"{title}: bands, 95 % intervals over episodes (dark) and over scenes (light)", fontsize=9)
-    fig.legend(fontsize=7, loc="lower center", ncol=2 * len(gaps), frameon=False, markerscale=0.5)
-    fig.tight_layout(rect=(0, 0.08, 1, 1))  # the legend's row below the axes
+    fig.legend(fontsize=7, loc="lower center", ncol=columns, frameon=False, markerscale=0.5)
+    fig.tight_layout(rect=(0, 0.02 + 0.06 * rows, 1, 1))  # the legend's rows below the axes
     try:
         return save_figure_atomic(fig, path, dpi=120)
     finally:
