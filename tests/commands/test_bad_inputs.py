@@ -117,7 +117,7 @@ def test_a_config_the_renderer_cannot_draw_is_refused_before_any_plant_grows(
     ), line
     config.write_text("groups: [{scenario: sp, crop: banana, scenes: 1}]\n")
     line = refused(capsys, "generate", "--config", str(config), "--out", str(tmp_path / "out"))
-    assert line.endswith("groups.0.crop: unknown crop 'banana': choose one of strawberry, tomato, vine"), line
+    assert "groups.0.crop: unknown crop 'banana': choose one of strawberry, tomato, vine, apple" in line, line
     assert not (tmp_path / "out").exists()
 
 
@@ -291,3 +291,21 @@ def test_point_clouds_of_a_dataset_without_depth_or_camera(
     a_file.write_text("x")
     refused(capsys, "export", "pointcloud", str(sp_root), str(a_file))
     assert a_file.read_text() == "x"
+
+
+def test_what_a_plant_library_crop_does_not_offer_is_refused_before_any_plant_grows(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, never_grow: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    out = str(tmp_path / "out")
+    for command in ("generate", "preview"):
+        line = refused(capsys, command, "--crop", "apple", "--plants", "canopy", "--out", out)
+        assert "--plants canopy: apple grows from Helios's plant library only" in line, line
+    line = refused(capsys, "generate", "--crop", "apple", "--scenario", "orchard", "--out", out)
+    assert "unknown scenario 'orchard': choose sp (single plant), mp (multi plant) or row" in line, line
+    # A row too large for the machine's memory: pretend it has 4 GB.
+    import davis_ag.scene.scene_size as scene_size
+
+    monkeypatch.setattr(scene_size, "machine_memory", lambda: 4 * 10**9)
+    line = refused(capsys, "generate", "--crop", "vsp-vine", "--scenario", "row", "--out", out)
+    assert "a row scene of vsp-vine holds 12 plants" in line and "4.0 GB" in line, line
+    assert not (tmp_path / "out").exists()

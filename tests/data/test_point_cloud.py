@@ -10,7 +10,17 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from davis_ag.data.point_cloud import POINT_DTYPE, Pinhole, read_ply, unproject, voxel_thin, write_ply
+from davis_ag.data.point_cloud import (
+    POINT_DTYPE,
+    POINT_DTYPE_16,
+    Pinhole,
+    read_ply,
+    unproject,
+    view_points,
+    voxel_thin,
+    widen,
+    write_ply,
+)
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.view_grid import Viewpoint
 
@@ -76,3 +86,47 @@ def test_ply_round_trips_and_other_libraries_read_it(tmp_path: Path) -> None:
     assert isinstance(cloud, trimesh.PointCloud) and np.allclose(
         cloud.vertices, np.stack([points["x"], points["y"], points["z"]], 1), atol=1e-6
     )
+
+
+def test_fruit_ids_widen_to_16_bits_only_for_a_scene_with_16_bit_masks(tmp_path: Path) -> None:
+    points = points_at(np.random.default_rng(2).uniform(-1, 1, size=(50, 3)).astype(np.float32))
+    points["fruit_id"][:5] = 255  # none
+    path = write_ply(points, tmp_path / "narrow.ply")
+    assert read_ply(path).dtype == POINT_DTYPE and b"fruit_id 255: none" in path.read_bytes()[:600]
+    wide = widen(points)
+    assert wide.dtype == POINT_DTYPE_16 and (wide["fruit_id"][:5] == 65535).all()
+    assert np.array_equal(wide["fruit_id"][5:], points["fruit_id"][5:])
+    wide["fruit_id"][5] = 300
+    path = write_ply(wide, tmp_path / "wide.ply")
+    back = read_ply(path)
+    assert back.dtype == POINT_DTYPE_16 and np.array_equal(back, wide)
+    assert b"property ushort fruit_id" in path.read_bytes()[:600] and b"fruit_id 65535: none" in path.read_bytes()[:600]
+
+
+class _View:
+    """What view_points reads of a view: one fruit with id 300 in a 16-bit mask."""
+
+    name = "0003.jpeg"
+    pose = (0.0, 0.0, 1.0, 0.0, 0.0)
+    depth_path = Path("0003_depth.png")
+
+    def depth(self) -> np.ndarray:
+        return np.full((4, 6), 2.0, dtype=np.float32)
+
+    def image(self) -> np.ndarray:
+        return np.zeros((4, 6, 3), dtype=np.uint8)
+
+    def classes(self) -> None:
+        return None
+
+    def mask(self) -> np.ndarray:
+        mask = np.full((4, 6), 65535, dtype=np.uint16)
+        mask[1:3, 2:4] = 300
+        return mask
+
+
+def test_view_points_keep_a_16_bit_fruit_id() -> None:
+    points = view_points(_View(), Pinhole(6, 4, 3.0, 3.0, 3.0, 2.0))  # type: ignore[arg-type]
+    assert points.dtype == POINT_DTYPE_16 and len(points) == 24
+    assert sorted(set(points["fruit_id"].tolist())) == [300, 65535] and (points["fruit_id"] == 300).sum() == 4
+    assert (points["view"] == 3).all()

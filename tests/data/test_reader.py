@@ -11,6 +11,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 from layout_factory import write_original_style_dataset, write_tiny_dataset
+from wide_masks import widen_scene
 
 from davis_ag.data.reader import (
     Box,
@@ -119,6 +120,21 @@ def test_pixels_and_boxes_follow_writer_conventions(ours: Path) -> None:
             assert view.box(box.fruit_id) is box
             assert 0 < exposure_rate(mask, box) <= 1
     assert scene.view(1).box(254) is None
+
+
+def test_a_16_bit_mask_reads_with_its_ids_above_255(tmp_path: Path) -> None:
+    root = write_tiny_dataset(tmp_path, "sp", "strawberry", scenes=1)
+    widen_scene(root / "Single-Strawberry" / "000")
+    scene = open_dataset(root).scene("Single-Strawberry/000")
+    seen = 0
+    for view in scene:
+        mask = view.mask()
+        assert mask is not None and mask.dtype == np.uint16 and mask.shape == (72, 128)
+        assert boxes_from_mask(mask) == {b.fruit_id: b for b in view.boxes}
+        for box in view.boxes:
+            assert box.fruit_id >= 300 and 0 < exposure_rate(mask, box) <= 1
+            seen += 1
+    assert seen > 10
 
 
 def test_oer_varies_and_fruits_hide(ours: Path) -> None:

@@ -10,9 +10,11 @@ import numpy as np
 import pytest
 from layout_factory import tiny_specs, write_original_style_dataset, write_tiny_dataset
 from PIL import Image
+from wide_masks import widen_scene
 
 from davis_ag import cli
 from davis_ag.data.validate import validate_dataset
+from davis_ag.formats.masks import mask_image
 from davis_ag.scene.view_grid import views_per_scene
 
 SCENE = Path("Single-Strawberry") / "000"
@@ -198,9 +200,47 @@ def test_wrong_mask_mode_and_size(dataset: Path, capsys: pytest.CaptureFixture[s
     (images / "0003.jpeg").write_bytes((images / "0003.jpeg").read_bytes()[:300])
     code, lines, _ = run(capsys, str(dataset / SCENE))
     assert code == 1
-    assert lines[0] == f"{images / '0001_seg.png'}: must be a uint8 single-channel PNG, got mode RGB"
+    assert lines[0] == f"{images / '0001_seg.png'}: must be a uint8 or uint16 single-channel PNG, got mode RGB"
     assert lines[1] == f"{images / '0002_seg.png'}: is 10x10 but its image is 128x72"
     assert lines[2].startswith(f"{images / '0003.jpeg'}: cannot decode (")
+
+
+def test_a_scene_of_more_than_255_fruit_with_16_bit_masks_is_sound(
+    dataset: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    widen_scene(dataset / SCENE)  # fruit ids 300 and up, uint16 masks, 306 fruit in scene.json
+    code, lines, _ = run(capsys, str(dataset / SCENE))
+    assert code == 0 and len(lines) == 1 and lines[0].endswith(": sound")
+    mask = np.asarray(Image.open(dataset / SCENE / "images" / "0001_seg.png"))
+    assert mask.dtype == np.uint16 and mask.max() == 65535 and 300 <= mask[mask != 65535].min()
+
+
+def test_a_mask_of_the_wrong_type_for_the_fruit_count_is_refused(
+    dataset: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    images = dataset / SCENE / "images"
+    mask = np.asarray(Image.open(images / "0001_seg.png"))
+    mask_image(np.where(mask == 255, 65535, mask.astype(np.uint16)).astype(np.uint16)).save(images / "0001_seg.png")
+    fruit = len(json.loads((dataset / SCENE / "scene.json").read_text())["fruits"])
+    code, lines, _ = run(capsys, str(dataset / SCENE))
+    assert code == 1 and lines[:-1] == [
+        f"{images / '0001_seg.png'}: is uint16 but scene.json records {fruit} fruit, whose masks are uint8 (255 = no fruit)"
+    ]
+    # The other way round, and a box naming a fruit id a uint8 mask cannot hold.
+    widen_scene(dataset / SCENE.parent / "001")
+    wide = dataset / SCENE.parent / "001" / "images"
+    mask = np.asarray(Image.open(wide / "0002_seg.png"))
+    Image.fromarray(np.where(mask == 65535, 255, mask % 256).astype(np.uint8), mode="L").save(wide / "0002_seg.png")
+    edit_annotations(
+        dataset / SCENE / "annotations.json",
+        lambda data: data["0003.jpeg"]["bounding_boxes"].append([0, 0, 1, 1, 300, 0]),
+    )
+    code, lines, _ = run(capsys, str(dataset / SCENE.parent))
+    assert (
+        f"{dataset / SCENE / 'annotations.json'}: 0003.jpeg: box [0, 0, 1, 1, 300]: fruit id must be 0..254 to fit the uint8 mask"
+        in lines
+    )
+    assert any(line.startswith(f"{wide / '0002_seg.png'}: is uint8 but scene.json records ") for line in lines)
 
 
 def test_not_a_dataset(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

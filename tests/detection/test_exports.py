@@ -7,10 +7,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
 from layout_factory import write_original_style_dataset, write_tiny_dataset
 from PIL import Image
+from wide_masks import widen_scene
 
 from davis_ag.cli import main
+from davis_ag.scene.specs import CROPS
 from davis_ag.data.reader import open_dataset
 from davis_ag.detection.coco_export import export_coco
 from davis_ag.detection.instances import scenes_by_split
@@ -41,11 +44,10 @@ def test_coco_masks_and_boxes_round_trip(dataset: Path, tmp_path: Path) -> None:
     for split, scenes in by_split.items():
         coco = COCO(str(tmp_path / "annotations" / f"instances_{split}.json"))
         assert counts[split]["images"] == len(coco.imgs) == sum(len(s) for s in scenes)
-        assert {c["name"]: c["id"] for c in coco.loadCats(coco.getCatIds())} == {
-            "strawberry": 1,
-            "tomato": 2,
-            "vine": 3,
-        }
+        categories = {c["name"]: c["id"] for c in coco.loadCats(coco.getCatIds())}
+        # The paper's crops keep ids 1-3; the plant-library crops follow in specs.CROPS's order.
+        assert categories == {name: i + 1 for i, name in enumerate(CROPS)}
+        assert [categories[name] for name in ("strawberry", "tomato", "vine")] == [1, 2, 3]
         checked = 0
         for image in coco.imgs.values():
             view = data.scene(image["scene"]).view(image["view"])
@@ -85,6 +87,40 @@ def test_coco_of_the_original_download_without_a_mask_keeps_the_boxes(tmp_path: 
     assert anns and all("segmentation" not in a and a["attributes"]["visible_fraction"] is None for a in anns)
 
 
+def test_coco_and_yolo_of_a_scene_with_16_bit_masks_keep_ids_above_255(tmp_path: Path) -> None:
+    from pycocotools.coco import COCO
+
+    root = write_tiny_dataset(tmp_path / "wide", "sp", "strawberry", scenes=2, size=(64, 48))
+    for scene in ("000", "001"):
+        widen_scene(root / "Single-Strawberry" / scene)
+    export_coco(root, tmp_path / "coco", progress=False)
+    export_yolo(root, tmp_path / "yolo", "segment", progress=False)
+    data = open_dataset(root)
+    checked = 0
+    for split, scenes in scenes_by_split(data).items():
+        coco = COCO(str(tmp_path / "coco" / "annotations" / f"instances_{split}.json"))
+        for image in coco.imgs.values():
+            view = data.scene(image["scene"]).view(image["view"])
+            seg = view.mask()
+            assert seg is not None and seg.dtype == np.uint16
+            anns = coco.loadAnns(coco.getAnnIds(imgIds=image["id"]))
+            assert [a["attributes"]["fruit_id"] for a in anns] == [b.fruit_id for b in view.boxes]
+            for ann, box in zip(anns, view.boxes):
+                assert box.fruit_id >= 300
+                assert np.array_equal(coco.annToMask(ann).astype(bool), seg == box.fruit_id)
+                assert ann["area"] == int((seg == box.fruit_id).sum()) > 0
+                checked += 1
+            label = tmp_path / "yolo" / "labels" / split / f"{flat_name(image['scene'] + '/' + image['view'])}.txt"
+            lines = label.read_text().splitlines()
+            assert len(lines) == len(view.boxes)
+            for line, box in zip(lines, view.boxes):
+                xy = np.array(line.split()[1:], dtype=float).reshape(-1, 2) * [64, 48]
+                # Outlines through pixel centres: the extremes are the box's first and last pixels + 0.5.
+                assert (xy[:, 0].min(), xy[:, 1].min()) == pytest.approx((box.xmin + 0.5, box.ymin + 0.5), abs=1e-3)
+                assert (xy[:, 0].max(), xy[:, 1].max()) == pytest.approx((box.xmax + 0.5, box.ymax + 0.5), abs=1e-3)
+    assert checked > 10
+
+
 def _yolo_boxes(label: Path, width: int, height: int) -> list[tuple[int, float, float, float, float]]:
     rows = []
     for line in label.read_text().splitlines():
@@ -115,7 +151,7 @@ def test_yolo_boxes_round_trip_and_load_in_ultralytics(dataset: Path, tmp_path: 
     from ultralytics.data.utils import check_det_dataset
 
     info = check_det_dataset(str(tmp_path / "data.yaml"))
-    assert info["nc"] == 3 and info["names"][1] == "tomato"
+    assert info["nc"] == len(CROPS) and info["names"][1] == "tomato"
     loaded = YOLODataset(img_path=info["val"], data=info, task="detect", augment=False, imgsz=64)
     n_boxes = sum(len(lab["cls"]) for lab in loaded.labels)
     assert len(loaded.labels) == counts["test"]["images"] and n_boxes == counts["test"]["instances"]
@@ -203,6 +239,9 @@ def test_coco_organs_are_semantic_rle_masks(dataset: Path, tmp_path: Path) -> No
         103: "leaf",
         104: "stem",
         105: "trunk",
+        106: "petiole",
+        107: "peduncle",
+        108: "flower",
     }
     checked = 0
     for image in coco.loadImgs(coco.getImgIds()):
@@ -229,30 +268,33 @@ def test_yolo_organs_are_polygons_after_the_crops(dataset: Path, tmp_path: Path)
         export_yolo(copy, tmp_path / "boxes", "detect", progress=False, organs=True)
     export_yolo(copy, tmp_path / "out", "segment", progress=False, organs=True)
     names = yaml.safe_load((tmp_path / "out" / "data.yaml").read_text())["names"]
+    crops = len(CROPS)
     assert names == {
-        0: "strawberry",
-        1: "tomato",
-        2: "vine",
-        3: "organ_soil",
-        4: "organ_fruit",
-        5: "organ_leaf",
-        6: "organ_stem",
-        7: "organ_trunk",
+        **dict(enumerate(CROPS)),
+        crops: "organ_soil",
+        crops + 1: "organ_fruit",
+        crops + 2: "organ_leaf",
+        crops + 3: "organ_stem",
+        crops + 4: "organ_trunk",
+        crops + 5: "organ_petiole",
+        crops + 6: "organ_peduncle",
+        crops + 7: "organ_flower",
     }
+    assert list(names.values())[:3] == ["strawberry", "tomato", "vine"]  # the paper's crops keep 0-2
     import cv2
     from scipy.ndimage import binary_fill_holes
 
     for name, classes in written.items():
         label = tmp_path / "out" / "labels" / "train" / f"{flat_name('Single-Strawberry/000/' + name)}.txt"
-        organ = [line.split() for line in label.read_text().splitlines() if int(line.split()[0]) >= 3]
-        assert {int(line[0]) for line in organ} == {2 + v for v in set(np.unique(classes).tolist()) - {0}}
+        organ = [line.split() for line in label.read_text().splitlines() if int(line.split()[0]) >= crops]
+        assert {int(line[0]) for line in organ} == {crops - 1 + v for v in set(np.unique(classes).tolist()) - {0}}
         # Each part of a class is its own polygon: filled, they give the class's pixels back. Joined
         # into one polygon with seams (as before), the fruit's separate discs filled in a fan.
         height, width = classes.shape
         for value in set(np.unique(classes).tolist()) - {0, 1}:  # the soil's outline has no holes
             filled = np.zeros((height, width), np.uint8)
             for line in organ:
-                if int(line[0]) == 2 + value:
+                if int(line[0]) == crops - 1 + value:
                     xy = np.array(line[1:], dtype=float).reshape(-1, 2) * [width, height]
                     cv2.fillPoly(filled, [xy.astype(np.int32)], 1)
             truth = classes == value

@@ -8,6 +8,7 @@ import pytest
 import yaml
 from layout_factory import write_tiny_dataset
 
+from davis_ag.scene.specs import CROPS
 from davis_ag.detection.coco_export import export_coco
 from davis_ag.detection.real_sets import PAPER_TEST, PAPER_TRAIN, load_pool, split_sizes, write_split
 from davis_ag.detection.yolo_export import export_yolo
@@ -28,7 +29,7 @@ def test_coco_and_yolo_layouts_give_the_same_pool(exports: tuple[Path, Path]) ->
     from_yaml = load_pool(yolo / "data.yaml")
     from_folder = load_pool(yolo)
     from_coco = load_pool(coco / "annotations" / "instances_train.json")
-    assert from_yaml.names == {0: "strawberry", 1: "tomato", 2: "vine"} == from_coco.names
+    assert from_yaml.names == dict(enumerate(CROPS)) == from_coco.names
     train = {p.name.removesuffix(".jpeg"): lines for p, lines in from_yaml.items if "/train/" in str(p)}
     coco_lines = {
         f"{p.parent.parent.parent.name}_{p.parent.parent.name}_{p.stem}": lines for p, lines in from_coco.items

@@ -117,7 +117,8 @@ def test_report_of_a_folder_without_a_dataset_is_a_user_error(tmp_path: Path) ->
 
 
 def test_results_markdown_puts_ours_beside_the_paper(tmp_path: Path) -> None:
-    from davis_ag.commands.reproduce import CONFIGS, write_results_md
+    from davis_ag.workflows.reproduce_configs import CONFIGS
+    from davis_ag.workflows.results_page import write_results_md
 
     stat = {"mean": 0.5, "std": 0.01}
     state = {

@@ -66,9 +66,11 @@ def test_annotation_entries_as_we_write_them() -> None:
         "backward": "",
     }
     assert AnnotationEntry.model_validate(entry).to_json() == {**entry, "pose": [0.0, 0.0, 0.25, 90.0, -10.0]}
+    # Ids above 254 belong to scenes of more than 255 fruit (16-bit masks: davis_ag.formats.masks).
+    assert AnnotationEntry.model_validate({**entry, "bounding_boxes": [[1, 2, 3, 4, 65534, 0]]})
     for change, path in (
         ({"bounding_boxes": [[1, 2, 0, 4, 5, 0]]}, "bounding_boxes.0.2"),
-        ({"bounding_boxes": [[1, 2, 3, 4, 255, 0]]}, "bounding_boxes.0.4"),
+        ({"bounding_boxes": [[1, 2, 3, 4, 65535, 0]]}, "bounding_boxes.0.4"),  # no fruit of a 16-bit mask
         ({"left": "2.jpeg"}, "left"),
         ({"jump": ""}, "jump"),
     ):

@@ -107,6 +107,28 @@ def test_boxes_and_masks_agree(fruit_map: np.ndarray, min_pixels: int, seed: int
         assert (x, y, x + w - 1, y + h - 1) == (cols.min(), rows.min(), cols.max(), rows.max())
 
 
+def test_a_scene_of_more_than_255_fruit_labels_ids_above_255_in_a_16_bit_mask() -> None:
+    # 400 fruit, fruit k on UUID 100 + k; UUIDs 0..99 are leaves and soil.
+    many = {k: np.array([100 + k]) for k in range(400)}
+    lookup = fruit_lookup(many, 600)
+    assert lookup.dtype == np.uint16 and lookup[0] == lookup[50 + 1] == 65535 and lookup[100 + 300 + 1] == 300
+    assert fruit_lookup(dict(list(many.items())[:255]), 600).dtype == np.uint8  # 255 fruit: as before
+    ids = paint(
+        (20, 30),
+        (100 + 300, slice(2, 6), slice(3, 9)),  # fruit 300: 24 pixels
+        (100 + 255, slice(10, 12), slice(0, 2)),  # fruit 255 (no fruit in a uint8 mask): 4 pixels
+        (100 + 256, slice(15, 16), slice(20, 21)),  # fruit 256 (0 in uint8): 1 pixel, under the threshold
+        (7, slice(18, 20), slice(0, 30)),  # a leaf
+    )
+    labels = label_view(ids, lookup, min_pixels=4)
+    assert labels.boxes == [[0, 10, 2, 2, 255, 0], [3, 2, 6, 4, 300, 0]]
+    assert labels.visible_pixels == {255: 4, 300: 24}
+    seg = labels.segmentation
+    assert seg.dtype == np.uint16 and seg.shape == (20, 30)
+    assert (seg[2:6, 3:9] == 300).all() and (seg[10:12, 0:2] == 255).all()
+    assert int((seg != 65535).sum()) == 28 and seg[15, 20] == 65535
+
+
 # ---------------------------------------------------------------------------------------------
 # Silhouettes and visible fractions
 

@@ -18,6 +18,7 @@ from davis_ag.scene.specs import (
     SLIP_SIGMA,
     CropSpec,
     ScenarioSpec,
+    camera_altitudes,
     plant_centres,
     scenario_spec,
 )
@@ -82,8 +83,15 @@ def test_every_view_and_pointer_is_inside_the_grid_and_outside_exclusion(
     scenario, crop, grid = case
     shape = lattice_shape(scenario)
     stems = np.asarray(plant_centres(scenario, crop))[:, :2]
-    altitudes = [crop.altitudes[i] for i in scenario.altitude_levels]
+    altitudes = camera_altitudes(scenario, crop)
     half_x, half_y = scenario.extent[0] / 2, scenario.extent[1] / 2
+
+    def free(x: float, y: float) -> bool:
+        """No camera within a plant's exclusion radius, nor inside a row (its band)."""
+        if scenario.name == "row":
+            return abs(y) > crop.row.exclusion_band + 1e-9
+        return bool(np.hypot(*(stems - (x, y)).T).min() > crop.exclusion_radius + 1e-9)
+
     for view in grid.viewpoints:
         x, y, z = view.nominal
         # Even rows lie within the extent; odd rows reach half a step further east.
@@ -91,21 +99,22 @@ def test_every_view_and_pointer_is_inside_the_grid_and_outside_exclusion(
         assert abs(y) <= half_y + 1e-9
         assert (x, y) == pytest.approx(lattice_point(view.ix, view.iy, shape, scenario.step))
         assert z == altitudes[view.level]
-        assert np.hypot(*(stems - (x, y)).T).min() > crop.exclusion_radius
+        assert free(x, y)
         for action in scenario.actions:
             target = grid.pointer(view.index, action)
             if target is not None:
                 to = grid.viewpoints[target].nominal
                 assert 0 <= target < len(grid.viewpoints)
-                assert np.hypot(*(stems - to[:2]).T).min() > crop.exclusion_radius
+                assert free(*to[:2])
+                if scenario.name == "row":  # no move crosses the row
+                    assert np.sign(to[1]) == np.sign(y)
     # Every allowed lattice position holds a view at every altitude: nothing else is left out.
     stations = {(v.ix, v.iy, v.level) for v in grid.viewpoints}
     for level in range(len(altitudes)):
         for iy in range(shape[1]):
             for ix in range(shape[0]):
                 x, y = lattice_point(ix, iy, shape, scenario.step)
-                free = np.hypot(*(stems - (x, y)).T).min() > crop.exclusion_radius + 1e-9
-                assert ((ix, iy, level) in stations) == free
+                assert ((ix, iy, level) in stations) == free(x, y)
 
 
 @settings(max_examples=40, deadline=None)
@@ -288,3 +297,16 @@ def test_grid_edges_and_exclusion_give_empty_pointers() -> None:
     columns = lattice_shape(scenario_spec("sp", CROPS["strawberry"]))[0]
     blocked = [v for v in grid.viewpoints if v.ix + 1 < columns and grid.pointer(v.index, "right") is None]
     assert blocked and all(v.nominal[0] < 0 for v in blocked)
+
+
+def test_the_view_shown_in_the_docs_faces_the_plants_from_their_middle() -> None:
+    from davis_ag.scene.view_grid import view_facing
+
+    for name in ("strawberry", "apple-wall"):
+        crop = CROPS[name]
+        for scenario_name, level in (("sp", 1), ("row", 1)):
+            scenario = scenario_spec(scenario_name, crop)
+            grid = make_grid(scenario, crop)
+            view = grid.viewpoints[view_facing(scenario, crop, level, 90.0) - 1]
+            assert view.level == level and abs(view.yaw - 90.0) < 10.0
+            assert view.nominal[1] < 0 and abs(view.nominal[0]) <= scenario.step

@@ -37,6 +37,7 @@ from PIL import Image
 from davis_ag.data.safe_read import check_inside
 from davis_ag.errors import UserError
 from davis_ag.formats.layout import ANNOTATIONS, CACHE_FOLDER, IMAGES
+from davis_ag.formats.masks import no_fruit_value
 from davis_ag.scene.specs import ALL_ACTIONS
 
 #: Side of the square observation image (section V-C: 224x224).
@@ -237,8 +238,9 @@ def _build(scene: Any, folder: Path, fingerprint: str) -> None:
                         f"missing view {target!r}; fix annotations.json or regenerate the scene"
                     )
                 pointers[i, j] = position[target]
-        # One bincount gives every fruit's visible pixel count in the view.
-        counts = np.bincount(mask.ravel(), minlength=256)
+        # One bincount gives every fruit's visible pixel count in the view (uint8 or uint16 mask:
+        # davis_ag.formats.masks; no fruit is its last bin).
+        counts = np.bincount(mask.ravel(), minlength=no_fruit_value(mask) + 1)
         for box in view.boxes:
             rows.append(
                 (
@@ -246,7 +248,7 @@ def _build(scene: Any, folder: Path, fingerprint: str) -> None:
                     int(box.fruit_id),
                     (int(box.xmin), int(box.ymin), int(box.width), int(box.height)),
                     float(exposure_rate(mask, box)),
-                    int(counts[int(box.fruit_id)]) if 0 <= box.fruit_id < 256 else 0,
+                    int(counts[int(box.fruit_id)]) if 0 <= box.fruit_id < len(counts) else 0,
                 )
             )
     images.flush()

@@ -142,7 +142,7 @@ class Protocol(_Model):
 
     version: int = Field(0, ge=0, le=PROTOCOL_VERSION)
     environment: str = "davis_ag/TVM-v0"
-    scenario: Literal["sp", "mp"]
+    scenario: Literal["sp", "mp", "row"]
     crop: str | None = None
     split: str
     tau: int = Field(ge=1)

@@ -194,6 +194,30 @@ def add_renderer_flags(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def check_crop_flags(args: argparse.Namespace, crop, scenario, local: bool = True) -> None:
+    """Refuse, before anything grows, what a crop does not offer: ``--plants`` for a plant-library
+    crop (its plants come from the library only), and a scene too large for this machine.
+
+    Args:
+        args: The parsed flags (``plants``).
+        crop, scenario: The scene's kind.
+        local: Whether the scene is made on this machine (the size check).
+
+    Raises:
+        UserError: one line.
+    """
+    from davis_ag.errors import UserError
+    from davis_ag.scene.scene_size import check_scene_size
+
+    if getattr(args, "plants", None) is not None and crop.source == "library":
+        raise UserError(
+            f"--plants {args.plants}: {crop.name} grows from Helios's plant library only; "
+            "--plants chooses the paper's crops' plants: drop it"
+        )
+    if local:
+        check_scene_size(scenario, crop)
+
+
 def add_dataset_flags(parser: argparse.ArgumentParser, verb: str) -> None:
     """Add ``--dataset``, ``--scenario``, ``--crop`` and ``--cache-dir``, shared by train and evaluate.
 
@@ -203,7 +227,10 @@ def add_dataset_flags(parser: argparse.ArgumentParser, verb: str) -> None:
     """
     parser.add_argument("--dataset", type=path, required=True, metavar="DIR", help="dataset root")
     parser.add_argument(
-        "--scenario", required=True, choices=["sp", "mp"], help="single plant (tau=3) or multi plant (tau=5)"
+        "--scenario",
+        required=True,
+        choices=["sp", "mp", "row"],
+        help="single plant (tau=3), multi plant (tau=5) or an orchard row (tau=5)",
     )
     parser.add_argument("--crop", default=None, help=f"{verb} on one crop only (default: all)")
     parser.add_argument(

@@ -30,8 +30,14 @@ GROUP_FLAGS = ("crop", "scenario", "scenes", "first")
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add ``generate``'s arguments to its ``parser`` (see :mod:`davis_ag.commands`)."""
     parser.add_argument("--config", help="dataset config: a preset (paper, mini) or a YAML file")
-    parser.add_argument("--crop", help="strawberry, tomato or vine (default strawberry; not with --config)")
-    parser.add_argument("--scenario", help="sp (single plant) or mp (multi plant) (default sp)")
+    parser.add_argument(
+        "--crop",
+        help="strawberry, tomato or vine (the paper's), or a plant-library crop: apple, apple-wall, almond, "
+        "olive, pistachio, walnut, capsicum, cherry-tomato, vsp-vine, wye-vine (default strawberry; not with --config)",
+    )
+    parser.add_argument(
+        "--scenario", help="sp (single plant), mp (multi plant) or row (an orchard row and its alleys) (default sp)"
+    )
     parser.add_argument("--scenes", type=arguments.bounded(1, 100_000), help="how many scenes (default 1)")
     parser.add_argument("--first", type=arguments.whole, help="index of the first scene (default 0)")
     parser.add_argument("--seed", type=arguments.seed, help="dataset seed (default 0, or the config's)")
@@ -121,6 +127,8 @@ def run(args: argparse.Namespace) -> int:
         )
     if args.strawberry_altitudes:
         config = use_strawberry_altitudes(config, args.strawberry_altitudes)
+    for group in config.groups:
+        arguments.check_crop_flags(args, group.crop, group.scenario, local=args.executor == "local")
     if args.executor != "ray" and args.address:
         raise UserError("--address is for --executor ray")
     if args.executor == "ray" and args.workers is not None:

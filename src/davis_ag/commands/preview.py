@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 
+import numpy as np
 from PIL import Image, ImageDraw
 
 from davis_ag.atomic_files import atomic_output
@@ -22,6 +23,7 @@ from davis_ag.labels.fruit_labels import fruit_lookup, label_view, visible_fract
 from davis_ag.render.backends import DEFAULT_RENDERER, open_renderer, resolve_look
 from davis_ag.scene.appearance import DEFAULT_APPEARANCE
 from davis_ag.scene.camera import Camera
+from davis_ag.scene.organs import SKY
 from davis_ag.scene.specs import (
     DEFAULT_PLANTS,
     CropSpec,
@@ -37,8 +39,12 @@ DESCRIPTION = __doc__
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add ``preview``'s arguments to its ``parser`` (see :mod:`davis_ag.commands`)."""
-    parser.add_argument("--crop", default="strawberry", help="strawberry, tomato or vine")
-    parser.add_argument("--scenario", default="sp", help="sp or mp")
+    parser.add_argument(
+        "--crop",
+        default="strawberry",
+        help="strawberry, tomato, vine or a plant-library crop (generate --help lists them)",
+    )
+    parser.add_argument("--scenario", default="sp", help="sp, mp or row")
     parser.add_argument("--seed", type=arguments.seed, default=0, help="dataset seed (default 0)")
     parser.add_argument("--index", type=arguments.whole, default=0, help="scene index (default 0)")
     parser.add_argument(
@@ -47,6 +53,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--size", type=arguments.image_size, default=(1280, 720), help="image size (default 1280x720)")
     arguments.add_renderer_flags(parser)
     parser.add_argument("--out", type=arguments.path, required=True, help="folder for the pictures")
+    parser.add_argument(
+        "--classes", action="store_true", help="also write each view's organ classes in colour (NAME-classes.png)"
+    )
     parser.add_argument("--force", action="store_true", help="replace pictures an earlier preview wrote")
 
 
@@ -55,6 +64,7 @@ def run(args: argparse.Namespace) -> int:
     if args.strawberry_altitudes:
         crop = with_strawberry_altitudes(crop, args.strawberry_altitudes)
     scenario = scenario_spec(args.scenario, crop)
+    arguments.check_crop_flags(args, crop, scenario)
     numbers = args.views
     renderer_name = args.renderer or DEFAULT_RENDERER
     look = resolve_look(renderer_name, args.look)
@@ -65,6 +75,8 @@ def run(args: argparse.Namespace) -> int:
     arguments.prove_writable_folder(args.out)
     stems = [f"{crop.name}-{scenario.name}-{args.index:03d}-{view_stem(view_name(n))}" for n in numbers]
     pictures = [args.out / f"{stem}{suffix}{IMAGE_SUFFIX}" for stem in stems for suffix in ("", "-boxes")]
+    if args.classes:
+        pictures += [args.out / f"{stem}-classes.png" for stem in stems]
     with claim_output(pictures[0], force=args.force, also=[(p, "--out") for p in pictures[1:]]):  # the output rule
         return _draw(args, scenario, crop, numbers, stems, renderer_name, look)
 
@@ -94,6 +106,10 @@ def _draw(
     _check_views(numbers, len(grid.viewpoints))
     lookup = fruit_lookup({f.id: f.uuids for f in model.fruits}, model.uuid_count)
     polygons = {f.id: f.polygons for f in model.fruits}
+    from davis_ag.figures.label_pictures import class_colours
+
+    # Organ class by id-buffer value (UUID + 1; 0 is the sky), as generate writes NNNN_class.png.
+    class_of_id = np.concatenate([[SKY], model.organ_of_uuid()]).astype(np.uint8)
     args.out.mkdir(parents=True, exist_ok=True)
     with open_renderer(
         renderer_name, model.context, request.camera, model.lighting, look, args.antialiasing
@@ -113,6 +129,9 @@ def _draw(
                 draw.text((x, max(0, y - 12)), f"{fruit_id}: {fractions[fruit_id]:.2f}", fill=(255, 220, 0))
             with atomic_output(args.out / f"{stem}-boxes{IMAGE_SUFFIX}") as handle:
                 boxed.save(handle, format="JPEG", quality=JPEG_QUALITY)
+            if args.classes:
+                with atomic_output(args.out / f"{stem}-classes.png") as handle:
+                    Image.fromarray(class_colours(class_of_id[primitive_ids])).save(handle, format="PNG")
             print(f"{args.out / stem}{IMAGE_SUFFIX}: {len(labels.boxes)} fruit boxed, pose {view.pose}")
     return 0
 

@@ -15,11 +15,9 @@ from pathlib import Path
 
 from davis_ag.commands import arguments
 from davis_ag.errors import UserError
-from davis_ag.workflows.reproduce import load_state, reproduce
+from davis_ag.workflows.reproduce import load_state, reproduce, write_page
 from davis_ag.workflows.reproduce_configs import CONFIGS
-from davis_ag.workflows.run_groups import SCENARIO_CROPS
 from davis_ag.workflows.reproduce_status import format_status, run_config
-from davis_ag.workflows.results_page import write_results_md
 
 HELP = "reproduce Table 4: generate, train A2C and PPO, benchmark, write results.md"
 DESCRIPTION = __doc__
@@ -43,8 +41,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default="small",
         help="small (default: a smoke test of every stage, under an hour on 2 CPU cores; not comparable "
         "with Table 4), "
-        "medium (the paper's grids and 300K A2C steps, hours) or paper-scale (Table 3's 130 scenes "
-        "at 1280x720, over many sittings: --status says where a run stands)",
+        "medium (the paper's grids and 300K A2C steps, hours), paper-scale (Table 3's 130 scenes "
+        "at 1280x720, over many sittings: --status says where a run stands) or crops (every "
+        "plant-library crop's SP and row scenes, its page docs/crops.md)",
     )
     parser.add_argument(
         "--sp-scenes", type=arguments.bounded(1, 1000), default=None, help="override the SP scene count"
@@ -54,7 +53,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--sp-timesteps", type=arguments.bounded(1, 10**9), default=None, help="override SP A2C steps")
     parser.add_argument("--mp-timesteps", type=arguments.bounded(1, 10**9), default=None, help="override MP A2C steps")
-    parser.add_argument("--only", choices=["sp", "mp"], default=None, help="run one scenario only")
+    parser.add_argument("--only", choices=["sp", "mp", "row"], default=None, help="run one scenario only")
     parser.add_argument(
         "--rewrite-results", action="store_true", help="only rewrite --results from DIR/state.json; run nothing"
     )
@@ -110,9 +109,11 @@ def run(args: argparse.Namespace) -> int:
         state = load_state(args.out / "state.json")
         if not state.get("config"):
             raise UserError(f"{args.out / 'state.json'}: no finished run to write results from")
-        write_results_md(args.results, run_config(state, args.out / "state.json"), state, args.out)
+        write_page(args.results, run_config(state, args.out / "state.json"), state, args.out)
         print(f"wrote {args.results}")
         return 0
     arguments.prove_writable_folder(args.out)
-    pairs = [p for p in SCENARIO_CROPS if args.only in (None, p[0])]
+    pairs = [p for p in config.pairs if args.only in (None, p[0])]
+    if not pairs:
+        raise UserError(f"--only {args.only}: the {config.name} run has no {args.only} groups")
     return reproduce(config, args.out, args.results, pairs)

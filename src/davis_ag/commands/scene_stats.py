@@ -9,10 +9,11 @@ from __future__ import annotations
 import argparse
 
 from davis_ag.commands import arguments
+from davis_ag.scene.specs import CROPS
 
 HELP = "measure our scenes against the paper and rewrite docs/scenes.md"
 DESCRIPTION = __doc__
-MEASUREMENTS = ("views", "plants", "findings", "refused")
+MEASUREMENTS = ("views", "plants", "crops", "findings", "refused")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -21,7 +22,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "measurement",
         nargs="?",
         choices=MEASUREMENTS,
-        help="views (instant), plants (grows --count plants per crop), findings or refused "
+        help="views (instant), plants (grows --count plants of each paper crop), crops (--count plants "
+        "of each plant-library crop, beside the literature), findings or refused "
         "(generate --count scenes at --size); none: only rewrite the pages",
     )
     parser.add_argument(
@@ -37,9 +39,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--crops",
-        type=arguments.name_list(("strawberry", "tomato", "vine")),
+        type=arguments.name_list(tuple(CROPS)),
         default=None,
-        help="plants: the crops to grow (default all; the others keep their saved rows)",
+        help="plants, crops: the crops to grow (default all of the measurement's; the others keep their saved rows)",
     )
     parser.add_argument(
         "--generators",

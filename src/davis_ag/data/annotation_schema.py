@@ -3,7 +3,8 @@
 No file access here: the reader (:mod:`davis_ag.data.reader`) and the validator share these, and
 the parsers raise ``ValueError`` with a reason that each turns into its own kind of report.
 Conventions: a box is ``[xmin, ymin, width, height, fruit_id, 0]`` with the inclusive pixel
-extent of the fruit's mask (``width = xmax - xmin + 1``); mask value 255 is no fruit.
+extent of the fruit's mask (``width = xmax - xmin + 1``); mask value 255 (uint8 masks) or 65535
+(uint16 masks, scenes of more than 255 fruit: :mod:`davis_ag.formats.masks`) is no fruit.
 """
 
 from __future__ import annotations
@@ -15,8 +16,9 @@ from typing import Any
 import numpy as np
 
 from davis_ag.formats.layout import IMAGE_SUFFIX, view_name
+from davis_ag.formats.masks import fruit_pixels
 from davis_ag.scene import specs as config
-from davis_ag.scene.specs import NO_FRUIT
+from davis_ag.scene.specs import NO_FRUIT  # noqa: F401 - the uint8 masks' value, re-exported by the reader
 
 _IMAGE_SUFFIXES = (IMAGE_SUFFIX, ".jpg")
 #: Box values beyond this are damage, not pixels.
@@ -185,12 +187,12 @@ def boxes_from_mask(mask: np.ndarray) -> dict[int, Box]:
     """The bounding box of every fruit id's pixels in an instance mask (our writer's convention).
 
     Args:
-        mask: ``H x W`` instance mask; 255 is no fruit.
+        mask: ``H x W`` instance mask, uint8 (255 is no fruit) or uint16 (65535 is no fruit).
 
     Returns:
         Fruit id to its :class:`Box` (inclusive pixel extent), in id order.
     """
-    ys, xs = np.nonzero(mask != NO_FRUIT)
+    ys, xs = np.nonzero(fruit_pixels(mask))
     if not len(ys):
         return {}
     ids = mask[ys, xs]

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from davis_ag.data.annotation_schema import NO_FRUIT
+from davis_ag.formats.masks import fruit_pixels
 from davis_ag.scene.organs import FRUIT, ORGAN_NAMES
 
 
@@ -41,7 +41,7 @@ def class_problems(class_path: Path, mask: np.ndarray | None) -> list[str]:
         return problems
     if mask.shape != classes.shape:
         return problems + [f"is {classes.shape[1]}x{classes.shape[0]} but its mask is {mask.shape[1]}x{mask.shape[0]}"]
-    fruit = mask != NO_FRUIT
+    fruit = fruit_pixels(mask)
     wrong = int(np.count_nonzero(fruit & (classes != FRUIT)))
     if wrong:
         problems.append(f"{wrong} of {int(fruit.sum())} fruit pixels of the mask are not class {FRUIT} (fruit)")

@@ -12,9 +12,10 @@ from pathlib import Path
 
 import numpy as np
 
-from davis_ag.data.reader import NO_FRUIT, Box, ViewRecord, boxes_from_mask
+from davis_ag.data.reader import Box, ViewRecord, boxes_from_mask
 from davis_ag.errors import UserError
 from davis_ag.formats.layout import read_depth_millimetres
+from davis_ag.formats.masks import fruit_pixels, mask_dtype, mask_from_image, no_fruit_value
 from davis_ag.formats.scene_file import SceneFile
 
 #: Depth images: surfaces nearer than this cannot be seen (the renderers' near plane), mm.
@@ -61,7 +62,8 @@ def image_problems(image: Path, metadata: SceneFile | None) -> tuple[tuple[int, 
 
 
 def read_mask(mask_path: Path) -> tuple[np.ndarray | None, str | None]:
-    """An instance mask as a 2-D uint8 array, or None and the reason it is not one."""
+    """An instance mask as a 2-D uint8 or uint16 array (:mod:`davis_ag.formats.masks`), or None
+    and the reason it is not one."""
     from PIL import Image
 
     try:
@@ -69,9 +71,25 @@ def read_mask(mask_path: Path) -> tuple[np.ndarray | None, str | None]:
             mode, mask = im.mode, np.asarray(im)
     except Exception as error:
         return None, f"cannot decode ({error})"
-    if mode not in ("L", "P") or mask.dtype != np.uint8 or mask.ndim != 2:
-        return None, f"must be a uint8 single-channel PNG, got mode {mode}"
-    return mask, None
+    return mask_from_image(mode, mask)
+
+
+def mask_type_problems(mask: np.ndarray, metadata: SceneFile | None) -> list[str]:
+    """A mask's integer type against the rule of :mod:`davis_ag.formats.masks` for the fruit count
+    scene.json records (uint8 up to 255 fruit, uint16 above); no check without recorded fruit."""
+    if metadata is None or not metadata.fruits:
+        return []
+    count = len(metadata.fruits)
+    try:
+        expected = mask_dtype(count)
+    except ValueError as error:
+        return [str(error)]
+    if mask.dtype == expected:
+        return []
+    return [
+        f"is {mask.dtype.name} but scene.json records {count} fruit, whose masks are "
+        f"{expected.name} ({no_fruit_value(expected)} = no fruit)"
+    ]
 
 
 def mask_problems(record: ViewRecord, mask: np.ndarray, size: tuple[int, int], tolerance: int) -> list[str]:
@@ -131,13 +149,14 @@ def depth_problems(
     elif int(depth[hit].min()) < DEPTH_NEAR_MM:
         problems.append(f"holds a surface {int(depth[hit].min())} mm from the camera, nearer than any renderer draws")
     # Against the pose and the fruit's centres only where those are whole (a short pose or a
-    # centre without three numbers is reported by the schema checks; a mask holds ids 0-254).
+    # centre without three numbers is reported by the schema checks; a mask holds ids below its
+    # no-fruit value).
     if mask is None or metadata is None or record.pose is None or len(record.pose) < 5 or mask.shape != depth.shape:
         return problems
     fruits = {
         f.id: f
         for f in metadata.fruits
-        if f.id is not None and 0 <= f.id < NO_FRUIT and f.center is not None and len(f.center) == 3
+        if f.id is not None and 0 <= f.id < no_fruit_value(mask) and f.center is not None and len(f.center) == 3
     }
     x, y, z, yaw, pitch = (float(v) for v in record.pose[:5])
     forward = np.array(
@@ -166,11 +185,11 @@ def _median_depth_by_fruit(
 ) -> dict[int, float]:
     """The median depth (mm) of each fruit's pixels that hit a surface, for the fruits of
     ``fruit_ids`` that have any: one pass over the image, not one per fruit."""
-    wanted = np.zeros(256, dtype=bool)
+    wanted = np.zeros(no_fruit_value(mask) + 1, dtype=bool)
     wanted[fruit_ids] = True
-    fruit_pixels = np.flatnonzero(mask.ravel() != NO_FRUIT)  # a few per cent of the image
-    labels, values = mask.ravel()[fruit_pixels], depth.ravel()[fruit_pixels]
-    kept = wanted[labels] & hit.ravel()[fruit_pixels]
+    seen = np.flatnonzero(fruit_pixels(mask).ravel())  # a few per cent of the image
+    labels, values = mask.ravel()[seen], depth.ravel()[seen]
+    kept = wanted[labels] & hit.ravel()[seen]
     labels, values = labels[kept], values[kept]
     order = np.argsort(labels, kind="stable")
     labels, values = labels[order], values[order]

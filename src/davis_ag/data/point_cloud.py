@@ -5,14 +5,18 @@ a point through the pinhole scene.json records (``camera``: fx, fy, cx, cy, pixe
 +0.5, row 0 at the top) and the view's pose (``[x, y, z, yaw, pitch]``, :mod:`davis_ag.scene.camera`
 conventions: the camera's right is forward x up-axis, its up is right x forward). Every point
 keeps the pixel's colour, organ class (``NNNN_class.png``; 255 where the scene has none) and fruit
-id (``NNNN_seg.png``; 255 for none), and the view it came from.
+id (``NNNN_seg.png``; its no-fruit value for none), and the view it came from.
 
 A fused cloud joins a scene's views and keeps one point per voxel (the first view's), so
 overlapping views do not pile points up; the labels of the kept point stay whole (no averaging).
 
 PLY is written with ``plyfile`` (binary little-endian): properties ``x y z`` (float32, m),
-``red green blue`` (uint8), ``organ``, ``fruit_id`` (uint8) and ``view`` (uint16, the image
-number). Open3D, trimesh, CloudCompare and MeshLab read it.
+``red green blue`` (uint8), ``organ`` (uint8), ``fruit_id`` and ``view`` (uint16, the image
+number). ``fruit_id`` has its masks' type (:mod:`davis_ag.formats.masks`), so it widens only where
+needed: uint8 with 255 for none (:data:`POINT_DTYPE`, every scene of at most 255 fruit: their
+clouds are what they were before 16-bit masks), uint16 with 65535 for none
+(:data:`POINT_DTYPE_16`) for a scene with 16-bit masks. Open3D, trimesh, CloudCompare and MeshLab
+read either.
 """
 
 from __future__ import annotations
@@ -24,29 +28,39 @@ from pathlib import Path
 import numpy as np
 
 from davis_ag.atomic_files import atomic_output
-from davis_ag.data.annotation_schema import NO_FRUIT
 from davis_ag.data.reader import Scene, View, open_dataset
 from davis_ag.errors import UserError
 from davis_ag.formats.layout import view_number
+from davis_ag.formats.masks import NO_FRUIT_8, NO_FRUIT_16, no_fruit_value
 
 #: Organ value of points whose scene has no class images.
 NO_CLASS = 255
 #: Depth images store this for "65.535 m or farther": not a measured surface.
 DEPTH_SATURATED_M = 65.535
-#: Fields of every point, in PLY order.
-POINT_DTYPE = np.dtype(
-    [
-        ("x", "<f4"),
-        ("y", "<f4"),
-        ("z", "<f4"),
-        ("red", "u1"),
-        ("green", "u1"),
-        ("blue", "u1"),
-        ("organ", "u1"),
-        ("fruit_id", "u1"),
-        ("view", "<u2"),
-    ]
-)
+
+
+def point_dtype(fruit_id: str) -> np.dtype:
+    """The fields of every point, in PLY order, with ``fruit_id`` of type ``"u1"`` or ``"<u2"``."""
+    return np.dtype(
+        [
+            ("x", "<f4"),
+            ("y", "<f4"),
+            ("z", "<f4"),
+            ("red", "u1"),
+            ("green", "u1"),
+            ("blue", "u1"),
+            ("organ", "u1"),
+            ("fruit_id", fruit_id),
+            ("view", "<u2"),
+        ]
+    )
+
+
+#: Fields of every point, in PLY order: a scene with uint8 masks (at most 255 fruit).
+POINT_DTYPE = point_dtype("u1")
+#: The same with a uint16 ``fruit_id`` (65535 for none): a scene with 16-bit masks.
+POINT_DTYPE_16 = point_dtype("<u2")
+_POINT_DTYPES = (POINT_DTYPE, POINT_DTYPE_16)
 
 
 @dataclass(frozen=True)
@@ -119,7 +133,8 @@ def unproject(depth: np.ndarray, pinhole: Pinhole, pose: tuple[float, ...]) -> n
 
 
 def view_points(view: View, pinhole: Pinhole, max_depth: float | None = None) -> np.ndarray:
-    """The points of one view, as a structured array of :data:`POINT_DTYPE`.
+    """The points of one view, as a structured array of :data:`POINT_DTYPE`, or of
+    :data:`POINT_DTYPE_16` where its mask is 16-bit.
 
     Args:
         view: A view of a generated scene (with a depth image and a pose).
@@ -145,13 +160,14 @@ def view_points(view: View, pinhole: Pinhole, max_depth: float | None = None) ->
     world = unproject(depth, pinhole, view.pose)[keep]
     colour = view.image()[keep]
     classes, mask = view.classes(), view.mask()
-    points = np.empty(len(world), dtype=POINT_DTYPE)
+    wide = mask is not None and no_fruit_value(mask) == NO_FRUIT_16
+    points = np.empty(len(world), dtype=POINT_DTYPE_16 if wide else POINT_DTYPE)
     for axis, name in enumerate("xyz"):
         points[name] = world[:, axis]
     for channel, name in enumerate(("red", "green", "blue")):
         points[name] = colour[:, channel]
     points["organ"] = classes[keep] if classes is not None else NO_CLASS
-    points["fruit_id"] = mask[keep] if mask is not None else NO_FRUIT
+    points["fruit_id"] = mask[keep] if mask is not None else NO_FRUIT_8
     points["view"] = view_number(view.name) or 0
     return points
 
@@ -171,17 +187,31 @@ def scene_points(scene: Scene, max_depth: float | None = None, voxel: float = 0.
     """Every view of a scene fused into one cloud, thinned to one point per voxel."""
     pinhole = Pinhole.of_scene(scene)
     parts = [voxel_thin(view_points(view, pinhole, max_depth), voxel) for view in scene]
+    if any(part.dtype == POINT_DTYPE_16 for part in parts):
+        parts = [widen(part) for part in parts]  # a view without a mask in a 16-bit scene
     return voxel_thin(np.concatenate(parts) if parts else np.empty(0, POINT_DTYPE), voxel)
 
 
+def widen(points: np.ndarray) -> np.ndarray:
+    """Points of :data:`POINT_DTYPE` as :data:`POINT_DTYPE_16` (no fruit 255 becomes 65535)."""
+    if points.dtype == POINT_DTYPE_16:
+        return points
+    wide = points.astype(POINT_DTYPE_16)
+    wide["fruit_id"][points["fruit_id"] == NO_FRUIT_8] = NO_FRUIT_16
+    return wide
+
+
 def write_ply(points: np.ndarray, path: Path, comment: str = "") -> Path:
-    """Write points (:data:`POINT_DTYPE`) as a binary PLY, atomically, with ``plyfile``."""
+    """Write points (:data:`POINT_DTYPE` or :data:`POINT_DTYPE_16`) as a binary PLY, atomically,
+    with ``plyfile``."""
     from plyfile import PlyData, PlyElement
 
-    element = PlyElement.describe(np.ascontiguousarray(points, dtype=POINT_DTYPE), "vertex")
+    dtype = points.dtype if points.dtype in _POINT_DTYPES else POINT_DTYPE
+    element = PlyElement.describe(np.ascontiguousarray(points, dtype=dtype), "vertex")
+    none = NO_FRUIT_16 if dtype == POINT_DTYPE_16 else NO_FRUIT_8
     comments = [
         "davis-ag point cloud: world frame x east, y north, z up, metres",
-        "organ: 0 sky 1 soil 2 fruit 3 leaf 4 stem 5 trunk, 255 unknown; fruit_id 255: none",
+        f"organ: 0 sky 1 soil 2 fruit 3 leaf 4 stem 5 trunk, 255 unknown; fruit_id {none}: none",
     ]
     if comment:
         comments.append(comment)
@@ -192,11 +222,13 @@ def write_ply(points: np.ndarray, path: Path, comment: str = "") -> Path:
 
 
 def read_ply(path: Path) -> np.ndarray:
-    """Read a PLY this module wrote back into :data:`POINT_DTYPE` points."""
+    """Read a PLY this module wrote back into :data:`POINT_DTYPE` points (:data:`POINT_DTYPE_16`
+    where its ``fruit_id`` is 16-bit)."""
     from plyfile import PlyData
 
     vertex = PlyData.read(str(path))["vertex"].data
-    points = np.empty(len(vertex), dtype=POINT_DTYPE)
+    wide = vertex.dtype["fruit_id"].itemsize == 2
+    points = np.empty(len(vertex), dtype=POINT_DTYPE_16 if wide else POINT_DTYPE)
     for name in POINT_DTYPE.names:
         points[name] = vertex[name]
     return points

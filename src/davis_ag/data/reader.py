@@ -190,7 +190,9 @@ class View:
         """Decode the instance mask.
 
         Returns:
-            ``H x W`` uint8 array (fruit id per pixel, 255 for none), or ``None`` without a mask file.
+            ``H x W`` fruit id per pixel, or ``None`` without a mask file: uint8 with 255 for none,
+            or uint16 with 65535 for none in a scene of more than 255 fruit
+            (:mod:`davis_ag.formats.masks`; ``fruit_pixels(mask)`` is where a fruit is seen).
 
         Raises:
             UserError: when the file exists but cannot be read.
@@ -228,12 +230,12 @@ class Scene(Sequence["View"]):
 
     @property
     def scenario(self) -> str | None:
-        """``"sp"`` or ``"mp"`` from the group name; ``None`` for an unknown group name."""
+        """``"sp"``, ``"mp"`` or ``"row"`` from the group name; ``None`` for an unknown group name."""
         return self._specs[0].name if self._specs else None
 
     @property
     def crop(self) -> str | None:
-        """``"strawberry"``, ``"tomato"`` or ``"vine"``; ``None`` for an unknown group name."""
+        """The crop's name (``"strawberry"``, ``"apple-wall"``...); ``None`` for an unknown group name."""
         return self._specs[1].name if self._specs else None
 
     @property

@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from davis_ag.errors import UserError
+from davis_ag.formats.masks import as_mask
 
 
 def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
@@ -82,7 +83,8 @@ def check_inside(path: Path, root: Path | None) -> Path:
 
 
 def load_pixels(path: Path, mode: str | None) -> np.ndarray:
-    """Decode an image (``mode`` "RGB") or an instance mask (``mode`` None: H x W uint8).
+    """Decode an image (``mode`` "RGB") or an instance mask (``mode`` None: H x W uint8, or uint16
+    for a 16-bit PNG: :func:`davis_ag.formats.masks.as_mask`).
 
     Raises:
         UserError: naming the file, when it is missing or cannot be decoded.
@@ -99,8 +101,5 @@ def load_pixels(path: Path, mode: str | None) -> np.ndarray:
     except (OSError, UnidentifiedImageError, ValueError, Image.DecompressionBombError) as error:
         raise UserError(f"{path}: cannot decode ({error}); re-download or regenerate the scene") from None
     if mode is None:
-        # A mask saved as RGB still carries the id in every channel; keep one.
-        if pixels.ndim == 3:
-            pixels = pixels[..., 0]
-        pixels = pixels.astype(np.uint8, copy=False)
+        pixels = as_mask(pixels)
     return pixels

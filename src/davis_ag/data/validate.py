@@ -27,12 +27,12 @@ from davis_ag.data.pixel_checks import (
     depth_problems,
     image_problems,
     mask_problems,
+    mask_type_problems,
     read_mask,
 )
 from davis_ag.formats.scene_file import SceneFile, scene_file_from
 from davis_ag.data.reader import (
     ANNOTATIONS,
-    NO_FRUIT,
     SCENE_METADATA,
     Scene,
     ViewRecord,
@@ -43,6 +43,7 @@ from davis_ag.data.reader import (
 from davis_ag.data.problems import Problem, Report, outside_reason, read_json_file
 from davis_ag.data.validate_pool import in_scene_order
 from davis_ag.formats.layout import IMAGES, view_file, view_of_file
+from davis_ag.formats.masks import MAX_FRUIT_ID, mask_dtype, max_fruit_id
 from davis_ag.formats.models import AnnotationEntry, one_line
 
 
@@ -102,6 +103,7 @@ def validate_scene(
         if error:
             flag(scene.path / SCENE_METADATA, error)
     tolerance = box_tolerance if box_tolerance is not None else (0 if metadata is not None else 1)
+    id_limit = _fruit_id_limit(metadata)
 
     records: dict[str, ViewRecord] = {}
     keys: dict[str, str] = {}  # each record's key in annotations.json
@@ -125,7 +127,7 @@ def validate_scene(
             if target and target not in names:
                 flag(ann_path, f"{record.name}: {action} points to {target}, which is not a view of this scene")
         report.boxes += len(record.boxes)
-        box_problems = _box_schema_problems(record)
+        box_problems = _box_schema_problems(record, id_limit)
         for problem in box_problems:
             flag(ann_path, problem)
         if metadata is not None and not box_problems:  # ours: held to the entry we write
@@ -189,9 +191,12 @@ def _check_pixels(
         mask, unreadable = read_mask(mask_path)
         if unreadable:
             flag(mask_path, unreadable)
-        elif size is not None and mask is not None:
-            for problem in mask_problems(record, mask, size, tolerance):
+        elif mask is not None:
+            for problem in mask_type_problems(mask, metadata):
                 flag(mask_path, problem)
+            if size is not None:
+                for problem in mask_problems(record, mask, size, tolerance):
+                    flag(mask_path, problem)
     for kind, check in (
         ("depth", lambda path: depth_problems(record, path, mask, metadata)),
         ("classes", lambda path: class_problems(path, mask)),
@@ -211,7 +216,20 @@ def _name_or_key(key: str) -> str:
         return key
 
 
-def _box_schema_problems(record: ViewRecord) -> list[str]:
+def _fruit_id_limit(metadata: SceneFile | None) -> tuple[int, str]:
+    """The largest fruit id a scene's boxes may name, and its mask type in words: the rule of
+    :mod:`davis_ag.formats.masks` for the fruit count scene.json records, else any 16-bit id."""
+    if metadata is not None and metadata.fruits:
+        try:
+            dtype = mask_dtype(len(metadata.fruits))
+        except ValueError:  # more fruit than any mask holds: the mask check says so
+            return MAX_FRUIT_ID, "uint16"
+        return max_fruit_id(dtype), dtype.name
+    return MAX_FRUIT_ID, "uint16"
+
+
+def _box_schema_problems(record: ViewRecord, id_limit: tuple[int, str] = (MAX_FRUIT_ID, "uint16")) -> list[str]:
+    largest, dtype = id_limit
     problems = []
     seen: set[int] = set()
     for box in record.boxes:
@@ -220,8 +238,8 @@ def _box_schema_problems(record: ViewRecord) -> list[str]:
             problems.append(f"{where} has no area")
         if box.xmin < 0 or box.ymin < 0:
             problems.append(f"{where} starts outside the image")
-        if not 0 <= box.fruit_id < NO_FRUIT:
-            problems.append(f"{where}: fruit id must be 0..254 to fit the uint8 mask")
+        if not 0 <= box.fruit_id <= largest:
+            problems.append(f"{where}: fruit id must be 0..{largest} to fit the {dtype} mask")
         if box.fruit_id in seen:
             problems.append(f"{where}: fruit {box.fruit_id} has two boxes in this view")
         seen.add(box.fruit_id)

@@ -12,7 +12,7 @@ annotation: ``bbox`` is the published box (``[xmin, ymin, width, height]``, incl
 extent, which is COCO's convention for pixel masks), ``segmentation`` the RLE of the fruit's
 pixels (views without ``_seg.png`` get boxes only, no ``segmentation`` key), ``area`` its pixel
 count, and ``attributes`` the stable ``fruit_id`` and the ``visible_fraction``. One category per
-crop, fixed ids: strawberry 1, tomato 2, vine 3. With ``organs``, the organ classes as semantic
+crop, fixed ids: strawberry 1, tomato 2, vine 3, then the plant-library crops. With ``organs``, the organ classes as semantic
 masks too (:mod:`davis_ag.detection.organ_export`).
 
 The JSON is streamed: images and annotations go to two temporary files as views are read, then

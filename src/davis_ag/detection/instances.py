@@ -18,9 +18,11 @@ from davis_ag.benchmark.splits import dataset_splits
 from davis_ag.data.reader import Box, Dataset, Scene, View
 from davis_ag.data.safe_read import check_inside
 from davis_ag.errors import UserError
+from davis_ag.scene.specs import CROPS
 
-#: One category per crop; ids are fixed so every split and every export agrees (COCO counts from 1).
-CATEGORIES: tuple[str, ...] = ("strawberry", "tomato", "vine")
+#: One category per crop, in ``specs.CROPS``'s order (the paper's three first, the plant-library
+#: crops appended after them); ids are fixed so every split and every export agrees (COCO counts from 1).
+CATEGORIES: tuple[str, ...] = tuple(CROPS)
 #: The splits an export writes, and ``all`` for every scene.
 EXPORT_SPLITS: tuple[str, ...] = ("train", "test")
 

@@ -12,7 +12,7 @@ space), copies elsewhere. One label line per fruit: ``class xc yc w h`` (``--tas
 ``class x1 y1 x2 y2 ...`` (``--task segment``: the outline of the fruit's pixels; a fruit split
 into pieces by a leaf is one polygon whose pieces are joined by zero-width seams, as
 ultralytics' own COCO converter joins them; rasterised, a seam adds a one-pixel line). Coordinates are normalised to [0, 1]; classes are
-0 strawberry, 1 tomato, 2 vine. ``val`` is the test split (ultralytics validates on ``val``).
+0 strawberry, 1 tomato, 2 vine, then the plant-library crops (``instances.CATEGORIES``). ``val`` is the test split (ultralytics validates on ``val``).
 """
 
 from __future__ import annotations

@@ -76,7 +76,7 @@ def action_names(results: dict[str, Any]) -> list[str]:
     names = protocol.get("actions")
     if isinstance(names, list) and names:
         return [str(n) for n in names]
-    moves = MP_ACTIONS if protocol.get("scenario") == "mp" else SP_ACTIONS
+    moves = MP_ACTIONS if protocol.get("scenario") in ("mp", "row") else SP_ACTIONS
     return [*moves, "done"]
 
 

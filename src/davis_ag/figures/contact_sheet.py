@@ -13,7 +13,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from davis_ag.data.reader import NO_FRUIT, Scene, View
+from davis_ag.data.reader import Scene, View
+from davis_ag.formats.masks import fruit_pixels, no_fruit_value
 from davis_ag.errors import UserError
 from davis_ag.figures.canvas import new_figure, save_figure
 
@@ -136,13 +137,13 @@ def draw_masks(view: View, out_path: str | Path) -> Path:
     draw_boxes(left, view, labels=True)
     left.set_title(f"{view.scene.id} {view.name}\n{_pose_text(view)}", fontsize=7)
     # Ids are labels, not magnitudes: a qualitative colour map, and no-fruit left blank.
-    shown = np.ma.masked_equal(mask, NO_FRUIT)
+    shown = np.ma.masked_equal(mask, no_fruit_value(mask))
     from matplotlib import colormaps
 
     cmap = colormaps["tab20"].with_extremes(bad="black")
     right.imshow(shown % 20, cmap=cmap, vmin=0, vmax=19, interpolation="nearest")
     draw_boxes(right, view, labels=True)
-    ids = sorted(int(i) for i in np.unique(mask) if i != NO_FRUIT)
+    ids = np.unique(mask[fruit_pixels(mask)]).tolist()
     right.set_title(f"instance mask: {len(ids)} fruits", fontsize=7)
     for ax in (left, right):
         ax.set_axis_off()

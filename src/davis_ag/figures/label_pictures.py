@@ -15,9 +15,21 @@ from davis_ag.data.reader import View, open_dataset
 from davis_ag.figures.canvas import new_figure, save_figure
 from davis_ag.scene.organs import ORGAN_NAMES
 
-#: One colour per organ class (sky, soil, fruit, leaf, stem, trunk), for class images and clouds.
+#: One colour per organ class (sky, soil, fruit, leaf, stem, trunk, petiole, peduncle, flower), for
+#: class images and clouds.
 ORGAN_COLOURS = np.array(
-    [[135, 190, 235], [120, 90, 60], [220, 30, 40], [60, 170, 60], [240, 200, 40], [110, 60, 150]], dtype=np.uint8
+    [
+        [135, 190, 235],
+        [120, 90, 60],
+        [220, 30, 40],
+        [60, 170, 60],
+        [240, 200, 40],
+        [110, 60, 150],
+        [40, 200, 190],
+        [250, 130, 30],
+        [250, 250, 250],
+    ],
+    dtype=np.uint8,
 )
 
 

@@ -31,7 +31,8 @@ from urllib.parse import parse_qs, unquote, urlsplit
 
 import numpy as np
 
-from davis_ag.data.reader import NO_FRUIT, Dataset, Scene, open_dataset
+from davis_ag.data.reader import Dataset, Scene, open_dataset
+from davis_ag.formats.masks import no_fruit_value
 from davis_ag.formats.layout import IMAGES, VIEW_FILES, read_depth_millimetres
 from davis_ag.errors import UserError
 from davis_ag.figures.scene_numbers import altitudes
@@ -81,13 +82,16 @@ def scene_payload(scene: Scene) -> dict[str, Any]:
 
 
 def mask_overlay(mask: np.ndarray) -> bytes:
-    """An RGBA PNG of an instance mask: one colour per fruit id, no-fruit transparent."""
+    """An RGBA PNG of an instance mask (uint8 or uint16): one colour per fruit id (20 repeating),
+    no-fruit transparent."""
     from matplotlib import colormaps
     from PIL import Image
 
-    table = (np.array([colormaps["tab20"](i % 20) for i in range(256)]) * 255).astype(np.uint8)
+    colours = (np.array([colormaps["tab20"](i) for i in range(20)]) * 255).astype(np.uint8)
+    no_fruit = no_fruit_value(mask)
+    table = colours[np.arange(no_fruit + 1) % 20]
     table[:, 3] = 170
-    table[NO_FRUIT] = 0
+    table[no_fruit] = 0
     buffer = io.BytesIO()
     Image.fromarray(table[mask], "RGBA").save(buffer, format="PNG")
     return buffer.getvalue()

@@ -6,12 +6,14 @@ use, so a name or an encoding changes in one place::
     <root>/dataset.json, splits.json, .davis_ag_cache/ (benchmark caches), .davis_ag.lock
     <root>/<Group>/<NNN>/annotations.json, scene.json
     <root>/<Group>/<NNN>/images/NNNN.jpeg          colour, JPEG quality 95, NNNN from 0001
-    <root>/<Group>/<NNN>/images/NNNN_seg.png       uint8 fruit id per pixel, 255 = no fruit
+    <root>/<Group>/<NNN>/images/NNNN_seg.png       fruit id per pixel: uint8, 255 = no fruit (at most
+                                                   255 fruit); uint16, 65535 = no fruit (more)
     <root>/<Group>/<NNN>/images/NNNN_depth.png     uint16 mm along the optical axis, 0 = nothing hit
     <root>/<Group>/<NNN>/images/NNNN_class.png     uint8 organ class per pixel
 
 A new per-view image is one more entry in :data:`VIEW_FILES` (its suffix and what it holds);
 :func:`view_file`, :func:`view_of_file` and the validator's stray-file check then know it.
+Which integer type a scene's masks use is the rule of :mod:`davis_ag.formats.masks`.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from davis_ag.errors import UserError
+from davis_ag.formats.masks import mask_image
 
 if TYPE_CHECKING:
     from davis_ag.scene.view_grid import ViewGrid
@@ -46,7 +49,7 @@ DEPTH_MAX_MM = 65535
 #: Every per-view file: kind -> (suffix after the view's number, what it holds).
 VIEW_FILES: dict[str, tuple[str, str]] = {
     "image": (IMAGE_SUFFIX, "RGB, JPEG"),
-    "mask": ("_seg.png", "uint8 fruit id per pixel, 255 = no fruit"),
+    "mask": ("_seg.png", "fruit id per pixel, uint8 (255 = no fruit) or uint16 (65535): formats.masks"),
     "depth": ("_depth.png", "uint16 millimetres along the optical axis, 0 = nothing hit"),
     "classes": ("_class.png", "uint8 organ class per pixel (davis_ag.scene.organs)"),
 }
@@ -133,7 +136,8 @@ def write_view_files(
         images_dir: The scene's ``images`` folder (the writer's hidden one while it writes).
         name: The view's image name.
         colour: ``H x W x 3`` uint8.
-        segmentation: ``H x W`` uint8 fruit ids, 255 elsewhere.
+        segmentation: ``H x W`` fruit ids, no fruit elsewhere: uint8 (255) or uint16 (65535), as
+            :func:`davis_ag.formats.masks.mask_dtype` of the scene's fruit count gives.
         depth: ``H x W`` metres along the optical axis, 0 where nothing is hit.
         classes: ``H x W`` uint8 organ classes.
 
@@ -147,7 +151,7 @@ def write_view_files(
         Image.fromarray(colour).save(images_dir / name, quality=JPEG_QUALITY)
         written.append(name)
     if segmentation is not None:
-        Image.fromarray(segmentation, mode="L").save(images_dir / view_file_name(name, "mask"), compress_level=1)
+        mask_image(segmentation).save(images_dir / view_file_name(name, "mask"), compress_level=1)
         written.append(view_file_name(name, "mask"))
     if depth is not None:
         Image.fromarray(encode_depth(depth)).save(images_dir / view_file_name(name, "depth"), compress_level=1)

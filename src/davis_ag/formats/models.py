@@ -34,6 +34,7 @@ from pydantic import (
 )
 
 from davis_ag.errors import UserError
+from davis_ag.formats.masks import MAX_FRUIT_ID as _MAX_MASK_FRUIT_ID
 from davis_ag.scene.appearance import APPEARANCES, DEFAULT_APPEARANCE
 from davis_ag.scene.specs import ALL_ACTIONS, DEFAULT_PLANTS, PLANT_GENERATORS, crop_spec, group_name, scenario_spec
 
@@ -53,8 +54,9 @@ MAX_SCENES = 1000
 MAX_VIEWS_PER_SCENE = 10_000
 #: Largest grid side, m (the paper's grids are at most 7 m).
 MAX_GRID_EXTENT = 100.0
-#: Fruit ids fit the uint8 mask, whose 255 means no fruit.
-MAX_FRUIT_ID = 254
+#: Fruit ids fit a 16-bit mask, whose 65535 means no fruit (a scene of at most 255 fruit keeps
+#: them to 0..254 in its uint8 mask: :mod:`davis_ag.formats.masks`).
+MAX_FRUIT_ID = _MAX_MASK_FRUIT_ID
 
 
 def whole(low: int, high: int) -> Any:

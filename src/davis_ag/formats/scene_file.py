@@ -127,7 +127,8 @@ class SceneFile(_Record):
         format: :data:`SCENE_FORMAT` for scenes our generator wrote.
         seed, dataset_seed: The scene's seed and the dataset seed it follows from.
         scenario, crop, scene: Which scene (``scene`` is ``Group/NNN``).
-        plant_generator: ``canopy`` or ``architecture``; scenes from before the choice lack it.
+        plant_generator: ``canopy`` or ``architecture``, ``library`` for a plant-library crop;
+            scenes from before the choice lack it.
         depth, classes: What the depth and class images hold; ``None`` where not written.
         min_fruit_pixels: The box threshold the scene's labels were made with, at its own size.
         visible_fraction: Per view name, per fruit id (text), the fruit's visible fraction.

@@ -17,6 +17,7 @@ from typing import Any, Callable
 import numpy as np
 
 from davis_ag.formats.layout import published_pointers, view_name
+from davis_ag.formats.masks import segmentation_convention
 from davis_ag.formats.models import AnnotationEntry
 from davis_ag.formats.scene_file import SCENE_FORMAT, SceneFile
 from davis_ag.provenance import code_version
@@ -31,6 +32,7 @@ from davis_ag.scene.build import build_scene
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.organs import ORGAN_NAMES, SKY
 from davis_ag.scene.specs import (
+    camera_altitudes,
     CROPS,
     DEFAULT_PLANTS,
     SCENARIOS,
@@ -48,7 +50,8 @@ CONVENTIONS = {
     "pose": "[x, y, z, yaw, pitch]: camera position after slip; yaw counter-clockwise from +x; "
     "pitch above the horizon (negative looks down)",
     "box": "[xmin, ymin, width, height, fruit_id, 0]: inclusive pixel extent, row 0 at the top",
-    "segmentation": "uint8 fruit_id per pixel for fruit with a box in the view, 255 elsewhere",
+    # A scene of more than 255 fruit says uint16 and 65535 (scene_metadata: davis_ag.formats.masks).
+    "segmentation": segmentation_convention(0),
     "grid": "staggered lattice: rows step apart along y, numbered from -y, odd rows shifted half a "
     "step along +x; positions within the exclusion radius (2-D) of a stem are left out",
     "actions_sp": "forward +y, backward -y to the next row at the same column index (half a step "
@@ -322,7 +325,7 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict, timing: di
         crop=request.crop.name,
         scene=request.folder,
         plant_generator=model.plant_generator,
-        conventions=CONVENTIONS,
+        conventions={**CONVENTIONS, "segmentation": segmentation_convention(len(model.fruits))},
         camera=request.camera.intrinsics(),
         renderer={
             "name": request.renderer,
@@ -357,7 +360,7 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict, timing: di
         grid={
             "extent_m": list(request.scenario.extent),
             "step_m": request.scenario.step,
-            "altitudes_m": [request.crop.altitudes[i] for i in request.scenario.altitude_levels],
+            "altitudes_m": camera_altitudes(request.scenario, request.crop),
             "headings": request.scenario.headings,
             "exclusion_radius_m": request.crop.exclusion_radius,
             "aim_height_m": model.aim_height,

@@ -56,6 +56,7 @@ from davis_ag.render.backends import DEFAULT_RENDERER, resolve_look
 from davis_ag.scene.appearance import resolve_appearance
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import (
+    camera_altitudes,
     DEFAULT_PLANTS,
     CropSpec,
     ScenarioSpec,
@@ -359,5 +360,5 @@ def grid_settings(scenario: ScenarioSpec, crop: CropSpec | None = None) -> dict[
         "headings": scenario.headings,
     }
     if crop is not None:
-        settings["altitudes_m"] = [crop.altitudes[i] for i in scenario.altitude_levels]
+        settings["altitudes_m"] = camera_altitudes(scenario, crop)
     return settings

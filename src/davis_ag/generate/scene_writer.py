@@ -94,7 +94,8 @@ class SceneWriter:
         Args:
             name: Image name, ``NNNN.jpeg``.
             colour: (height, width, 3) uint8.
-            segmentation: (height, width) uint8.
+            segmentation: (height, width) uint8, or uint16 in a scene of more than 255 fruit
+                (:mod:`davis_ag.formats.masks`).
             entry: Its annotations.json entry.
             depth: (height, width) metres along the optical axis, 0 where nothing is hit; written
                 as ``NNNN_depth.png`` (uint16 millimetres) unless None.

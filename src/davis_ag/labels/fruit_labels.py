@@ -3,7 +3,8 @@
 Box convention (the published one): ``[xmin, ymin, width, height, fruit_id, 0]`` where xmin, ymin
 is the fruit's leftmost column and topmost row and width, height its inclusive pixel extent.
 The segmentation image holds, per pixel, the id of the fruit seen there if that fruit has a box
-in this view, else 255.
+in this view, else no fruit: 255 in the uint8 masks of a scene of at most 255 fruit, 65535 in the
+uint16 masks of a larger one (the rule of :mod:`davis_ag.formats.masks`).
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from davis_ag.formats.masks import mask_dtype, no_fruit_value
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import MAX_FRUIT, NO_FRUIT  # noqa: F401 - part of this module's interface
 from davis_ag.scene.view_grid import Viewpoint
@@ -22,7 +24,8 @@ class ViewLabels:
     """Labels of one view.
 
     Attributes:
-        segmentation: (height, width) uint8, fruit id per pixel, 255 where no labelled fruit.
+        segmentation: (height, width) fruit id per pixel, no fruit where no labelled fruit: the
+            lookup's type, uint8 (255) or uint16 (65535).
         boxes: Published boxes ``[xmin, ymin, width, height, fruit_id, 0]``, sorted by fruit id.
         visible_pixels: Visible pixels of each boxed fruit.
     """
@@ -33,13 +36,18 @@ class ViewLabels:
 
 
 def fruit_lookup(fruit_primitives: dict[int, np.ndarray], uuid_count: int) -> np.ndarray:
-    """Table from primitive-id pixel value (UUID + 1, 0 = nothing) to fruit id, 255 for non-fruit.
+    """Table from primitive-id pixel value (UUID + 1, 0 = nothing) to fruit id, no fruit for the rest.
+
+    Its type is the scene's mask type (:func:`davis_ag.formats.masks.mask_dtype`): uint8 with 255
+    for non-fruit up to 255 fruit, uint16 with 65535 above; the labels of :func:`label_view` keep it.
 
     Args:
-        fruit_primitives: Primitive UUIDs of each fruit id.
+        fruit_primitives: Primitive UUIDs of each fruit id (ids 0..n-1 for n fruit).
         uuid_count: One more than the largest UUID in the scene.
     """
-    table = np.full(uuid_count + 1, NO_FRUIT, dtype=np.uint8)
+    fruit_count = max(len(fruit_primitives), max(fruit_primitives, default=-1) + 1)
+    dtype = mask_dtype(fruit_count)
+    table = np.full(uuid_count + 1, no_fruit_value(dtype), dtype=dtype)
     for fruit_id, uuids in fruit_primitives.items():
         table[np.asarray(uuids, dtype=np.int64) + 1] = fruit_id
     return table
@@ -53,10 +61,11 @@ def label_view(primitive_ids: np.ndarray, lookup: np.ndarray, min_pixels: int) -
         lookup: :func:`fruit_lookup` of the scene.
         min_pixels: Visible pixels a fruit needs for a box (section III-C).
     """
+    no_fruit = no_fruit_value(lookup)
     fruit_map = lookup[np.minimum(primitive_ids, len(lookup) - 1)]
-    flat = np.flatnonzero(fruit_map != NO_FRUIT)
+    flat = np.flatnonzero(fruit_map != no_fruit)
     ids = fruit_map.ravel()[flat]
-    counts = np.bincount(ids, minlength=NO_FRUIT)
+    counts = np.bincount(ids, minlength=no_fruit)
     kept = np.flatnonzero(counts >= min_pixels)
     width = fruit_map.shape[1]
     rows, cols = np.divmod(flat, width)
@@ -66,9 +75,9 @@ def label_view(primitive_ids: np.ndarray, lookup: np.ndarray, min_pixels: int) -
         r, c = rows[mine], cols[mine]
         x0, y0 = int(c.min()), int(r.min())
         boxes.append([x0, y0, int(c.max()) - x0 + 1, int(r.max()) - y0 + 1, int(fruit_id), 0])
-    keep = np.zeros(NO_FRUIT + 1, dtype=bool)
+    keep = np.zeros(no_fruit + 1, dtype=bool)
     keep[kept] = True
-    segmentation = np.where(keep[fruit_map], fruit_map, NO_FRUIT).astype(np.uint8)
+    segmentation = np.where(keep[fruit_map], fruit_map, no_fruit).astype(lookup.dtype)
     return ViewLabels(segmentation, boxes, {int(f): int(counts[f]) for f in kept})
 
 

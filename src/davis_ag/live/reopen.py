@@ -37,8 +37,8 @@ from davis_ag.scene.specs import (
     STRAWBERRY_ALTITUDES,
     CropSpec,
     ScenarioSpec,
-    check_plants,
     crop_spec,
+    regrowing_plants,
     scenario_spec,
     with_strawberry_altitudes,
 )
@@ -184,7 +184,7 @@ def read_settings(scene_dir: str | Path) -> SceneSettings:
             str(renderer.name),
             str(renderer.look),
             antialiasing_of(renderer),
-            check_plants(metadata.plant_generator or "architecture"),
+            regrowing_plants(metadata.plant_generator),
             resolve_appearance((metadata.appearance or {}).get("mode", "paper")),
         )
     except (ValueError, TypeError, UserError, AttributeError) as error:

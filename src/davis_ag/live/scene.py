@@ -37,7 +37,8 @@ class LiveView:
     Attributes:
         pose: ``[x, y, z, yaw, pitch]`` (m, degrees).
         colour: (height, width, 3) uint8 RGB, row 0 at the top.
-        segmentation: (height, width) uint8, fruit id per pixel for boxed fruit, 255 elsewhere.
+        segmentation: (height, width) fruit id per pixel for boxed fruit, no fruit elsewhere: uint8
+            with 255, or uint16 with 65535 in a scene of more than 255 fruit (:mod:`davis_ag.formats.masks`).
         boxes: ``[xmin, ymin, width, height, fruit_id, 0]`` per fruit above the threshold.
         visible_pixels: Visible pixels of each boxed fruit.
         oer: Object exposure rate (eq. 1, section V-A) of each boxed fruit.

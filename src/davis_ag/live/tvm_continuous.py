@@ -51,7 +51,7 @@ from davis_ag.errors import UserError
 from davis_ag.formats.layout import ANNOTATIONS, SCENE_METADATA
 from davis_ag.live.reopen import SceneSettings
 from davis_ag.live.scene import LiveScene, LiveView, open_live_scene
-from davis_ag.scene.specs import SLIP_SIGMA, scenario_spec
+from davis_ag.scene.specs import SLIP_SIGMA, camera_altitudes, scenario_spec
 from davis_ag.scene.view_grid import Viewpoint, excluded
 
 #: Random poses tried per reset before giving up on a scene.
@@ -186,7 +186,7 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         rows reach half a step further east) and altitude range."""
         settings = (scene or self.scene).settings
         ex, ey = settings.scenario.extent
-        altitudes = [settings.crop.altitudes[i] for i in settings.scenario.altitude_levels]
+        altitudes = camera_altitudes(settings.scenario, settings.crop)
         return (
             np.array([-ex / 2, -ey / 2, min(altitudes)]),
             np.array([ex / 2 + settings.scenario.step / 2, ey / 2, max(altitudes)]),
@@ -344,7 +344,7 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         if given is not None:
             return float(given)
         grid = self._grid
-        altitudes = [grid.crop.altitudes[i] for i in grid.scenario.altitude_levels]
+        altitudes = camera_altitudes(grid.scenario, grid.crop)
         return (max(altitudes) - min(altitudes)) / 2
 
     @property

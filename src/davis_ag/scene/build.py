@@ -24,6 +24,7 @@ from davis_ag.scene.plants import (
 )
 from davis_ag.scene.specs import (
     DEFAULT_PLANTS,
+    LIBRARY_PLANTS,
     MAX_FRUIT,
     CropSpec,
     ScenarioSpec,
@@ -75,7 +76,8 @@ class SceneModel:
         fruits: Every fruit, by id.
         lighting: Sun and sky.
         aim_height: Height single-plant cameras aim at, m.
-        plant_generator: Which generator grew the plants (``canopy`` or ``architecture``).
+        plant_generator: Which generator grew the plants (``canopy``, ``architecture`` or, for a
+            plant-library crop, ``library``).
     """
 
     context: object
@@ -208,6 +210,17 @@ def _grow_canopy_plants(context, scenario: ScenarioSpec, crop: CropSpec, rng: np
     return plants
 
 
+def _grow_library_plants(context, scenario: ScenarioSpec, crop: CropSpec, rng: np.random.Generator) -> list[GrownPlant]:
+    """Plant-library crops, grown as their recipes grow them (:mod:`davis_ag.scene.library_plants`)."""
+    from davis_ag.scene.library_plants import grow_library_crop_plant, load_library_model
+
+    model = load_library_model(context, crop, rng)
+    return [
+        grow_library_crop_plant(model, index, position, rng)
+        for index, position in enumerate(plant_positions(scenario, crop))
+    ]
+
+
 def build_scene(
     scenario: ScenarioSpec,
     crop: CropSpec,
@@ -221,7 +234,9 @@ def build_scene(
         scenario: Single or multi plant.
         crop: The crop.
         rng: The scene's only source of randomness.
-        plants: The plant generator (:data:`~davis_ag.scene.specs.PLANT_GENERATORS`).
+        plants: The plant generator of the paper's crops
+            (:data:`~davis_ag.scene.specs.PLANT_GENERATORS`); a plant-library crop grows from
+            the library whatever it says, recorded as ``library``.
         soil_texture: The soil's image (:func:`add_ground`).
 
     Returns:
@@ -231,7 +246,11 @@ def build_scene(
     from pyhelios import Context
 
     context = Context()
-    grow = _grow_canopy_plants if check_plants(plants) == "canopy" else _grow_architecture_plants
+    check_plants(plants)
+    if crop.source == "library":
+        plants, grow = LIBRARY_PLANTS, _grow_library_plants
+    else:
+        grow = _grow_canopy_plants if plants == "canopy" else _grow_architecture_plants
     grown = grow(context, scenario, crop, rng)
     add_ground(context, soil_texture)
 
@@ -239,7 +258,10 @@ def build_scene(
     for plant in grown:
         for body in plant.fruit_bodies:
             if len(fruits) >= MAX_FRUIT:
-                raise UserError(f"a {crop.name} scene grew more than {MAX_FRUIT} fruit, the most uint8 ids can label")
+                raise UserError(
+                    f"a {crop.name} scene grew more than {MAX_FRUIT} fruit, the most a 16-bit mask can label "
+                    "(davis_ag.formats.masks)"
+                )
             fruits.append(_fruit(context, len(fruits), plant.index, body))
     lighting = Lighting(sun_elevation=float(rng.uniform(35.0, 75.0)), sun_azimuth=float(rng.uniform(0.0, 360.0)))
     return SceneModel(context, grown, fruits, lighting, aim_height=crop.centre_height, plant_generator=plants)

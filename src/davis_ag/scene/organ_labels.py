@@ -24,7 +24,7 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from davis_ag.scene.organs import FRUIT, LEAF, ORGAN_DATA, SOIL, STEM, TRUNK
+from davis_ag.scene.organs import FLOWER, FRUIT, LEAF, ORGAN_DATA, PEDUNCLE, PETIOLE, SOIL, STEM, TRUNK
 from davis_ag.scene.plant_geometry import fruit_body_uuids
 
 
@@ -65,3 +65,30 @@ def label_architecture_plant(context, plant_architecture, plant_id: int, woody_s
     for shoot_type in woody_shoots:
         woody = plant_architecture.getPlantInternodeObjectIDs(plant_id, shoot_type)
         set_organ(context, object_primitives(context, woody), TRUNK)
+
+
+def label_library_plant(context, plant_architecture, plant_id: int, woody_shoots: tuple[str, ...]) -> None:
+    """Label every primitive of a plant-library crop's plant, each organ list its own class.
+
+    Unlike :func:`label_architecture_plant` (the paper's crops, whose classes stay as they were),
+    petioles, peduncles and flowers get their own classes, and a fruit is its whole fruit object.
+
+    Args:
+        context: The scene's Helios Context.
+        plant_architecture: The PlantArchitecture that built the plant.
+        plant_id: The plant.
+        woody_shoots: Shoot types whose internodes are ``trunk`` (trunks, scaffolds, canes);
+            ``("*",)``: every internode.
+    """
+    set_organ(context, plant_architecture.getAllPlantUUIDs(plant_id), STEM)
+    for shoot_type in woody_shoots:
+        woody = plant_architecture.getPlantInternodeObjectIDs(plant_id, None if shoot_type == "*" else shoot_type)
+        set_organ(context, object_primitives(context, woody), TRUNK)
+    for query, organ in (
+        (plant_architecture.getPlantPetioleObjectIDs, PETIOLE),
+        (plant_architecture.getPlantPeduncleObjectIDs, PEDUNCLE),
+        (plant_architecture.getPlantFlowerObjectIDs, FLOWER),
+        (plant_architecture.getPlantLeafObjectIDs, LEAF),
+        (plant_architecture.getPlantFruitObjectIDs, FRUIT),
+    ):
+        set_organ(context, object_primitives(context, query(plant_id)), organ)

@@ -5,7 +5,10 @@ unsigned int, one of the values below), so labels can be read back from the Cont
 renderer reads everything else: in bulk, by UUID. :meth:`SceneModel.organ_of_uuid
 <davis_ag.scene.build.SceneModel>` turns it into a lookup array indexed by UUID.
 
-Value 0 is the sky: a pixel where nothing was hit. It is never stored on a primitive.
+Value 0 is the sky: a pixel where nothing was hit. It is never stored on a primitive. Values 6-8
+(petiole, peduncle, flower) are given to the crops of Helios's plant library
+(:mod:`davis_ag.scene.library_crops`), whose organs come as separate lists; the paper's three crops
+keep petioles and peduncles in ``stem``, as their labels have always had them.
 """
 
 from __future__ import annotations
@@ -13,7 +16,7 @@ from __future__ import annotations
 #: Name of the Context's per-primitive organ data (uint).
 ORGAN_DATA = "organ"
 
-SKY, SOIL, FRUIT, LEAF, STEM, TRUNK = 0, 1, 2, 3, 4, 5
+SKY, SOIL, FRUIT, LEAF, STEM, TRUNK, PETIOLE, PEDUNCLE, FLOWER = 0, 1, 2, 3, 4, 5, 6, 7, 8
 
 #: Class value -> (name, what it covers). The order is the value: ``ORGAN_CLASSES[v]``.
 ORGAN_CLASSES: tuple[tuple[str, str], ...] = (
@@ -21,8 +24,11 @@ ORGAN_CLASSES: tuple[tuple[str, str], ...] = (
     ("soil", "the ground"),
     ("fruit", "fruit bodies: strawberries, tomatoes, grape berries"),
     ("leaf", "leaf blades and leaflets"),
-    ("stem", "green stems, shoots and petioles"),
-    ("trunk", "woody parts: trunk, cordons (arms) and canes"),
+    ("stem", "green stems and shoots; the paper's crops' petioles and peduncles too"),
+    ("trunk", "woody parts: trunk, scaffolds, cordons (arms) and canes"),
+    ("petiole", "leaf stalks of the plant-library crops"),
+    ("peduncle", "fruit and flower stalks of the plant-library crops"),
+    ("flower", "flowers and flower buds of the plant-library crops"),
 )
 
 ORGAN_NAMES: tuple[str, ...] = tuple(name for name, _ in ORGAN_CLASSES)

@@ -28,7 +28,7 @@ import os
 import sys
 import time
 from dataclasses import asdict, dataclass, field
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 
@@ -80,6 +80,8 @@ class GrownPlant:
             Canopy Generator plants); otherwise read from ``fruit_objects``.
         build_s: Seconds it took to build and measure (not in :meth:`summary`: scene.json is the
             same, byte for byte, whenever the scene is made again).
+        library: For a plant-library crop: its model, age, shoot changes, drawn factors and
+            measured crown width (:mod:`davis_ag.scene.library_plants`).
     """
 
     index: int
@@ -92,6 +94,7 @@ class GrownPlant:
     builds: int
     fruit_bodies: list[list[int]] | None = field(default=None, repr=False)
     build_s: float | None = None
+    library: dict[str, Any] | None = None
 
     @property
     def fruit_count(self) -> int:
@@ -108,6 +111,7 @@ class GrownPlant:
             "phenotype_measured": asdict(self.measured),
             "fruit_count": self.fruit_count,
             "builds": self.builds,
+            **({"library": self.library} if self.library is not None else {}),
         }
 
 

@@ -8,6 +8,8 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 from davis_ag.errors import UserError
+from davis_ag.scene.crop_spec import PAPER_IMAGE_SIZE, PAPER_PIXELS, CropSpec, RowSpec  # noqa: F401 - re-exported
+from davis_ag.scene.library_crops import LIBRARY_CROPS
 
 #: Actions of the single-plant scenario, in the order the environment numbers them.
 SP_ACTIONS: tuple[str, ...] = ("forward", "backward", "left", "right", "up", "down")
@@ -29,9 +31,6 @@ INVERSE_ACTION: dict[str, str] = {
 }
 
 
-#: The paper's image size (section III-C), at which the crops' box thresholds are given.
-PAPER_IMAGE_SIZE = (1280, 720)
-PAPER_PIXELS = PAPER_IMAGE_SIZE[0] * PAPER_IMAGE_SIZE[1]
 #: Table 3 of the paper: (scenario, crop) -> (scenes, images).
 PAPER_TABLE3: dict[tuple[str, str], tuple[int, int]] = {
     ("sp", "strawberry"): (86, 24_510),
@@ -41,63 +40,6 @@ PAPER_TABLE3: dict[tuple[str, str], tuple[int, int]] = {
     ("sp", "vine"): (182, 63_336),
     ("mp", "vine"): (44, 79_200),
 }
-
-
-@dataclass(frozen=True)
-class CropSpec:
-    """One crop's Table 1 defaults and the settings that follow from them.
-
-    Attributes:
-        name: Short name used on the command line (``strawberry``, ``tomato``, ``vine``).
-        title: Capitalised name in published folder names (``Strawberry``...).
-        plant_height: Plant height, or trunk height for the vine (Table 1), m.
-        fruit_radius: Fruit radius, or single-berry radius for the vine (Table 1), m: the Canopy
-            Generator's ``fruit_radius`` parameter, whose defaults Table 1 lists.
-        fruit_size_per_radius: Half the mean principal extent of a fruit body (what
-            :mod:`davis_ag.scene.plants` measures) per unit of ``fruit_radius``, as the Canopy
-            Generator builds it. Its tomato fruit and grape berries are spheres of that radius
-            (1.0); its strawberry is a tube whose widest radius is half ``fruit_radius`` and whose
-            length is 1.1 ``fruit_radius``, so (0.5 + 0.5 + 0.55) / 3 (``strawberry.cpp`` of
-            Helios's canopygenerator plug-in): Table 1's 2.5 cm makes a strawberry 2.5 cm wide.
-        leaf_length: Leaf length (Table 1), m.
-        altitudes: The three camera altitudes, low to high (Table 1), m.
-        min_fruit_pixels: Visible pixels a fruit needs to get a box (section III-C), at the paper's
-            1280x720 (:meth:`min_fruit_pixels_at` scales it to another size).
-        exclusion_radius: Cameras at most this far from a plant's stem, measured horizontally,
-            are not placed, m (section III-C: "<75cm for strawberry and <100cm for others").
-        centre_height: Height of the plant's centre, which single-plant cameras aim at: half
-            the plant, or the middle of the vine's canopy, m.
-        mp_plants: Plants in the multi-plant row.
-        mp_spacing: Distance between neighbouring plants in the multi-plant row, m.
-        sp_extent: The single-plant grid's size along x and y, m (the comment above ``CROPS`` says why).
-        mp_extent: The multi-plant grid's size along x and y, m.
-        min_fruit: A plant with fewer fruit is regrown from the next seed.
-        helios_model: The pyhelios3d PlantArchitecture model the plant starts from.
-        age_days: Age the plant is grown to: old enough to bear fruit.
-    """
-
-    name: str
-    title: str
-    plant_height: float
-    fruit_radius: float
-    leaf_length: float
-    altitudes: tuple[float, float, float]
-    min_fruit_pixels: int
-    exclusion_radius: float
-    centre_height: float
-    mp_plants: int
-    mp_spacing: float
-    min_fruit: int
-    helios_model: str
-    age_days: float
-    sp_extent: tuple[float, float] = (3.0, 3.0)
-    mp_extent: tuple[float, float] = (7.0, 3.0)
-    fruit_size_per_radius: float = 1.0
-
-    def min_fruit_pixels_at(self, width: int, height: int) -> int:
-        """The box threshold at an image size: :attr:`min_fruit_pixels` scaled by the image area
-        over the paper's 1280x720, at least 1 pixel."""
-        return max(1, round(self.min_fruit_pixels * width * height / PAPER_PIXELS))
 
 
 # Why the grids differ by crop. Section III-B gives 3 x 3 m (SP) and 7 x 3 m (MP) grids, but Table 3's
@@ -127,6 +69,18 @@ CROPS: dict[str, CropSpec] = {
         sp_extent=(2.5, 2.5),
         mp_extent=(4.0, 3.0),
         fruit_size_per_radius=(0.5 + 0.5 + 0.55) / 3,
+        primitives_per_plant=17_000,
+        row=RowSpec(
+            system="hill system beds",
+            in_row_spacing=0.30,
+            row_spacing=1.20,
+            plants=10,
+            standoff=0.375,
+            altitudes=(0.25, 0.40, 0.55),
+            source="Sunset, 'Planting strawberries': hills 12-14 in apart, rows 48 in apart "
+            "(http://www.sunset.com/garden/fruits-veggies/tip-from-test-garden)",
+            step=0.25,
+        ),
     ),
     "tomato": CropSpec(
         name="tomato",
@@ -143,6 +97,18 @@ CROPS: dict[str, CropSpec] = {
         min_fruit=4,
         helios_model="tomato",
         age_days=100.0,
+        primitives_per_plant=10_000,
+        row=RowSpec(
+            system="staked rows",
+            in_row_spacing=0.50,
+            row_spacing=1.50,
+            plants=8,
+            standoff=0.50,
+            altitudes=(0.70, 1.10, 1.50),
+            source="tomatocultivation.com, 'Tomato crop spacing': rows 5 ft apart, 18-24 in in the row "
+            "(https://tomatocultivation.com/Tomato-Crop-Spacing.html)",
+            step=0.25,
+        ),
     ),
     "vine": CropSpec(
         name="vine",
@@ -159,7 +125,19 @@ CROPS: dict[str, CropSpec] = {
         min_fruit=4,
         helios_model="grapevine_VSP",
         age_days=95.0,
+        primitives_per_plant=241_000,
+        row=RowSpec(
+            system="head-trained (goblet) vineyard",
+            in_row_spacing=2.00,
+            row_spacing=3.00,
+            plants=3,
+            standoff=1.00,
+            altitudes=(0.50, 0.75, 1.00),
+            source="vineyardpost.com: vines 1.8-2 m apart along the row, rows 3-3.5 m apart "
+            "(https://vineyardpost.com/simple-overturn/)",
+        ),
     ),
+    **LIBRARY_CROPS,
 }
 
 #: Visible pixels (at 1280x720) from which Helios's Synthetic Annotation plug-in, which labelled
@@ -206,6 +184,26 @@ PLANT_GENERATORS: tuple[str, ...] = ("canopy", "architecture")
 DEFAULT_PLANTS = "canopy"
 
 
+#: What scene.json records as the plant generator of a plant-library crop's scene: its plants
+#: grow from the library whatever ``--plants`` says.
+LIBRARY_PLANTS = "library"
+
+
+def regrowing_plants(recorded: str | None) -> str:
+    """The ``plants`` setting that grows a scene again as scene.json records it was grown.
+
+    Args:
+        recorded: Its ``plant_generator``: ``canopy``, ``architecture``, ``library`` or none
+            (scenes from before the choice, grown with PlantArchitecture).
+
+    Raises:
+        UserError: for an unknown generator.
+    """
+    if recorded == LIBRARY_PLANTS:
+        return DEFAULT_PLANTS  # not read: a plant-library crop grows from the library
+    return check_plants(recorded or "architecture")
+
+
 def check_plants(name: str) -> str:
     """The plant generator's name, checked.
 
@@ -235,6 +233,9 @@ class ScenarioSpec:
         headings: Camera headings per position (1 means: always aimed at the plant).
         actions: The pointer keys every view carries.
         tau: Steps per episode in the benchmark (section V-D).
+
+    The ``row`` scenario is ours: a crop's commercial row (:class:`RowSpec`), cameras in its alleys
+    with MP's headings, actions and tau; its extent and step come from the crop's row.
     """
 
     name: str
@@ -268,22 +269,52 @@ SCENARIOS: dict[str, ScenarioSpec] = {
         actions=MP_ACTIONS,
         tau=5,
     ),
+    "row": ScenarioSpec(
+        name="row",
+        title="Row",
+        extent=(7.0, 3.0),
+        step=0.50,
+        altitude_levels=(0, 2),
+        headings=12,
+        actions=MP_ACTIONS,
+        tau=5,
+    ),
 }
 
 #: Standard deviation of the Gaussian "slip" added to each camera x and y (section III-B), m.
 SLIP_SIGMA = 0.025
 
-#: Value of a segmentation pixel that shows no fruit (the published layout's uint8 masks).
+#: Value of a segmentation pixel that shows no fruit in the published layout's uint8 masks (scenes
+#: of at most 255 fruit); 16-bit masks use 65535. The rule is :mod:`davis_ag.formats.masks`'s.
 NO_FRUIT = 255
-#: Fruit ids are uint8 values below NO_FRUIT, so a scene holds at most this many fruit.
-MAX_FRUIT = NO_FRUIT
+#: The most fruit a scene holds: ids 0..65534 of a 16-bit mask (:mod:`davis_ag.formats.masks`).
+MAX_FRUIT = 65535
+
+
+#: Other names a crop is known by on the command line.
+CROP_ALIASES = {
+    "grape": "vine",
+    "goblet": "vine",
+    "goblet_vine": "vine",
+    "apple_wall": "apple-wall",
+    "apple_fruitingwall": "apple-wall",
+    "pepper": "capsicum",
+    "sweet-pepper": "capsicum",
+    "cherrytomato": "cherry-tomato",
+    "cherry_tomato": "cherry-tomato",
+    "grapevine_vsp": "vsp-vine",
+    "vsp_vine": "vsp-vine",
+    "grapevine_wye": "wye-vine",
+    "wye_vine": "wye-vine",
+}
 
 
 def crop_spec(name: str) -> CropSpec:
     """Look a crop up by name.
 
     Args:
-        name: ``strawberry``, ``tomato`` or ``vine`` (``grape`` and ``goblet`` are accepted too).
+        name: One of :data:`CROPS` (``grape`` and ``goblet`` are accepted for ``vine``, and
+            the library models' own names, e.g. ``apple_fruitingwall``, for theirs).
 
     Returns:
         Its :class:`CropSpec`.
@@ -291,33 +322,48 @@ def crop_spec(name: str) -> CropSpec:
     Raises:
         UserError: for any other name.
     """
-    key = {"grape": "vine", "goblet": "vine", "goblet_vine": "vine"}.get(name.lower(), name.lower())
+    key = CROP_ALIASES.get(name.lower(), name.lower())
     if key not in CROPS:
         raise UserError(f"unknown crop {name!r}: choose one of {', '.join(CROPS)}")
     return CROPS[key]
 
 
 def scenario_spec(name: str, crop: CropSpec | None = None) -> ScenarioSpec:
-    """Look a scenario up by name (``sp``/``single`` or ``mp``/``multi``).
+    """Look a scenario up by name (``sp``/``single``, ``mp``/``multi`` or ``row``).
 
     Args:
         name: The scenario's name.
-        crop: When given, the grid is that crop's (``sp_extent`` / ``mp_extent``), which gives
-            Table 3's images per scene; without it, section III-B's nominal 3 x 3 m / 7 x 3 m.
+        crop: When given, the grid is that crop's (``sp_extent`` / ``mp_extent``, which give
+            Table 3's images per scene, or its row's extent and step); without it, section
+            III-B's nominal 3 x 3 m / 7 x 3 m (the row's: MP's).
 
     Returns:
         Its :class:`ScenarioSpec`.
 
     Raises:
-        UserError: for any other name.
+        UserError: for any other name, or ``row`` for a crop without a row.
     """
     key = {"single": "sp", "multi": "mp"}.get(name.lower(), name.lower())
     if key not in SCENARIOS:
-        raise UserError(f"unknown scenario {name!r}: choose sp (single plant) or mp (multi plant)")
+        raise UserError(
+            f"unknown scenario {name!r}: choose sp (single plant), mp (multi plant) or row (an orchard row)"
+        )
     scenario = SCENARIOS[key]
     if crop is None:
         return scenario
-    return replace(scenario, extent=crop.sp_extent if key == "sp" else crop.mp_extent)
+    if key == "row":
+        if crop.row is None:
+            raise UserError(f"{crop.name} has no row scenario: choose sp or mp")
+        return replace(scenario, extent=crop.row.extent, step=crop.row.step)
+    return replace(
+        scenario, extent=crop.sp_extent if key == "sp" else crop.mp_extent, step=scenario.step * crop.grid_scale
+    )
+
+
+def camera_altitudes(scenario: ScenarioSpec, crop: CropSpec) -> list[float]:
+    """The camera heights of a scenario's altitude levels, m: the crop's (Table 1), or its row's."""
+    heights = crop.row.altitudes if scenario.name == "row" and crop.row is not None else crop.altitudes
+    return [heights[level] for level in scenario.altitude_levels]
 
 
 def group_name(scenario: ScenarioSpec, crop: CropSpec) -> str:
@@ -341,7 +387,12 @@ def parse_group_name(name: str) -> tuple[ScenarioSpec, CropSpec] | None:
 
 
 def plant_positions(scenario: ScenarioSpec, crop: CropSpec) -> list[tuple[float, float]]:
-    """Stem positions (x, y): the origin for a single plant, else a row along x centred on it."""
+    """Stem positions (x, y): the origin for a single plant, a row along x centred on it for
+    multi plant, the crop's row and its two neighbours for ``row`` (:meth:`RowSpec.stems`)."""
+    if scenario.name == "row":
+        if crop.row is None:
+            raise UserError(f"{crop.name} has no row scenario: choose sp or mp")
+        return crop.row.stems()
     count = 1 if scenario.name == "sp" else crop.mp_plants
     offset = (count - 1) / 2
     return [((i - offset) * crop.mp_spacing, 0.0) for i in range(count)]

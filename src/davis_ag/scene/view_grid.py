@@ -20,6 +20,10 @@ Conventions (also in the README, "Images per scene"):
   undone by its opposite.
 - Single plant: the camera always aims at ``(0, 0, aim_height)``; forward, backward, right and
   left are world-fixed as above (+y, -y, +x, -x), since the camera's heading follows the plant.
+- Row (ours): the lattice of MP over the crop's row (``RowSpec``): rows of positions along x in
+  the two alleys, the lines within ``exclusion_band`` of the row's centre line left out, and no
+  move crosses the row; headings, moves and pitch as MP's, the pitch aiming at ``aim_height``
+  at the standoff ahead.
 - Multi plant: 12 headings 30 degrees apart; forward moves along the lattice axis (row or
   column) nearest the heading (no heading is exactly diagonal), backward the opposite, left 90
   degrees counter-clockwise of forward, right clockwise; a move along y zigzags as above.
@@ -40,9 +44,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from davis_ag.scene.specs import SLIP_SIGMA, CropSpec, ScenarioSpec, plant_centres
+from davis_ag.scene.specs import SLIP_SIGMA, CropSpec, ScenarioSpec, camera_altitudes, plant_centres
 
-#: Horizontal distance ahead at which a multi-plant camera's optical axis meets aim_height, m.
+#: Horizontal distance ahead at which a multi-plant camera's optical axis meets aim_height, m
+#: (a row's camera: its standoff).
 MP_AIM_DISTANCE = 1.5
 
 # Unit grid steps of the four grid axes, counter-clockwise from +x.
@@ -194,8 +199,10 @@ def build_view_grid(
         The :class:`ViewGrid`.
     """
     shape = lattice_shape(scenario)
-    altitudes = [crop.altitudes[level] for level in scenario.altitude_levels]
+    altitudes = camera_altitudes(scenario, crop)
     centres = np.asarray(plant_centres, dtype=float).reshape(-1, 3)
+    row = crop.row if scenario.name == "row" else None
+    aim_distance = MP_AIM_DISTANCE if row is None else row.standoff
 
     viewpoints: list[Viewpoint] = []
     index_of: dict[tuple[int, int, int, int], int] = {}
@@ -203,7 +210,10 @@ def build_view_grid(
         for iy in range(shape[1]):
             for ix in range(shape[0]):
                 x, y = lattice_point(ix, iy, shape, scenario.step)
-                if excluded(x, y, centres, crop.exclusion_radius):
+                if row is not None:
+                    if abs(y) <= row.exclusion_band + 1e-9:  # the row itself: no camera inside it
+                        continue
+                elif excluded(x, y, centres, crop.exclusion_radius):
                     continue
                 slip_x, slip_y = rng.normal(0.0, SLIP_SIGMA, size=2)
                 nominal = (float(x), float(y), float(z))
@@ -213,7 +223,7 @@ def build_view_grid(
                         yaw, pitch = _aim(position, (0.0, 0.0, aim_height))
                     else:
                         yaw = heading * 360.0 / scenario.headings
-                        pitch = math.degrees(math.atan2(aim_height - z, MP_AIM_DISTANCE))
+                        pitch = math.degrees(math.atan2(aim_height - z, aim_distance))
                     key = (ix, iy, level, heading)
                     index_of[key] = len(viewpoints)
                     viewpoints.append(
@@ -225,8 +235,11 @@ def build_view_grid(
     next_view = np.full((len(viewpoints), len(scenario.actions)), -1, dtype=np.int32)
     for view in viewpoints:
         for column, action in enumerate(scenario.actions):
-            key = _move(view, action, scenario)
-            next_view[view.index, column] = index_of.get(key, -1)
+            target = index_of.get(_move(view, action, scenario), -1)
+            # A row is a wall: on a grid coarser than its band a move could jump it.
+            if target >= 0 and row is not None and (viewpoints[target].nominal[1] > 0) != (view.nominal[1] > 0):
+                target = -1
+            next_view[view.index, column] = target
     return ViewGrid(tuple(viewpoints), scenario.actions, next_view)
 
 
@@ -262,3 +275,27 @@ def _move(view: Viewpoint, action: str, scenario: ScenarioSpec) -> tuple[int, in
         turn = {"forward": 0, "left": 1, "backward": 2, "right": 3}[action]
         dx, dy = _AXES[(forward + turn) % 4]
     return ix + dx, iy + dy, level, heading
+
+
+def view_facing(scenario: ScenarioSpec, crop: CropSpec, level: int, yaw: float) -> int:
+    """The number of a view to show: at altitude ``level``, looking along ``yaw`` (to 10 degrees)
+    towards the plants, the nearest to their middle (x = 0) and to the plants among those.
+
+    Args:
+        scenario, crop: The grid.
+        level: Altitude level, 0 the lowest the scenario uses.
+        yaw: Degrees counter-clockwise from +x (90: looking north, from south of the plants).
+
+    Returns:
+        The view's published number (from 1); the slip of dataset seed 0 decides near-ties.
+    """
+    grid = build_view_grid(scenario, crop, plant_centres(scenario, crop), crop.centre_height, np.random.default_rng(0))
+
+    direction = (math.cos(math.radians(yaw)), math.sin(math.radians(yaw)))
+
+    def score(view: Viewpoint) -> tuple[bool, float, float, float]:
+        off = abs((view.yaw - yaw + 180.0) % 360.0 - 180.0)
+        away = direction[0] * view.nominal[0] + direction[1] * view.nominal[1] > 0  # its back to the plants
+        return away, round(off / 10.0), round(abs(view.nominal[0]), 3), abs(view.nominal[1])
+
+    return min((v for v in grid.viewpoints if v.level == level), key=score).number

@@ -35,7 +35,7 @@ import tempfile
 import time
 from functools import partial
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
@@ -56,6 +56,7 @@ from davis_ag.workflows.bench_report import (
     projection,
     write_continuous,
 )
+from davis_ag.workflows.bench_timing import time_loop, time_ours
 from davis_ag.workflows.bench_training import training_speed, training_table, write_training
 
 CAMERA = Camera(1280, 720)
@@ -68,36 +69,6 @@ GRIDS = {
 }
 VIEWS = {"strawberry": 12, "tomato": 8, "vine": 8}
 REPEATS = 3
-
-
-def cpu_seconds() -> float:
-    """CPU time of this process, every thread (Mesa's rasteriser threads included)."""
-    times = os.times()
-    return times.user + times.system
-
-
-def time_loop(views: list, step: Callable[[object], None]) -> float:
-    """Run ``step`` on every view; seconds per view of all but the first."""
-    step(views[0])
-    start = time.perf_counter()
-    for view in views[1:]:
-        step(view)
-    return (time.perf_counter() - start) / (len(views) - 1)
-
-
-def time_ours(request: SceneRequest, model, grid, views: list, root: Path) -> tuple[float, float]:
-    """The generate path on the chosen views: seconds per view (views 2..n, publishing included)
-    and the seconds before the first view was done (renderer set-up and the first view)."""
-    marks: dict[str, float] = {}
-
-    def on_view(done: int, total: int) -> None:
-        if done == 1:
-            marks["first"] = time.perf_counter()
-
-    start = time.perf_counter()
-    draw_scene(request, model, grid, root, on_view, views=views)
-    end = time.perf_counter()
-    return (end - marks["first"]) / (len(views) - 1), marks["first"] - start
 
 
 def bench_crop(
@@ -331,12 +302,17 @@ def run_only(
     what: str, out: Path, doc: Path | None, devices: tuple[str, ...] = ("cpu",), gpu_machine: bool = False
 ) -> dict:
     """One measurement alone (``--only continuous``: TVMContinuous-v0's rate, about a minute;
-    ``--only training``: the learners' training rates, about 8 minutes, on each of ``devices``):
+    ``--only training``: the learners' training rates, about 8 minutes, on each of ``devices``;
+    ``--only crops``: the plant-library crops' SP and row scenes, :mod:`davis_ag.workflows.bench_crops`):
     JSON, the doc's section (its GPU section on a ``gpu_machine``) and the line another page shows
     of it."""
+    from davis_ag.scene.library_crops import LIBRARY_CROPS
+    from davis_ag.workflows.bench_crops import crops_speed, crops_table, write_crops
+
     measurements: dict[str, tuple[str, Any, Any, Any]] = {
         "continuous": ("continuous_env", continuous_env_speed, continuous_table, write_continuous),
         "training": ("training", partial(training_speed, devices=devices), training_table, write_training),
+        "crops": ("crops", lambda _scratch: crops_speed(list(LIBRARY_CROPS)), crops_table, write_crops),
     }
     key, measure, table_of, write = measurements[what]
     start = os.getloadavg()[0]

@@ -19,7 +19,7 @@ from typing import Any
 
 from davis_ag.atomic_files import write_json_atomic
 from davis_ag.workflows.reproduce_configs import ReproduceConfig, check_disk
-from davis_ag.workflows.run_groups import SCENARIO_CROPS, group_key
+from davis_ag.workflows.run_groups import group_key
 
 
 def load_state(path: Path) -> dict[str, Any]:
@@ -49,7 +49,7 @@ def reproduce(
     config: ReproduceConfig,
     out: Path,
     results_md: Path,
-    pairs: list[tuple[str, str]] | tuple[tuple[str, str], ...] = SCENARIO_CROPS,
+    pairs: list[tuple[str, str]] | tuple[tuple[str, str], ...] | None = None,
 ) -> int:
     """Generate, validate, split, train and benchmark each scenario; write ``results_md``.
 
@@ -57,7 +57,7 @@ def reproduce(
         config: The size of the run.
         out: Work folder (``dataset``, ``models``, ``results``, ``state.json``).
         results_md: The Markdown file to (re)write.
-        pairs: ``(scenario, crop)`` pairs to run.
+        pairs: ``(scenario, crop)`` pairs to run (default: the configuration's).
 
     Returns:
         0 on success, 1 when a dataset failed validation.
@@ -69,11 +69,11 @@ def reproduce(
     from davis_ag.scene.camera import Camera
     from davis_ag.provenance import code_version, machine_summary
     from davis_ag.workflows.demo import evaluation_split, generate_scenes, run_baselines
-    from davis_ag.workflows.results_page import write_results_md
     from davis_ag.workflows.reproduce_learners import train_learner
     from davis_ag.workflows.stage_clock import CLOCK_FILE, StageClock, generation_seconds
     from davis_ag.workflows.results_policies import model_path
 
+    pairs = config.pairs if pairs is None else pairs
     check_disk(config, Path(out).expanduser().absolute(), pairs)
     out = prove_writable_folder(out)  # absolute at once: Helios moves the working directory
     results_md = prove_writable_file(results_md, "--results")
@@ -151,13 +151,25 @@ def reproduce(
         if add_train_scores(results, root, scenario_name, crop_name, models, config) or added:
             write_or_rescue(results_json, partial(write_json, results), "the results")
         print(format_table(results), flush=True)
-        state["results"][scenario_name] = _summary(results)
+        state["results"][config.result_key(scenario_name, crop_name)] = _summary(results)
         evaluated = state["stages"][f"{key}: evaluate"]
         # A reused evaluation keeps the code that ran it.
         record(f"{key}: evaluate", evaluated["seconds"], evaluated["note"], evaluated.get("code"))
-        write_results_md(results_md, config, state, out)
+        write_page(results_md, config, state, out)
         print(f"wrote {results_md}", flush=True)
     return 0
+
+
+def write_page(path: Path, config: ReproduceConfig, state: dict[str, Any], out: Path) -> None:
+    """Write the run's page from its records: Table 4's results page, or the crops run's."""
+    if config.page == "crops":
+        from davis_ag.workflows.crops_page import write_crops_md
+
+        write_crops_md(path, config, state, out)
+    else:
+        from davis_ag.workflows.results_page import write_results_md
+
+        write_results_md(path, config, state, out)
 
 
 def validate_once(group: Path, state: dict[str, Any], stage: str, clock: Any, record: Any) -> bool:

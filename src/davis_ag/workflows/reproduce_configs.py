@@ -1,5 +1,6 @@
-"""The sizes ``davis-ag reproduce`` runs at (``small``, ``medium``, ``paper-scale``), what each is
-comparable with, and the disk each needs: one owner for docs/benchmark.md's table of them.
+"""The sizes ``davis-ag reproduce`` runs at (``small``, ``medium``, ``paper-scale``: Table 4; ``crops``:
+the plant-library crops' ladder), what each is comparable with, and the disk each needs: one owner
+for docs/benchmark.md's table of them.
 """
 
 from __future__ import annotations
@@ -10,7 +11,7 @@ from pathlib import Path
 
 from davis_ag.benchmark.cache import OBS_SIZE
 from davis_ag.scene.specs import PAPER_IMAGE_SIZE, PAPER_TABLE3, CropSpec, ScenarioSpec, crop_spec, scenario_spec
-from davis_ag.workflows.run_groups import SCENARIO_CROPS
+from davis_ag.workflows.run_groups import CROPS_PAIRS, SCENARIO_CROPS, group_key
 
 
 @dataclass(frozen=True)
@@ -18,9 +19,10 @@ class ReproduceConfig:
     """One reproduction's size.
 
     Attributes:
-        name: ``small``, ``medium`` or ``paper-scale``.
+        name: ``small``, ``medium``, ``paper-scale`` or ``crops``.
         size: Image width and height.
-        sp_scenes, mp_scenes: SP strawberry and MP vine scenes.
+        sp_scenes, mp_scenes: Scenes of each SP group, and of each MP or row group (Table 4: SP
+            strawberry and MP vine).
         mp_extent: MP grid extent (x, y) in metres; ``None`` keeps section III-B's 7 x 3 m.
         sp_timesteps, mp_timesteps: Environment steps per scenario of each learner.
         n_envs: Parallel environments of each learner.
@@ -29,6 +31,8 @@ class ReproduceConfig:
         learners: The algorithms trained (:data:`davis_ag.benchmark.algorithms.ALGORITHMS`), each
             with the same steps, seed, network, train split and keep rule: the paper's ``a2c``
             and, beside it, ``ppo`` with RL Baselines3 Zoo's Atari settings.
+        pairs: The run's ``(scenario, crop)`` groups, in the order it takes them.
+        page: The page the run writes: ``table4`` (docs/results.md) or ``crops`` (docs/crops.md).
     """
 
     name: str
@@ -43,14 +47,21 @@ class ReproduceConfig:
     sessions: int = 3
     seed: int = 0
     learners: tuple[str, ...] = ("a2c", "ppo")
+    pairs: tuple[tuple[str, str], ...] = SCENARIO_CROPS
+    page: str = "table4"
 
     def scenes(self, scenario_name: str) -> int:
-        """How many scenes the run makes of a scenario (``sp`` or ``mp``)."""
+        """How many scenes the run makes of a scenario (``sp``; ``mp`` or ``row``)."""
         return self.sp_scenes if scenario_name == "sp" else self.mp_scenes
 
     def timesteps(self, scenario_name: str) -> int:
-        """Environment steps each learner trains for on a scenario (``sp`` or ``mp``)."""
+        """Environment steps each learner trains for on a scenario (``sp``; ``mp`` or ``row``)."""
         return self.sp_timesteps if scenario_name == "sp" else self.mp_timesteps
+
+    def result_key(self, scenario_name: str, crop_name: str) -> str:
+        """Where ``state.json`` keeps a group's results: by scenario for Table 4's two groups (as
+        runs have always kept them), by group for the crops run."""
+        return scenario_name if self.page == "table4" else group_key(scenario_name, crop_name)
 
     def specs(self, scenario_name: str, crop_name: str) -> tuple[ScenarioSpec, CropSpec]:
         """The scenario and crop of one group of the run, the MP grid cut to :attr:`mp_extent`."""
@@ -70,6 +81,9 @@ class ReproduceConfig:
 #: machine, resumable across sittings.
 #: ``paper-scale``: Table 3's scene counts at 1280x720 and 300K steps of each learner, many sittings
 #: on such a machine (its results page gives the hours of every stage).
+#: ``crops``: every plant-library crop, 10 SP and 4 row scenes at 640x360, 20K steps of each
+#: learner per group: about a night of such a machine per sitting's worth of groups, resumable
+#: (docs/crops.md is its page).
 #: Scene counts of Table 3 (SP strawberry, MP vine), what a configuration is measured against.
 PAPER_SCENES = (PAPER_TABLE3["sp", "strawberry"][0], PAPER_TABLE3["mp", "vine"][0])
 CONFIGS: dict[str, ReproduceConfig] = {
@@ -87,6 +101,17 @@ CONFIGS: dict[str, ReproduceConfig] = {
         mp_extent=None,
         sp_timesteps=300_000,
         mp_timesteps=300_000,
+    ),
+    "crops": ReproduceConfig(
+        "crops",
+        (640, 360),
+        sp_scenes=10,
+        mp_scenes=4,
+        mp_extent=None,
+        sp_timesteps=20_000,
+        mp_timesteps=20_000,
+        pairs=CROPS_PAIRS,
+        page="crops",
     ),
 }
 
@@ -133,7 +158,7 @@ def configurations_table() -> str:
         "| disk (views and caches) | beside Table 4 |",
         "|---|---|---|---|---|---|---|---|",
     ]
-    for config in CONFIGS.values():
+    for config in (c for c in CONFIGS.values() if c.page == "table4"):
         grid = (
             f"{config.mp_extent[0]:g} x {config.mp_extent[1]:g} m grid"
             if config.mp_extent

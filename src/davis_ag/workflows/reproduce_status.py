@@ -60,6 +60,7 @@ def run_config(state: dict[str, Any], path: Path) -> ReproduceConfig:
             size=tuple(saved["size"]),
             mp_extent=tuple(saved["mp_extent"]) if saved.get("mp_extent") else None,
             learners=tuple(saved.get("learners", ("a2c",))),  # a run from before PPO trained A2C alone
+            pairs=tuple(tuple(pair) for pair in saved.get("pairs", SCENARIO_CROPS)),
         )
         return ReproduceConfig(**saved)
     except (TypeError, KeyError, ValueError) as error:
@@ -97,7 +98,7 @@ def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
 
     made = set(complete_scenes(out / "dataset"))
     stages: list[StageStatus] = []
-    for scenario, crop in SCENARIO_CROPS:
+    for scenario, crop in config.pairs:
         key = group_key(scenario, crop)
         stage = f"{key}: generate"
         stages.append(_generation_status(out / "dataset", config, scenario, crop, state, made, seconds(stage)))
@@ -115,7 +116,7 @@ def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
             stage = f"{key}: train {algo.upper()}"
             stages.append(_training_status(out, key, algo, timesteps, stage, seconds(stage)))
             if stages[-1].progress == "not started":
-                stages[-1] = _estimated_from_elsewhere(out, key, algo, timesteps, stages[-1])
+                stages[-1] = _estimated_from_elsewhere(out, config, key, algo, timesteps, stages[-1])
         stage = f"{key}: evaluate"
         written = (out / "results" / f"{key}.json").is_file()
         progress = f"{config.sessions} x {config.episodes} episodes written" if written else "not started"
@@ -213,13 +214,15 @@ def _training_status(out: Path, key: str, algo: str, timesteps: int, stage: str,
     return StageStatus(stage, False, progress + _best(record.get("selection")), seconds, left)
 
 
-def _estimated_from_elsewhere(out: Path, key: str, algo: str, timesteps: int, status: StageStatus) -> StageStatus:
+def _estimated_from_elsewhere(
+    out: Path, config: ReproduceConfig, key: str, algo: str, timesteps: int, status: StageStatus
+) -> StageStatus:
     """A learner not started, timed at the rate the same learner trained at on another group of
     the run (the same network and observations; the scenes differ), where one has finished."""
 
     from davis_ag.workflows.results_policies import training_record
 
-    for other in (group_key(s, c) for s, c in SCENARIO_CROPS):
+    for other in (group_key(s, c) for s, c in config.pairs):
         rate = training_record(out, other, algo).get("steps_per_second") if other != key else None
         if rate:
             return replace(
@@ -242,7 +245,7 @@ def _validation_from_elsewhere(
     from davis_ag.scene.view_grid import views_per_scene
 
     views = config.scenes(scenario) * views_per_scene(*config.specs(scenario, crop))
-    for other_scenario, other_crop in SCENARIO_CROPS:
+    for other_scenario, other_crop in config.pairs:
         other = group_key(other_scenario, other_crop)
         sittings = clock.get(f"{other}: validate")
         if other == group_key(scenario, crop) or not sittings or f"{other}: validate" not in recorded:

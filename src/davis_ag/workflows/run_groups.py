@@ -3,8 +3,16 @@ by: in the stages, ``state.json``, the models, the results files and the results
 
 from __future__ import annotations
 
+from davis_ag.scene.library_crops import LIBRARY_CROPS
+
 #: Table 4's two benchmarks: single-plant strawberry and multi-plant vine.
 SCENARIO_CROPS: tuple[tuple[str, str], ...] = (("sp", "strawberry"), ("mp", "vine"))
+
+
+#: The crops run's groups: every plant-library crop's single plant and row (docs/crops.md).
+CROPS_PAIRS: tuple[tuple[str, str], ...] = tuple(
+    (scenario, crop) for crop in LIBRARY_CROPS for scenario in ("sp", "row")
+)
 
 
 def group_key(scenario: str, crop: str) -> str:

@@ -48,7 +48,8 @@ def measure_views() -> dict:
 
 def measure_plants(count: int, crops: list[str], generator: str = "canopy") -> dict:
     """Grow ``count`` single plants of each of ``crops`` with the plant ``generator`` (``canopy``,
-    ``architecture``) as ``generate`` grows them; their fruit counts and phenotypes."""
+    ``architecture``; the plant-library crops grow from the library whatever it says) as
+    ``generate`` grows them; their fruit counts, phenotypes and primitives."""
     from davis_ag.generate.one_scene import SceneRequest
     from davis_ag.scene.build import build_scene
 
@@ -67,6 +68,7 @@ def measure_plants(count: int, crops: list[str], generator: str = "canopy") -> d
                     "build_s": None if plant.build_s is None else round(plant.build_s, 3),
                     "scene_seed": seed,
                     "grow_s": round(time.perf_counter() - started, 1),
+                    "primitives": len(plant.uuids),
                 }
             )
             print(f"{crop.name} {index}: {plant.fruit_count} fruit", file=sys.stderr, flush=True)

@@ -12,6 +12,8 @@ from pathlib import Path
 import numpy as np
 
 from davis_ag.atomic_files import read_page, write_json_atomic, write_text_atomic
+from davis_ag.errors import UserError
+from davis_ag.workflows.library_crops_table import CROPS_FILE, library_crops_table, library_recipes_table
 from davis_ag.scene.specs import CROPS, PHENOTYPE_SPREAD, SEEABLE_FRUIT_PIXELS
 
 #: The measurements' folder below the docs folder.
@@ -224,6 +226,7 @@ def render_markdown(docs: Path) -> str:
     sections = [
         ("views", "Images per scene (Table 3)", views_table(docs)),
         ("plants", "Fruit per plant", plants_table(docs)),
+        ("crops", "The plant-library crops beside the literature", library_crops_table(docs / DATA / CROPS_FILE)),
         ("refused", "Moves the benchmark refuses from its episode starts", refused_table(docs)),
         ("findings", "The paper's findings on single-plant strawberry scenes", findings_table(docs)),
         (
@@ -296,13 +299,27 @@ def write_measurement(
         write_json_atomic(data / "scenes-views.json", scene_stats.measure_views(), indent=1)
     elif what == "plants":
         # Crops measured earlier are kept: the vine takes long, so crops can be measured apart.
+        paper = [name for name in CROPS if CROPS[name].source == "canopy"]
+        if others := [name for name in crops or [] if name not in paper]:
+            raise UserError(f"--crops {','.join(others)}: 'plants' measures the paper's crops; use 'crops'")
         for generator in generators or ["canopy"]:
             path = data / PLANT_FILES[generator]
-            fresh = scene_stats.measure_plants(count, crops or list(CROPS), generator)
+            fresh = scene_stats.measure_plants(count, crops or paper, generator)
             before = json.loads(path.read_text()) if path.exists() else {"crops": {}}
             merged = {**before, **fresh, "crops": {**before["crops"], **fresh["crops"]}, "machine": machine}
             merged["crops"] = {name: merged["crops"][name] for name in CROPS if name in merged["crops"]}
             write_json_atomic(path, merged, indent=1)
+    elif what == "crops":
+        library = [name for name in CROPS if CROPS[name].source == "library"]
+        others = [name for name in crops or [] if name not in library]
+        if others:
+            raise UserError(f"--crops {','.join(others)}: 'crops' measures the plant-library crops; use 'plants'")
+        path = data / CROPS_FILE
+        fresh = scene_stats.measure_plants(count, crops or library)
+        before = json.loads(path.read_text()) if path.exists() else {"crops": {}}
+        merged = {**before, **fresh, "crops": {**before["crops"], **fresh["crops"]}, "machine": machine}
+        merged["crops"] = {name: merged["crops"][name] for name in library if name in merged["crops"]}
+        write_json_atomic(path, merged, indent=1)
     elif what == "refused":
         write_json_atomic(
             data / "scenes-refused.json",
@@ -315,5 +332,12 @@ def write_measurement(
         )
     write_text_atomic(docs / "scenes.md", render_markdown(docs))
     update_docs_pages(
-        docs, {"views": views_table(docs), "plants": plants_table(docs), "findings": findings_table(docs)}
+        docs,
+        {
+            "views": views_table(docs),
+            "plants": plants_table(docs),
+            "crops": library_crops_table(docs / DATA / CROPS_FILE),
+            "crop-recipes": library_recipes_table(),
+            "findings": findings_table(docs),
+        },
     )

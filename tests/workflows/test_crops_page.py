@@ -1,0 +1,106 @@
+"""The crops run: its configuration, its records and docs/crops.md's tables written from them."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict
+from pathlib import Path
+
+from davis_ag.scene.library_crops import LIBRARY_CROPS, LIBRARY_RECIPES, LITERATURE
+from davis_ag.workflows.crops_page import crops_table, write_crops_md
+from davis_ag.workflows.library_crops_table import library_crops_table, library_recipes_table
+from davis_ag.workflows.reproduce_configs import CONFIGS
+from davis_ag.workflows.reproduce_status import run_config
+
+CROPS_RUN = CONFIGS["crops"]
+
+
+def result(best: float, oracle: float, a2c: float | None, starts: int) -> dict:
+    """A group's results summary as reproduce keeps it in state.json."""
+    row = {"oer_tau": {"mean": 0.4, "std": 0.01}, "oer_0": {"mean": 0.2, "std": 0.01}}
+    policies = {
+        "LRD": row,
+        "Rand": row,
+        "Best fixed action": {"oer_tau": {"mean": best, "std": 0.01}},
+        "Oracle": {"oer_tau": {"mean": oracle, "std": 0.01}},
+    }
+    summary = {"protocol": {"split": "test", "scenes": ["a", "b", "c"], "starts": starts}, "policies": policies}
+    if a2c is not None:
+        policies["A2C"] = {"oer_tau": {"mean": a2c, "std": 0.01}}
+        summary["a2c_vs_best_fixed"] = {"gap": a2c - best, "low": a2c - best - 0.01, "high": a2c - best + 0.01}
+    return summary
+
+
+def test_the_crops_run_covers_every_library_crop_alone_and_in_its_row() -> None:
+    assert CROPS_RUN.pairs == tuple((s, c) for c in LIBRARY_CROPS for s in ("sp", "row"))
+    assert (CROPS_RUN.scenes("sp"), CROPS_RUN.scenes("row"), CROPS_RUN.size) == (10, 4, (640, 360))
+    # state.json keeps each group's results apart (Table 4's runs keep theirs by scenario).
+    assert CROPS_RUN.result_key("row", "olive") == "row-olive" and CONFIGS["small"].result_key("sp", "x") == "sp"
+    # A resumed run reads its configuration back from state.json, pairs included.
+    saved = json.loads(json.dumps({"config": asdict(CROPS_RUN)}))
+    assert run_config(saved, Path("state.json")) == CROPS_RUN
+
+
+def test_the_table_ranks_groups_hardest_first_and_names_those_not_run(tmp_path: Path) -> None:
+    state = {
+        "results": {
+            "sp-olive": result(best=0.50, oracle=0.70, a2c=0.55, starts=1234),
+            "row-apple": result(best=0.30, oracle=0.60, a2c=None, starts=56),
+        }
+    }
+    table = crops_table(CROPS_RUN, state)
+    rows = [line for line in table.splitlines() if line.startswith("| ") and "---" not in line][1:]
+    assert [row.split(" | ")[0:2] for row in rows] == [["| apple", "row"], ["| olive", "sp"]]
+    assert "1,234" in rows[1] and "+.200" in rows[1] and "+.050" in rows[1]  # headroom and A2C's gap
+    assert rows[0].rstrip(" |").endswith("–")  # no learner yet: a dash, not a number
+    assert "Not evaluated yet: sp-apple, " in table
+    page = tmp_path / "crops.md"
+    page.write_text("# Crops\n\nbefore\n<!-- crops-run:start -->\nold\n<!-- crops-run:end -->\nafter\n")
+    write_crops_md(page, CROPS_RUN, state, None)
+    text = page.read_text()
+    assert text.startswith("# Crops\n\nbefore\n") and text.endswith("after\n") and "old" not in text
+    assert "| apple | row |" in text
+    alone = write_crops_md(tmp_path / "run.md", CROPS_RUN, state, None)  # no markers: a page of its own
+    assert "Wall time per stage" in alone.read_text()
+
+
+def test_the_measured_crops_sit_beside_the_literature(tmp_path: Path) -> None:
+    plant = {
+        "fruit_count": 40,
+        "phenotype_measured": {"plant_height": 3.6, "fruit_radius": 0.04, "leaf_length": 0.09},
+        "library": {"width_m": [2.8, 2.9]},
+        "primitives": 125_000,
+        "build_s": 40.0,
+    }
+    data = {"plants_per_crop": 2, "machine": "test", "crops": {"apple": [plant, {**plant, "fruit_count": 50}]}}
+    path = tmp_path / "scenes-crops.json"
+    path.write_text(json.dumps(data))
+    lines = library_crops_table(path)
+    (row,) = [line for line in lines if line.startswith("| apple |")]
+    low, high = LITERATURE["apple"].fruit_per_plant
+    assert f"40-50 (median 45) [{low:.0f}-{high:.0f}]" in row and "80-80" in row and "125-125K" in row
+    assert any(LITERATURE["apple"].source in line for line in lines)
+    assert library_crops_table(tmp_path / "missing.json") == []
+    recipes = library_recipes_table()
+    assert all(
+        any(line.startswith(f"| {name} | {LIBRARY_RECIPES[name].model} |") for line in recipes)
+        for name in LIBRARY_RECIPES
+    )
+
+
+def test_the_crops_bench_table_gives_each_scene_beside_the_strawberry() -> None:
+    from davis_ag.workflows.bench_crops import crops_table as bench_table
+
+    row = {
+        "plants": 12,
+        "primitives": 3_816_534,
+        "fruit": 322,
+        "views_in_scene": 768,
+        "grow_s": 150.0,
+        "seconds_per_view": 0.9,
+        "over_strawberry": 9.0,
+        "peak_gb": 10.5,
+        "bytes_per_primitive": 2760,
+    }
+    table = bench_table({"image_size": [640, 360], "views": 6, "crops": {"vsp-vine": {"row": row}}}, (1.0, 2.0))
+    assert "| vsp-vine | row | 12 | 3,816,534 | 322 | 768 | 150 | 0.900 | 9.0 | 10.5 | 2,760 |" in table
