@@ -3,6 +3,8 @@ labelled by the library's lists, their growth reproducible, their boxes Helios's
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -117,3 +119,18 @@ def test_fruit_boxes_match_helios_visualizer(grown) -> None:
                 compared += 1
         assert len({b[4] for b in mine.boxes} ^ set(boxes)) <= 1
     assert compared >= 3
+
+
+@pytest.mark.parametrize("name", sorted(LIBRARY_RECIPES))
+def test_every_recipe_change_lands_on_a_shoot_type_of_its_model(name: str) -> None:
+    from pyhelios import Context
+
+    from davis_ag.scene.library_plants import load_library_model, shoot_parameters
+
+    model = load_library_model(Context(), CROPS[name], np.random.default_rng(0))
+    factors = {"size": 1.0, "fruit": 1.0, "leaf": 1.0}
+    changed = shoot_parameters(model.shoot_defaults, LIBRARY_RECIPES[name], factors)  # raises on a miss
+    assert set(changed) == set(model.shoot_defaults)
+    broken = replace(LIBRARY_RECIPES[name], shoot_changes=(("*", "no.such.parameter", 1.0),))
+    with pytest.raises(ValueError, match="no.such.parameter"):
+        shoot_parameters(model.shoot_defaults, broken, factors)

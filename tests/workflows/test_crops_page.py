@@ -62,6 +62,16 @@ def test_the_table_ranks_groups_hardest_first_and_names_those_not_run(tmp_path: 
     assert "| apple | row |" in text
     alone = write_crops_md(tmp_path / "run.md", CROPS_RUN, state, None)  # no markers: a page of its own
     assert "Wall time per stage" in alone.read_text()
+    # With the run's dataset: the share of views with a fruit boxed and the fewest fruit on a plant.
+    scene = tmp_path / "run" / "dataset" / "Single-Olive" / "000"
+    scene.mkdir(parents=True)
+    (scene / "annotations.json").write_text(
+        json.dumps({"0001.jpeg": {"bounding_boxes": [[1, 1, 2, 2, 0, 0]]}, "0002.jpeg": {"bounding_boxes": []}})
+    )
+    (scene / "scene.json").write_text(json.dumps({"plants": [{"fruit_count": 12}]}))
+    state["scene_folders"] = {"sp-olive": ["Single-Olive/000"]}
+    write_crops_md(page, CROPS_RUN, state, tmp_path / "run")
+    assert "| olive | sp | 50% / 12 |" in page.read_text()
 
 
 def test_the_measured_crops_sit_beside_the_literature(tmp_path: Path) -> None:
@@ -102,5 +112,8 @@ def test_the_crops_bench_table_gives_each_scene_beside_the_strawberry() -> None:
         "peak_gb": 10.5,
         "bytes_per_primitive": 2760,
     }
-    table = bench_table({"image_size": [640, 360], "views": 6, "crops": {"vsp-vine": {"row": row}}}, (1.0, 2.0))
-    assert "| vsp-vine | row | 12 | 3,816,534 | 322 | 768 | 150 | 0.900 | 9.0 | 10.5 | 2,760 |" in table
+    sp = {**row, "boxes_compared": 30, "max_corner_px": 1, "boxed_by_one": 2}
+    crops = {"vsp-vine": {"sp": sp, "row": row}}
+    table = bench_table({"image_size": [640, 360], "views": 6, "crops": crops}, (1.0, 2.0))
+    assert "| vsp-vine | row | 12 | 3,816,534 | 322 | 768 | 150 | 0.900 | 9.0 | 10.5 | 2,760 | – |" in table
+    assert "| vsp-vine | sp | 12 | 3,816,534 | 322 | 768 | 150 | 0.900 | 9.0 | 10.5 | 2,760 | 30, 1, 2 |" in table

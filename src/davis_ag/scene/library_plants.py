@@ -112,22 +112,32 @@ def shoot_parameters(defaults: dict[str, dict], recipe: LibraryRecipe, factors: 
 
     Returns:
         New parameters by shoot type (``defaults`` is left as it is).
+
+    Raises:
+        ValueError: for a recipe change no shoot type of the model has (a misspelt path would
+            otherwise change nothing, silently).
     """
     scales = {
         FRUIT_SCALE: recipe.fruit_scale * factors["fruit"] / factors["size"],
         LEAF_SCALE: factors["leaf"] / factors["size"],
     }
     shoots = {}
+    applied = set()
     for label, params in defaults.items():
         params = copy.deepcopy(params)
-        for shoot, path, value in recipe.shoot_changes:
+        for change in recipe.shoot_changes:
+            shoot, path, value = change
             if shoot in ("*", label) and _get(params, path) is not None:
                 _set(params, path, value)
+                applied.add(change[:2])
+
         for path, factor in scales.items():
             spec = _get(params, path)
             if isinstance(spec, dict) and spec.get("distribution") in ("constant", "uniform", "normal"):
                 scale_parameter(spec, factor)
         shoots[label] = params
+    if missing := [change[:2] for change in recipe.shoot_changes if change[:2] not in applied]:
+        raise ValueError(f"{recipe.model}: no shoot type has {missing[0][1]!r} for the change on {missing[0][0]!r}")
     return shoots
 
 

@@ -5,7 +5,8 @@ a fresh process grows the scene and draws its first :data:`VIEWS` views on the g
 (:func:`davis_ag.workflows.bench_timing.time_ours`: colour, ids, depth, labels, files, publish), and reports the
 seconds to grow, the scene's primitives and fruit, the seconds per view (all but the first) and the
 process's peak memory, which :mod:`davis_ag.scene.scene_size`'s bytes per primitive is checked
-against. The reference, in the same process as each row: the paper's SP strawberry, so the table
+against; on the single plant, our fruit boxes beside Helios's Visualizer's on three views (peak
+memory is taken before that). The reference, in the same process as each row: the paper's SP strawberry, so the table
 gives each crop's seconds per view as a ratio to it, which a busy machine moves less than seconds.
 """
 
@@ -29,8 +30,34 @@ VIEWS = 6
 MARKER = "bench-crops"
 
 
+def helios_agreement(model, grid, crop) -> dict[str, int]:
+    """Our fruit boxes against Helios's Visualizer's on three views of a single plant (low, middle,
+    high, three sides): boxes both drew, the largest corner difference, fruit only one boxed."""
+    import numpy as np
+
+    from davis_ag.labels.fruit_labels import fruit_lookup, label_view
+    from davis_ag.render.backends import open_renderer
+
+    views = [grid.viewpoints[i] for i in (20, 150, 290) if i < len(grid.viewpoints)]
+    lookup = fruit_lookup({f.id: f.uuids for f in model.fruits}, model.uuid_count)
+    threshold = crop.min_fruit_pixels_at(CAMERA.width, CAMERA.height)
+    boxes = {}
+    for renderer in ("helios", "opengl"):
+        with open_renderer(renderer, model.context, CAMERA, model.lighting, "helios") as drawing:
+            boxes[renderer] = [
+                {b[4]: b[:4] for b in label_view(drawing.render(v)[1], lookup, threshold).boxes} for v in views
+            ]
+    both = [(ours[i], theirs[i]) for ours, theirs in zip(boxes["opengl"], boxes["helios"]) for i in ours if i in theirs]
+    return {
+        "boxes_compared": len(both),
+        "max_corner_px": int(max((np.abs(np.subtract(a, b)).max() for a, b in both), default=0)),
+        "boxed_by_one": sum(len(set(o) ^ set(t)) for o, t in zip(boxes["opengl"], boxes["helios"])),
+    }
+
+
 def _measure(crop_name: str, scenario_name: str) -> dict[str, Any]:
-    """Grow one scene and draw its first views (in a process of its own: its peak memory is its)."""
+    """Grow one scene and draw its first views (in a process of its own: its peak memory is its);
+    a single plant's boxes are checked against Helios's Visualizer's too."""
     from davis_ag.generate.one_scene import SceneRequest, grow_scene
     from davis_ag.scene.scene_size import BYTES_PER_PRIMITIVE
     from davis_ag.scene.specs import CROPS, scenario_spec
@@ -45,7 +72,9 @@ def _measure(crop_name: str, scenario_name: str) -> dict[str, Any]:
     with tempfile.TemporaryDirectory(prefix="davis-ag-bench-crops-") as scratch:
         per_view, first = time_ours(request, model, grid, list(grid.viewpoints[:VIEWS]), Path(scratch))
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+    agreement = helios_agreement(model, grid, crop) if scenario_name == "sp" else {}
     return {
+        **agreement,
         "plants": len(model.plants),
         "primitives": primitives,
         "fruit": len(model.fruits),
@@ -94,15 +123,20 @@ def crops_table(result: dict[str, Any], load: tuple[float, float]) -> str:
         "seconds per view over an SP strawberry's measured just before (the same process's reference).",
         "",
         "| crop | scenario | plants | primitives | fruit | views a scene | grow s | s/view | x strawberry | "
-        "peak GB | bytes/primitive |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
+        "peak GB | bytes/primitive | boxes beside Helios's (compared, largest difference px, boxed by one) |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for crop, rows in result["crops"].items():
         for scenario, r in rows.items():
             lines.append(
                 f"| {crop} | {scenario} | {r['plants']} | {r['primitives']:,} | {r['fruit']} | {r['views_in_scene']} | "
                 f"{r['grow_s']:.0f} | {r['seconds_per_view']:.3f} | {r['over_strawberry']:.1f} | {r['peak_gb']:.1f} | "
-                f"{r['bytes_per_primitive']:,} |"
+                f"{r['bytes_per_primitive']:,} | "
+                + (
+                    f"{r['boxes_compared']}, {r['max_corner_px']}, {r['boxed_by_one']} |"
+                    if "boxes_compared" in r
+                    else "– |"
+                )
             )
     return "\n".join(lines)
 

@@ -42,12 +42,34 @@ def _learner(result: dict[str, Any], learner: str) -> str:
     return _score(policies, learner) + gap
 
 
-def crops_table(config: Any, state: dict[str, Any]) -> str:
+def boxed_share(root: Path | None, folders: list[str]) -> str:
+    """The share of a group's views with at least one fruit boxed, and its fewest fruit on a plant,
+    read from the scenes' annotations.json and scene.json (``–`` where they are not there)."""
+    import json
+
+    if root is None:
+        return "–"
+    views = boxed = 0
+    fewest: list[int] = []
+    for folder in folders:
+        try:
+            annotations = json.loads((root / folder / "annotations.json").read_text())
+            plants = json.loads((root / folder / "scene.json").read_text()).get("plants", [])
+        except (OSError, ValueError):
+            continue
+        views += len(annotations)
+        boxed += sum(1 for entry in annotations.values() if entry.get("bounding_boxes"))
+        fewest += [int(plant.get("fruit_count", 0)) for plant in plants]
+    return f"{boxed / views:.0%} / {min(fewest)}" if views and fewest else "–"
+
+
+def crops_table(config: Any, state: dict[str, Any], root: Path | None = None) -> str:
     """The run's table, hardest group first (the lowest Best fixed action).
 
     Args:
         config: The run's :class:`~davis_ag.workflows.reproduce_configs.ReproduceConfig`.
         state: Its ``state.json``.
+        root: Its dataset (``OUT/dataset``), for the share of views with a fruit boxed.
 
     Returns:
         Markdown: a line on the run, the table, the groups not evaluated yet.
@@ -70,6 +92,7 @@ def crops_table(config: Any, state: dict[str, Any]) -> str:
                 [
                     crop,
                     scenario,
+                    boxed_share(root, state.get("scene_folders", {}).get(group_key(scenario, crop), [])),
                     str(len(protocol.get("scenes", []))),
                     f"{protocol['starts']:,}" if "starts" in protocol else "–",
                     cell(start) if start is not None else "–",
@@ -88,7 +111,8 @@ def crops_table(config: Any, state: dict[str, Any]) -> str:
         f"Each learner's gap to the {BEST_FIXED} on the same episodes follows its score "
         f"({CONFIDENCE:.0%} bootstrap interval over episodes). Hardest first: the lowest {BEST_FIXED}."
     )
-    columns = ["crop", "scenario", "test scenes", "eligible starts", "OER_0", "Rand", BEST_FIXED, "Oracle"]
+    columns = ["crop", "scenario", "views with a fruit boxed / fewest fruit on a plant", "test scenes"]
+    columns += ["eligible starts", "OER_0", "Rand", BEST_FIXED, "Oracle"]
     columns += ["Oracle − best fixed", *learners]
     lines = [head, "", "| " + " | ".join(columns) + " |", "|---" * len(columns) + "|"]
     lines += ["| " + " | ".join(cells) + " |" for _, cells in sorted(rows, key=lambda row: row[0])]
@@ -106,7 +130,7 @@ def write_crops_md(path: Path, config: Any, state: dict[str, Any], out: Path | N
     Returns:
         The path written.
     """
-    table = crops_table(config, state)
+    table = crops_table(config, state, None if out is None else Path(out) / "dataset")
     path = Path(path)
     if path.is_file() and f"<!-- {CROPS_MARKER}:start -->" in path.read_text(errors="replace"):
         write_marked_section(path, CROPS_MARKER, table)
