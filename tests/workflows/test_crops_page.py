@@ -78,7 +78,7 @@ def test_the_measured_crops_sit_beside_the_literature(tmp_path: Path) -> None:
     plant = {
         "fruit_count": 40,
         "phenotype_measured": {"plant_height": 3.6, "fruit_radius": 0.04, "leaf_length": 0.09},
-        "library": {"width_m": [2.8, 2.9]},
+        "library": {"width_m": [2.8, 2.9], "fruit_length_m": 0.081, "fruit_diameter_m": 0.079},
         "primitives": 125_000,
         "build_s": 40.0,
     }
@@ -87,8 +87,8 @@ def test_the_measured_crops_sit_beside_the_literature(tmp_path: Path) -> None:
     path.write_text(json.dumps(data))
     lines = library_crops_table(path)
     (row,) = [line for line in lines if line.startswith("| apple |")]
-    low, high = LITERATURE["apple"].fruit_per_plant
-    assert f"40-50 (median 45) [{low:.0f}-{high:.0f}]" in row and "80-80" in row and "125-125K" in row
+    assert f"40-50 (median 45) [{LITERATURE['apple'].fruit_per_plant}]" in row
+    assert "81-81 x 79-79 [-]" in row and "125-125K" in row
     assert any(LITERATURE["apple"].source in line for line in lines)
     assert library_crops_table(tmp_path / "missing.json") == []
     recipes = library_recipes_table()
@@ -111,9 +111,12 @@ def test_the_crops_bench_table_gives_each_scene_beside_the_strawberry() -> None:
         "over_strawberry": 9.0,
         "peak_gb": 10.5,
         "bytes_per_primitive": 2760,
+        "estimated_gb": 11.5,
     }
     sp = {**row, "boxes_compared": 30, "max_corner_px": 1, "boxed_by_one": 2}
     crops = {"vsp-vine": {"sp": sp, "row": row}}
     table = bench_table({"image_size": [640, 360], "views": 6, "crops": crops}, (1.0, 2.0))
-    assert "| vsp-vine | row | 12 | 3,816,534 | 322 | 768 | 150 | 0.900 | 9.0 | 10.5 | 2,760 | – |" in table
-    assert "| vsp-vine | sp | 12 | 3,816,534 | 322 | 768 | 150 | 0.900 | 9.0 | 10.5 | 2,760 | 30, 1, 2 |" in table
+    assert "| vsp-vine | row | 12 | 3,816,534 | 322 | 768 | 150 | 0.900 | 9.0 | 10.5 (11.5) | 2,760 | – |" in table
+    assert (
+        "| vsp-vine | sp | 12 | 3,816,534 | 322 | 768 | 150 | 0.900 | 9.0 | 10.5 (11.5) | 2,760 | 30, 1, 2 |" in table
+    )

@@ -253,96 +253,86 @@ LIBRARY_RECIPES: dict[str, LibraryRecipe] = {
 
 @dataclass(frozen=True)
 class Literature:
-    """Published figures a crop's recipe is checked against (docs/crops.md).
+    """Published figures a crop's recipe is checked against (docs/crops.md), quoted as found: a
+    figure the sources do not give is ``-``, never an estimate of ours.
 
     Attributes:
-        fruit_per_plant: Fruit a plant of the library's size bears (low, high).
-        fruit_diameter_mm: Fruit size, mm (a grape cluster's width).
-        plant_height_m: Plant height, m.
+        fruit_per_plant: Fruit a plant of the library's size bears.
+        fruit_size: Fruit size (length, width; a grape cluster's berries).
+        plant_height: Plant height.
         source: The citations.
     """
 
-    fruit_per_plant: tuple[float, float]
-    fruit_diameter_mm: tuple[float, float]
-    plant_height_m: tuple[float, float]
+    fruit_per_plant: str
+    fruit_size: str
+    plant_height: str
     source: str
 
 
 LITERATURE: dict[str, Literature] = {
     "apple": Literature(
-        (15, 100),
-        (70, 85),
-        (3.0, 4.9),
-        "third-leaf trees carry under 0.5-1 bushel (MSU Extension, "
-        "http://www.canr.msu.edu/news/manage_crop_load_of_young_tall_spindle_apple_plantings); semi-dwarf "
-        "trees 10-16 ft (https://www.mckaynursery.com/online-plants/fruit-trees-shrubs/apples-trees/semi-dwarf.html)",
+        "under 0.5-1 bushel (over-cropping at the third leaf)",
+        "-",
+        "3-4.9 m (semi-dwarf)",
+        "MSU Extension (http://www.canr.msu.edu/news/manage_crop_load_of_young_tall_spindle_apple_plantings); "
+        "McKay Nursery (https://www.mckaynursery.com/online-plants/fruit-trees-shrubs/apples-trees/semi-dwarf.html)",
     ),
     "apple-wall": Literature(
-        (15, 60),
-        (70, 85),
-        (3.0, 3.7),
-        "a tall spindle 'bears 15 to 20 apples in its second year' (Robinson 2007, "
-        "https://fruitgrowersnews.com/article/the-tall-spindle-system-apple-orchard-design-for-the-future/); "
-        "walls about 12 ft tall, at most 3 ft deep (http://read.dmtmag.com/i/123862-may-1/24)",
+        "15-20 in the second year",
+        "-",
+        "about 12 ft, at most 3 ft deep",
+        "Robinson 2007 (https://fruitgrowersnews.com/article/the-tall-spindle-system-apple-orchard-design-for-the-future/); "
+        "http://read.dmtmag.com/i/123862-may-1/24",
     ),
     "almond": Literature(
-        (2, 60),
-        (25, 40),
-        (2.0, 3.5),
-        "a first crop is 'one or two nuts up to a hatful' (https://bitlit.ru/chapter/en/r-h-taylor/"
-        "the-almond-in-california/yields); a mature tree about 16,000 nuts "
-        "(https://biologyinsights.com/how-many-almonds-does-a-tree-produce-each-year)",
+        "a first crop of 'one or two nuts up to a hatful'",
+        "-",
+        "-",
+        "https://bitlit.ru/chapter/en/r-h-taylor/the-almond-in-california/yields",
     ),
     "olive": Literature(
-        (50, 300),
-        (15, 35),
-        (1.5, 3.0),
-        "1-2 fruit per fruiting inflorescence (Lavee et al. 1996, "
-        "https://c.coek.info/pdf-the-floral-biology-of-the-olive-effect-of-flower-number-type-and-distribution-on.html); "
-        "super-high-density hedgerow trees 2.5-3 m (http://www.agromillora-ca.com/products/high-density-requirements/)",
+        "1-2 fruit per fruiting inflorescence",
+        "-",
+        "2.5-3 m (hedgerow, final)",
+        "Lavee et al. 1996 (https://c.coek.info/pdf-the-floral-biology-of-the-olive-effect-of-flower-number-"
+        "type-and-distribution-on.html); http://www.agromillora-ca.com/products/high-density-requirements/",
     ),
     "pistachio": Literature(
-        (0, 1000),
-        (15, 25),
-        (2.0, 3.5),
-        "bearing starts in year 5-8, a mature tree ~1,000+ nuts "
-        "(https://wikifarmer.com/library/en/article/pistachio-tree-harvest-and-yield); nuts 1.5-2 cm "
-        "(http://aryafirm.com/index.php/pistachio/)",
+        "bearing from year 5-8; a mature tree ~1,000+",
+        "15-20 mm long",
+        "-",
+        "https://wikifarmer.com/library/en/article/pistachio-tree-harvest-and-yield; http://aryafirm.com/index.php/pistachio/",
     ),
     "walnut": Literature(
-        (0, 100),
-        (28, 55),
-        (2.5, 4.0),
-        "bearing from about year 5 (http://chandlerwalnutsapling.com/chandler-walnut-sapling.php); "
-        "in-shell nuts 28-32 mm (http://foodsource.us/nuts/walnuts/), more in the green husk",
+        "bearing from about year 5",
+        "28-32 mm in the shell, more in the husk",
+        "-",
+        "http://chandlerwalnutsapling.com/chandler-walnut-sapling.php; http://foodsource.us/nuts/walnuts/",
     ),
     "capsicum": Literature(
-        (3, 8),
-        (76, 100),
-        (1.0, 2.0),
-        "a plant sets two to four fruit per flush and the flowers above abort "
-        "(https://www.ingreenhouses.com/young-fruits-pull-so-hard-flowers-above-abort/); the largest bell "
-        "peppers 4 in long, 3-3.5 in broad (https://hort.purdue.edu/newcrop/Crops/Peppers%5BBell%5D.html)",
+        "2-4 set per flush, later flowers abort",
+        "up to 4 in long, 3-3.5 in broad",
+        "-",
+        "https://www.ingreenhouses.com/young-fruits-pull-so-hard-flowers-above-abort/; "
+        "https://hort.purdue.edu/newcrop/Crops/Peppers%5BBell%5D.html",
     ),
     "cherry-tomato": Literature(
-        (30, 100),
-        (10, 30),
-        (1.5, 3.0),
-        "fruit 1-3 cm (https://simple.wikipedia.org/wiki/Cherry_tomato, "
-        "https://biologyinsights.com/how-big-do-cherry-tomatoes-get); up to about a hundred fruit a plant "
-        "(https://tomato-daily.blogspot.com/2008/06/trusses-clusters.html)",
+        "up to about 100",
+        "1-3 cm",
+        "-",
+        "https://simple.wikipedia.org/wiki/Cherry_tomato; https://tomato-daily.blogspot.com/2008/06/trusses-clusters.html",
     ),
     "vsp-vine": Literature(
-        (12, 80),
-        (60, 120),
-        (1.5, 2.2),
-        "12-80 clusters a vine, 70-100 berries a cluster (https://biologyinsights.com/how-many-grapes-grow-on-a-vine)",
+        "12-80 clusters",
+        "70-100 berries a cluster",
+        "-",
+        "https://biologyinsights.com/how-many-grapes-grow-on-a-vine",
     ),
     "wye-vine": Literature(
-        (12, 80),
-        (60, 120),
-        (2.0, 3.0),
-        "12-80 clusters a vine, 70-100 berries a cluster (https://biologyinsights.com/how-many-grapes-grow-on-a-vine)",
+        "12-80 clusters",
+        "70-100 berries a cluster",
+        "-",
+        "https://biologyinsights.com/how-many-grapes-grow-on-a-vine",
     ),
 }
 

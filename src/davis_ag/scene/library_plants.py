@@ -34,6 +34,7 @@ from davis_ag.scene.plants import (
     helios_seed,
     object_vertices,
     primitive_vertices,
+    principal_extents,
     quiet_stdout,
     scale_parameter,
 )
@@ -178,15 +179,16 @@ def draw_factors(rng: np.random.Generator) -> dict[str, float]:
 
 
 def measure_library_plant(context, plant_architecture, plant_id: int) -> dict[str, float]:
-    """Height, crown width (x, y), median fruit diameter and leaf length of a built plant, m."""
+    """Height, crown width (x, y), fruit length and width (the median over fruit of their largest
+    and middle extents along their principal axes) and median leaf length of a built plant, m."""
     parts = primitive_vertices(context, plant_architecture.getAllPlantUUIDs(plant_id))
     points = np.concatenate(parts)
     lo, hi = points.min(axis=0), points.max(axis=0)
-    diameters = []
+    sizes = []  # per fruit, its extents along its principal axes, largest first
     for fruit in plant_architecture.getPlantFruitObjectIDs(plant_id):
         vertices = object_vertices(context, int(fruit))
-        if len(vertices):
-            diameters.append(float(np.median(vertices.max(axis=0) - vertices.min(axis=0))))
+        if len(vertices) > 3:
+            sizes.append(principal_extents(vertices))
     leaves = []
     for leaf in plant_architecture.getPlantLeafObjectIDs(plant_id):
         vertices = object_vertices(context, int(leaf))
@@ -196,7 +198,8 @@ def measure_library_plant(context, plant_architecture, plant_id: int) -> dict[st
         "plant_height": float(hi[2]),
         "width_x": float(hi[0] - lo[0]),
         "width_y": float(hi[1] - lo[1]),
-        "fruit_diameter": float(np.median(diameters)) if diameters else float("nan"),
+        "fruit_length": float(np.median([e[0] for e in sizes])) if sizes else float("nan"),
+        "fruit_diameter": float(np.median([e[1] for e in sizes])) if sizes else float("nan"),
         "leaf_length": float(np.median(leaves)) if leaves else float("nan"),
     }
 
@@ -272,6 +275,7 @@ def grow_library_crop_plant(
             "yaw_deg": recipe.yaw_deg,
             "factors": factors,
             "width_m": [measured["width_x"], measured["width_y"]],
+            "fruit_length_m": measured["fruit_length"],
             "fruit_diameter_m": measured["fruit_diameter"],
         },
     )

@@ -3,7 +3,9 @@
 A scene lives three times in memory while it is drawn: Helios's Context (its primitives with
 their data), our renderer's vertex arrays and the labelling tables. Measured on the 2-core
 machine: a VSP vineyard row (12 vines, 3.82 million primitives) peaked at 5.8 GB grown and
-10.5 GB once drawn at 640x360, 2,760 bytes a primitive (:data:`BYTES_PER_PRIMITIVE`).
+10.5 GB once drawn at 640x360, 2,760 bytes a primitive (:data:`BYTES_PER_PRIMITIVE`); an apple
+row (1.21 million) at 4.3 GB, which a process's own 0.8 GB (:data:`BASE_BYTES`: Python, numpy,
+Helios and the GL context) beside them explains (``davis-ag bench --only crops`` measures both).
 """
 
 from __future__ import annotations
@@ -16,6 +18,8 @@ from davis_ag.scene.specs import ScenarioSpec, plant_positions
 
 #: Peak memory per primitive of a scene while it grows and is drawn, bytes (module docstring).
 BYTES_PER_PRIMITIVE = 2_800
+#: A scene process's memory before any primitive, bytes (module docstring).
+BASE_BYTES = 800_000_000
 #: Share of the machine's memory one scene may take.
 MEMORY_SHARE = 0.75
 
@@ -26,8 +30,9 @@ def machine_memory() -> int:
 
 
 def scene_bytes(scenario: ScenarioSpec, crop: CropSpec) -> int:
-    """Estimated peak memory of one scene: its plants' primitives times :data:`BYTES_PER_PRIMITIVE`."""
-    return len(plant_positions(scenario, crop)) * crop.primitives_per_plant * BYTES_PER_PRIMITIVE
+    """Estimated peak memory of one scene: its plants' primitives times :data:`BYTES_PER_PRIMITIVE`,
+    and the process's own :data:`BASE_BYTES`."""
+    return BASE_BYTES + len(plant_positions(scenario, crop)) * crop.primitives_per_plant * BYTES_PER_PRIMITIVE
 
 
 def check_scene_size(scenario: ScenarioSpec, crop: CropSpec, memory: int | None = None) -> None:

@@ -59,7 +59,7 @@ def _measure(crop_name: str, scenario_name: str) -> dict[str, Any]:
     """Grow one scene and draw its first views (in a process of its own: its peak memory is its);
     a single plant's boxes are checked against Helios's Visualizer's too."""
     from davis_ag.generate.one_scene import SceneRequest, grow_scene
-    from davis_ag.scene.scene_size import BYTES_PER_PRIMITIVE
+    from davis_ag.scene.scene_size import scene_bytes
     from davis_ag.scene.specs import CROPS, scenario_spec
     from davis_ag.workflows.bench_timing import time_ours
 
@@ -84,7 +84,7 @@ def _measure(crop_name: str, scenario_name: str) -> dict[str, Any]:
         "first_view_s": round(first, 1),
         "peak_gb": round(peak / 1e9, 2),
         "bytes_per_primitive": round(peak / primitives),
-        "estimated_gb": round(primitives * BYTES_PER_PRIMITIVE / 1e9, 2),
+        "estimated_gb": round(scene_bytes(request.scenario, crop) / 1e9, 2),
     }
 
 
@@ -123,14 +123,16 @@ def crops_table(result: dict[str, Any], load: tuple[float, float]) -> str:
         "seconds per view over an SP strawberry's measured just before (the same process's reference).",
         "",
         "| crop | scenario | plants | primitives | fruit | views a scene | grow s | s/view | x strawberry | "
-        "peak GB | bytes/primitive | boxes beside Helios's (compared, largest difference px, boxed by one) |",
+        "peak GB (estimated) | bytes/primitive | boxes beside Helios's (compared, largest difference px, "
+        "boxed by one) |",
         "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for crop, rows in result["crops"].items():
         for scenario, r in rows.items():
             lines.append(
                 f"| {crop} | {scenario} | {r['plants']} | {r['primitives']:,} | {r['fruit']} | {r['views_in_scene']} | "
-                f"{r['grow_s']:.0f} | {r['seconds_per_view']:.3f} | {r['over_strawberry']:.1f} | {r['peak_gb']:.1f} | "
+                f"{r['grow_s']:.0f} | {r['seconds_per_view']:.3f} | {r['over_strawberry']:.1f} | {r['peak_gb']:.1f} "
+                f"({r['estimated_gb']:.1f}) | "
                 f"{r['bytes_per_primitive']:,} | "
                 + (
                     f"{r['boxes_compared']}, {r['max_corner_px']}, {r['boxed_by_one']} |"

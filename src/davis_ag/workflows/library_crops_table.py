@@ -25,11 +25,6 @@ def _span(values: list[float], scale: float = 1.0, digits: int = 2) -> str:
     return f"{min(values):.{digits}f}-{max(values):.{digits}f}"
 
 
-def _range(bounds: tuple[float, float], digits: int = 0) -> str:
-    low, high = bounds
-    return f"{low:.{digits}f}-{high:.{digits}f}" if low != high else f"{low:.{digits}f}"
-
-
 def library_crops_table(path: Path) -> list[str]:
     """Markdown: per crop, the model and age, fruit per plant, fruit diameter, height and crown width
     as grown (min-max over the plants), each beside the literature's, primitives and seconds.
@@ -46,9 +41,11 @@ def library_crops_table(path: Path) -> list[str]:
     lines = [
         f"{data['plants_per_crop']} single plants per crop, grown as `davis-ag generate` grows them "
         f"(scene seeds of dataset seed 0); {data.get('machine', 'machine not recorded')}. Each measured "
-        "column is min-max over the plants, the literature's beside it in brackets.",
+        "figure is min-max over the plants (a fruit's size: the median over its fruit of the largest and "
+        "middle extents along its principal axes); the literature's follows in brackets, `-` where the "
+        "sources give none.",
         "",
-        "| crop | library model, age (days) | fruit per plant | fruit diameter, mm | height, m | "
+        "| crop | library model, age (days) | fruit per plant | fruit length x width, mm | height, m | "
         "crown width (x / y), m | primitives | seconds per plant |",
         "|---|---|---|---|---|---|---|---|",
     ]
@@ -56,16 +53,17 @@ def library_crops_table(path: Path) -> list[str]:
         recipe, seen = LIBRARY_RECIPES[name], LITERATURE[name]
         fruit = [p["fruit_count"] for p in plants]
         library = [p.get("library", {}) for p in plants]
-        diameters = [p["phenotype_measured"]["fruit_radius"] * 2 for p in plants]
+        lengths = [lib.get("fruit_length_m", float("nan")) for lib in library]
+        widths = [lib.get("fruit_diameter_m", float("nan")) for lib in library]
         heights = [p["phenotype_measured"]["plant_height"] for p in plants]
-        widths = [w for lib in library for w in lib.get("width_m", [])]
+        crowns = [w for lib in library for w in lib.get("width_m", [])]
         primitives = [p["primitives"] for p in plants if "primitives" in p]
         seconds = [p["build_s"] if p.get("build_s") is not None else p["grow_s"] for p in plants]
         lines.append(
             f"| {name} | {recipe.model}, {recipe.age_days:g} | {min(fruit)}-{max(fruit)} "
-            f"(median {np.median(fruit):g}) [{_range(seen.fruit_per_plant)}] | "
-            f"{_span(diameters, 1000, 0)} [{_range(seen.fruit_diameter_mm)}] | "
-            f"{_span(heights)} [{_range(seen.plant_height_m, 1)}] | {_span(widths)} | "
+            f"(median {np.median(fruit):g}) [{seen.fruit_per_plant}] | "
+            f"{_span(lengths, 1000, 0)} x {_span(widths, 1000, 0)} [{seen.fruit_size}] | "
+            f"{_span(heights)} [{seen.plant_height}] | {_span(crowns)} | "
             f"{_span(primitives, 1e-3, 0)}K | {np.median(seconds):.1f} |"
         )
     lines += ["", "Sources of the bracketed figures:", ""]
