@@ -120,3 +120,16 @@ def test_the_crops_bench_table_gives_each_scene_beside_the_strawberry() -> None:
     assert (
         "| vsp-vine | sp | 12 | 3,816,534 | 322 | 768 | 150 | 0.900 | 9.0 | 10.5 (11.5) | 2,760 | 30, 1, 2 |" in table
     )
+
+
+def test_a_crop_measured_again_alone_keeps_the_others_rows(tmp_path: Path) -> None:
+    from davis_ag.workflows.bench_crops import merged
+
+    earlier = {"image_size": [640, 360], "crops": {"wye-vine": {"sp": 1}, "apple": {"sp": 2}}}
+    report = tmp_path / "bench-crops.json"
+    report.write_text(json.dumps({"crops": earlier}))
+    fresh = {"image_size": [640, 360], "crops": {"wye-vine": {"sp": 3}}}
+    assert merged(report, fresh)["crops"] == {"apple": {"sp": 2}, "wye-vine": {"sp": 3}}  # specs.CROPS's order
+    other_size = {**fresh, "image_size": [1280, 720]}
+    assert merged(report, other_size)["crops"] == {"wye-vine": {"sp": 3}}
+    assert merged(tmp_path / "none.json", fresh)["crops"] == fresh["crops"]

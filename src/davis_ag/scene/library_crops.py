@@ -55,7 +55,7 @@ class LibraryRecipe:
             the next seed.
         primitives: Primitives of a typical plant (measured), for the scene-size check.
         yaw_deg: Turn of the built plant about its stem, degrees counter-clockwise: the library
-            trains its fruiting wall along y, where our rows run along x.
+            trains its fruiting wall and its grapevines' cordons along y, where our rows run along x.
     """
 
     model: str
@@ -236,6 +236,7 @@ LIBRARY_RECIPES: dict[str, LibraryRecipe] = {
         (10, 250),
         318_000,
         build_parameters={"vine_spacing": 1.8},
+        yaw_deg=90.0,
     ),
     # 60 berries of 13.7 mm a cluster instead of about 90 of 12 mm (the same cluster volume): a
     # Wye vine is 0.9 million primitives, 82 % of them berries, and its row would not fit 24 GB.
@@ -247,6 +248,7 @@ LIBRARY_RECIPES: dict[str, LibraryRecipe] = {
         (10, 250),
         575_000,
         build_parameters={"vine_spacing": 1.8, "cluster_berry_count": 60, "berry_diameter": 0.0137},
+        yaw_deg=90.0,
     ),
 }
 

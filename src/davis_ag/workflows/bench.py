@@ -299,20 +299,31 @@ def continuous_env_speed(scratch: Path, steps: int = 600) -> dict:
 
 
 def run_only(
-    what: str, out: Path, doc: Path | None, devices: tuple[str, ...] = ("cpu",), gpu_machine: bool = False
+    what: str,
+    out: Path,
+    doc: Path | None,
+    devices: tuple[str, ...] = ("cpu",),
+    gpu_machine: bool = False,
+    crops: list[str] | None = None,
 ) -> dict:
     """One measurement alone (``--only continuous``: TVMContinuous-v0's rate, about a minute;
     ``--only training``: the learners' training rates, about 8 minutes, on each of ``devices``;
-    ``--only crops``: the plant-library crops' SP and row scenes, :mod:`davis_ag.workflows.bench_crops`):
+    ``--only crops``: the plant-library crops' SP and row scenes, :mod:`davis_ag.workflows.bench_crops`,
+    ``crops`` of them, the others' rows kept from an earlier report at ``out``):
     JSON, the doc's section (its GPU section on a ``gpu_machine``) and the line another page shows
     of it."""
     from davis_ag.scene.library_crops import LIBRARY_CROPS
-    from davis_ag.workflows.bench_crops import crops_speed, crops_table, write_crops
+    from davis_ag.workflows.bench_crops import crops_speed, crops_table, merged, write_crops
 
     measurements: dict[str, tuple[str, Any, Any, Any]] = {
         "continuous": ("continuous_env", continuous_env_speed, continuous_table, write_continuous),
         "training": ("training", partial(training_speed, devices=devices), training_table, write_training),
-        "crops": ("crops", lambda _scratch: crops_speed(list(LIBRARY_CROPS)), crops_table, write_crops),
+        "crops": (
+            "crops",
+            lambda _scratch: merged(out, crops_speed(crops or list(LIBRARY_CROPS))),
+            crops_table,
+            write_crops,
+        ),
     }
     key, measure, table_of, write = measurements[what]
     start = os.getloadavg()[0]

@@ -114,6 +114,24 @@ def crops_speed(crops: list[str]) -> dict[str, Any]:
     return out
 
 
+def merged(report: Path, fresh: dict[str, Any]) -> dict[str, Any]:
+    """``fresh`` with the crops it did not measure taken from an earlier ``--only crops`` report at
+    ``report`` (so one crop can be measured again alone), in ``specs.CROPS``'s order."""
+    import json
+
+    from davis_ag.scene.specs import CROPS
+
+    try:
+        before = json.loads(Path(report).read_text()).get("crops", {})
+    except (OSError, ValueError, AttributeError):
+        before = {}
+    earlier = (
+        before.get("crops", {}) if isinstance(before, dict) and before.get("image_size") == fresh["image_size"] else {}
+    )
+    every = {**earlier, **fresh["crops"]}
+    return {**fresh, "crops": {name: every[name] for name in CROPS if name in every}}
+
+
 def crops_table(result: dict[str, Any], load: tuple[float, float]) -> str:
     """The Markdown table of :func:`crops_speed`'s result."""
     lines = [
