@@ -46,7 +46,7 @@ def library_crops_table(path: Path) -> list[str]:
         "sources give none.",
         "",
         "| crop | library model, age (days) | fruit per plant | fruit length x width, mm | height, m | "
-        "crown width (x / y), m | primitives | seconds per plant |",
+        "crown along the row (x) / across it (y), m | primitives | seconds per plant |",
         "|---|---|---|---|---|---|---|---|",
     ]
     for name, plants in data["crops"].items():
@@ -56,14 +56,15 @@ def library_crops_table(path: Path) -> list[str]:
         lengths = [lib.get("fruit_length_m", float("nan")) for lib in library]
         widths = [lib.get("fruit_diameter_m", float("nan")) for lib in library]
         heights = [p["phenotype_measured"]["plant_height"] for p in plants]
-        crowns = [w for lib in library for w in lib.get("width_m", [])]
+        along = [lib["width_m"][0] for lib in library if len(lib.get("width_m", [])) == 2]
+        across = [lib["width_m"][1] for lib in library if len(lib.get("width_m", [])) == 2]
         primitives = [p["primitives"] for p in plants if "primitives" in p]
         seconds = [p["build_s"] if p.get("build_s") is not None else p["grow_s"] for p in plants]
         lines.append(
             f"| {name} | {recipe.model}, {recipe.age_days:g} | {min(fruit)}-{max(fruit)} "
             f"(median {np.median(fruit):g}) [{seen.fruit_per_plant}] | "
             f"{_span(lengths, 1000, 0)} x {_span(widths, 1000, 0)} [{seen.fruit_size}] | "
-            f"{_span(heights)} [{seen.plant_height}] | {_span(crowns)} | "
+            f"{_span(heights)} [{seen.plant_height}] | {_span(along)} / {_span(across)} | "
             f"{_span(primitives, 1e-3, 0)}K | {np.median(seconds):.1f} |"
         )
     lines += ["", "Sources of the bracketed figures:", ""]
