@@ -59,7 +59,6 @@ def _measure(crop_name: str, scenario_name: str) -> dict[str, Any]:
     """Grow one scene and draw its first views (in a process of its own: its peak memory is its);
     a single plant's boxes are checked against Helios's Visualizer's too."""
     from davis_ag.generate.one_scene import SceneRequest, grow_scene
-    from davis_ag.scene.scene_size import scene_bytes
     from davis_ag.scene.specs import CROPS, scenario_spec
     from davis_ag.workflows.bench_timing import time_ours
 
@@ -84,7 +83,6 @@ def _measure(crop_name: str, scenario_name: str) -> dict[str, Any]:
         "first_view_s": round(first, 1),
         "peak_gb": round(peak / 1e9, 2),
         "bytes_per_primitive": round(peak / primitives),
-        "estimated_gb": round(scene_bytes(request.scenario, crop) / 1e9, 2),
     }
 
 
@@ -133,7 +131,11 @@ def merged(report: Path, fresh: dict[str, Any]) -> dict[str, Any]:
 
 
 def crops_table(result: dict[str, Any], load: tuple[float, float]) -> str:
-    """The Markdown table of :func:`crops_speed`'s result."""
+    """The Markdown table of :func:`crops_speed`'s result, each scene's peak memory beside what
+    :func:`davis_ag.scene.scene_size.scene_bytes` estimates for it today."""
+    from davis_ag.scene.scene_size import scene_bytes
+    from davis_ag.scene.specs import CROPS, scenario_spec
+
     lines = [
         f"{result['image_size'][0]}x{result['image_size'][1]}, scene 0 of dataset seed 0, the first "
         f"{result['views']} views on the generate path (the first untimed), each scene in a process of "
@@ -150,7 +152,7 @@ def crops_table(result: dict[str, Any], load: tuple[float, float]) -> str:
             lines.append(
                 f"| {crop} | {scenario} | {r['plants']} | {r['primitives']:,} | {r['fruit']} | {r['views_in_scene']} | "
                 f"{r['grow_s']:.0f} | {r['seconds_per_view']:.3f} | {r['over_strawberry']:.1f} | {r['peak_gb']:.1f} "
-                f"({r['estimated_gb']:.1f}) | "
+                f"({scene_bytes(scenario_spec(scenario, CROPS[crop]), CROPS[crop]) / 1e9:.1f}) | "
                 f"{r['bytes_per_primitive']:,} | "
                 + (
                     f"{r['boxes_compared']}, {r['max_corner_px']}, {r['boxed_by_one']} |"
