@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from davis_ag.errors import UserError
+from real_scenes import generate_config
 
 TINY_REAL = """\
 seed: 5
@@ -24,21 +24,7 @@ groups:
 @pytest.fixture(scope="session")
 def real_root(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The dataset root of the tiny real scene."""
-    from davis_ag.generate.run_config import load_dataset_config
-    from davis_ag.generate.run_progress import RunOptions
-    from davis_ag.generate.runner import run_dataset
-    from davis_ag.scene.plants import require_native_helios
-
-    try:
-        require_native_helios()
-    except UserError as error:
-        pytest.skip(str(error))
-    folder = tmp_path_factory.mktemp("real")
-    config = folder / "tiny.yaml"
-    config.write_text(TINY_REAL)
-    root = folder / "data"
-    run_dataset(load_dataset_config(config).requests(), root, RunOptions(workers=1, progress=False))
-    return root
+    return generate_config(tmp_path_factory.mktemp("real"), TINY_REAL)
 
 
 @pytest.fixture(scope="session")

@@ -8,7 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from davis_ag.errors import UserError
+from real_scenes import generate_config
+
 from davis_ag.scene.specs import CROPS
 
 pytestmark = pytest.mark.slow
@@ -26,21 +27,7 @@ groups:
 
 @pytest.fixture(scope="module")
 def row_root(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    from davis_ag.generate.run_config import load_dataset_config
-    from davis_ag.generate.run_progress import RunOptions
-    from davis_ag.generate.runner import run_dataset
-    from davis_ag.scene.plants import require_native_helios
-
-    try:
-        require_native_helios()
-    except UserError as error:
-        pytest.skip(str(error))
-    folder = tmp_path_factory.mktemp("row")
-    config = folder / "row.yaml"
-    config.write_text(ROW)
-    root = folder / "data"
-    run_dataset(load_dataset_config(config).requests(), root, RunOptions(workers=1, progress=False))
-    return root
+    return generate_config(tmp_path_factory.mktemp("row"), ROW)
 
 
 def test_the_row_validates_and_records_its_three_rows_of_plants(row_root: Path) -> None:
