@@ -40,3 +40,19 @@ def test_the_interval_keeps_logs_short(capsys: pytest.CaptureFixture[str]) -> No
         progress.event(("view", request.folder, done, 352))
     progress.close()
     assert capsys.readouterr().err == ""  # well within a minute: nothing yet
+
+
+def test_large_scenes_get_as_many_processes_as_memory_holds(monkeypatch: pytest.MonkeyPatch) -> None:
+    import os
+
+    from davis_ag.generate.one_scene import SceneRequest
+    from davis_ag.generate.run_progress import default_workers
+    from davis_ag.scene.specs import CROPS, scenario_spec
+
+    monkeypatch.setattr(os, "cpu_count", lambda: 16)
+    monkeypatch.setattr(os, "sysconf", lambda name: {"SC_PHYS_PAGES": 24 * 2**18, "SC_PAGE_SIZE": 4096}[name])
+    small = [SceneRequest(scenario_spec("sp", CROPS["strawberry"]), CROPS["strawberry"], 0, 0)]
+    row = CROPS["cherry-tomato"]
+    large = [SceneRequest(scenario_spec("row", row), row, 0, 0), *small]
+    assert default_workers(small) == 8  # 24 GiB of 3 GiB processes
+    assert default_workers(large) == 1  # one 18 GB row at a time

@@ -139,7 +139,7 @@ def run(args: argparse.Namespace) -> int:
     only = [item for value in args.only or [] for item in value.split(",") if item.strip()]
     requests = config.requests(only)
     options = RunOptions(
-        workers=args.workers or default_workers(),
+        workers=args.workers or default_workers(requests),
         executor=args.executor,
         address=args.address,
         cpus_per_scene=args.cpus_per_scene,

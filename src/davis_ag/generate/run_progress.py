@@ -20,6 +20,7 @@ from tqdm import tqdm
 
 from davis_ag.errors import MachineError, UserError
 from davis_ag.generate.one_scene import SceneRequest
+from davis_ag.scene.scene_size import MEMORY_SHARE, scene_bytes
 from davis_ag.scene.specs import CropSpec, ScenarioSpec
 from davis_ag.scene.view_grid import build_view_grid
 
@@ -29,18 +30,26 @@ WORKER_MEMORY = 3 * 2**30
 DEFAULT_MAX_RETRIES = 2
 
 
-def default_workers() -> int:
+def default_workers(requests: Sequence[SceneRequest] = ()) -> int:
     """Scene processes for this machine: one per core, as far as memory allows.
 
     Measured on 2 cores (docs/performance.md): two processes drawing with one Mesa thread each
     made 1.90 views/s, one process with two Mesa threads 1.61 (llvmpipe's threads leave part of
     each frame serial), and plant growth, single-threaded, only overlaps across processes.
+
+    Args:
+        requests: The scenes to make: where the largest needs more than :data:`WORKER_MEMORY`
+            (:func:`davis_ag.scene.scene_size.scene_bytes`; a cherry-tomato row peaks near 18 GB),
+            only as many processes as fit the share of memory one scene may take.
     """
     cores = os.cpu_count() or 1
     try:
         memory = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
     except (ValueError, OSError):
         return cores
+    largest = max((scene_bytes(r.scenario, r.crop) for r in requests), default=0)
+    if largest > WORKER_MEMORY:  # a large scene: its processes share what one scene may take
+        return max(1, min(cores, int(MEMORY_SHARE * memory) // largest))
     return max(1, min(cores, memory // WORKER_MEMORY))
 
 

@@ -151,7 +151,7 @@ LIBRARY_RECIPES: dict[str, LibraryRecipe] = {
         ),
         ("*",),
         (10, 250),
-        125_000,
+        135_000,
     ),
     # The wall fruits in its second season only (max age 730 days): full-size fruit from about day
     # 570; thinned to single fruit per bud (the library sets clusters of 5-6 interpenetrating apples).
@@ -172,7 +172,7 @@ LIBRARY_RECIPES: dict[str, LibraryRecipe] = {
         73_000,
         yaw_deg=90.0,
     ),
-    "almond": LibraryRecipe("almond", TREE_HARVEST_DAY, (), ("*",), (10, 250), 34_000),
+    "almond": LibraryRecipe("almond", TREE_HARVEST_DAY, (), ("*",), (10, 250), 36_000),
     # The library sets 10 olives per fruiting inflorescence; olives set 1-2 (Lavee et al. 1996).
     "olive": LibraryRecipe(
         "olive",
@@ -226,7 +226,7 @@ LIBRARY_RECIPES: dict[str, LibraryRecipe] = {
         ),
         (),
         (10, 250),
-        218_000,
+        260_000,
     ),
     "vsp-vine": LibraryRecipe(
         "grapevine_VSP",

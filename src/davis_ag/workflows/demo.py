@@ -58,7 +58,7 @@ def generate_scenes(
         UserError: for an unusable root, another run on it, finished scenes made with other
             settings, or scenes that failed (the finished ones are kept).
     """
-    workers = workers or max(1, min(default_workers(), len(requests)))
+    workers = workers or max(1, min(default_workers(requests), len(requests)))
     report = run_dataset(requests, root, RunOptions(workers=workers, progress=progress))
     return [
         {"scene": r.folder, "skipped": r.folder in report.skipped, **report.stats.get(r.folder, {})} for r in requests
