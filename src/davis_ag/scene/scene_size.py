@@ -5,7 +5,8 @@ their data), our renderer's vertex arrays and the labelling tables. Measured on 
 machine: a VSP vineyard row (12 vines, 3.82 million primitives) peaked at 5.8 GB grown and
 10.5 GB once drawn at 640x360, 2,760 bytes a primitive (:data:`BYTES_PER_PRIMITIVE`); an apple
 row (1.21 million) at 4.3 GB, which a process's own 0.8 GB (:data:`BASE_BYTES`: Python, numpy,
-Helios and the GL context) beside them explains (``davis-ag bench --only crops`` measures both).
+Helios and the GL context) beside them explains; a cherry-tomato row (24 plants, 6.2 million) at
+17.8 GB, 2,853 bytes a primitive (``davis-ag bench --only crops`` measures every crop's).
 """
 
 from __future__ import annotations
