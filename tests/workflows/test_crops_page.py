@@ -34,6 +34,8 @@ def result(best: float, oracle: float, a2c: float | None, starts: int) -> dict:
 def test_the_crops_run_covers_every_library_crop_alone_and_in_its_row() -> None:
     assert CROPS_RUN.pairs == tuple((s, c) for c in LIBRARY_CROPS for s in ("sp", "row"))
     assert (CROPS_RUN.scenes("sp"), CROPS_RUN.scenes("row"), CROPS_RUN.size) == (10, 4, (640, 360))
+    assert CROPS_RUN.scenes_in_words() == "10 SP and 4 row scenes of each of 10 crops"
+    assert CONFIGS["medium"].scenes_in_words() == "10 SP strawberry and 10 MP vine scenes"
     # state.json keeps each group's results apart (Table 4's runs keep theirs by scenario).
     assert CROPS_RUN.result_key("row", "olive") == "row-olive" and CONFIGS["small"].result_key("sp", "x") == "sp"
     # A resumed run reads its configuration back from state.json, pairs included.

@@ -58,6 +58,14 @@ class ReproduceConfig:
         """Environment steps each learner trains for on a scenario (``sp``; ``mp`` or ``row``)."""
         return self.sp_timesteps if scenario_name == "sp" else self.mp_timesteps
 
+    def scenes_in_words(self) -> str:
+        """What the run makes: ``10 SP strawberry and 10 MP vine scenes`` (Table 4's runs), or per
+        crop for the crops run."""
+        if self.page == "table4":
+            return f"{self.sp_scenes} SP strawberry and {self.mp_scenes} MP vine scenes"
+        crops = len({crop for _, crop in self.pairs})
+        return f"{self.sp_scenes} SP and {self.mp_scenes} row scenes of each of {crops} crops"
+
     def result_key(self, scenario_name: str, crop_name: str) -> str:
         """Where ``state.json`` keeps a group's results: by scenario for Table 4's two groups (as
         runs have always kept them), by group for the crops run."""

@@ -273,8 +273,8 @@ def format_status(out: Path) -> str:
     """The run's status as a Markdown table under one line naming the run."""
     config, stages = run_status(out)
     lines = [
-        f"`{config.name}` run in {out}: {config.sp_scenes} SP strawberry and {config.mp_scenes} MP vine "
-        f"scenes at {config.size[0]}x{config.size[1]}, learners {', '.join(a.upper() for a in config.learners)}",
+        f"`{config.name}` run in {out}: {config.scenes_in_words()} at {config.size[0]}x{config.size[1]}, "
+        f"learners {', '.join(a.upper() for a in config.learners)}",
         "",
         "| stage | done | what its files show | hours on the clock | about hours left |",
         "|---|---|---|---|---|",
