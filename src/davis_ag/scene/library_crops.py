@@ -121,6 +121,20 @@ def _constant(value: float) -> dict[str, Any]:
     return {"distribution": "constant", "parameters": [float(value)]}
 
 
+def _one_fruit_per_bud(shoots: tuple[str, ...], fruit_set: float) -> tuple[tuple[str, str, Any], ...]:
+    """Shoot changes that thin an apple's flower clusters to one fruit per bud, set with ``fruit_set``
+    (the library's spur clusters set several apples at one point, inside each other)."""
+    return tuple(
+        change
+        for shoot in shoots
+        for change in (
+            (shoot, "max_terminal_floral_buds", _constant(1)),
+            (shoot, "phytomer_parameters.internode.max_floral_buds_per_petiole", _constant(1)),
+            (shoot, "fruit_set_probability", _constant(fruit_set)),
+        )
+    )
+
+
 #: The harvest day of the nut and olive trees: the library builds them dormant, breaks dormancy
 #: at day 90 (almond) or 165, sets fruit 7-10 days later, grows them to full size in 20 more and
 #: makes the tree dormant (fruit dropped) at day 365 of each cycle; in the second season the fruit
@@ -140,15 +154,7 @@ LIBRARY_RECIPES: dict[str, LibraryRecipe] = {
     "apple": LibraryRecipe(
         "apple",
         1000.0,
-        tuple(
-            change
-            for shoot in ("proleptic", "spur")
-            for change in (
-                (shoot, "max_terminal_floral_buds", _constant(1)),
-                (shoot, "phytomer_parameters.internode.max_floral_buds_per_petiole", _constant(1)),
-                (shoot, "fruit_set_probability", _constant(0.4)),
-            )
-        ),
+        _one_fruit_per_bud(("proleptic", "spur"), 0.4),
         ("*",),
         (10, 250),
         135_000,
@@ -158,15 +164,7 @@ LIBRARY_RECIPES: dict[str, LibraryRecipe] = {
     "apple-wall": LibraryRecipe(
         "apple_fruitingwall",
         650.0,
-        tuple(
-            change
-            for shoot in ("lateral", "proleptic", "spur")
-            for change in (
-                (shoot, "max_terminal_floral_buds", _constant(1)),
-                (shoot, "phytomer_parameters.internode.max_floral_buds_per_petiole", _constant(1)),
-                (shoot, "fruit_set_probability", _constant(0.8)),
-            )
-        ),
+        _one_fruit_per_bud(("lateral", "proleptic", "spur"), 0.8),
         ("*",),
         (10, 250),
         73_000,
