@@ -30,7 +30,12 @@ def test_the_page_runs_as_written(
     monkeypatch.chdir(tmp_path)
     monkeypatch.syspath_prepend(str(tmp_path))
     page = blocks(PAGE.read_text())
-    assert [(lang, name) for lang, name, _ in page] == [("python", "my_policy.py"), ("bash", None), ("python", None)]
+    assert [(lang, name) for lang, name, _ in page] == [
+        ("python", "my_policy.py"),
+        ("bash", None),
+        ("python", None),
+        ("bash", None),
+    ]
     for language, name, body in page:
         if name:
             Path(name).write_text(body)
@@ -52,3 +57,7 @@ def test_the_page_runs_as_written(
         assert f"| {row} |" in board
     assert "eligible starts" in board and "3 sessions x 50 episodes" in board
     assert re.search(r"[+-]\d?\.\d{3} \[[+-]\d?\.\d{3}, [+-]\d?\.\d{3}\] over 150 episodes", printed)
+    # A leaderboard maintainer's check: both files replay sound on the dataset, and rank as before.
+    assert "heuristic.json: sound: 900 episodes of 6 policies replayed on the dataset" in printed
+    assert "ppo.json: sound: 900 episodes of 6 policies" in printed
+    assert Path("verified.md").read_text() == board

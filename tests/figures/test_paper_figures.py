@@ -231,7 +231,7 @@ def test_stats_table3_and_fruit(real_root: Path, tmp_path: Path, capsys: pytest.
         (["plot", "visibility", "ROOT", "--scene", "Single-Tomato/009", "--out", "X"], "no scene"),
         (["plot", "episode", "ROOT", "--start", "0001", "--actions", "fly", "--out", "X"], "unknown action"),
         (["plot", "oer", "ROOT", "--formats", "gif", "--out", "X"], "--formats"),
-        (["plot", "actions", "--results", "OLD", "--out", "X"], "rerun"),
+        (["plot", "actions", "--results", "OLD", "--out", "X"], "not davis-ag evaluation results"),
         (["stats", "NOWHERE"], "no such folder"),
         # Continuous results (actions are numbers), a file without policies, a loop of up moves:
         # a traceback twice and a figure that never finished.

@@ -198,3 +198,25 @@ def test_a_whole_run_times_every_stage_on_its_clock_and_a_rerun_adds_no_sitting(
     view.write_bytes(view.read_bytes()[: view.stat().st_size // 2])  # cut short since
     assert reproduce(config, out, page, SP_ONLY) == 1
     assert "validated before" not in capsys.readouterr().out
+
+
+def test_an_edited_evaluation_of_a_run_is_not_written_into_its_page(sp_root: Path, tmp_path: Path) -> None:
+    """A run reuses its evaluation's JSON at every sitting: one whose summary was edited is refused
+    in one line (and left where it is) rather than shown on the page."""
+    import json
+
+    from davis_ag.benchmark import evaluate
+    from davis_ag.errors import UserError
+    from davis_ag.workflows.reproduce import _reusable_results
+    from davis_ag.workflows.reproduce_configs import CONFIGS
+
+    config = CONFIGS["small"]
+    path = evaluate([], sp_root, "sp", sessions=config.sessions, episodes=4, seed=config.seed).write(
+        tmp_path / "r.json"
+    )
+    data = json.loads(path.read_text())
+    data["policies"]["Rand"]["oer_tau"]["mean"] = 0.999
+    path.write_text(json.dumps(data))
+    with pytest.raises(UserError, match=r"Rand's oer_tau.mean is 0.999 .* move it aside") as refused:
+        _reusable_results(path, [], "test", ["Single-Strawberry/001"], config)
+    assert "\n" not in str(refused.value) and json.loads(path.read_text()) == data

@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import os
 import traceback
-from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
@@ -33,8 +32,16 @@ import numpy as np
 
 from davis_ag.benchmark import exact
 from davis_ag.benchmark.agents import FixedActionAgent
+from davis_ag.benchmark.code_digest import code_digest
 from davis_ag.benchmark.paired import FEW_SCENES
 from davis_ag.benchmark.policies import prepare
+from davis_ag.benchmark.summaries import (
+    PAIRED_BASELINES,
+    action_counts,
+    mean_abs_action,
+    paired_gaps,
+    session_metrics,
+)
 from davis_ag.benchmark.results import (
     PROTOCOL_VERSION,
     EvaluationResults,
@@ -53,8 +60,6 @@ from davis_ag.provenance import code_version
 METRICS: dict[str, str] = {"oer_tau": "OER_tau", "reward": "Cum. Reward", "length": "Ep. Length"}
 #: The row of the best policy that always plays one action (see the module docstring).
 BEST_FIXED = exact.BEST_FIXED
-#: The baselines every policy is compared with episode by episode, where the evaluation has them.
-PAIRED_BASELINES: tuple[str, ...] = (BEST_FIXED, "Rand")
 
 
 def episode_seeds(seed: int, session: int, episodes: int) -> tuple[list[int], list[int]]:
@@ -159,23 +164,12 @@ def play_sessions(
         Per key the mean, std and per-session values over sessions and the standard error of the
         mean over all episodes (``sem``); and every episode's record with its ``session``.
     """
-    per_session: dict[str, list[float]] = {k: [] for k in keys}
     records = []
     for session in range(sessions):
         env_seeds, policy_seeds = episode_seeds(seed, session, episodes)
         runs = [run_episode(env, policy, r, a, prepared=True) for r, a in zip(env_seeds, policy_seeds)]
-        for key in per_session:
-            per_session[key].append(float(np.mean([run[key] for run in runs])))
         records.extend({"session": session, **run} for run in runs)
-    summary = {
-        key: {
-            "mean": float(np.mean(v)),
-            "std": float(np.std(v)),
-            "sem": float(np.std([r[key] for r in records]) / np.sqrt(len(records))),
-            "sessions": v,
-        }
-        for key, v in per_session.items()
-    }
+    summary: dict[str, Any] = session_metrics(records, keys, sessions)
     return summary, records
 
 
@@ -233,15 +227,14 @@ def evaluate_policies(
         summary, played = play_sessions(env, policy, keys, seed, sessions, episodes)
         records[policy.name] = played
         summary["source"] = getattr(policy, "source", None)
+        summary["digest"] = code_digest(policy)
         if grid:
-            chosen = np.bincount([a for r in played for a in r["actions"]], minlength=len(inner.action_names))
-            summary["action_counts"] = {n: int(c) for n, c in zip(inner.action_names, chosen)}
+            summary["action_counts"] = action_counts(played, inner.action_names)
             probs = exact.agent_probabilities(policy, inner)
             if probs is not None:
                 summary["exact"] = exact.expected_metrics(inner, probs)
         else:
-            moves = np.abs(np.array([a for r in played for a in r["actions"]], dtype=np.float64))
-            summary["mean_abs_action"] = dict(zip(protocol.actions, moves.mean(axis=0).round(4).tolist()))
+            summary["mean_abs_action"] = mean_abs_action(played, protocol.actions)
         if isinstance(getattr(policy, "play", None), str):
             summary["play"] = policy.play
         if isinstance(policy, FixedActionAgent):
@@ -250,7 +243,7 @@ def evaluate_policies(
             summary["episodes"] = played
         rows[policy.name] = summary
     for name, row in rows.items():
-        row["paired"] = paired_gaps(name, records, seed)
+        row["paired"] = {b: PairedGap.model_validate(g) for b, g in paired_gaps(name, records, seed).items()}
     return EvaluationResults(
         protocol=protocol,
         dataset=identify_dataset(protocol.dataset),
@@ -258,17 +251,6 @@ def evaluate_policies(
         policies={n: PolicyResult.model_validate(r) for n, r in rows.items()},
         fixed_actions=fixed,
     )
-
-
-def paired_gaps(name: str, records: dict[str, list[dict[str, Any]]], seed: int) -> dict[str, PairedGap]:
-    """The paired gap of policy ``name`` to each of :data:`PAIRED_BASELINES` that played too."""
-    from davis_ag.benchmark.paired import paired_gap
-
-    return {
-        baseline: PairedGap.model_validate(asdict(paired_gap(records[name], records[baseline], seed=seed)))
-        for baseline in PAIRED_BASELINES
-        if baseline in records and baseline != name
-    }
 
 
 def format_table(results: EvaluationResults | dict[str, Any]) -> str:

@@ -156,8 +156,9 @@ def _gap(
 def leaderboard(paths: list[str | os.PathLike[str]]) -> list[Row]:
     """The rows of the leaderboard of some results files, best OER_tau first.
 
-    A method in several files with the same numbers (a baseline evaluated again on the same
-    episodes) is one row; a name with different numbers gets its file's name beside it.
+    A method in several files with the same numbers and code (a baseline evaluated again on the
+    same episodes) is one row; a name with other code gets its code's digest beside it, one with
+    the same code and other numbers its file's name.
 
     Raises:
         UserError: for an unreadable file or results that cannot be ranked together.
@@ -170,12 +171,25 @@ def leaderboard(paths: list[str | os.PathLike[str]]) -> list[Row]:
     for path, results in files:
         for name, policy in results.policies.items():
             same = [r for r in rows if r.base == name]
-            if any(r.policy.oer_tau == policy.oer_tau and r.policy.reward == policy.reward for r in same):
+            if any(_same_row(r.policy, policy) for r in same):
                 continue
-            label = f"{name} ({path.name})" if same else name
+            label = name
+            if same:
+                other_code = policy.digest is not None and all(_code(r.policy) != policy.digest.sha256 for r in same)
+                label = f"{name} (code {policy.digest.short()})" if other_code else f"{name} ({path.name})"
             gaps = {b: _gap(results, policy, b, files) for b in PAIRED_BASELINES if b != name}
             rows.append(Row(label, name, path, results, policy, gaps))
     return sorted(rows, key=lambda r: -r.policy.oer_tau.mean)
+
+
+def _code(policy: PolicyResult) -> str | None:
+    return policy.digest.sha256 if policy.digest is not None else None
+
+
+def _same_row(a: PolicyResult, b: PolicyResult) -> bool:
+    """One method evaluated twice: the same numbers, and the same code where both record it."""
+    same_code = a.digest is None or b.digest is None or _code(a) == _code(b)
+    return a.oer_tau == b.oer_tau and a.reward == b.reward and same_code
 
 
 def _gap_cell(gap: PairedGap | None) -> str:
@@ -201,21 +215,24 @@ def format_leaderboard(rows: list[Row]) -> str:
         "| Rank | Method | OER_tau | Cum. reward | Ep. length | "
         + " | ".join(f"Gap to {b} [95 %]" for b in baselines)
         + (" | " if baselines else "")
-        + "File |",
-        "|---:|---|---:|---:|---:|" + "---:|" * len(baselines) + "---|",
+        + "Code | File |",
+        "|---:|---|---:|---:|---:|" + "---:|" * len(baselines) + "---|---|",
     ]
     for rank, row in enumerate(rows, 1):
         p = row.policy
         cells = [str(rank), row.name] + [
             f"{table_number(m.mean)} ±{table_number(m.std)}" for m in (p.oer_tau, p.reward, p.length)
         ]
-        cells += [_gap_cell(row.gaps.get(b)) for b in baselines] + [row.file.name]
+        code = f"`{p.digest.short()}`" if p.digest is not None else "-"
+        cells += [_gap_cell(row.gaps.get(b)) for b in baselines] + [code, row.file.name]
         lines.append("| " + " | ".join(cells) + " |")
     lines += [
         "",
         "Mean ± std over sessions. Gap: mean OER_tau minus the baseline's on the same episodes, with the "
         "95 % bootstrap interval over episodes (would it hold on other starts of these scenes?) and, after "
         f"`scenes`, over the test scenes resampled (would it hold on other scenes like these? coarse below "
-        f"{FEW_SCENES} scenes); `-`: the baseline itself, or a method that did not play the same episodes.",
+        f"{FEW_SCENES} scenes); `-`: the baseline itself, or a method that did not play the same episodes. "
+        "Code: the first digits of the SHA-256 of what played (the model's zip, the policy's source file; "
+        "`-`: results from before digests), recorded with davis-ag's version and commit.",
     ]
     return "\n".join(lines) + "\n"

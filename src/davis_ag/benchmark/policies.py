@@ -246,7 +246,10 @@ class ModelPolicy:
         """
         #: The scenes it was trained on, where its training record says (``davis-ag train``'s).
         self.trained_on: list[str] | None = None
+        #: The zip it was loaded from (None: a model given in memory); its digest names the code.
+        self.path: Path | None = None
         if isinstance(model, (str, os.PathLike)):
+            self.path = Path(os.fspath(model)).expanduser()
             from davis_ag.benchmark.training_record import recorded_train_scenes
 
             self.trained_on = recorded_train_scenes(model)

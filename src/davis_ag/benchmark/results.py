@@ -94,6 +94,23 @@ class Episode(_Model):
     refused: int | None = None
 
 
+class CodeDigest(_Model):
+    """The code a policy played with (:mod:`davis_ag.benchmark.code_digest`): a SHA-256 of it,
+    what was hashed, and the davis-ag that evaluated it."""
+
+    sha256: str = Field(pattern="^[0-9a-f]{64}$")
+    of: Literal["model", "parameters", "source", "name"] = Field(
+        description="the model's zip, a model's parameters in memory, the policy's source file, or its name"
+    )
+    file: str | None = Field(None, description="the name of the file hashed")
+    package: str = Field(description="davis-ag's version")
+    commit: str | None = Field(None, description="davis-ag's git commit (-dirty: with changes)")
+
+    def short(self) -> str:
+        """The first 8 hex digits, as a leaderboard shows them."""
+        return self.sha256[:8]
+
+
 class PolicyResult(_Model):
     """One policy's row: Table 4's metrics and what else the evaluation knows of it."""
 
@@ -109,6 +126,7 @@ class PolicyResult(_Model):
     mean_abs_action: dict[str, float] | None = None
     exact: dict[str, float] | None = Field(None, description="exact expectations of an image-blind policy")
     paired: dict[str, PairedGap] = Field(default_factory=dict, description="gap to each baseline by name")
+    digest: CodeDigest | None = Field(None, description="the code it played with (None: results from before)")
     episodes: list[Episode] | None = None
 
 
@@ -184,11 +202,14 @@ def as_results(results: EvaluationResults | dict[str, Any]) -> EvaluationResults
     return results if isinstance(results, EvaluationResults) else EvaluationResults.model_validate(results)
 
 
-def load_results(path: str | os.PathLike[str]) -> EvaluationResults:
-    """Read a results file.
+def load_results(path: str | os.PathLike[str], check: bool = True) -> EvaluationResults:
+    """Read a results file and, unless ``check`` is False, make every summary in it again from its
+    episodes (:func:`davis_ag.benchmark.summaries.check_summaries`): a reader ranks what the
+    episodes say, never a number typed into the file.
 
     Raises:
-        UserError: when the file is missing, not JSON, or not an evaluation's results.
+        UserError: when the file is missing, not JSON, not an evaluation's results, or holds a
+            summary its episodes do not give.
     """
     path = Path(path)
     try:
@@ -198,7 +219,7 @@ def load_results(path: str | os.PathLike[str]) -> EvaluationResults:
     except ValueError as error:
         raise UserError(f"{path}: not JSON ({error}); give a RESULTS.json davis-ag evaluate wrote") from None
     try:
-        return EvaluationResults.model_validate(data)
+        results = EvaluationResults.model_validate(data)
     except ValidationError as error:
         first = error.errors()[0]
         where = ".".join(str(p) for p in first["loc"])
@@ -206,6 +227,11 @@ def load_results(path: str | os.PathLike[str]) -> EvaluationResults:
             f"{path}: not davis-ag evaluation results ({where}: {first['msg']}); give a RESULTS.json "
             "davis-ag evaluate wrote"
         ) from None
+    if check:
+        from davis_ag.benchmark.summaries import check_summaries
+
+        check_summaries(results, str(path))
+    return results
 
 
 def scene_identity(scene_id: str, metadata: SceneFile | None) -> SceneIdentity:

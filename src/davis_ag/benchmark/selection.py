@@ -98,6 +98,9 @@ class KeepBestOnTrain(BaseCallback):
         self.env, self.final, self.every, self.save = env, final, every, save
         self.episodes, self.prune_at_once = episodes, prune_at_once
         self.scores: list[dict[str, Any]] = list(scores or [])
+        #: The entry of a new best whose snapshot could not be written (a full disk): the model in
+        #: memory, which the run stopped on, is that snapshot, and only it holds it.
+        self.unsaved: dict[str, Any] | None = None
         if self.best is not None and not snapshot_path(final, self.best["step"]).is_file():
             print(
                 f"note: the best snapshot so far ({self.best['step']} steps) is gone; earlier scores are dropped",
@@ -136,8 +139,9 @@ class KeepBestOnTrain(BaseCallback):
         if self.best is entry:
             try:
                 self.save(self.model, snapshot_path(self.final, step))
-            except BaseException:  # a full disk: the best stays the last one saved, whose file is there
+            except BaseException as error:  # a full disk: the best stays the last one saved, whose file is there
                 self.scores.remove(entry)
+                self.unsaved = entry if isinstance(error, OSError) else None
                 raise
         if self.prune_at_once:
             self.prune()

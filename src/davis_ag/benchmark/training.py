@@ -22,11 +22,7 @@ from typing import Any
 import torch
 from stable_baselines3.common.vec_env import DummyVecEnv
 
-from davis_ag.atomic_files import (
-    prove_writable_file,
-    write_json_atomic,
-    write_or_rescue,
-)
+from davis_ag.atomic_files import prove_writable_file, write_json_atomic
 from davis_ag.benchmark import TVMEnv
 from davis_ag.benchmark.algorithms import (
     ALGORITHMS,
@@ -41,6 +37,7 @@ from davis_ag.benchmark.progress import LearningCurve, TrainingProgress
 from davis_ag.benchmark.selection import KeepBestOnTrain, check_keep, publish_snapshot, snapshot_path
 from davis_ag.benchmark.splits import select_scenes
 from davis_ag.benchmark.training_record import model_path, training_record_path
+from davis_ag.benchmark.training_rescue import keep_what_it_trained, rescued_selection, what_survives
 from davis_ag.benchmark.tvm import as_dataset
 from davis_ag.errors import MachineError, UserError
 from davis_ag.formats.models import check_seed
@@ -188,7 +185,9 @@ def train_agent(
     Raises:
         UserError: for a bad dataset, scenario, split, algorithm or architecture, or a checkpoint
             that cannot be resumed without ``force``.
-        MachineError: when the machine fails the run (a full disk), naming what survives where.
+        MachineError: when the machine fails the run (a full disk), naming what survives where:
+            a model in memory that no file beside ``out_path`` holds is kept in a rescue folder
+            first, whatever ``keep`` says (:func:`keep_what_it_trained`).
     """
     import stable_baselines3
 
@@ -269,6 +268,7 @@ def train_agent(
         callbacks.append(
             CheckpointEvery(checkpoint_every, model_file, settings_file, settings, sittings, curve, selection)
         )
+    written = False  # the final model is in place (what may fail after it: the training record)
     try:
         if total_timesteps > done:
             model.learn(
@@ -280,25 +280,13 @@ def train_agent(
         curve.flush(int(model.num_timesteps))
         extra: dict[str, Any] = {}
         if selection is None:
-            saved = write_or_rescue(
-                final,
-                lambda path: save_model(model, path),
-                "the trained model",
-                # The last checkpoint survives a write that fails at both places (a full disk).
-                lambda: (
-                    f"the last checkpoint is kept in {model_file}: free the space and run the same "
-                    "command again to finish"
-                    if model_file.is_file()
-                    else "the trained model is lost; free space and run again"
-                ),
-            )
+            save_model(model, final)
         else:
             selection.score_now()  # the last snapshot competes too
             # A link, not a copy: it needs no space, so a full disk cannot lose the best snapshot;
             # and the snapshot keeps its name until the record and checkpoint are done, so a run
             # stopped in between resumes with every score and snapshot it had (it then trains
             # from its last checkpoint to the budget again, and the last score is redrawn).
-            saved = final
             publish_snapshot(snapshot_path(final, selection.best["step"]), final)
             extra["selection"] = selection.record()
             print(
@@ -306,47 +294,39 @@ def train_agent(
                 f"{selection.best['oer_tau']:.3f}, the best of {len(selection.scores)})",
                 flush=True,
             )
-        record = sittings.upto(int(model.num_timesteps))
-        seconds = sum(s["seconds"] for s in record)
-        write_json_atomic(
-            training_record_path(final),
-            {
-                **settings,
-                "timesteps": int(model.num_timesteps),
-                "sittings": record,
-                "seconds": round(seconds, 1),
-                "steps_per_second": round((int(model.num_timesteps) - record[0]["from_step"]) / max(seconds, 1e-9), 1),
-                "curve": curve.points,
-                **extra,
-            },
-        )
-    except OSError as error:  # a full disk at any point: say which finished snapshot survives, and where
-        raise MachineError(what_survives(error, final, selection, model_file)) from None
+        written = True
+        write_json_atomic(training_record_path(final), training_record(settings, model, sittings, curve, extra))
+    except OSError as error:  # a full disk, a folder it cannot write: keep what it trained, and say where
+        if written:
+            raise MachineError(what_survives(error, final, selection, model_file)) from None
+        record = training_record(settings, model, sittings, curve, rescued_selection(selection, model))
+        raise MachineError(
+            keep_what_it_trained(error, model, total_timesteps, final, selection, model_file, record)
+        ) from None
     model_file.unlink(missing_ok=True)
     settings_file.unlink(missing_ok=True)
     if selection is not None:
         selection.prune(keep_none=True)
-    return saved
+    return final
 
 
-def what_survives(error: OSError, final: Path, selection: KeepBestOnTrain | None, model_file: Path) -> str:
-    """The one line of a training run that a failure of the machine (a full disk) ended: what
-    failed, and which finished model survives where (the final model, the best snapshot so far,
-    or the last checkpoint), so nothing finished is lost or claimed where it is not."""
-    best = selection.best if selection is not None else None
-    if final.is_file() and (best is None or not snapshot_path(final, best["step"]).is_file()):
-        kept = f"the trained model is saved in {final} (its training record is not)"
-    elif best is not None and snapshot_path(final, best["step"]).is_file():
-        kept = (
-            f"the best snapshot so far ({best['step']} steps, train-split OER_tau {best['oer_tau']:.3f}) "
-            f"is kept in {snapshot_path(final, best['step'])}"
-        )
-    elif model_file.is_file():
-        kept = f"the last checkpoint is kept in {model_file}"
-    else:
-        kept = "no snapshot was finished yet"
-    reason = (f"{error.filename}: " if error.filename else "") + (error.strerror or str(error))
-    return f"training stopped: {reason}; {kept}: free the space and run the same command again to finish"
+def training_record(
+    settings: dict[str, Any], model: Any, sittings: Sittings, curve: LearningCurve, extra: dict[str, Any]
+) -> dict[str, Any]:
+    """The training record of a run's model (:func:`training_record_path`): its settings, steps,
+    sittings, speed and learning curve, with ``extra`` (the snapshot scores)."""
+    steps = int(model.num_timesteps)
+    record = sittings.upto(steps)
+    seconds = sum(s["seconds"] for s in record)
+    return {
+        **settings,
+        "timesteps": steps,
+        "sittings": record,
+        "seconds": round(seconds, 1),
+        "steps_per_second": round((steps - record[0]["from_step"]) / max(seconds, 1e-9), 1),
+        "curve": curve.points,
+        **extra,
+    }
 
 
 def check_device(device: str) -> None:

@@ -50,11 +50,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--only",
-        choices=("all", "continuous", "training", "crops"),
+        choices=("all", "continuous", "training", "crops", "verify"),
         default="all",
         help="continuous: only TVMContinuous-v0's steps/s (about a minute); training: only the "
         "learners' training steps/s (about 8 minutes); crops: only the plant-library crops' single "
-        "plants and rows (grow, s/view, memory; about half an hour)",
+        "plants and rows (grow, s/view, memory; about half an hour); verify: only how fast a results "
+        "file's summaries and episodes are checked (about a minute)",
     )
     parser.add_argument(
         "--device",
@@ -71,7 +72,7 @@ def _is_report(path: Path) -> bool:
         data = json.loads(path.read_text())
     except (OSError, ValueError):
         return False
-    return isinstance(data, dict) and bool({"machine", "continuous_env", "training", "crops"} & set(data))
+    return isinstance(data, dict) and bool({"machine", "continuous_env", "training", "crops", "verify"} & set(data))
 
 
 def run(args: argparse.Namespace) -> int:
@@ -101,9 +102,12 @@ def run(args: argparse.Namespace) -> int:
         raise UserError(f"--device {args.device} is for --only training: add --only training, or leave --device out")
     # A GPU machine's numbers go to the page's GPU sections, beside the 2-core machine's.
     gpu = args.doc is not None and is_gpu_machine()
-    sections = {"continuous": ["bench-continuous"], "training": ["bench-training"], "crops": ["bench-crops"]}.get(
-        args.only
-    )
+    sections = {
+        "continuous": ["bench-continuous"],
+        "training": ["bench-training"],
+        "crops": ["bench-crops"],
+        "verify": ["bench-verify"],
+    }.get(args.only)
     if sections is None:  # the whole bench: the view costs, and with strawberry the rates too
         sections = ["bench", "bench-continuous", "bench-training"] if "strawberry" in args.crops else ["bench"]
     markers = [doc_section(name, gpu) for name in sections]
@@ -114,7 +118,7 @@ def run(args: argparse.Namespace) -> int:
             f"--doc {args.doc}: not a Markdown page with <!-- {missing[0]}:start --> and <!-- {missing[0]}:end --> "
             "markers; give docs/performance.md or leave --doc out"
         )
-    if args.only in ("continuous", "training", "crops"):
+    if args.only in ("continuous", "training", "crops", "verify"):
         # A GPU machine's training table is always the CPU's beside the GPU's (where torch has CUDA).
         devices = ("cpu", args.device) if args.device != "cpu" else (training_devices() if gpu else ("cpu",))
         run_only(args.only, args.out, args.doc, devices, gpu, crops=args.crops)

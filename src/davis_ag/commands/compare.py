@@ -12,7 +12,10 @@ DESCRIPTION = (
     "Rank every method of the given results files (written by davis-ag evaluate) by OER_tau, with reward, "
     "episode length and the paired gaps to the Best fixed action and Rand (95 % bootstrap intervals "
     "where the episodes are the same), and say what the numbers rest on (scenes, eligible starts, "
-    "sessions x episodes). Refuses results of different datasets, splits or protocol versions."
+    "sessions x episodes). Every summary is made again from the file's episodes first, and a file "
+    "whose stored summary differs is refused; with --verify DATA every episode is also played again on "
+    "the dataset (davis-ag verify). Refuses results of different datasets, splits or protocol versions. "
+    "Each row shows the first digits of the SHA-256 of the code that played."
 )
 
 
@@ -29,6 +32,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="also write the leaderboard as a Markdown page",
     )
     parser.add_argument("--force", action="store_true", help="replace an existing --out")
+    parser.add_argument(
+        "--verify",
+        type=arguments.path,
+        default=None,
+        metavar="DATA",
+        help="replay every file's episodes on this dataset first (davis-ag verify) and rank only sound files",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -41,6 +51,12 @@ def run(args: argparse.Namespace) -> int:
 
     reads = [(path, "RESULTS") for path in args.results]
     with claim_output(args.out, force=args.force, reads=reads) if args.out else nullcontext():  # the output rule
+        if args.verify is not None:
+            from davis_ag.commands.verify import verify_results
+
+            if verify_results(args.results, args.verify) != 0:
+                print("not ranked: a file above is not sound on the dataset", flush=True)
+                return 1
         page = format_leaderboard(leaderboard(args.results))
         print(page, end="")
         if args.out:

@@ -1,4 +1,5 @@
-"""``davis-ag verify SCENE...``: make scenes again from their records and compare them byte for byte."""
+"""``davis-ag verify SCENE...``: make scenes again from their records and compare them byte for byte;
+``davis-ag verify RESULTS.json... --dataset DATA``: replay every episode of results files on their dataset."""
 
 from __future__ import annotations
 
@@ -8,14 +9,19 @@ from typing import Any
 
 from davis_ag.commands import arguments
 
-HELP = "make scenes again from their scene.json and compare every file byte for byte"
+HELP = "make scenes again and compare them byte for byte, or replay results files on their dataset"
 DESCRIPTION = (
     "Prove that a dataset of ours regenerates bit for bit: each SCENE folder is grown and drawn "
     "again from its scene.json (seed, grid, camera, renderer, plants, appearance) in a folder of "
     "its own, and every file is compared with the one on disk (scene.json as JSON, without the "
     "generator's versions and the timings). Nothing is written inside the dataset. Prints one line "
     "per scene; exits 0 when every scene came out identical, 1 otherwise. A scene takes as long as "
-    "generate takes to make it."
+    "generate takes to make it. "
+    "With --dataset, the arguments are results files of davis-ag evaluate instead: each is checked "
+    "against the dataset it names (its fingerprint, the environment its protocol builds), every "
+    "summary is made again from the episodes, and every episode of every policy is played again "
+    "(its seeded start, then its recorded actions); prints sound, or the first episode that "
+    "differs (policy, session, episode, field, stored and replayed value) and exits 1."
 )
 
 
@@ -25,8 +31,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "scenes",
         type=arguments.path,
         nargs="+",
-        metavar="SCENE",
-        help="scene folders of a dataset made by davis-ag generate (e.g. data/Single-Strawberry/000)",
+        metavar="SCENE|RESULTS.json",
+        help="scene folders of a dataset made by davis-ag generate (e.g. data/Single-Strawberry/000), "
+        "or with --dataset results files of davis-ag evaluate",
     )
     parser.add_argument(
         "--keep",
@@ -35,10 +42,32 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="DIR",
         help="keep the scenes made again in DIR, as a dataset (default: a temporary folder, removed after)",
     )
+    parser.add_argument(
+        "--dataset",
+        type=arguments.path,
+        default=None,
+        metavar="DATA",
+        help="replay the RESULTS.json files given on this dataset (the one they evaluated)",
+    )
+    parser.add_argument(
+        "--cache-dir",
+        type=arguments.path,
+        default=None,
+        metavar="DIR",
+        help="with --dataset: the observation cache folder, as evaluate took it (default: in the dataset)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
-    """Verify each scene in turn; 0 when all are identical, 1 otherwise."""
+    """Verify each scene (or results file) in turn; 0 when all are sound, 1 otherwise."""
+    from davis_ag.errors import UserError
+
+    if args.dataset is not None:
+        if args.keep is not None:
+            raise UserError("--keep is for scenes made again; with --dataset nothing is made: leave it out")
+        return verify_results(args.scenes, args.dataset, args.cache_dir)
+    if files := [p for p in args.scenes if p.suffix == ".json"]:
+        raise UserError(f"{files[0]}: to verify results, give the dataset they evaluated: --dataset DATA")
     from davis_ag.workflows.regenerate import verify_scene
 
     check_before_making(args.scenes, args.keep)
@@ -51,6 +80,33 @@ def run(args: argparse.Namespace) -> int:
     if len(verdicts) > 1:
         print(f"{same} of {len(verdicts)} scenes identical")
     return 0 if same == len(verdicts) else 1
+
+
+def verify_results(paths: list[Path], dataset: Path, cache_dir: Path | None = None) -> int:
+    """Replay each results file on ``dataset`` (:mod:`davis_ag.benchmark.replay`); 0 when all are sound.
+
+    Raises:
+        UserError: for a file that is not results, holds a summary its episodes do not give, or
+            cannot be replayed, or a dataset that is not one.
+    """
+    from davis_ag.benchmark.replay import replay_grid
+    from davis_ag.benchmark.results import load_results
+
+    reports = []
+    for path in paths:
+        results = load_results(path)  # every summary made again from the episodes first
+        if results.protocol.environment == "davis_ag/TVMContinuous-v0":
+            from davis_ag.live.replay import replay_continuous
+
+            report = replay_continuous(results, dataset, str(path))
+        else:
+            report = replay_grid(results, dataset, str(path), cache_dir)
+        print(report.text(), flush=True)
+        reports.append(report)
+    sound = sum(r.sound for r in reports)
+    if len(reports) > 1:
+        print(f"{sound} of {len(reports)} results files sound")
+    return 0 if sound == len(reports) else 1
 
 
 def check_before_making(scenes: list[Path], keep: Path | None) -> None:

@@ -68,6 +68,7 @@ def _results(path: Path) -> dict[str, Any]:
         UserError: for a file that is not evaluation results, holds no policy, or records the
             continuous environment's actions (numbers, not grid moves).
     """
+    from davis_ag.benchmark.results import load_results
     from davis_ag.figures.benchmark_plots import policy_names
 
     data = read_json(path, "evaluation results")
@@ -83,6 +84,7 @@ def _results(path: Path) -> dict[str, Any]:
             f"{path}: results of {environment}, whose actions are numbers, not grid moves; these "
             "figures draw TVM-v0 results (evaluate without --env continuous)"
         )
+    load_results(path)  # its summaries made again from its episodes: a figure draws what they say
     return data
 
 

@@ -309,11 +309,13 @@ def run_only(
     """One measurement alone (``--only continuous``: TVMContinuous-v0's rate, about a minute;
     ``--only training``: the learners' training rates, about 8 minutes, on each of ``devices``;
     ``--only crops``: the plant-library crops' SP and row scenes, :mod:`davis_ag.workflows.bench_crops`,
-    ``crops`` of them, the others' rows kept from an earlier report at ``out``):
+    ``crops`` of them, the others' rows kept from an earlier report at ``out``; ``--only verify``:
+    how fast a results file is checked, :mod:`davis_ag.workflows.bench_verify`, about a minute):
     JSON, the doc's section (its GPU section on a ``gpu_machine``) and the line another page shows
     of it."""
     from davis_ag.scene.library_crops import LIBRARY_CROPS
     from davis_ag.workflows.bench_crops import crops_speed, crops_table, merged, write_crops
+    from davis_ag.workflows.bench_verify import verify_speed, verify_table, write_verify
 
     measurements: dict[str, tuple[str, Any, Any, Any]] = {
         "continuous": ("continuous_env", continuous_env_speed, continuous_table, write_continuous),
@@ -324,6 +326,7 @@ def run_only(
             crops_table,
             write_crops,
         ),
+        "verify": ("verify", verify_speed, verify_table, write_verify),
     }
     key, measure, table_of, write = measurements[what]
     start = os.getloadavg()[0]

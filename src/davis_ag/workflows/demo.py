@@ -125,7 +125,9 @@ def run_baselines(
     policies = []
     if model:
         sampled = ModelPolicy(model)
-        policies = [sampled, ModelPolicy(sampled.model, deterministic=True, name="A2C (deterministic)")]
+        deterministic = ModelPolicy(sampled.model, deterministic=True, name="A2C (deterministic)")
+        deterministic.path = sampled.path  # one zip: one digest on both rows
+        policies = [sampled, deterministic]
     policies += [ModelPolicy(path) for path in learners]
     results = evaluate(
         policies,

@@ -219,13 +219,30 @@ def _reusable_results(
     One made before a learner of the run (PPO) existed is run anew with every row: the episodes
     are seeded, so the rows it had come out as they were, and the page is never half one
     evaluation, half another.
+
+    Raises:
+        UserError: for a file whose summaries its episodes do not give
+            (:func:`davis_ag.benchmark.summaries.check_summaries`): the page is never written
+            from an edited summary, and the file is left for its owner to look at.
     """
+    from davis_ag.benchmark.results import load_results
+    from davis_ag.benchmark.summaries import check_summaries
+    from davis_ag.errors import UserError
+
     try:
         results = json.loads(path.read_text())
     except (OSError, ValueError):
         return None
     if not isinstance(results, dict):
         return None
+    try:
+        typed = load_results(path, check=False)
+    except UserError:  # not results of this schema: evaluated anew, as a damaged file is
+        return None
+    try:
+        check_summaries(typed, str(path))
+    except UserError as error:
+        raise UserError(f"{error}; or move it aside to evaluate the run anew") from None
     protocol = results.get("protocol", {})
     try:
         fresh = all(path.stat().st_mtime >= model.stat().st_mtime for model in models)
