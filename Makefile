@@ -3,9 +3,10 @@ PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-$(shell cat pyproject.toml | cksum | cut -d' ' -f1)
+DOCS_STAMP := $(VENV)/.docs-installed-$(shell cat pyproject.toml | cksum | cut -d' ' -f1)
 OUT ?= out
 
-.PHONY: setup demo test lint bench reproduce clean
+.PHONY: setup demo test lint docs bench reproduce clean
 
 setup: $(STAMP)
 
@@ -33,6 +34,17 @@ lint: $(STAMP)
 	$(BIN)/ruff check src tests
 	$(BIN)/ruff format --check src tests
 	$(BIN)/mypy src
+
+# The documentation site from docs/ and the docstrings (mkdocs.yml) into out/site. --strict: a
+# broken link or anchor, or a docstring mkdocstrings cannot read, fails it. Its tools (the `docs`
+# extra) go on top of the setup above, which pins torch first, so `make test` does without them.
+$(DOCS_STAMP): $(STAMP)
+	$(BIN)/python -m pip install -q -e ".[docs]"
+	rm -f $(VENV)/.docs-installed-*
+	touch $@
+
+docs: $(DOCS_STAMP)
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict
 
 bench: $(STAMP)
 	$(BIN)/davis-ag bench --out $(OUT)/bench.json --doc docs/performance.md

@@ -1,7 +1,9 @@
 """The package's layout is its pipeline: stages import only earlier stages, with no import cycles.
 
 Every import counts, at module level or inside a function: a late import still ties a stage to a
-later one. The order is docs/architecture.md's "Layout" section, and each stage package's docstring opens
+later one. Only imports under ``if TYPE_CHECKING:``, which never run, are left out where what counts
+is what runs: the import cycles, and the root ``davis_ag/__init__.py``, which names the public API
+of every stage for type checkers and loads each name only when it is used. The order is docs/architecture.md's "Layout" section, and each stage package's docstring opens
 with its number there ("Stage 3, formats: ...").
 """
 
@@ -49,10 +51,26 @@ def module_name(path: Path) -> str:
 MODULES = {module_name(p): p for p in sorted(PACKAGE.rglob("*.py"))}
 
 
-def imports(path: Path, top_level_only: bool = False) -> list[tuple[str, int, list[str]]]:
-    """``(module, line, names)`` for every import in a file (absolute names, davis_ag or not)."""
+def type_checking_only(tree: ast.Module) -> set[int]:
+    """The ids of the nodes under ``if TYPE_CHECKING:`` (or ``typing.TYPE_CHECKING``): they never run."""
+    blocks = [
+        node
+        for node in ast.walk(tree)
+        if isinstance(node, ast.If) and ast.unparse(node.test) in ("TYPE_CHECKING", "typing.TYPE_CHECKING")
+    ]
+    return {id(inner) for block in blocks for statement in block.body for inner in ast.walk(statement)}
+
+
+def imports(path: Path, top_level_only: bool = False, runtime_only: bool = False) -> list[tuple[str, int, list[str]]]:
+    """``(module, line, names)`` for every import in a file (absolute names, davis_ag or not).
+
+    ``runtime_only`` leaves out the imports under ``if TYPE_CHECKING:``, which never run.
+    """
     tree = ast.parse(path.read_text(), str(path))
     nodes = tree.body if top_level_only else list(ast.walk(tree))
+    if runtime_only:
+        never_run = type_checking_only(tree)
+        nodes = [node for node in nodes if id(node) not in never_run]
     found = []
     for node in nodes:
         if isinstance(node, ast.Import):
@@ -70,8 +88,11 @@ def stage(module: str) -> str:
 
 
 def own_edges() -> dict[str, set[str]]:
-    """Module -> the davis_ag modules it imports."""
-    return {name: {m for m, _, _ in imports(path) if m in MODULES and m != name} for name, path in MODULES.items()}
+    """Module -> the davis_ag modules it imports when it runs (a cycle is a run-time failure)."""
+    return {
+        name: {m for m, _, _ in imports(path, runtime_only=True) if m in MODULES and m != name}
+        for name, path in MODULES.items()
+    }
 
 
 def test_every_module_belongs_to_a_stage_and_says_what_it_is() -> None:
@@ -85,9 +106,10 @@ def test_every_module_belongs_to_a_stage_and_says_what_it_is() -> None:
 
 @pytest.mark.parametrize("name", list(MODULES))
 def test_imports_point_to_earlier_stages(name: str) -> None:
-    # The root __init__ runs before any stage is imported, so it may use the helpers only.
+    # The root __init__ runs before any stage is imported, so it may use the helpers only; it names
+    # every stage's public API for type checkers (never run) and loads each name on first use.
     rank = RANK[stage(name)] if name != "davis_ag" else 0
-    for module, line, _ in imports(MODULES[name]):
+    for module, line, _ in imports(MODULES[name], runtime_only=name == "davis_ag"):
         if module.startswith("davis_ag.") and stage(module) in RANK:
             assert RANK[stage(module)] <= rank, f"{MODULES[name]}:{line}: {stage(name)} imports {module}, a later stage"
 

@@ -39,7 +39,7 @@ def source_revision() -> str | None:
 
 
 def code_version() -> str:
-    """``0.1.0`` or ``0.1.0+<commit>[-dirty]``: what to record beside an output."""
+    """``__version__``, or ``__version__+<commit>[-dirty]`` in a git checkout: what to record beside an output."""
     revision = source_revision()
     return f"{__version__}+{revision}" if revision else __version__
 

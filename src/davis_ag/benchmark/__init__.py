@@ -23,7 +23,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from davis_ag.benchmark.cache import OBS_SIZE, SceneCache, load_scene_cache
+from davis_ag.benchmark.cache import OBS_SIZE
 from davis_ag.benchmark.tvm import MAX_START_OER, TVMEnv
 from davis_ag.environments import CONTINUOUS_ID, TVM_ID, register_environments
 
@@ -58,23 +58,22 @@ def benchmark_steps(env: gym.Env, n: int = 20_000, seed: int = 0) -> float:
 
 
 def __getattr__(name: str) -> Any:
-    """``evaluate`` (:func:`davis_ag.benchmark.evaluation.evaluate`), loaded when first used: importing
-    davis_ag registers the environments through this package, and the evaluation (pydantic, the
-    code version of :mod:`davis_ag.provenance`) is not needed for that."""
+    """``evaluate`` (:func:`davis_ag.benchmark.evaluation.evaluate`), loaded when first used: making
+    an environment needs this package, not the evaluation (pydantic, the code version of
+    :mod:`davis_ag.provenance`)."""
     if name == "evaluate":
         return importlib.import_module("davis_ag.benchmark.evaluation").evaluate
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
+#: What users call; the helpers (``benchmark_steps`` here, the scene cache in
+#: :mod:`davis_ag.benchmark.cache`) are imported from their modules.
 __all__ = [
     "CONTINUOUS_ID",
     "ENV_IDS",
     "MAX_START_OER",
     "OBS_SIZE",
     "TVM_ID",
-    "SceneCache",
     "TVMEnv",
-    "benchmark_steps",
     "evaluate",
-    "load_scene_cache",
 ]

@@ -374,7 +374,9 @@ def evaluate(
         dataset: A dataset root (or an opened dataset, on the grid).
         scenario: ``sp`` or ``mp``.
         split: ``test`` (default), ``train`` or ``all``.
-        sessions, episodes, seed: The protocol (3 x 200, seed 0 as in the paper's setting).
+        sessions: Sessions of the protocol (3, as in the paper's setting).
+        episodes: Episodes per session (200, as in the paper's setting).
+        seed: The protocol's seed (0, as in the paper's setting).
         env: ``grid`` (TVM-v0) or ``continuous`` (TVMContinuous-v0).
         crop: Keep one crop of the scenario.
         baselines: True: the environment's baselines (grid: LRD, UDD, Rand, Oracle and the Best

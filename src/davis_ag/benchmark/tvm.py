@@ -357,7 +357,7 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
         """The current target's dynamics, for exact planners such as the Oracle agent.
 
         Returns:
-            What :meth:`target_move_table` returns for the current episode's scene and target.
+            The tables :meth:`target_move_table` returns for the current episode's scene and target.
         """
         return self.target_move_table(self._scene, self._fruit)
 
@@ -370,9 +370,9 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
 
         Returns:
             ``next_view``: ``(n_views, n_moves)`` int32, the view each move (actions
-            ``0..done_action-1``) leads to from each view, with refused moves staying put;
-            and ``oer``: ``(n_views,)`` float32, the target's OER per view, NaN where it has
-            no box (such views are never entered).
+                ``0..done_action-1``) leads to from each view, with refused moves staying put;
+                and ``oer``: ``(n_views,)`` float32, the target's OER per view, NaN where it has
+                no box (such views are never entered).
         """
         cache = self.caches[scene]
         nxt = cache.pointers[:, self._columns]

@@ -191,8 +191,8 @@ class View:
 
         Returns:
             ``H x W`` fruit id per pixel, or ``None`` without a mask file: uint8 with 255 for none,
-            or uint16 with 65535 for none in a scene of more than 255 fruit
-            (:mod:`davis_ag.formats.masks`; ``fruit_pixels(mask)`` is where a fruit is seen).
+                or uint16 with 65535 for none in a scene of more than 255 fruit
+                (:mod:`davis_ag.formats.masks`; ``fruit_pixels(mask)`` is where a fruit is seen).
 
         Raises:
             UserError: when the file exists but cannot be read.
@@ -413,7 +413,7 @@ def open_dataset(path: str | Path) -> Dataset:
         path: The folder.
 
     Returns:
-        The :class:`Dataset`; nothing but folder names is read yet.
+        The opened dataset (:class:`Dataset`); nothing but folder names is read yet.
 
     Raises:
         UserError: when the path does not exist or holds no DAVIS-Ag scene.

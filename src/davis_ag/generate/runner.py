@@ -86,7 +86,7 @@ def run_dataset(requests: Sequence[SceneRequest], root: Path, options: RunOption
         options: Workers and executor (default: :class:`RunOptions`).
 
     Returns:
-        The :class:`RunReport`.
+        The run's report (:class:`RunReport`).
 
     Raises:
         UserError: for an unusable folder, another run holding it, settings that differ from the

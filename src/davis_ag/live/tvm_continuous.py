@@ -379,8 +379,8 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         """Whether the camera may go from the current pose to ``view``, and the labels there.
 
         Returns:
-            ("", labels) when allowed, else (reason, labels or None): ``bounds``, ``collision``
-            or ``target lost``.
+            The pair ``("", labels)`` when allowed, else ``(reason, labels or None)``, the reason
+                ``bounds``, ``collision`` or ``target lost``.
         """
         reason = self.blocked(np.asarray(self._view.position), np.asarray(view.position))
         if reason:

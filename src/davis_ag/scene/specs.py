@@ -317,7 +317,7 @@ def crop_spec(name: str) -> CropSpec:
             the library models' own names, e.g. ``apple_fruitingwall``, for theirs).
 
     Returns:
-        Its :class:`CropSpec`.
+        The crop's spec (:class:`CropSpec`).
 
     Raises:
         UserError: for any other name.
@@ -338,7 +338,7 @@ def scenario_spec(name: str, crop: CropSpec | None = None) -> ScenarioSpec:
             III-B's nominal 3 x 3 m / 7 x 3 m (the row's: MP's).
 
     Returns:
-        Its :class:`ScenarioSpec`.
+        The scenario's spec (:class:`ScenarioSpec`).
 
     Raises:
         UserError: for any other name, or ``row`` for a crop without a row.

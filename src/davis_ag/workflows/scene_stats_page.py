@@ -184,8 +184,8 @@ def recipes_table(docs: Path) -> list[str]:
         "Canopy Generator plants take Table 1's parameters instead). "
         f"Scenes {', '.join(str(i) for i in data['scenes'])} of dataset seed 0, grown under each recipe and "
         f"drawn at {data['size'][0]}x{data['size'][1]} on the grid every {data['step']:g} m, at both "
-        f"strawberry altitude sets (measured once by a script since removed, see CHANGELOG.md; "
-        f'{data["machine"]}). "hidden by fruit": '
+        "strawberry altitude sets (a one-off measurement: `git show f39bb12:tools/strawberry_recipes.py` is "
+        f'the script at the commit that wrote its numbers; {data["machine"]}). "hidden by fruit": '
         "of the box pixels that are not the target in boxes with OER < 0.4, the share covered by other fruit.",
         "",
         "| recipe | altitudes | visible per view: min / median / max | views < 5 | views >= 16 | "
