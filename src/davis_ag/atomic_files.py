@@ -236,7 +236,7 @@ def rescue_folder() -> Path:
 
 
 def write_or_rescue(
-    path: str | os.PathLike[str], write: Callable[[Path], None], what: str, survivor: Callable[[], str] | None = None
+    path: str | os.PathLike[str], write: Callable[[Path], object], what: str, survivor: Callable[[], str] | None = None
 ) -> Path:
     """Write a result that took long to make; when its path fails, keep it elsewhere and say so.
 

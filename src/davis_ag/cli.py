@@ -8,7 +8,7 @@ import os
 import re
 import signal
 import sys
-from typing import Any
+from typing import Any, NoReturn
 
 from davis_ag.errors import MachineError, Stopped, UserError, stop
 from davis_ag.provenance import code_version
@@ -55,7 +55,7 @@ class OneLineParser(argparse.ArgumentParser):
     Sub-command parsers are made of the same class (argparse's default).
     """
 
-    def error(self, message: str):  # type: ignore[override]
+    def error(self, message: str) -> NoReturn:
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 

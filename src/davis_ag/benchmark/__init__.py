@@ -47,7 +47,9 @@ def benchmark_steps(env: gym.Env, n: int = 20_000, seed: int = 0) -> float:
     Returns:
         Steps per second.
     """
-    actions = np.random.default_rng(seed).integers(env.action_space.n, size=n)
+    space = env.action_space
+    assert isinstance(space, gym.spaces.Discrete)  # the grid's moves
+    actions = np.random.default_rng(seed).integers(space.n, size=n)
     env.reset(seed=seed)
     start = time.perf_counter()
     for a in actions:

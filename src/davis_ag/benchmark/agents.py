@@ -10,12 +10,13 @@ looks at the image.
 
 from __future__ import annotations
 
-from typing import Any
+from functools import partial
+from typing import Any, Callable
 
 import gymnasium as gym
 import numpy as np
 
-from davis_ag.benchmark.policies import SeededPolicy, baselines_by_name, unwrapped
+from davis_ag.benchmark.policies import Policy, SeededPolicy, baselines_by_name, unwrapped
 from davis_ag.benchmark.tvm import TVMEnv
 from davis_ag.environments import TVM_ID
 from davis_ag.benchmark.exact import action_probabilities
@@ -190,14 +191,14 @@ class OracleAgent:
 
 #: Baseline names :func:`build_agents` accepts (trained models come from
 #: :func:`davis_ag.benchmark.policies.policy_from_spec`), and what makes each.
-BASELINES: dict[str, Any] = {
-    **{name: (lambda name=name: heuristic(name)) for name in HEURISTIC_ACTIONS},
+BASELINES: dict[str, Callable[[], Policy]] = {
+    **{name: partial(heuristic, name) for name in HEURISTIC_ACTIONS},
     "Oracle": OracleAgent,
 }
 AGENT_NAMES: tuple[str, ...] = tuple(BASELINES)
 
 
-def build_agents(names: list[str]) -> list[Any]:
+def build_agents(names: list[str]) -> list[Policy]:
     """Baselines by name, in the order given (case-insensitive; see :data:`AGENT_NAMES`).
 
     Raises:

@@ -29,7 +29,7 @@ import shutil
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from PIL import Image
@@ -39,6 +39,9 @@ from davis_ag.errors import UserError
 from davis_ag.formats.layout import ANNOTATIONS, CACHE_FOLDER, IMAGES
 from davis_ag.formats.masks import no_fruit_value
 from davis_ag.scene.specs import ALL_ACTIONS
+
+if TYPE_CHECKING:  # the reader's types only: at run time the cache module stays light
+    from davis_ag.data.reader import Scene, View
 
 #: Side of the square observation image (section V-C: 224x224).
 OBS_SIZE = 224
@@ -107,7 +110,7 @@ _TABLES = (
 )
 
 
-def scene_fingerprint(scene: Any, root: Path) -> str:
+def scene_fingerprint(scene: Scene, root: Path) -> str:
     """Hash what the cache is derived from: the scene's annotations.json, the name, size and
     modification time of every file in its ``images/`` folder (a view replaced or cut short after
     the cache was built makes it stale, so the rebuild reads, and reports, the damaged file), and
@@ -136,7 +139,7 @@ def scene_fingerprint(scene: Any, root: Path) -> str:
     return digest.hexdigest()
 
 
-def annotations_path(scene: Any, root: Path) -> Path:
+def annotations_path(scene: Scene, root: Path) -> Path:
     """The scene's annotations.json: the reader's ``path`` if it has one, else root/id."""
     path = getattr(scene, "annotations_path", None)
     return Path(path) if path is not None else Path(root) / scene.id / ANNOTATIONS
@@ -164,7 +167,7 @@ def scaled_box(xmin: int, ymin: int, width: int, height: int, image_size: tuple[
     return clip(x0), clip(y0), max(clip(x1), clip(x0)), max(clip(y1), clip(y0))
 
 
-def _resized_image(view: Any) -> tuple[np.ndarray, tuple[int, int]]:
+def _resized_image(view: View) -> tuple[np.ndarray, tuple[int, int]]:
     """Decode a view and downsize it to 224x224 (aspect not kept, as in the paper's input).
 
     The JPEG is decoded in draft mode (DCT scaling to the smallest size still >= 224 on both
@@ -174,11 +177,10 @@ def _resized_image(view: Any) -> tuple[np.ndarray, tuple[int, int]]:
     Returns:
         The 224x224x3 uint8 image and the original ``(width, height)``.
     """
-    path = getattr(view, "image_path", None)
-    if path is not None:  # never decode a link out of the dataset, even on the fast path
-        check_inside(Path(path), getattr(getattr(view, "scene", None), "root", None))
+    path = view.image_path
+    check_inside(path, view.scene.root)  # never decode a link out of the dataset, even on the fast path
     try:
-        with Image.open(path) as pil:  # type: ignore[arg-type]
+        with Image.open(path) as pil:
             size = pil.size
             pil.draft("RGB", (OBS_SIZE, OBS_SIZE))
             small = pil.convert("RGB").resize((OBS_SIZE, OBS_SIZE), Image.Resampling.BILINEAR)
@@ -191,7 +193,7 @@ def _resized_image(view: Any) -> tuple[np.ndarray, tuple[int, int]]:
     return np.asarray(small, dtype=np.uint8), size
 
 
-def _build(scene: Any, folder: Path, fingerprint: str) -> None:
+def _build(scene: Scene, folder: Path, fingerprint: str) -> None:
     """Decode every view of ``scene`` once and write the cache files into ``folder``."""
     # Local import: the reader may import heavy modules; the cache module stays light.
     from davis_ag.data.reader import exposure_rate
@@ -272,7 +274,9 @@ def _build(scene: Any, folder: Path, fingerprint: str) -> None:
         "box_oer": np.array([r[3] for r in rows], dtype=np.float32),
         "box_pixels": np.array([r[4] for r in rows], dtype=np.int32),
     }
-    np.savez(folder / "tables.npz", **tables)
+    # Numbers only, as _load reads them (allow_pickle named: type checkers then match **tables
+    # against the arrays alone, not against this bool too).
+    np.savez(folder / "tables.npz", allow_pickle=False, **tables)
     meta = {
         "version": CACHE_VERSION,
         "fingerprint": fingerprint,
@@ -339,7 +343,7 @@ def _consistent(cache: SceneCache) -> bool:
     )
 
 
-def cache_folder(scene: Any, root: Path, cache_dir: str | os.PathLike[str] | None) -> Path:
+def cache_folder(scene: Scene, root: Path, cache_dir: str | os.PathLike[str] | None) -> Path:
     """Where a scene's cache lives: ``<cache_dir or root/.davis_ag_cache>/<scene id>``."""
     base = Path(cache_dir) if cache_dir is not None else Path(root) / CACHE_FOLDER
     return base / scene.id
@@ -363,7 +367,7 @@ def _replaceable(folder: Path) -> bool:
     return all(entry.name in _CACHE_FILES and not entry.is_symlink() for entry in entries)
 
 
-def load_scene_cache(scene: Any, root: Path, cache_dir: str | os.PathLike[str] | None = None) -> SceneCache:
+def load_scene_cache(scene: Scene, root: Path, cache_dir: str | os.PathLike[str] | None = None) -> SceneCache:
     """Open a scene's cache, building (or rebuilding a stale one) first.
 
     Args:

@@ -14,9 +14,12 @@ from __future__ import annotations
 import hashlib
 import inspect
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any, Literal
 
 from davis_ag.benchmark.results import CodeDigest
+
+if TYPE_CHECKING:
+    from davis_ag.benchmark.policies import Policy
 
 #: Characters of the digest a leaderboard shows (32 bits: a chance collision needs ~65,000 rows).
 SHORT = 8
@@ -43,7 +46,7 @@ def _parameters_sha256(model: Any) -> str:
     return digest.hexdigest()
 
 
-def _source_file(policy: Any) -> Path | None:
+def _source_file(policy: Policy) -> Path | None:
     """The file of the code that acts: a wrapped function's, else the policy's class's."""
     thing = getattr(policy, "function", None) or type(policy)
     thing = thing if inspect.isfunction(thing) or inspect.isclass(thing) else type(thing)
@@ -54,7 +57,7 @@ def _source_file(policy: Any) -> Path | None:
     return Path(found) if found and Path(found).is_file() else None
 
 
-def code_digest(policy: Any) -> CodeDigest:
+def code_digest(policy: Policy) -> CodeDigest:
     """The digest of the code a policy plays with (see the module docstring).
 
     Args:
@@ -70,6 +73,8 @@ def code_digest(policy: Any) -> CodeDigest:
 
     path: Path | None = getattr(policy, "path", None)
     model = getattr(policy, "model", None)
+    of: Literal["model", "parameters", "source", "name"]
+    name: str | None
     if path is not None and path.is_file():
         sha, of, name = file_sha256(path), "model", path.name
     elif model is not None and hasattr(model, "policy"):

@@ -23,10 +23,12 @@ name, which the environment's ``action_for`` turns into its action.
 
 from __future__ import annotations
 
+import importlib
 import os
 import traceback
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any, Callable, cast
 
 import numpy as np
 
@@ -34,7 +36,7 @@ from davis_ag.benchmark import exact
 from davis_ag.benchmark.agents import FixedActionAgent
 from davis_ag.benchmark.code_digest import code_digest
 from davis_ag.benchmark.paired import FEW_SCENES
-from davis_ag.benchmark.policies import prepare
+from davis_ag.benchmark.policies import Policy, prepare
 from davis_ag.benchmark.summaries import (
     PAIRED_BASELINES,
     action_counts,
@@ -55,6 +57,9 @@ from davis_ag.benchmark.results import (
 )
 from davis_ag.errors import UserError
 from davis_ag.provenance import code_version
+
+if TYPE_CHECKING:
+    from davis_ag.data.reader import Dataset
 
 #: Table 4's metrics: key in the results, row label.
 METRICS: dict[str, str] = {"oer_tau": "OER_tau", "reward": "Cum. Reward", "length": "Ep. Length"}
@@ -85,7 +90,7 @@ def _action(env: Any, action: Any) -> Any:
     return action
 
 
-def _act(policy: Any, observation: Any, info: dict[str, Any]) -> Any:
+def _act(policy: Policy, observation: Any, info: dict[str, Any]) -> Any:
     """The policy's answer; a policy that fails is one line naming where (its own code's last frame)."""
     try:
         return policy.act(observation, info)
@@ -100,7 +105,7 @@ def _act(policy: Any, observation: Any, info: dict[str, Any]) -> Any:
 
 
 def run_episode(
-    env: Any, policy: Any, reset_seed: int, policy_seed: int | None = None, prepared: bool = False
+    env: Any, policy: Policy, reset_seed: int, policy_seed: int | None = None, prepared: bool = False
 ) -> dict[str, Any]:
     """Play one episode.
 
@@ -155,7 +160,7 @@ def run_episode(
 
 
 def play_sessions(
-    env: Any, policy: Any, keys: tuple[str, ...], seed: int, sessions: int, episodes: int
+    env: Any, policy: Policy, keys: tuple[str, ...], seed: int, sessions: int, episodes: int
 ) -> tuple[dict[str, Any], list[dict[str, Any]]]:
     """Play ``sessions`` x ``episodes`` seeded episodes (the same for every policy) and summarise;
     the policy was prepared for ``env`` once before (the Policy protocol: not once per episode).
@@ -164,7 +169,7 @@ def play_sessions(
         Per key the mean, std and per-session values over sessions and the standard error of the
         mean over all episodes (``sem``); and every episode's record with its ``session``.
     """
-    records = []
+    records: list[dict[str, Any]] = []
     for session in range(sessions):
         env_seeds, policy_seeds = episode_seeds(seed, session, episodes)
         runs = [run_episode(env, policy, r, a, prepared=True) for r, a in zip(env_seeds, policy_seeds)]
@@ -175,7 +180,7 @@ def play_sessions(
 
 def evaluate_policies(
     env: Any,
-    policies: list[Any],
+    policies: Sequence[Policy],
     episodes: int = 200,
     sessions: int = 3,
     seed: int = 0,
@@ -235,8 +240,8 @@ def evaluate_policies(
                 summary["exact"] = exact.expected_metrics(inner, probs)
         else:
             summary["mean_abs_action"] = mean_abs_action(played, protocol.actions)
-        if isinstance(getattr(policy, "play", None), str):
-            summary["play"] = policy.play
+        if isinstance(play := getattr(policy, "play", None), str):
+            summary["play"] = play
         if isinstance(policy, FixedActionAgent):
             summary["action"] = policy.action
         if keep_episodes:
@@ -281,7 +286,7 @@ def format_table(results: EvaluationResults | dict[str, Any]) -> str:
                 [
                     "",
                     f"{title} exact",
-                    *(table_number(policies[n].exact[key]) if policies[n].exact else "-" for n in names),
+                    *(table_number(expected[key]) if (expected := policies[n].exact) else "-" for n in names),
                 ]
             )
     baselines = [b for b in PAIRED_BASELINES if b in policies]
@@ -350,8 +355,8 @@ def write_json(results: EvaluationResults | dict[str, Any], path: str | os.PathL
 
 
 def evaluate(
-    policies: list[Any],
-    dataset: Any,
+    policies: Sequence[Policy | Callable[..., Any] | str | os.PathLike[str]],
+    dataset: Dataset | str | os.PathLike[str],
     scenario: str = "sp",
     split: str = "test",
     sessions: int = 3,
@@ -405,7 +410,9 @@ def evaluate(
     ]
     names, builder = ENVIRONMENTS[env]
     if baselines:
-        build = gym.envs.registration.load_env_creator(builder)
+        # By name, as Gymnasium loads an entry point: the continuous baselines are a later stage's.
+        module, attr = builder.split(":")
+        build = cast("Callable[[list[str]], list[Policy]]", getattr(importlib.import_module(module), attr))
         chosen += build(list(names if baselines is True else baselines))
     kwargs: dict[str, Any] = {"dataset": dataset, "scenario": scenario, "split": split, "crop": crop}
     if env == "grid":

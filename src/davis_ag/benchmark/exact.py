@@ -14,12 +14,17 @@ expectation over the split's episodes, which a sampled evaluation estimates.
 
 from __future__ import annotations
 
-from typing import Any
+import os
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from davis_ag.benchmark.tvm import TVMEnv
 from davis_ag.errors import UserError
+
+if TYPE_CHECKING:
+    from davis_ag.benchmark.policies import Policy
+    from davis_ag.data.reader import Dataset
 
 #: The metrics computed exactly, as named in the evaluation's results.
 EXACT_METRICS = ("oer_tau", "reward", "length")
@@ -116,7 +121,9 @@ def fixed_action_expectations(env: TVMEnv) -> dict[str, dict[str, float]]:
     }
 
 
-def split_fixed_actions(dataset: Any, scenario: str, split: str, crop: str | None) -> dict[str, Any]:
+def split_fixed_actions(
+    dataset: Dataset | str | os.PathLike[str], scenario: str, split: str, crop: str | None
+) -> dict[str, Any]:
     """Every fixed action's exact expectations on one split of a dataset, and its start count.
 
     The yardstick on the split an A2C snapshot is chosen on (train): a snapshot that scores no
@@ -143,7 +150,7 @@ def best_fixed_action(expectations: dict[str, dict[str, float]]) -> str:
     return max(expectations, key=lambda name: expectations[name]["oer_tau"])
 
 
-def agent_probabilities(agent: Any, env: TVMEnv) -> np.ndarray | None:
+def agent_probabilities(agent: Policy, env: TVMEnv) -> np.ndarray | None:
     """The fixed action distribution of an agent that ignores the image, else ``None``.
 
     Agents say so with an ``action_probabilities(env)`` method (heuristics, fixed actions).

@@ -174,9 +174,11 @@ def leaderboard(paths: list[str | os.PathLike[str]]) -> list[Row]:
             if any(_same_row(r.policy, policy) for r in same):
                 continue
             label = name
-            if same:
-                other_code = policy.digest is not None and all(_code(r.policy) != policy.digest.sha256 for r in same)
-                label = f"{name} (code {policy.digest.short()})" if other_code else f"{name} ({path.name})"
+            digest = policy.digest
+            if same and digest is not None and all(_code(r.policy) != digest.sha256 for r in same):
+                label = f"{name} (code {digest.short()})"
+            elif same:
+                label = f"{name} ({path.name})"
             gaps = {b: _gap(results, policy, b, files) for b in PAIRED_BASELINES if b != name}
             rows.append(Row(label, name, path, results, policy, gaps))
     return sorted(rows, key=lambda r: -r.policy.oer_tau.mean)
@@ -203,6 +205,7 @@ def format_leaderboard(rows: list[Row]) -> str:
     """The leaderboard as a Markdown page: what the numbers rest on, then the ranked table."""
     protocol = rows[0].results.protocol
     dataset = rows[0].results.dataset
+    assert dataset is not None  # results that do not record their dataset are refused before ranking
     sampling = sorted({split_text(r.results.protocol) for r in rows})
     baselines = [b for b in PAIRED_BASELINES if any(r.gaps.get(b) for r in rows)]
     lines = [

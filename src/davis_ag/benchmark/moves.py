@@ -8,14 +8,18 @@ scenario, this share says how much room the plants leave a policy to act in.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from davis_ag.benchmark.cache import SceneCache
 from davis_ag.benchmark.tvm import MAX_START_OER, TVMEnv
 from davis_ag.scene.specs import ALL_ACTIONS, scenario_spec
+
+if TYPE_CHECKING:
+    from davis_ag.data.reader import Scene
 
 
 @dataclass(frozen=True)
@@ -64,7 +68,7 @@ def refused_moves(
     return RefusedMoves(len(rows), int(nxt.size), no_view, target_lost)
 
 
-def refused_moves_of_scenes(scenes: list[Any], caches: list[SceneCache], scenario: str) -> RefusedMoves:
+def refused_moves_of_scenes(scenes: Sequence[Scene], caches: list[SceneCache], scenario: str) -> RefusedMoves:
     """:func:`refused_moves` summed over scenes of one scenario (the environment's own threshold)."""
     actions = tuple(scenario_spec(scenario).actions)
     parts = [refused_moves(cache, actions, TVMEnv._min_pixels(scene, cache)) for scene, cache in zip(scenes, caches)]

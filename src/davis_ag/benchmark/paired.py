@@ -182,7 +182,8 @@ def a2c_against_best_fixed(results: dict[str, Any], learner: str = "A2C") -> dic
         return None
     # None kept, or one written before the interval over scenes: the episodes give it again (the
     # same seed, so the interval over episodes comes out as it was).
-    return asdict(paired_gap(*records, seed=int(results.get("protocol", {}).get("seed", 0))))
+    first, second = records
+    return asdict(paired_gap(first, second, seed=int(results.get("protocol", {}).get("seed", 0))))
 
 
 def lacks_scene_interval(gap: dict[str, Any]) -> bool:

@@ -27,10 +27,10 @@ import json
 import os
 import sys
 import zipfile
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, Callable, Protocol, runtime_checkable
+from typing import Any, Callable, Protocol, TypeVar, runtime_checkable
 
 import numpy as np
 
@@ -65,7 +65,10 @@ class Policy(Protocol):
         """The action for ``observation`` (``info``: what the environment said with it)."""
 
 
-def unwrapped(env: Any, kind: type, env_id: str) -> Any:
+EnvT = TypeVar("EnvT")
+
+
+def unwrapped(env: object, kind: type[EnvT], env_id: str) -> EnvT:
     """The environment of class ``kind`` under any wrappers (what a policy's ``prepare`` reads).
 
     Raises:
@@ -92,7 +95,7 @@ class SeededPolicy:
             self._rng = np.random.default_rng(seed)
 
 
-def baselines_by_name(names: list[str], makers: dict[str, Callable[[], Any]], kind: str = "") -> list[Any]:
+def baselines_by_name(names: list[str], makers: Mapping[str, Callable[[], Policy]], kind: str = "") -> list[Policy]:
     """An environment's baselines by name, in the order given (any case).
 
     Args:
@@ -116,7 +119,7 @@ def baselines_by_name(names: list[str], makers: dict[str, Callable[[], Any]], ki
     return made
 
 
-def prepare(policy: Any, env: Any) -> None:
+def prepare(policy: Policy, env: Any) -> None:
     """Call the policy's optional ``prepare(env)`` (learn the environment, refuse a misfit)."""
     method = getattr(policy, "prepare", None)
     if callable(method):
@@ -132,7 +135,7 @@ class FunctionPolicy:
         name: Row name (default: the callable's ``__name__``).
         """
         self.function = function
-        self.name = name or getattr(function, "__name__", type(function).__name__)
+        self.name: str = name if name else str(getattr(function, "__name__", type(function).__name__))
 
     def reset(self, seed: int | None = None) -> None:
         """Seed NumPy's global generator, which a plain function may draw from."""
@@ -144,7 +147,7 @@ class FunctionPolicy:
         return self.function(observation, info)
 
 
-def as_policy(thing: Any, name: str | None = None) -> Any:
+def as_policy(thing: Any, name: str | None = None) -> Policy:
     """A :class:`Policy` from a policy object, a class with ``reset``/``act`` or a callable.
 
     Raises:
@@ -358,7 +361,9 @@ def _import_errors(spec: str, where: str, keep_missing: bool = True) -> Iterator
         ) from None
 
 
-def policy_from_spec(spec: str, name: str | None = None, deterministic: bool = DETERMINISTIC_PLAY) -> Any:
+def policy_from_spec(
+    spec: str | os.PathLike[str], name: str | None = None, deterministic: bool = DETERMINISTIC_PLAY
+) -> Policy:
     """The :class:`Policy` a SPEC names (see the module docstring).
 
     Args:
@@ -376,9 +381,9 @@ def policy_from_spec(spec: str, name: str | None = None, deterministic: bool = D
     if not colon or not target or not attr or attr.endswith((".zip", ".py")) or os.sep in attr:
         if text.endswith(".py"):
             raise UserError(f"--policy {spec}: name the function or class too, e.g. {text}:my_policy")
-        policy = ModelPolicy(text, deterministic=deterministic, name=name)
+        policy: Policy = ModelPolicy(text, deterministic=deterministic, name=name)
     else:
-        module = _import_target(target, spec)
+        module = _import_target(target, str(spec))
         try:
             thing = getattr(module, attr)
         except AttributeError:
@@ -387,5 +392,6 @@ def policy_from_spec(spec: str, name: str | None = None, deterministic: bool = D
             policy = as_policy(thing, name)
         except UserError as error:  # which --policy it was, as every other refusal of one says
             raise UserError(f"--policy {spec}: {error}") from None
-    policy.source = text
+    # The results record where each policy came from; a user's own policy object has no such field.
+    setattr(policy, "source", text)  # noqa: B010
     return policy

@@ -5,11 +5,14 @@ from __future__ import annotations
 
 import sys
 import time
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from stable_baselines3.common.callbacks import BaseCallback
 
 from davis_ag.benchmark.selection import KeepBestOnTrain
+
+if TYPE_CHECKING:  # tqdm loads when training starts
+    from tqdm import tqdm
 
 #: Seconds between progress lines in a log (on a terminal a bar is redrawn instead).
 PROGRESS_EVERY_S = 60.0
@@ -34,7 +37,8 @@ class TrainingProgress(BaseCallback):
         super().__init__()
         self.total, self.label, self.selection = total, label, selection
         self.every_s = PROGRESS_EVERY_S if every_s is None else every_s
-        self.steps, self._first, self._start, self._last, self.bar = 0, 0, 0.0, 0.0, None
+        self.steps, self._first, self._start, self._last = 0, 0, 0.0, 0.0
+        self.bar: tqdm | None = None
 
     def _on_training_start(self) -> None:
         from tqdm import tqdm
@@ -61,6 +65,7 @@ class TrainingProgress(BaseCallback):
 
         n = self.training_env.num_envs
         self.steps += n
+        assert self.bar is not None  # made when training starts
         if not self.bar.disable:
             self.bar.set_postfix_str(self._score(), refresh=False)
             self.bar.update(n)

@@ -16,7 +16,7 @@ import hashlib
 import json
 import os
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Final, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
@@ -26,7 +26,7 @@ from davis_ag.formats.scene_file import SceneFile
 #: Section V-D's protocol as this code implements it (see the module docstring).
 PROTOCOL_VERSION = 1
 #: The ``format`` field of every results file.
-FORMAT = "davis-ag evaluation results"
+FORMAT: Final = "davis-ag evaluation results"
 
 
 class _Model(BaseModel):
@@ -102,9 +102,9 @@ class CodeDigest(_Model):
     of: Literal["model", "parameters", "source", "name"] = Field(
         description="the model's zip, a model's parameters in memory, the policy's source file, or its name"
     )
-    file: str | None = Field(None, description="the name of the file hashed")
+    file: str | None = Field(default=None, description="the name of the file hashed")
     package: str = Field(description="davis-ag's version")
-    commit: str | None = Field(None, description="davis-ag's git commit (-dirty: with changes)")
+    commit: str | None = Field(default=None, description="davis-ag's git commit (-dirty: with changes)")
 
     def short(self) -> str:
         """The first 8 hex digits, as a leaderboard shows them."""
@@ -119,14 +119,14 @@ class PolicyResult(_Model):
     length: Metric
     oer_0: Metric
     refused: Metric | None = None
-    source: str | None = Field(None, description="the SPEC or baseline name it was built from")
-    play: str | None = Field(None, description="a trained model's play: sampled or deterministic")
-    action: str | None = Field(None, description="the action of the Best fixed action row")
+    source: str | None = Field(default=None, description="the SPEC or baseline name it was built from")
+    play: str | None = Field(default=None, description="a trained model's play: sampled or deterministic")
+    action: str | None = Field(default=None, description="the action of the Best fixed action row")
     action_counts: dict[str, int] | None = None
     mean_abs_action: dict[str, float] | None = None
-    exact: dict[str, float] | None = Field(None, description="exact expectations of an image-blind policy")
+    exact: dict[str, float] | None = Field(default=None, description="exact expectations of an image-blind policy")
     paired: dict[str, PairedGap] = Field(default_factory=dict, description="gap to each baseline by name")
-    digest: CodeDigest | None = Field(None, description="the code it played with (None: results from before)")
+    digest: CodeDigest | None = Field(default=None, description="the code it played with (None: results from before)")
     episodes: list[Episode] | None = None
 
 
@@ -140,7 +140,7 @@ class SceneIdentity(_Model):
     seed: int | None = None
     code: str | None = None
     drawn: str | None = Field(
-        None,
+        default=None,
         description="digest of scene.json's camera, renderer, plant generator, appearance, grid and box threshold",
     )
 

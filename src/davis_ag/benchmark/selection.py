@@ -145,11 +145,11 @@ class KeepBestOnTrain(BaseCallback):
                 raise
         if self.prune_at_once:
             self.prune()
-        print(
-            f"train-split score at {step} steps: OER_tau {entry['oer_tau']:.3f}"
-            + (" (best so far)" if self.best is entry else f" (best {before['oer_tau']:.3f} at {before['step']})"),
-            flush=True,
-        )
+        if self.best is entry or before is None:  # (before is None only where this entry is the best)
+            note = " (best so far)"
+        else:
+            note = f" (best {before['oer_tau']:.3f} at {before['step']})"
+        print(f"train-split score at {step} steps: OER_tau {entry['oer_tau']:.3f}" + note, flush=True)
 
     def prune(self, keep_none: bool = False) -> None:
         """Remove every snapshot file but the best's (all of them with ``keep_none``)."""

@@ -12,17 +12,20 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 from davis_ag.errors import UserError
 from davis_ag.formats.layout import ANNOTATIONS
 from davis_ag.formats.splits import recorded_seed, split_scenes
 from davis_ag.scene.specs import crop_spec, parse_group_name, scenario_spec
 
+if TYPE_CHECKING:
+    from davis_ag.data.reader import Dataset, Scene
+
 SPLITS = ("train", "test", "all")
 
 
-def scene_scenario(scene: Any) -> str | None:
+def scene_scenario(scene: Scene) -> str | None:
     """A scene's scenario (``sp``/``mp``): the reader's, else from its group folder name."""
     value = getattr(scene, "scenario", None)
     if value:
@@ -31,7 +34,7 @@ def scene_scenario(scene: Any) -> str | None:
     return parsed[0].name if parsed else None
 
 
-def scene_crop(scene: Any) -> str | None:
+def scene_crop(scene: Scene) -> str | None:
     """A scene's crop name (``strawberry``/``tomato``/``vine``), or ``None`` if unknown."""
     value = getattr(scene, "crop", None)
     if value:
@@ -43,7 +46,7 @@ def scene_crop(scene: Any) -> str | None:
     return parsed[1].name if parsed else None
 
 
-def dataset_splits(dataset: Any) -> dict[str, list[str]]:
+def dataset_splits(dataset: Dataset) -> dict[str, list[str]]:
     """The train and test scene ids of a dataset (see the module docstring).
 
     Args:
@@ -64,7 +67,7 @@ def dataset_splits(dataset: Any) -> dict[str, list[str]]:
     return split_scenes((s.id for s in dataset.scenes), recorded_seed(dataset.root))
 
 
-def _refuse_unlabelled(dataset: Any, lists: dict[str, list[str]]) -> None:
+def _refuse_unlabelled(dataset: Dataset, lists: dict[str, list[str]]) -> None:
     """Refuse a split naming a scene under the opened folder whose folder is there without
     readable labels: the reader passes over such a folder, so the scene would silently leave its
     split (and a benchmark or an export be made on fewer scenes than it says)."""
@@ -83,7 +86,7 @@ def _refuse_unlabelled(dataset: Any, lists: dict[str, list[str]]) -> None:
                 )
 
 
-def select_scenes(dataset: Any, scenario: str, split: str, crop: str | None = None) -> list[Any]:
+def select_scenes(dataset: Dataset, scenario: str, split: str, crop: str | None = None) -> list[Scene]:
     """The scenes of one scenario (and crop) in one split, sorted by id.
 
     Args:

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import torch
 from stable_baselines3.common.vec_env import DummyVecEnv
@@ -43,6 +43,9 @@ from davis_ag.errors import MachineError, UserError
 from davis_ag.formats.models import check_seed
 from davis_ag.seeds import resumed_training_seed, training_env_seed
 
+if TYPE_CHECKING:
+    from davis_ag.data.reader import Dataset
+
 #: Steps between checkpoints by default: about a minute of training on a 2-core CPU.
 CHECKPOINT_EVERY = 10_000
 #: Environment steps per point of the learning curve kept in the training record (Fig. 4a).
@@ -53,7 +56,7 @@ SELECT_EVERY = 10_000
 
 
 def make_vec_tvm(
-    dataset: Any,
+    dataset: Dataset | str | os.PathLike[str],
     scenario: str,
     n_envs: int,
     seed: int,
@@ -108,13 +111,13 @@ def checkpoint_paths(out_path: str | os.PathLike[str]) -> tuple[Path, Path]:
     return stem.with_name(stem.name + ".checkpoint.zip"), stem.with_name(stem.name + ".checkpoint.json")
 
 
-def train_a2c(dataset: Any, scenario: str, **kwargs: Any) -> Path:
+def train_a2c(dataset: Dataset | str | os.PathLike[str], scenario: str, **kwargs: Any) -> Path:
     """:func:`train_agent` with ``algo="a2c"``: the paper's agent."""
     return train_agent(dataset, scenario, algo="a2c", **kwargs)
 
 
 def train_agent(
-    dataset: Any,
+    dataset: Dataset | str | os.PathLike[str],
     scenario: str,
     total_timesteps: int = 300_000,
     seed: int = 0,
@@ -207,7 +210,7 @@ def train_agent(
     prove_writable_file(final)  # before hours of training, not after
     model_file, settings_file = checkpoint_paths(final)
     # A path names the dataset itself (a Path's own .root would be "/"); a reader's dataset, its root.
-    root = dataset if isinstance(dataset, (str, os.PathLike)) else getattr(dataset, "root", dataset)
+    root = dataset if isinstance(dataset, (str, os.PathLike)) else dataset.root
     settings = {
         "dataset": str(Path(root).expanduser().absolute()),
         "scenario": scenario,
@@ -283,15 +286,17 @@ def train_agent(
             save_model(model, final)
         else:
             selection.score_now()  # the last snapshot competes too
+            best = selection.best
+            assert best is not None  # score_now has scored at least this snapshot
             # A link, not a copy: it needs no space, so a full disk cannot lose the best snapshot;
             # and the snapshot keeps its name until the record and checkpoint are done, so a run
             # stopped in between resumes with every score and snapshot it had (it then trains
             # from its last checkpoint to the budget again, and the last score is redrawn).
-            publish_snapshot(snapshot_path(final, selection.best["step"]), final)
+            publish_snapshot(snapshot_path(final, best["step"]), final)
             extra["selection"] = selection.record()
             print(
-                f"kept the snapshot at {selection.best['step']} steps (train-split OER_tau "
-                f"{selection.best['oer_tau']:.3f}, the best of {len(selection.scores)})",
+                f"kept the snapshot at {best['step']} steps (train-split OER_tau "
+                f"{best['oer_tau']:.3f}, the best of {len(selection.scores)})",
                 flush=True,
             )
         written = True

@@ -37,7 +37,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any, overload
 
 import gymnasium as gym
 import numpy as np
@@ -48,11 +48,18 @@ from davis_ag.benchmark.splits import scene_crop, select_scenes
 from davis_ag.errors import UserError
 from davis_ag.scene.specs import ALL_ACTIONS, crop_spec, scenario_spec
 
+if TYPE_CHECKING:  # the reader loads on first use (see as_dataset)
+    from davis_ag.data.reader import Dataset, Scene
+
 #: Section V-D: an episode starts on a target with OER below this.
 MAX_START_OER = 0.4
 
 
-def can_start(oer: Any, max_start_oer: float = MAX_START_OER) -> Any:
+@overload
+def can_start(oer: float, max_start_oer: float = MAX_START_OER) -> bool: ...
+@overload
+def can_start(oer: np.ndarray, max_start_oer: float = MAX_START_OER) -> np.ndarray: ...
+def can_start(oer: float | np.ndarray, max_start_oer: float = MAX_START_OER) -> bool | np.ndarray:
     """Section V-D's start rule: a fruit may be an episode's target when its OER is below the
     limit (a float, or an array of them); the grid and the continuous environments share it."""
     return oer < max_start_oer
@@ -77,9 +84,9 @@ class _Starts:
     boxes: np.ndarray  # rows of the scene's box tables
 
 
-def as_dataset(dataset: Any) -> Any:
+def as_dataset(dataset: Dataset | str | os.PathLike[str]) -> Dataset:
     """Accept an opened dataset or a path to one."""
-    if hasattr(dataset, "scenes") and hasattr(dataset, "root"):
+    if not isinstance(dataset, (str, os.PathLike)):
         return dataset
     from davis_ag.data.reader import open_dataset
 
@@ -93,7 +100,7 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
 
     def __init__(
         self,
-        dataset: Any,
+        dataset: Dataset | str | os.PathLike[str],
         scenario: str = "sp",
         split: str = "train",
         crop: str | None = None,
@@ -166,7 +173,7 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
         self._over = True
 
     @staticmethod
-    def _min_pixels(scene: Any, cache: SceneCache) -> float:
+    def _min_pixels(scene: Scene, cache: SceneCache) -> float:
         """Visible pixels a start target needs: scene.json's threshold if the scene has one
         (what its boxes were made with), else the crop's at the image size (the generator's rule)."""
         metadata = scene.metadata

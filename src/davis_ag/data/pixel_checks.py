@@ -169,7 +169,8 @@ def depth_problems(
     seen_mm = _median_depth_by_fruit(mask, depth, hit, [b.fruit_id for b in record.boxes if b.fruit_id in fruits])
     for fruit_id in (b.fruit_id for b in record.boxes if b.fruit_id in seen_mm):
         fruit = fruits[fruit_id]
-        expected = float(np.dot(np.subtract(fruit.center, (x, y, z)), forward))  # type: ignore[arg-type]
+        assert fruit.center is not None  # kept above only with its centre
+        expected = float(np.dot(np.subtract(fruit.center, (x, y, z)), forward))
         seen = seen_mm[fruit_id] / 1000.0
         allowed = 0.5 * float(np.linalg.norm(fruit.size or (0.0, 0.0, 0.0))) + DEPTH_SLACK_M
         if abs(seen - expected) > allowed:

@@ -229,6 +229,7 @@ def read_ply(path: Path) -> np.ndarray:
     vertex = PlyData.read(str(path))["vertex"].data
     wide = vertex.dtype["fruit_id"].itemsize == 2
     points = np.empty(len(vertex), dtype=POINT_DTYPE_16 if wide else POINT_DTYPE)
+    assert POINT_DTYPE.names is not None  # a structured dtype: its fields have names
     for name in POINT_DTYPE.names:
         points[name] = vertex[name]
     return points

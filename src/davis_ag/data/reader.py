@@ -406,7 +406,7 @@ def _scene_dirs(folder: Path) -> list[Path]:
     return sorted(p for p in folder.iterdir() if p.is_dir() and (p / ANNOTATIONS).is_file())
 
 
-def open_dataset(path: str | Path) -> Dataset:
+def open_dataset(path: str | os.PathLike[str]) -> Dataset:
     """Open a dataset root, a group folder (``Single-Strawberry``) or a single scene folder.
 
     Args:

@@ -93,9 +93,7 @@ def load_pixels(path: Path, mode: str | None) -> np.ndarray:
 
     try:
         with Image.open(path) as im:
-            if mode:
-                im = im.convert(mode)
-            pixels = np.asarray(im)
+            pixels = np.asarray(im.convert(mode) if mode else im)
     except FileNotFoundError:
         raise UserError(f"{path}: image file missing; re-download or regenerate the scene") from None
     except (OSError, UnidentifiedImageError, ValueError, Image.DecompressionBombError) as error:

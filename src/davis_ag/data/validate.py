@@ -98,8 +98,8 @@ def validate_scene(
         if error is None:
             try:
                 metadata = scene_file_from(raw_metadata)
-            except ValueError as problem:
-                error = str(problem)
+            except ValueError as invalid:
+                error = str(invalid)
         if error:
             flag(scene.path / SCENE_METADATA, error)
     tolerance = box_tolerance if box_tolerance is not None else (0 if metadata is not None else 1)

@@ -90,7 +90,7 @@ def organ_annotations(item: LabelledView, image_id: int, first_id: int) -> list[
     :mod:`davis_ag.detection.organ_export`); none without a class image."""
     from davis_ag.scene.organs import ORGAN_NAMES
 
-    entries = []
+    entries: list[dict[str, Any]] = []
     for value, mask in organ_masks(item.view):
         rows, cols = np.nonzero(mask)
         x0, y0 = int(cols.min()), int(rows.min())

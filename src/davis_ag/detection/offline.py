@@ -94,8 +94,8 @@ def prepare_ultralytics() -> ModuleType:
     Raises:
         UserError: when ultralytics or torchvision is missing, or ultralytics was imported first.
     """
-    if "ultralytics" in _state:
-        return _state["ultralytics"]  # type: ignore[return-value]
+    if isinstance(prepared := _state.get("ultralytics"), ModuleType):
+        return prepared
     import sys
 
     if "ultralytics" in sys.modules:

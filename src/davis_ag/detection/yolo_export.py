@@ -93,6 +93,7 @@ def label_lines(item: LabelledView, task: str) -> list[str]:
                 "unfinished export), or regenerate the scene"
             )
         if task == "segment":
+            assert inst.mask is not None  # refused above where missing
             points = mask_polygon(inst.mask)
             # Pixel centres: the outline through them covers exactly the mask's pixels when filled.
             coords = " ".join(f"{(x + 0.5) / w:.6f} {(y + 0.5) / h:.6f}" for x, y in points)

@@ -7,12 +7,13 @@ scene has one; boxes per view from the annotations; the OER of every box from th
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import asdict
 from typing import Any
 
 import numpy as np
 
-from davis_ag.data.reader import Dataset
+from davis_ag.data.reader import Dataset, Scene
 from davis_ag.errors import UserError
 from davis_ag.figures.scene_numbers import box_oers, visible_fractions
 from davis_ag.scene.specs import CROPS, PAPER_TABLE3, SCENARIOS, parse_group_name
@@ -21,7 +22,7 @@ from davis_ag.scene.specs import CROPS, PAPER_TABLE3, SCENARIOS, parse_group_nam
 OER_EDGES = np.linspace(0.0, 1.0, 11)
 
 
-def _summary(values: np.ndarray | list[float]) -> dict[str, Any] | None:
+def _summary(values: np.ndarray | Sequence[float]) -> dict[str, Any] | None:
     """Count, mean, min, quartiles and max of some values; ``None`` when there are none."""
     data = np.asarray(values, dtype=float)
     if data.size == 0:
@@ -86,7 +87,7 @@ def fruit_statistics(dataset: Dataset, with_oer: bool = True) -> dict[str, Any]:
         ``below_0.4``: the share of boxes an episode may start on), ``masks_missing`` (boxes
         whose view had no mask) and ``visible_fraction`` (scene.json; ``None`` without it).
     """
-    by_group: dict[str, list[Any]] = {}
+    by_group: dict[str, list[Scene]] = {}
     for scene in dataset.scenes:
         by_group.setdefault(scene.group, []).append(scene)
     out: dict[str, Any] = {}
@@ -130,7 +131,7 @@ def refused_move_statistics(dataset: Dataset) -> dict[str, Any]:
     from davis_ag.benchmark.cache import load_scene_cache
     from davis_ag.benchmark.moves import refused_moves_of_scenes
 
-    by_group: dict[str, list[Any]] = {}
+    by_group: dict[str, list[Scene]] = {}
     for scene in dataset.scenes:
         by_group.setdefault(scene.group, []).append(scene)
     out: dict[str, Any] = {}

@@ -74,6 +74,8 @@ def draw_point_cloud(points: np.ndarray, out_path: Path, radius: float = 0.4, ti
         radius: Horizontal distance from the plants' centre kept, m.
         title: Shown above.
     """
+    from mpl_toolkits.mplot3d.axes3d import Axes3D
+
     xyz = np.stack([points["x"], points["y"], points["z"]], axis=1).astype(np.float64)
     plant = points["organ"] > 1
     centre = np.median(xyz[plant, :2], axis=0) if plant.any() else np.zeros(2)
@@ -88,6 +90,7 @@ def draw_point_cloud(points: np.ndarray, out_path: Path, radius: float = 0.4, ti
     top = float(xyz[:, 2].max()) if len(xyz) else 1.0
     for k, (colours, label) in enumerate(((rgb, "colour"), (organ, "organ class"))):
         ax = figure.add_axes((k * 0.5, 0.0, 0.5, 0.9), projection="3d")
+        assert isinstance(ax, Axes3D)  # matplotlib's stubs know only 2-D axes
         ax.scatter(xyz[:, 0], xyz[:, 1], xyz[:, 2], c=colours, s=1.0, linewidths=0, depthshade=False)
         ax.view_init(elev=20, azim=-60)
         ax.set_xlim(centre[0] - radius, centre[0] + radius)

@@ -53,19 +53,25 @@ def front_view(scene: Scene, like: tuple[float, ...] | None = None) -> View:
     if not posed:
         raise UserError(f"{scene.annotations_path}: no view has a pose")
     if like is not None:
-        return min(posed, key=lambda v: float(np.linalg.norm(np.subtract(v.pose[:3], like[:3]))))  # type: ignore[index]
-    low = min(v.pose[2] for v in posed)  # type: ignore[index]
+        return min(posed, key=lambda v: float(np.linalg.norm(np.subtract(_pose(v)[:3], like[:3]))))
+    low = min(_pose(v)[2] for v in posed)
     px, py = (plant_xy(scene) or [(0.0, 0.0)])[0]
-    bottom = [v for v in posed if abs(v.pose[2] - low) < 0.01]  # type: ignore[index]
+    bottom = [v for v in posed if abs(_pose(v)[2] - low) < 0.01]
     # In front: as close to due south of the plant as the grid allows, nearest first.
     return min(
         bottom,
         key=lambda v: (
-            v.pose[1] > py,
-            abs(v.pose[0] - px) + abs(v.pose[1] - py),  # type: ignore[index]
+            _pose(v)[1] > py,
+            abs(_pose(v)[0] - px) + abs(_pose(v)[1] - py),
             v.name,
         ),
     )
+
+
+def _pose(view: View) -> tuple[float, ...]:
+    """The pose of a view known to have one."""
+    assert view.pose is not None
+    return view.pose
 
 
 def plot_phenotypes(

@@ -68,7 +68,8 @@ def positions(scene: Scene) -> list[Position]:
     """
     found: dict[tuple[int, int, int], Position] = {}
     for view in _posed(scene):
-        x, y, z = view.pose[:3]  # type: ignore[index]
+        assert view.pose is not None  # _posed keeps the views with a pose
+        x, y, z = view.pose[:3]
         key = (round(x * 1000), round(y * 1000), round(z * 1000))
         spot = found.setdefault(key, Position(x, y, z))
         spot.views.append(view.name)
@@ -78,7 +79,7 @@ def positions(scene: Scene) -> list[Position]:
 
 def altitudes(scene: Scene) -> list[float]:
     """The scene's camera altitudes (pose z to the centimetre), lowest first."""
-    return sorted({round(v.pose[2], 2) for v in _posed(scene)})  # type: ignore[index]
+    return sorted({round(pose[2], 2) for v in _posed(scene) if (pose := v.pose) is not None})
 
 
 def scene_fruit_count(scene: Scene) -> int:

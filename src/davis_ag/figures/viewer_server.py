@@ -210,7 +210,9 @@ def make_handler(viewer: Viewer, page: bytes) -> type[BaseHTTPRequestHandler]:
         def do_GET(self) -> None:  # noqa: N802 (http.server's name)
             # Only pages that asked for this address: a site rebinding its name to 127.0.0.1
             # sends its own Host, and would otherwise read the dataset through the browser.
-            port = self.server.server_address[1]
+            address = self.server.server_address
+            assert isinstance(address, tuple)  # an IP server: (host, port)
+            port = address[1]
             if self.headers.get("Host", "") not in (f"{HOST}:{port}", f"localhost:{port}"):
                 return self._send(HTTPStatus.FORBIDDEN, b"wrong host", "text/plain; charset=utf-8")
             url = urlsplit(self.path)
@@ -266,9 +268,10 @@ def make_handler(viewer: Viewer, page: bytes) -> type[BaseHTTPRequestHandler]:
                     return self._missing("no mask")
                 return self._send(HTTPStatus.OK, mask_overlay(mask), "image/png", cache=True)
             if layer == "classes":
-                if viewer.file(scene, view.class_path.name) is None:
+                classes = view.classes() if viewer.file(scene, view.class_path.name) is not None else None
+                if classes is None:
                     return self._missing("no organ classes")
-                return self._send(HTTPStatus.OK, classes_overlay(view.classes()), "image/png", cache=True)
+                return self._send(HTTPStatus.OK, classes_overlay(classes), "image/png", cache=True)
             path = viewer.file(scene, view.depth_path.name)
             if path is None:
                 return self._missing("no depth")

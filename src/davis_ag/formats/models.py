@@ -35,8 +35,8 @@ from pydantic import (
 
 from davis_ag.errors import UserError
 from davis_ag.formats.masks import MAX_FRUIT_ID as _MAX_MASK_FRUIT_ID
-from davis_ag.scene.appearance import APPEARANCES, DEFAULT_APPEARANCE
-from davis_ag.scene.specs import ALL_ACTIONS, DEFAULT_PLANTS, PLANT_GENERATORS, crop_spec, group_name, scenario_spec
+from davis_ag.scene.appearance import DEFAULT_APPEARANCE, AppearanceMode
+from davis_ag.scene.specs import ALL_ACTIONS, DEFAULT_PLANTS, PlantGenerator, crop_spec, group_name, scenario_spec
 
 #: Largest seed: NumPy's legacy seeding, Gymnasium and Stable-Baselines3 take 32-bit seeds.
 MAX_SEED = 2**32 - 1
@@ -59,18 +59,19 @@ MAX_GRID_EXTENT = 100.0
 MAX_FRUIT_ID = _MAX_MASK_FRUIT_ID
 
 
-def whole(low: int, high: int) -> Any:
-    """A whole number from ``low`` to ``high``, whose error names the range."""
+def in_range(low: int, high: int) -> AfterValidator:
+    """The check of a whole number from ``low`` to ``high``, whose error names the range: a field
+    ``Annotated[StrictInt, in_range(low, high)]`` holds such a number."""
 
     def check(value: int) -> int:
         if not low <= value <= high:
             raise ValueError(f"must be a whole number from {low} to {high}, not {value}")
         return value
 
-    return Annotated[StrictInt, AfterValidator(check)]
+    return AfterValidator(check)
 
 
-Seed = whole(0, MAX_SEED)
+Seed = Annotated[StrictInt, in_range(0, MAX_SEED)]
 
 
 def _size_from_text(value: Any) -> Any:
@@ -186,7 +187,7 @@ class GridOverride(_Model):
     ) = None
     step: Annotated[float, Field(gt=0, le=MAX_GRID_EXTENT, allow_inf_nan=False)] | None = None
     altitude_levels: list[Literal[0, 1, 2]] | None = None
-    headings: whole(1, 360) | None = None
+    headings: Annotated[StrictInt, in_range(1, 360)] | None = None
 
     @field_validator("altitude_levels")
     @classmethod
@@ -219,8 +220,8 @@ class GroupEntry(_Model):
 
     scenario: str
     crop: str
-    scenes: whole(1, MAX_SCENES)
-    first: whole(0, MAX_SCENES - 1) = 0
+    scenes: Annotated[StrictInt, in_range(1, MAX_SCENES)]
+    first: Annotated[StrictInt, in_range(0, MAX_SCENES - 1)] = 0
     grid: GridOverride | None = None
 
     @field_validator("scenario", "crop")
@@ -256,8 +257,8 @@ class DatasetConfigFile(_Model):
     look: Literal["default", "helios"] | None = None
     depth: StrictBool = True
     antialiasing: Annotated[Literal["fxaa", "msaa", "none"], BeforeValidator(_antialiasing)] = "fxaa"
-    plants: Literal[PLANT_GENERATORS] = DEFAULT_PLANTS  # type: ignore[valid-type]
-    appearance: Literal[APPEARANCES] = DEFAULT_APPEARANCE  # type: ignore[valid-type]
+    plants: PlantGenerator = DEFAULT_PLANTS
+    appearance: AppearanceMode = DEFAULT_APPEARANCE
     strawberry_altitudes: Literal["table1", "readme"] = "table1"
     grid: GridOverride | None = None
     groups: list[GroupEntry]
@@ -296,7 +297,7 @@ class GridSettings(_Model):
     extent: tuple[float, float]
     step: Annotated[float, Field(gt=0)]
     altitude_levels: list[Literal[0, 1, 2]]
-    headings: whole(1, 360)
+    headings: Annotated[StrictInt, in_range(1, 360)]
     altitudes_m: list[float] | None = None
 
 
@@ -310,7 +311,7 @@ class DatasetGroup(_Model):
 class OrganClass(_Model):
     """One row of dataset.json's organ class table: a value of NNNN_class.png and what it covers."""
 
-    value: whole(0, 255)
+    value: Annotated[StrictInt, in_range(0, 255)]
     name: str
     covers: str
 
@@ -328,9 +329,9 @@ class DatasetFile(_Model):
     renderer: Literal["opengl", "helios"] = "helios"
     look: Literal["default", "helios"] = "helios"
     # Datasets from before the choice of plants grew PlantArchitecture plants.
-    plants: Literal[PLANT_GENERATORS] = "architecture"  # type: ignore[valid-type]
+    plants: PlantGenerator = "architecture"
     # ... and before randomised appearance, the paper's.
-    appearance: Literal[APPEARANCES] = "paper"  # type: ignore[valid-type]
+    appearance: AppearanceMode = "paper"
     #: The organ class table of NNNN_class.png, where the scenes have them.
     classes: list[OrganClass] | None = None
     groups: dict[str, DatasetGroup]

@@ -37,12 +37,12 @@ class _Record(BaseModel):
 class GeneratorRecord(_Record):
     """Which code wrote the scene."""
 
-    name: str | None = Field(None, description="davis-ag for our generator")
-    version: str | None = Field(None, description="davis-ag's version and git commit")
-    pyhelios3d: str | None = Field(None, description="the pyhelios3d version that grew the plants")
+    name: str | None = Field(default=None, description="davis-ag for our generator")
+    version: str | None = Field(default=None, description="davis-ag's version and git commit")
+    pyhelios3d: str | None = Field(default=None, description="the pyhelios3d version that grew the plants")
     python: str | None = None
     gl_renderer: str | None = Field(
-        None,
+        default=None,
         description="GL_RENDERER of the OpenGL implementation our renderer drew the views with (llvmpipe: "
         "Mesa on the CPU; not recorded for Helios's renderer); another one draws other pixels from the "
         "same records",
@@ -71,9 +71,9 @@ class CameraRecord(_Record):
 class RendererRecord(_Record):
     """How the views were drawn (:mod:`davis_ag.render.backends`' names)."""
 
-    name: str | None = Field(None, description="opengl (ours) or helios")
-    look: str | None = Field(None, description="default or helios")
-    antialiasing: str | None = Field(None, description="the mode's description (ANTIALIASING_DESCRIPTIONS)")
+    name: str | None = Field(default=None, description="opengl (ours) or helios")
+    look: str | None = Field(default=None, description="default or helios")
+    antialiasing: str | None = Field(default=None, description="the mode's description (ANTIALIASING_DESCRIPTIONS)")
 
 
 class GridRecord(_Record):
@@ -107,17 +107,17 @@ class PlantRecord(_Record):
 class FruitRecord(_Record):
     """One fruit (:meth:`davis_ag.scene.build.Fruit.summary`): its id, plant and 3-D extent."""
 
-    id: int | None = Field(None, description="the fruit id of the masks and boxes")
-    plant: int | None = Field(None, description="the index of the plant bearing it")
-    center: list[Number] | None = Field(None, description="world x, y, z, metres")
-    size: list[Number] | None = Field(None, description="extent along x, y, z, metres")
+    id: int | None = Field(default=None, description="the fruit id of the masks and boxes")
+    plant: int | None = Field(default=None, description="the index of the plant bearing it")
+    center: list[Number] | None = Field(default=None, description="world x, y, z, metres")
+    size: list[Number] | None = Field(default=None, description="extent along x, y, z, metres")
 
 
 class ViewPlace(_Record):
     """A view's place on the grid and its pose before slip."""
 
-    grid: list[int] | None = Field(None, description="column, row, altitude level, heading")
-    nominal: list[Number] | None = Field(None, description="the pose before slip")
+    grid: list[int] | None = Field(default=None, description="column, row, altitude level, heading")
+    nominal: list[Number] | None = Field(default=None, description="the pose before slip")
 
 
 class SceneFile(_Record):

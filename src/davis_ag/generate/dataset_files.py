@@ -51,17 +51,19 @@ def dataset_settings(requests: Sequence[SceneRequest]) -> dict[str, Any]:
     groups: dict[str, Any] = {}
     for request in requests:
         groups[request.folder.split("/")[0]] = {"grid": grid_settings(request.scenario, request.crop)}
-    return DatasetFile(
-        format=DATASET_FORMAT,
-        seed=first.dataset_seed,
-        image_size=(first.camera.width, first.camera.height),
-        vfov_deg=first.camera.vfov,
-        renderer=first.renderer,
-        look=resolve_look(first.renderer, first.look),
-        plants=first.plants,
-        appearance=first.appearance,
-        classes=organ_table() if first.classes else None,
-        groups=groups,
+    return DatasetFile.model_validate(
+        {
+            "format": DATASET_FORMAT,
+            "seed": first.dataset_seed,
+            "image_size": (first.camera.width, first.camera.height),
+            "vfov_deg": first.camera.vfov,
+            "renderer": first.renderer,
+            "look": resolve_look(first.renderer, first.look),
+            "plants": first.plants,
+            "appearance": first.appearance,
+            "classes": organ_table() if first.classes else None,
+            "groups": groups,
+        }
     ).to_json()
 
 

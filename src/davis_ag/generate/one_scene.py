@@ -19,7 +19,15 @@ import numpy as np
 from davis_ag.formats.layout import published_pointers, view_name
 from davis_ag.formats.masks import segmentation_convention
 from davis_ag.formats.models import AnnotationEntry
-from davis_ag.formats.scene_file import SCENE_FORMAT, SceneFile
+from davis_ag.formats.scene_file import (
+    SCENE_FORMAT,
+    CameraRecord,
+    GeneratorRecord,
+    GridRecord,
+    RendererRecord,
+    SceneFile,
+    ViewPlace,
+)
 from davis_ag.provenance import code_version
 from davis_ag.seeds import derived_seed
 from davis_ag.errors import UserError
@@ -238,10 +246,12 @@ def draw_scene(
                     else None
                 )
                 fractions = visible_fractions(camera, view, labels, polygons, silhouette)
-                entry = AnnotationEntry(
-                    bounding_boxes=labels.boxes,
-                    pose=[round(v, 5) for v in view.pose],
-                    **published_pointers(grid, view.index),
+                entry = AnnotationEntry.model_validate(
+                    {
+                        "bounding_boxes": labels.boxes,
+                        "pose": [round(v, 5) for v in view.pose],
+                        **published_pointers(grid, view.index),
+                    }
                 ).to_json()
                 visible[view_name(view.number)] = {str(k): v for k, v in fractions.items()}
                 writer.add_view(
@@ -310,15 +320,15 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict, timing: di
     lighting = model.lighting
     return SceneFile(
         format=SCENE_FORMAT,
-        generator={
-            "name": "davis-ag",
-            "version": code_version(),
-            "pyhelios3d": pyhelios.__version__,
-            "python": platform.python_version(),
+        generator=GeneratorRecord(
+            name="davis-ag",
+            version=code_version(),
+            pyhelios3d=pyhelios.__version__,
+            python=platform.python_version(),
             # Pixels depend on the OpenGL implementation: `verify` on another one names both.
             # (Helios's Visualizer opens its own display, which $DAVIS_AG_EGL_DEVICE does not choose.)
-            "gl_renderer": renderer_name() if request.renderer == "opengl" else None,
-        },
+            gl_renderer=renderer_name() if request.renderer == "opengl" else None,
+        ),
         seed=request.seed,
         dataset_seed=request.dataset_seed,
         scenario=request.scenario.name,
@@ -326,14 +336,14 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict, timing: di
         scene=request.folder,
         plant_generator=model.plant_generator,
         conventions={**CONVENTIONS, "segmentation": segmentation_convention(len(model.fruits))},
-        camera=request.camera.intrinsics(),
-        renderer={
-            "name": request.renderer,
-            "look": resolve_look(request.renderer, request.look),
-            "antialiasing": ANTIALIASING_DESCRIPTIONS[request.antialiasing]
+        camera=CameraRecord.model_validate(request.camera.intrinsics()),
+        renderer=RendererRecord(
+            name=request.renderer,
+            look=resolve_look(request.renderer, request.look),
+            antialiasing=ANTIALIASING_DESCRIPTIONS[request.antialiasing]
             if request.renderer == "opengl"
             else "Helios Visualizer, 4x multisampled colour",
-        },
+        ),
         depth={
             "file": "images/NNNN_depth.png",
             "dtype": "uint16",
@@ -357,20 +367,20 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict, timing: di
             "white_balance": list(lighting.white_balance),
             "sky_texture": Path(lighting.sky_texture).name if lighting.sky_texture else None,
         },
-        grid={
-            "extent_m": list(request.scenario.extent),
-            "step_m": request.scenario.step,
-            "altitudes_m": camera_altitudes(request.scenario, request.crop),
-            "headings": request.scenario.headings,
-            "exclusion_radius_m": request.crop.exclusion_radius,
-            "aim_height_m": model.aim_height,
-            "views": len(grid.viewpoints),
-        },
+        grid=GridRecord(
+            extent_m=list(request.scenario.extent),
+            step_m=request.scenario.step,
+            altitudes_m=camera_altitudes(request.scenario, request.crop),
+            headings=request.scenario.headings,
+            exclusion_radius_m=request.crop.exclusion_radius,
+            aim_height_m=model.aim_height,
+            views=len(grid.viewpoints),
+        ),
         min_fruit_pixels=request.min_fruit_pixels,
         plants=[plant.summary() for plant in model.plants],
         fruits=[fruit.summary() for fruit in model.fruits],
         views={
-            view_name(v.number): {"grid": [v.ix, v.iy, v.level, v.heading], "nominal": list(v.nominal)}
+            view_name(v.number): ViewPlace(grid=[v.ix, v.iy, v.level, v.heading], nominal=list(v.nominal))
             for v in grid.viewpoints
         },
         visible_fraction=visible,

@@ -8,6 +8,7 @@ there atomically, exactly as a local run does, and the driver keeps the folder's
 
 from __future__ import annotations
 
+import logging
 import signal
 import threading
 import time
@@ -104,7 +105,7 @@ def connect(address: str | None):
     try:
         # Without --address, a new local instance (as docs/generating.md says), never the cluster
         # that /tmp/ray/ray_current_cluster or RAY_ADDRESS happens to name: --address auto joins it.
-        ray.init(address=address or "local", log_to_driver=False, logging_level="warning")
+        ray.init(address=address or "local", log_to_driver=False, logging_level=logging.WARNING)
     except Exception as error:  # ConnectionError, ValueError, RuntimeError depending on the address
         where = address or "a new local instance"
         reason = (str(error).splitlines() or [type(error).__name__])[0].rstrip(".")

@@ -176,10 +176,12 @@ def _run_here(todo: Sequence[SceneRequest], root: Path, progress: Progress, repo
     """Scenes one after another in this process (Mesa spreads each draw over every core)."""
     for request in todo:
         progress.event(("start", request.folder))
+
+        def on_view(done: int, total: int, scene: str = request.folder) -> None:
+            progress.event(("view", scene, done, total))
+
         try:
-            _, stats = generate_scene(
-                request, root, lambda done, total, scene=request.folder: progress.event(("view", scene, done, total))
-            )
+            _, stats = generate_scene(request, root, on_view)
         except Exception as error:  # one bad scene must not stop the others
             record_failure(report, progress, request, error)
             continue

@@ -94,7 +94,7 @@ def silhouette_pixels(camera: Camera, view: Viewpoint, polygons: list[np.ndarray
         view: The pose.
         polygons: The fruit's primitives, grouped by vertex count: arrays of (n, k, 3).
     """
-    triangles = []
+    triangles: list[np.ndarray] = []
     for group in polygons:
         uv, depth = camera.project(view, group)
         uv = uv[(depth > 0.01).all(axis=1)]

@@ -14,12 +14,13 @@ an action array in place of an index; ``prepare(env)`` reads the environment fir
 
 from __future__ import annotations
 
-from typing import Any
+from functools import partial
+from typing import Any, Callable
 
 import gymnasium as gym
 import numpy as np
 
-from davis_ag.benchmark.policies import SeededPolicy, baselines_by_name, unwrapped
+from davis_ag.benchmark.policies import Policy, SeededPolicy, baselines_by_name, unwrapped
 from davis_ag.environments import CONTINUOUS_ID
 from davis_ag.errors import UserError
 from davis_ag.live.tvm_continuous import TVMContinuousEnv
@@ -89,21 +90,21 @@ class Greedy(SeededPolicy):
         best, best_oer = np.zeros(size, dtype=np.float32), inner.oer
         for action in self._rng.uniform(-1.0, 1.0, size=(self.candidates, size)).astype(np.float32):
             reason, labels = inner.try_pose(inner.proposed(action, slip=False))
-            if not reason and labels.oer[inner.target] > best_oer:
+            if not reason and labels is not None and labels.oer[inner.target] > best_oer:
                 best, best_oer = action, labels.oer[inner.target]
         return best
 
 
 #: Baseline names :func:`build_policies` accepts (trained models come from
 #: :func:`davis_ag.benchmark.policies.policy_from_spec`), and what makes each.
-BASELINES: dict[str, Any] = {
-    **{name: (lambda name=name, axes=axes: RandomAxes(name, axes)) for name, axes in HEURISTIC_AXES.items()},
+BASELINES: dict[str, Callable[[], Policy]] = {
+    **{name: partial(RandomAxes, name, axes) for name, axes in HEURISTIC_AXES.items()},
     "Greedy": Greedy,
 }
 POLICY_NAMES: tuple[str, ...] = tuple(BASELINES)
 
 
-def build_policies(names: list[str]) -> list[Any]:
+def build_policies(names: list[str]) -> list[Policy]:
     """Continuous baselines by name, in order (case-insensitive; see :data:`POLICY_NAMES`).
 
     Raises:

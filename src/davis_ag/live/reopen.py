@@ -46,6 +46,7 @@ from davis_ag.scene.view_grid import Viewpoint
 
 if TYPE_CHECKING:
     from davis_ag.generate.one_scene import SceneRequest
+    from davis_ag.render.scene_geometry import SceneGeometry
 
 T = TypeVar("T")
 CACHE_FILE = "live_geometry.npz"
@@ -163,15 +164,17 @@ def read_settings(scene_dir: str | Path) -> SceneSettings:
             crop_spec(_needed(metadata.crop, "crop")), _needed(grid.altitudes_m, "grid.altitudes_m")
         )
         scenario = scenario_spec(_needed(metadata.scenario, "scenario"), crop)
+        extent_x, extent_y = _needed(grid.extent_m, "grid.extent_m")
         scenario = replace(
             scenario,
-            extent=tuple(_needed(grid.extent_m, "grid.extent_m")),
+            extent=(extent_x, extent_y),
             step=float(_needed(grid.step_m, "grid.step_m")),
             altitude_levels=levels,
             headings=int(grid.headings or scenario.headings),  # reduced grids may have fewer
         )
         width, height = _needed(metadata.image_size(), "camera.width and height")
-        camera = Camera(width, height, float(_needed(metadata.camera.vfov_deg, "camera.vfov_deg")))  # type: ignore[union-attr]
+        assert metadata.camera is not None  # image_size() read the size from it
+        camera = Camera(width, height, float(_needed(metadata.camera.vfov_deg, "camera.vfov_deg")))
         settings = SceneSettings(
             folder,
             metadata,
@@ -208,7 +211,7 @@ class SceneAssets:
         from_cache: Whether this came from the cache (False: regrown just now).
     """
 
-    geometry: object
+    geometry: SceneGeometry
     fruit_uuids: dict[int, np.ndarray]
     uuid_count: int
     lighting: Lighting
@@ -324,7 +327,7 @@ def save_cache(path: Path, key: str, assets: SceneAssets) -> None:
     arrays = {name: getattr(geometry, name) for name in _GEOMETRY_FIELDS}
     arrays.update(
         key=np.array(key),
-        texture_files=np.array([_portable(f, root) for f in geometry.texture_files], dtype=str),
+        texture_files=np.array([_portable(f, root) for f in geometry.texture_files], dtype=np.str_),
         fruit_ids=np.array(fruit_ids, dtype=np.int64),
         fruit_offsets=np.cumsum([0] + [len(u) for u in uuids]),
         fruit_uuids=np.concatenate(uuids + [np.zeros(0, np.int64)]).astype(np.int64),
@@ -365,8 +368,8 @@ def load_cache(path: Path, key: str) -> SceneAssets | None:
                     int(g[1]),
                     int(g[2]),
                     int(g[3]),
-                    tuple(map(float, n)),
-                    tuple(map(float, p)),
+                    (float(n[0]), float(n[1]), float(n[2])),
+                    (float(p[0]), float(p[1]), float(p[2])),
                     float(a[0]),
                     float(a[1]),
                 )

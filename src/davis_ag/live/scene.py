@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 from pathlib import Path
 
 import numpy as np
@@ -28,6 +29,9 @@ from davis_ag.live.reopen import SceneAssets, SceneSettings, read_settings, reop
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import plant_centres
 from davis_ag.scene.view_grid import Viewpoint
+
+if TYPE_CHECKING:  # the renderer loads OpenGL: imported where the first one is made
+    from davis_ag.render.opengl import OpenGLRenderer
 
 
 @dataclass(frozen=True)
@@ -135,7 +139,7 @@ class LiveScene:
         """
         self.settings, self.assets = settings, assets
         self.lookup = fruit_lookup(assets.fruit_uuids, assets.uuid_count)
-        self._renderers: dict[tuple, object] = {}
+        self._renderers: dict[tuple[Camera, str, bool], OpenGLRenderer] = {}
         self._names = {view_name(v.number): v for v in assets.grid_views}
 
     # ------------------------------------------------------------------------------ poses
@@ -184,7 +188,7 @@ class LiveScene:
         vfov: float | None = None,
         antialiasing: str | None = None,
         fast_ground: bool = False,
-    ):
+    ) -> OpenGLRenderer:
         """The renderer for an image size (made once, kept until :meth:`close`); ``fast_ground``
         draws the soil as one quad (:func:`merge_ground`)."""
         from davis_ag.render.backends import resolve_antialiasing

@@ -54,7 +54,9 @@ class EpisodeLog(gym.Wrapper):
         return obs, reward, terminated, truncated, info
 
 
-def make_logged_env(dataset: Any, scenario: str, seed: int, **env_kwargs: Any) -> tuple[gym.Env, EpisodeLog]:
+def make_logged_env(
+    dataset: str | os.PathLike[str], scenario: str, seed: int, **env_kwargs: Any
+) -> tuple[gym.Env, EpisodeLog]:
     """One TVMContinuous-v0 environment that records its episodes (:class:`EpisodeLog`), seeded."""
     from stable_baselines3.common.monitor import Monitor
 
@@ -86,7 +88,7 @@ def _progress_printer(log: EpisodeLog, total: int, every: int):
 
 
 def train_continuous(
-    dataset: Any,
+    dataset: str | os.PathLike[str],
     scenario: str = "sp",
     total_timesteps: int = 10_000,
     seed: int = 0,

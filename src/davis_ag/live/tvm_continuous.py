@@ -87,6 +87,7 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
     """TVM with a continuous camera pose; see the module docstring for the rules."""
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 2}
+    action_space: spaces.Box
 
     def __init__(
         self,
@@ -209,7 +210,7 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
     def _pose(self, position: np.ndarray, yaw: float, pitch: float) -> Viewpoint:
         if self.aim == "plant":
             return self.scene.aimed_pose(*position)
-        return self.scene.pose(*position, yaw, float(np.clip(pitch, *PITCH_RANGE)))
+        return self.scene.pose(position[0], position[1], position[2], yaw, float(np.clip(pitch, *PITCH_RANGE)))
 
     def _draw(self, view: Viewpoint) -> LiveView:
         self.draws += 1
@@ -368,12 +369,12 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
     def proposed(self, action: Any, slip: bool = True) -> Viewpoint:
         """The pose an action aims for from the current one (slip drawn when ``slip``)."""
         a = self._action(action)
-        here = np.asarray(self._view.position, dtype=np.float64)
+        here = np.asarray(self._here.position, dtype=np.float64)
         move = np.array([a[0] * self.max_move, a[1] * self.max_move, a[2] * self.max_climb])
         if slip and (move[0] or move[1]):
             move[:2] += self.np_random.normal(0.0, SLIP_SIGMA, size=2)
         turn = (a[3] * self.max_turn, a[4] * self.max_turn) if self.aim == "free" else (0.0, 0.0)
-        return self._pose(here + move, self._view.yaw + turn[0], self._view.pitch + turn[1])
+        return self._pose(here + move, self._here.yaw + turn[0], self._here.pitch + turn[1])
 
     def try_pose(self, view: Viewpoint) -> tuple[str, LiveView | None]:
         """Whether the camera may go from the current pose to ``view``, and the labels there.
@@ -382,7 +383,7 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
             The pair ``("", labels)`` when allowed, else ``(reason, labels or None)``, the reason
                 ``bounds``, ``collision`` or ``target lost``.
         """
-        reason = self.blocked(np.asarray(self._view.position), np.asarray(view.position))
+        reason = self.blocked(np.asarray(self._here.position), np.asarray(view.position))
         if reason:
             return reason, None
         labels = self._draw(view)
@@ -414,7 +415,7 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
     @property
     def oer(self) -> float:
         """The target's OER in the current view."""
-        return float(self._labels.oer[self._target])
+        return float(self._seen.oer[self._target])
 
     @property
     def steps_taken(self) -> int:
@@ -426,13 +427,30 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         """The target fruit's id."""
         return self._target
 
+    @property
+    def _here(self) -> Viewpoint:
+        """The current pose (an episode has started)."""
+        assert self._view is not None, "no pose before reset()"
+        return self._view
+
+    @property
+    def _seen(self) -> LiveView:
+        """The labels of the current view (an episode has started)."""
+        assert self._labels is not None, "no view before reset()"
+        return self._labels
+
+    def _target_box(self) -> list[int]:
+        box = self._seen.box(self._target)
+        assert box is not None  # a move that loses the target is refused, so the view holds it
+        return box
+
     def _rounded_pose(self) -> list[float]:
-        return [round(float(v), 4) for v in (*self._view.position, self._view.yaw, self._view.pitch)]
+        return [round(float(v), 4) for v in (*self._here.position, self._here.yaw, self._here.pitch)]
 
     def _observation(self) -> np.ndarray:
         obs = np.zeros((self.size, self.size, 4), dtype=np.uint8)
-        obs[..., :3] = self._labels.colour
-        x0, y0, w, h = self._labels.box(self._target)[:4]
+        obs[..., :3] = self._seen.colour
+        x0, y0, w, h = self._target_box()[:4]
         obs[y0 : y0 + h, x0 : x0 + w, 3] = 255
         return obs
 
@@ -451,8 +469,8 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         """``rgb_array``: the current view with the target's box outlined in red."""
         if self.render_mode != "rgb_array" or self._labels is None:
             return None
-        frame = np.array(self._labels.colour)
-        x0, y0, w, h = self._labels.box(self._target)[:4]
+        frame = np.array(self._seen.colour)
+        x0, y0, w, h = self._target_box()[:4]
         x1, y1 = x0 + w - 1, y0 + h - 1
         frame[y0, x0 : x1 + 1] = frame[y1, x0 : x1 + 1] = (255, 0, 0)
         frame[y0 : y1 + 1, x0] = frame[y0 : y1 + 1, x1] = (255, 0, 0)

@@ -116,9 +116,9 @@ def texture_layers(files: list[str], look: str) -> tuple[np.ndarray, np.ndarray]
     # Half floats in linear light: the shader samples colours it need not decode.
     data = np.zeros((max(1, len(images)), height, width, 4), dtype=np.float16)
     scale = np.ones((64, 2), dtype=np.float32)
-    for k, image in enumerate(images):
-        texels = image.astype(np.float64) / 255.0
+    for k, texture in enumerate(images):
+        texels = texture.astype(np.float64) / 255.0
         texels[..., :3] = decode_srgb(texels[..., :3])
-        data[k, : image.shape[0], : image.shape[1]] = texels
-        scale[k] = (image.shape[1] / width, image.shape[0] / height)
+        data[k, : texture.shape[0], : texture.shape[1]] = texels
+        scale[k] = (texture.shape[1] / width, texture.shape[0] / height)
     return data, scale

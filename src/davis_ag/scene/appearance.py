@@ -22,13 +22,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass, replace
+from typing import Final, Literal, get_args
 
 from davis_ag.errors import UserError
 from davis_ag.scene.lighting import Lighting
 from davis_ag.seeds import APPEARANCE_STREAM, stream_rng
 
-APPEARANCES = ("paper", "random")
-DEFAULT_APPEARANCE = "paper"
+AppearanceMode = Literal["paper", "random"]
+APPEARANCES: tuple[str, ...] = get_args(AppearanceMode)
+DEFAULT_APPEARANCE: Final = "paper"
 #: The paper's soil image.
 PAPER_SOIL = "dirt.jpg"
 #: Helios's sky images (pyhelios3d's Visualizer textures), equirectangular.
@@ -77,8 +79,8 @@ class Appearance:
             return base
         return replace(
             base,
-            sun_elevation=self.sun_elevation,
-            sun_azimuth=self.sun_azimuth,
+            sun_elevation=base.sun_elevation if self.sun_elevation is None else self.sun_elevation,
+            sun_azimuth=base.sun_azimuth if self.sun_azimuth is None else self.sun_azimuth,
             sky_texture=helios_texture(self.sky) if self.sky else None,
             sun_strength=self.sun_strength,
             exposure=self.exposure,

@@ -7,6 +7,7 @@ drawn from the generator handed in.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 from pathlib import Path
 
 import numpy as np
@@ -31,6 +32,9 @@ from davis_ag.scene.specs import (
     check_plants,
     plant_positions,
 )
+
+if TYPE_CHECKING:  # pyhelios loads its native library: imported only where a scene is built
+    from pyhelios import Context
 
 #: Side of the square soil tile under every scene, m: wide enough to reach the horizon's haze.
 GROUND_SIZE = 60.0
@@ -80,7 +84,7 @@ class SceneModel:
             plant-library crop, ``library``).
     """
 
-    context: object
+    context: Context
     plants: list[GrownPlant]
     fruits: list[Fruit]
     lighting: Lighting
@@ -177,8 +181,14 @@ def _fruit(context, fruit_id: int, plant: int, body: list[int]) -> Fruit:
     polygons = [np.stack(group).astype(np.float64) for group in by_count.values()]
     points = np.concatenate(parts)
     lo, hi = points.min(axis=0), points.max(axis=0)
+    centre, size = (lo + hi) / 2, hi - lo
     return Fruit(
-        fruit_id, plant, uuids, polygons, tuple(float(v) for v in (lo + hi) / 2), tuple(float(v) for v in hi - lo)
+        fruit_id,
+        plant,
+        uuids,
+        polygons,
+        (float(centre[0]), float(centre[1]), float(centre[2])),
+        (float(size[0]), float(size[1]), float(size[2])),
     )
 
 
@@ -256,6 +266,7 @@ def build_scene(
 
     fruits: list[Fruit] = []
     for plant in grown:
+        assert plant.fruit_bodies is not None  # every grower above fills it in
         for body in plant.fruit_bodies:
             if len(fruits) >= MAX_FRUIT:
                 raise UserError(

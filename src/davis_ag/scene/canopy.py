@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import TypedDict
 
 import numpy as np
 
@@ -70,13 +71,55 @@ TEXTURES = {
 #: 27 % of the width from the left, the main lobe's tip at the right edge, both on the midline.
 GRAPE_LEAF_STALK_UV = (0.27, 0.5)
 GRAPE_LEAF_TIP_UV = (0.98, 0.5)
+
+
+class StrawberryParameters(TypedDict):
+    """:data:`STRAWBERRY`'s keys: counts are whole numbers, sizes (m) and chances floats."""
+
+    stems: int
+    clusters_per_stem: float
+    stem_radius: float
+    subdivisions: int
+    fruit_subdivisions: int
+
+
+class TomatoParameters(TypedDict):
+    """:data:`TOMATO`'s keys."""
+
+    subdivisions: int
+    fruit_subdivisions: int
+    stem_radius: float
+    shoot_radius: float
+
+
+class GobletParameters(TypedDict):
+    """:data:`GOBLET`'s keys."""
+
+    trunk_radius: float
+    cordon_height: float
+    shoot_length: float
+    shoot_radius: float
+    shoots_per_cordon: int
+    leaf_spacing_fraction: float
+    cluster_radius: float
+    cluster_height_max: float
+    grape_subdivisions: int
+    wood_subdivisions: int
+
+
 #: The plug-in's defaults that Table 1 does not list (``CanopyGenerator.cpp``'s constructors).
 STEM_COLOUR = (0.35, 0.45, 0.2)
 TOMATO_COLOUR = (0.7, 0.28, 0.2)
 GRAPE_COLOUR = (0.18, 0.2, 0.25)
-STRAWBERRY = {"stems": 50, "clusters_per_stem": 0.6, "stem_radius": 0.005, "subdivisions": 10, "fruit_subdivisions": 12}
-TOMATO = {"subdivisions": 10, "fruit_subdivisions": 8, "stem_radius": 0.02, "shoot_radius": 0.005}
-GOBLET = {
+STRAWBERRY: StrawberryParameters = {
+    "stems": 50,
+    "clusters_per_stem": 0.6,
+    "stem_radius": 0.005,
+    "subdivisions": 10,
+    "fruit_subdivisions": 12,
+}
+TOMATO: TomatoParameters = {"subdivisions": 10, "fruit_subdivisions": 8, "stem_radius": 0.02, "shoot_radius": 0.005}
+GOBLET: GobletParameters = {
     "trunk_radius": 0.05,
     "cordon_height": 0.9,
     "shoot_length": 0.9,

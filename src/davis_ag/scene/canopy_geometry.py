@@ -13,6 +13,7 @@ whole plant's leaves reach the Helios Context in one call.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -245,4 +246,4 @@ class PlantParts:
     tubes: list[Tube] = field(default_factory=list)
     leaves: list[LeafMesh] = field(default_factory=list)
     leaf_texture: str = ""
-    fruits: list[list[Tube | Sphere]] = field(default_factory=list)
+    fruits: list[Sequence[Tube | Sphere]] = field(default_factory=list)

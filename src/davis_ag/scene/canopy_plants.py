@@ -59,6 +59,7 @@ def _add_tube(context, tube: Tube) -> list[int]:
     if tube.texture is not None:
         obj = context.addTubeObject(tube.subdivisions, nodes, radii, texturefile=tube.texture)
     else:
+        assert tube.colour is not None  # an untextured tube is coloured
         obj = context.addTubeObject(tube.subdivisions, nodes, radii, colors=[RGBcolor(*tube.colour)] * len(nodes))
     return list(context.getObjectPrimitiveUUIDs(obj))
 

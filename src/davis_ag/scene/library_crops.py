@@ -91,6 +91,7 @@ def scaled_crop(
         The crop's :class:`CropSpec`.
     """
     scale = round(plant_height / TOMATO_HEIGHT, 2)
+    low, middle, high = TOMATO_ALTITUDES
     fruit_area = (fruit_radius / TOMATO_FRUIT_RADIUS) ** 2 / scale**2
     return CropSpec(
         name=name,
@@ -98,7 +99,7 @@ def scaled_crop(
         plant_height=plant_height,
         fruit_radius=fruit_radius,
         leaf_length=leaf_length,
-        altitudes=tuple(round(a * scale, 3) for a in TOMATO_ALTITUDES),  # type: ignore[arg-type]
+        altitudes=(round(low * scale, 3), round(middle * scale, 3), round(high * scale, 3)),
         min_fruit_pixels=max(MIN_BOX_PIXELS, round(TOMATO_MIN_PIXELS * fruit_area)),
         exclusion_radius=round(TOMATO_EXCLUSION * scale, 3),
         centre_height=round(plant_height / 2, 3),

@@ -74,7 +74,9 @@ def berry_radii(context, object_id: int) -> np.ndarray:
     _, labels = connected_components(graph, directed=False)
     berry_of_corner = labels[vertex_ids]
     corner_count = np.bincount(berry_of_corner).astype(float)
-    centres = np.stack([np.bincount(berry_of_corner, weights=corners[:, axis]) for axis in range(3)], axis=1)
+    centres: np.ndarray = np.stack(
+        [np.bincount(berry_of_corner, weights=corners[:, axis]) for axis in range(3)], axis=1
+    )
     centres /= corner_count[:, None]
     spread = np.linalg.norm(corners - centres[berry_of_corner], axis=1)
     radii = np.bincount(berry_of_corner, weights=spread) / corner_count

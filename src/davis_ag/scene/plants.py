@@ -28,7 +28,7 @@ import os
 import sys
 import time
 from dataclasses import asdict, dataclass, field
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
@@ -46,6 +46,9 @@ from davis_ag.scene.plant_geometry import (  # noqa: F401 - re-exported for the 
 )
 from davis_ag.scene.shoot_recipes import CROWN_INTERNODE, fixed_internode, with_shoot_recipe
 from davis_ag.scene.specs import PHENOTYPE_SPREAD, CropSpec
+
+if TYPE_CHECKING:  # pyhelios loads its native library: imported only where a scene is built
+    from pyhelios import Context, PlantArchitecture
 
 #: Helios maps seeds 0, 1, 2**31 - 1 and 2**32 - 1 to the same plant: stay inside this range.
 HELIOS_SEED_RANGE = (2, 2**31 - 2)
@@ -306,8 +309,8 @@ class ArchitectureModel:
         shoot_defaults: The parameters of every shoot type as loaded, read before any change.
     """
 
-    context: object
-    plant_architecture: object
+    context: Context
+    plant_architecture: PlantArchitecture
     crop: CropSpec
     shoot_defaults: dict[str, dict]
 

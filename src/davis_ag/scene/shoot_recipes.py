@@ -83,7 +83,7 @@ def with_shoot_recipe(params: dict, crop: CropSpec) -> dict:
     """
     out = copy.deepcopy(params)
     for path, spec in SHOOT_RECIPES.get(crop.name, ()):
-        parent = out
+        parent: dict | None = out
         for key in path[:-1]:
             parent = parent.get(key) if isinstance(parent, dict) else None
             if parent is None:

@@ -6,6 +6,7 @@ Everything here is plain data. Lengths are metres, angles degrees.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import Final, Literal, get_args
 
 from davis_ag.errors import UserError
 from davis_ag.scene.crop_spec import PAPER_IMAGE_SIZE, PAPER_PIXELS, CropSpec, RowSpec  # noqa: F401 - re-exported
@@ -180,8 +181,9 @@ def with_strawberry_altitudes(crop: CropSpec, choice: str) -> CropSpec:
 #: Plant generators: ``canopy`` (the default) rebuilds Helios's Canopy Generator, which grew the
 #: paper's plants (section III-A); ``architecture`` grows pyhelios3d's PlantArchitecture models,
 #: bent towards the paper by recipes (the generator before 2026-11-24).
-PLANT_GENERATORS: tuple[str, ...] = ("canopy", "architecture")
-DEFAULT_PLANTS = "canopy"
+PlantGenerator = Literal["canopy", "architecture"]
+PLANT_GENERATORS: tuple[str, ...] = get_args(PlantGenerator)
+DEFAULT_PLANTS: Final = "canopy"
 
 
 #: What scene.json records as the plant generator of a plant-library crop's scene: its plants

@@ -48,6 +48,7 @@ from davis_ag.generate.run_progress import count_views
 from davis_ag.render.egl_context import renderer_name
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import CROPS, SCENARIOS
+from davis_ag.scene.view_grid import Viewpoint
 from davis_ag.workflows.bench_report import (
     PAPER_HOURS_TARGET,
     SEED,
@@ -110,7 +111,8 @@ def bench_crop(
     ours_renderer = OpenGLRenderer(model.context, request.camera, model.lighting, antialiasing=antialiasing)
     try:
 
-        def documented_view(view) -> None:
+        def documented_view(view: Viewpoint) -> None:
+            assert helios is not None  # timed only with the documented renderer
             name = view_name(view.number)
             helios.set_view(view)
             jpeg = str(images / name)

@@ -7,13 +7,15 @@ Shared by the renderer bench (:mod:`davis_ag.workflows.bench`) and the crops ben
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Callable
 
 from davis_ag.generate.one_scene import SceneRequest, draw_scene
+from davis_ag.scene.view_grid import Viewpoint
 
 
-def time_loop(views: list, step: Callable[[object], None]) -> float:
+def time_loop(views: Sequence[Viewpoint], step: Callable[[Viewpoint], object]) -> float:
     """Run ``step`` on every view; seconds per view of all but the first."""
     step(views[0])
     start = time.perf_counter()

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import os
 import time
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -78,14 +79,14 @@ def training_speed(scratch: Path, steps: int = STEPS, devices: tuple[str, ...] =
     for device in devices:
         check_device(device)  # before minutes of measuring
     root = training_scenes(scratch / "training")
-    common = dict(seed=SEED, n_envs=8, arch="paper", checkpoint_every=0, keep="last", progress=False)
+    train = partial(train_agent, seed=SEED, n_envs=8, arch="paper", checkpoint_every=0, keep="last", progress=False)
     rows: dict[str, Any] = {}
     for device in devices:
         # Builds the cache (first device) and warms the device up before anything is timed.
-        train_agent(root, "sp", total_timesteps=8, out_path=scratch / f"warm-{device}.zip", device=device, **common)
+        train(root, "sp", total_timesteps=8, out_path=scratch / f"warm-{device}.zip", device=device)
         for number, (row, algo, settings) in enumerate(LEARNERS):
             started = time.perf_counter()
-            train_agent(
+            train(
                 root,
                 "sp",
                 total_timesteps=steps,
@@ -93,7 +94,6 @@ def training_speed(scratch: Path, steps: int = STEPS, devices: tuple[str, ...] =
                 algo=algo,
                 settings=settings,
                 device=device,
-                **common,
             )
             rate = steps / (time.perf_counter() - started)
             reference = next(iter(rows.values()))["steps_per_second"] if rows else rate

@@ -76,7 +76,7 @@ class ReproduceConfig:
         crop = crop_spec(crop_name)
         scenario = scenario_spec(scenario_name, crop)
         if scenario_name == "mp" and self.mp_extent:
-            scenario = replace(scenario, extent=tuple(self.mp_extent))
+            scenario = replace(scenario, extent=self.mp_extent)
         return scenario, crop
 
 

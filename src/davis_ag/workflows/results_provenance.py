@@ -41,7 +41,10 @@ def _counted(counter: Counter) -> str:
 
 def scene_provenance(dataset: Path, scenes: list[str]) -> list[str]:
     """One line per fact about how a group's scenes were made, from their scene.json files."""
-    versions, plants, renderers, sizes = Counter(), Counter(), Counter(), Counter()
+    versions: Counter[str] = Counter()
+    plants: Counter[str] = Counter()
+    renderers: Counter[str] = Counter()
+    sizes: Counter[str] = Counter()
     for scene in scenes:
         meta = read_scene_file_or_empty(dataset / scene / SCENE_METADATA)
         versions[(meta.generator.version if meta.generator else None) or "unrecorded"] += 1
