@@ -39,3 +39,33 @@ def test_torchvision_imports_and_its_nms_keeps_the_right_boxes() -> None:
     compiled, kept = done.stdout.split(maxsplit=1)
     assert compiled in ("True", "False")  # False: the CUDA wheel beside a CPU torch, patched
     assert kept.strip() == "[0, 2]"
+
+
+DAMAGED = """
+import io
+import PIL.Image
+from davis_ag.detection.offline import prepare_ultralytics
+pil_open = PIL.Image.open
+prepare_ultralytics()
+assert PIL.Image.open is pil_open, "ultralytics' replacement of PIL.Image.open is still in place"
+try:
+    PIL.Image.open(io.BytesIO(b"not a jpeg"))
+except PIL.UnidentifiedImageError:
+    print("PIL's own error")
+"""
+
+
+def test_a_damaged_image_after_ultralytics_gets_pils_own_error() -> None:
+    """Importing ultralytics replaced PIL.Image.open for the whole process: a damaged JPEG read
+    after it raised ModuleNotFoundError (pi_heif) instead of PIL's error, which davis-ag turns
+    into one line, and tried to install a package from the network."""
+    pytest.importorskip("ultralytics")
+    done = subprocess.run(
+        [sys.executable, "-c", DAMAGED],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={"PYTHONPATH": str(SRC), "PATH": "/usr/bin:/bin", "HOME": str(Path.home()), "YOLO_OFFLINE": "1"},
+    )
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.strip() == "PIL's own error"

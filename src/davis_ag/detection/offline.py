@@ -98,6 +98,10 @@ def prepare_ultralytics() -> ModuleType:
         return prepared
     import sys
 
+    from PIL import Image
+
+    pil_open = Image.open  # before anything of ultralytics is imported (see below)
+
     if "ultralytics" in sys.modules:
         raise UserError(
             "ultralytics was imported before davis_ag.detection.offline.prepare_ultralytics(); "
@@ -118,6 +122,12 @@ def prepare_ultralytics() -> ModuleType:
         torchvision.extension._has_ops = lambda: True
     import ultralytics
     from ultralytics.utils import SETTINGS, USER_CONFIG_DIR
+
+    # Importing ultralytics replaces PIL.Image.open, for the whole process, with one that meets an
+    # image PIL cannot identify by installing pi-heif from the network. davis-ag reads JPEG and PNG
+    # only, works offline, and reports a damaged file in one line from PIL's own error: the
+    # original comes back.
+    Image.open = pil_open
 
     _place_fonts(Path(USER_CONFIG_DIR))
     if SETTINGS.get("sync"):
