@@ -202,19 +202,39 @@ def replay_grid(
         tau=protocol.tau,
         start_rule=protocol.start_rule or "pairs",
     )
+    keys = ("scenario", "split", "tau", "scenes", "actions", "start_rule", "starts")
+    return report(replay_on(env, results, keys, _replay_episode, before=_replay_exact))
+
+
+def replay_on(
+    env: Any,
+    results: EvaluationResults,
+    keys: tuple[str, ...],
+    replay_episode: Any,
+    before: Any = None,
+) -> Difference | None:
+    """The replay both environments share: the protocol's ``keys`` against ``env.describe()``,
+    ``before(results, env)`` (the grid's exact expectations), then ``replay_episode`` on every
+    episode of every policy; the environment is closed after.
+
+    Returns:
+        The first difference, or None.
+    """
+    protocol = results.protocol
     try:
         described = env.describe()
-        for key in ("scenario", "split", "tau", "scenes", "actions", "start_rule", "starts"):
+        for key in keys:
             expect(getattr(protocol, key), described[key], "", f"protocol {key}")
-        _replay_exact(results, env)
+        if before is not None:
+            before(results, env)
         for name, policy in results.policies.items():
             for index, episode in enumerate(policy.episodes or []):
-                _replay_episode(env, name, episode.model_dump(), index, protocol.seed, protocol.episodes)
+                replay_episode(env, name, episode.model_dump(), index, protocol.seed, protocol.episodes)
     except DifferenceFound as found:
-        return report(found.difference)
+        return found.difference
     finally:
         env.close()
-    return report(None)
+    return None
 
 
 def _replay_episode(env: Any, name: str, stored: dict[str, Any], index: int, seed: int, per_session: int) -> None:

@@ -21,10 +21,10 @@ from typing import Any
 from davis_ag.benchmark.replay import (
     Difference,
     ReplayReport,
-    DifferenceFound,
     check_replayable,
     dataset_difference,
     expect,
+    replay_on,
 )
 from davis_ag.benchmark.results import EvaluationResults
 from davis_ag.benchmark.tvm import episode_reward
@@ -56,18 +56,8 @@ def replay_continuous(results: EvaluationResults, root: str | os.PathLike[str], 
     env = TVMContinuousEnv(
         root, protocol.scenario, protocol.split, crop=protocol.crop, aim=protocol.aim, tau=protocol.tau
     )
-    try:
-        described = env.describe()
-        for key in ("scenario", "split", "tau", "aim", "scenes", "actions"):
-            expect(getattr(protocol, key), described[key], "", f"protocol {key}")
-        for name, policy in results.policies.items():
-            for index, episode in enumerate(policy.episodes or []):
-                _replay_episode(env, name, episode.model_dump(), index, protocol.seed, protocol.episodes)
-    except DifferenceFound as found:
-        return report(found.difference)
-    finally:
-        env.close()
-    return report(None)
+    keys = ("scenario", "split", "tau", "aim", "scenes", "actions")
+    return report(replay_on(env, results, keys, _replay_episode))
 
 
 def _replay_episode(env: Any, name: str, stored: dict[str, Any], index: int, seed: int, per_session: int) -> None:
