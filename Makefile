@@ -28,7 +28,7 @@ demo: $(STAMP)
 test: $(STAMP)
 	$(BIN)/python -m pytest -q
 
-# ruff (pyflakes, pycodestyle, bugbear, and the formatter's check) over the code and tests, mypy
+# ruff (pyflakes, pycodestyle, bugbear, import order, pyupgrade, RUF, and the formatter's check) over the code and tests, mypy
 # over src/ (settings in pyproject.toml). `ruff format src tests` makes the format check pass.
 lint: $(STAMP)
 	$(BIN)/ruff check src tests

@@ -17,9 +17,9 @@ from pathlib import Path
 import pytest
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
-from layout_factory import write_tiny_dataset
 
 from davis_ag import cli
+from layout_factory import write_tiny_dataset
 
 #: Values any option may get: numbers, signs, lists, names, paths of every kind.
 ANY = st.sampled_from(

@@ -16,6 +16,7 @@ import zipfile
 from pathlib import Path
 
 import pytest
+
 from layout_factory import write_tiny_dataset
 
 DAVIS_AG = [sys.executable, "-m", "davis_ag.cli"]
@@ -60,7 +61,7 @@ def test_sigterm_ends_generate_with_one_line_and_the_run_resumes(tmp_path: Path)
         "progress resumes from its views: run the same command again to resume"
     ], err
     assert "leaked" not in err
-    done = subprocess.run(command + ["--quiet"], capture_output=True, text=True, timeout=300)
+    done = subprocess.run([*command, "--quiet"], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0 and "leaked" not in done.stderr, done.stderr
     assert sorted(p.name for p in (out / "Single-Strawberry").iterdir()) == ["000", "001"]
 

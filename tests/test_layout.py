@@ -44,7 +44,7 @@ NO_HELIOS_AT_IMPORT = ("scene", "formats", "data", "benchmark", "detection")
 
 
 def module_name(path: Path) -> str:
-    parts = ("davis_ag",) + path.relative_to(PACKAGE).with_suffix("").parts
+    parts = ("davis_ag", *path.relative_to(PACKAGE).with_suffix("").parts)
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
@@ -122,10 +122,10 @@ def test_no_import_cycles() -> None:
         state[node] = 1
         for nxt in sorted(edges[node]):
             if state.get(nxt) == 1:
-                cycle = path[path.index(nxt) :] + [nxt] if nxt in path else [node, nxt]
+                cycle = [*path[path.index(nxt) :], nxt] if nxt in path else [node, nxt]
                 pytest.fail("import cycle: " + " -> ".join(cycle))
             if nxt not in state:
-                visit(nxt, path + [nxt])
+                visit(nxt, [*path, nxt])
         state[node] = 2
 
     for start in sorted(edges):

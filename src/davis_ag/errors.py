@@ -4,8 +4,9 @@ docs/errors.md lists the classes and their exit statuses: bad input 2, a failure
 a stop asked for by a signal 128 + the signal's number.
 """
 
+from collections.abc import Iterator
 from contextlib import contextmanager
-from typing import Any, Iterator
+from typing import Any
 
 
 class UserError(Exception):

@@ -6,7 +6,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from layout_factory import write_tiny_dataset
 
 from davis_ag.benchmark import TVMEnv
 from davis_ag.benchmark.agents import (
@@ -20,6 +19,7 @@ from davis_ag.benchmark.evaluation import evaluate_policies, run_episode
 from davis_ag.benchmark.policies import ModelPolicy
 from davis_ag.benchmark.training import train_a2c
 from davis_ag.errors import UserError
+from layout_factory import write_tiny_dataset
 
 
 @pytest.mark.parametrize("scenario", ["sp", "mp"])
@@ -103,7 +103,7 @@ def test_oracle_episode_length_counts_done(sp_root: Path) -> None:
 def test_build_agents_errors() -> None:
     with pytest.raises(UserError, match="unknown policy"):
         build_agents(["LRD", "Greedy"])
-    with pytest.raises(UserError, match="--policy MODEL.zip"):
+    with pytest.raises(UserError, match=r"--policy MODEL.zip"):
         build_agents(["A2C"])
     with pytest.raises(UserError, match="no such model"):
         ModelPolicy("/nonexistent/model.zip")

@@ -37,7 +37,7 @@ def test_a_lin_value_falls_linearly_from_its_number_to_zero(start: float, remain
 
 @pytest.mark.parametrize("settings", [{"learning_rate": "lin_fast"}, {"n_epochs": "lin_4"}, {"clip_range": "lin_"}])
 def test_a_lin_value_that_is_no_number_or_no_schedule_is_refused_in_one_line(settings: dict[str, str]) -> None:
-    with pytest.raises(UserError, match="lin_X .X a number. is for learning_rate, clip_range, clip_range_vf only"):
+    with pytest.raises(UserError, match=r"lin_X .X a number. is for learning_rate, clip_range, clip_range_vf only"):
         sb3_arguments(settings)
 
 

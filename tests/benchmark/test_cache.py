@@ -7,13 +7,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from layout_factory import write_tiny_dataset
 from PIL import Image
 
 from davis_ag.benchmark import TVMEnv
 from davis_ag.benchmark import cache as cache_module
 from davis_ag.benchmark.cache import CACHE_FOLDER, load_scene_cache, scaled_box
 from davis_ag.data.reader import View, exposure_rate, open_dataset
+from layout_factory import write_tiny_dataset
 
 
 @pytest.fixture()

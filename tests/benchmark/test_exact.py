@@ -36,7 +36,7 @@ def _enumerate(env: TVMEnv, start: tuple[str, str, int], probs: np.ndarray) -> d
             totals["length"] += weight * len(prefix)
             return
         for a in np.flatnonzero(probs):
-            play(prefix + [int(a)], weight * probs[a])
+            play([*prefix, int(a)], weight * probs[a])
 
     for a in np.flatnonzero(probs):
         play([int(a)], probs[a])

@@ -8,12 +8,12 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from layout_factory import write_tiny_dataset
 
 from davis_ag import cli
 from davis_ag.benchmark import evaluate
 from davis_ag.benchmark.leaderboard import format_leaderboard, leaderboard
 from davis_ag.errors import UserError
+from layout_factory import write_tiny_dataset
 
 
 def _always(move: str):

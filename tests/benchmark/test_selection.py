@@ -6,13 +6,13 @@ import json
 from pathlib import Path
 
 import pytest
-from kill_callback import KillAfter
-from layout_factory import write_tiny_dataset
 from stable_baselines3 import A2C
 
 from davis_ag.benchmark.selection import check_keep
 from davis_ag.benchmark.training import checkpoint_paths, train_a2c, training_record_path
 from davis_ag.errors import UserError
+from kill_callback import KillAfter
+from layout_factory import write_tiny_dataset
 
 KWARGS = dict(total_timesteps=240, seed=1, n_envs=2, arch="pooled", device="cpu", select_every=40)
 

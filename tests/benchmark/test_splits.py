@@ -6,11 +6,11 @@ import os
 from pathlib import Path
 
 import pytest
-from layout_factory import write_tiny_dataset
 
 from davis_ag.benchmark.splits import dataset_splits, select_scenes
 from davis_ag.data.reader import open_dataset
 from davis_ag.errors import UserError
+from layout_factory import write_tiny_dataset
 
 
 def test_a_listed_scene_without_readable_labels_is_refused(tmp_path: Path) -> None:
@@ -21,7 +21,7 @@ def test_a_listed_scene_without_readable_labels_is_refused(tmp_path: Path) -> No
     labels.unlink()
     os.symlink("annotations.json", labels)  # a link to itself: there, but never readable
     with pytest.raises(
-        UserError, match="Single-Strawberry/001: a (train|test) scene of splits.json without a readable"
+        UserError, match=r"Single-Strawberry/001: a (train|test) scene of splits.json without a readable"
     ):
         select_scenes(open_dataset(root), "sp", "train")
     with pytest.raises(UserError, match="Single-Strawberry/001"):

@@ -9,8 +9,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 import torch
-from kill_callback import KillAfter
-from layout_factory import write_tiny_dataset
 from stable_baselines3 import A2C
 from stable_baselines3.common.callbacks import BaseCallback, CallbackList
 
@@ -20,6 +18,8 @@ from davis_ag.benchmark.training import check_device, checkpoint_paths, train_a2
 from davis_ag.errors import MachineError, UserError
 from davis_ag.provenance import code_version
 from davis_ag.seeds import resumed_training_seed
+from kill_callback import KillAfter
+from layout_factory import write_tiny_dataset
 
 #: The smallest real training run: two environments, the tiny network, a checkpoint every 20 steps.
 TINY_RUN = dict(n_envs=2, arch="pooled", device="cpu", checkpoint_every=20)
@@ -84,7 +84,7 @@ def test_a_checkpoint_of_another_dataset_is_not_resumed(
         )
     saved = json.loads(checkpoint_paths(out)[1].read_text())
     assert saved["dataset"] == str(Path(first).absolute())
-    with pytest.raises(UserError, match="checkpoint of another run .*another dataset.*--force"):
+    with pytest.raises(UserError, match=r"checkpoint of another run .*another dataset.*--force"):
         train_a2c(
             second,
             "sp",
@@ -166,7 +166,7 @@ def test_a_model_is_never_scored_on_the_scenes_it_learnt_from(
             {**json.loads(splits.read_text()), "train": [], "test": ["Single-Strawberry/000", "Single-Strawberry/001"]}
         )
     )
-    with pytest.raises(UserError, match="trained on 1 of the 2 test scenes .*Single-Strawberry/000.*train it again"):
+    with pytest.raises(UserError, match=r"trained on 1 of the 2 test scenes .*Single-Strawberry/000.*train it again"):
         evaluate([ModelPolicy(out)], root, "sp", sessions=1, episodes=2)
     # A checkpoint of one split is not resumed on another.
     original = {"train": ["Single-Strawberry/000"], "test": ["Single-Strawberry/001"]}

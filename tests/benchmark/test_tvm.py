@@ -8,12 +8,12 @@ import gymnasium
 import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
-from layout_factory import write_original_style_dataset
 from PIL import Image
 
 import davis_ag  # noqa: F401 - registers the environments
 from davis_ag.benchmark import CONTINUOUS_ID, TVMEnv
 from davis_ag.errors import UserError
+from layout_factory import write_original_style_dataset
 
 #: Every grid environment registered; TVMContinuous-v0 renders scenes of ours, so it is checked
 #: on a generated scene in tests/live/test_tvm_continuous.py, not on these tiny layout datasets.
@@ -103,7 +103,7 @@ def test_reward_on_episodes(sp_root: Path) -> None:
     seen_positive = seen_zero = False
     for seed in range(30):
         for first in range(6):
-            _, info = env.reset(seed=seed)
+            _, _info = env.reset(seed=seed)
             trace = _episode(env, seed, [first, 3, 2])
             final = trace[-1]
             assert [step[1] for step in trace[1:-1]] == [0.0] * (len(trace) - 2)
@@ -147,7 +147,7 @@ def test_refused_moves_stay_and_cost_a_step(sp_root: Path, kind: str) -> None:
     env = TVMEnv(sp_root, "sp", split="all")
     scene, view, fruit, action = _find(env, kind)
     obs, info = env.reset(options={"start": (scene, view, fruit)})
-    obs2, reward, terminated, truncated, info2 = env.step(action)
+    obs2, reward, terminated, _truncated, info2 = env.step(action)
     np.testing.assert_array_equal(obs, obs2)
     assert info2["path"] == [view, view] and info2["steps"] == 1
     assert not terminated and reward == 0.0 and info2["oer_t"] == info["oer_0"]

@@ -17,7 +17,7 @@ from davis_ag.errors import UserError
 
 @pytest.mark.parametrize("text", ["-1", "x", "", "1.5", "4294967296", "²", " "])
 def test_bad_seeds_are_refused(text: str) -> None:
-    with pytest.raises(argparse.ArgumentTypeError, match="seed|whole"):
+    with pytest.raises(argparse.ArgumentTypeError, match=r"seed|whole"):
         arguments.seed(text)
 
 

@@ -9,9 +9,9 @@ import os
 from pathlib import Path
 
 import pytest
-from layout_factory import write_tiny_dataset
 
 from davis_ag import cli
+from layout_factory import write_tiny_dataset
 
 
 def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
@@ -205,7 +205,7 @@ def test_a_model_trained_for_another_scenario(
     capsys: pytest.CaptureFixture[str], sp_root: Path, mp_root: Path, tmp_path: Path
 ) -> None:
     model = tmp_path / "sp.zip"
-    code, out, err = run(
+    code, _out, err = run(
         capsys,
         "train",
         "--dataset",

@@ -15,20 +15,21 @@ import json
 import os
 import shutil
 import sys
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from layout_factory import write_tiny_dataset
 from PIL import Image
 
 from davis_ag.benchmark import TVMEnv
 from davis_ag.data.reader import open_dataset
 from davis_ag.data.validate import validate_dataset
 from davis_ag.errors import UserError
+from layout_factory import write_tiny_dataset
 
 SCENE = "Single-Strawberry/000"
 _counter = itertools.count()

@@ -9,17 +9,17 @@ import json
 import shutil
 import struct
 import zlib
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 import pytest
-from layout_factory import write_tiny_dataset
 from PIL import Image
 
 from davis_ag.data.reader import Box, exposure_rate, open_dataset
 from davis_ag.data.validate import validate_dataset
 from davis_ag.errors import UserError
+from layout_factory import write_tiny_dataset
 
 SCENE = Path("Single-Strawberry") / "000"
 

@@ -10,8 +10,6 @@ import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
-from layout_factory import write_original_style_dataset, write_tiny_dataset
-from wide_masks import widen_scene
 
 from davis_ag.data.reader import (
     Box,
@@ -26,6 +24,8 @@ from davis_ag.data.reader import (
 from davis_ag.errors import UserError
 from davis_ag.formats.models import SplitsFile
 from davis_ag.scene.specs import INVERSE_ACTION, MP_ACTIONS, SP_ACTIONS
+from layout_factory import write_original_style_dataset, write_tiny_dataset
+from wide_masks import widen_scene
 
 
 @pytest.fixture(scope="module")
@@ -198,7 +198,7 @@ def test_malformed_annotations_raise_user_error(tmp_path: Path) -> None:
     (scene_dir / "annotations.json").write_text('{"0001": {"forward": "0002"}}')
     scene = open_dataset(scene_dir).scenes[0]
     assert scene.actions == ("forward",)
-    with pytest.raises(UserError, match="forward points to 0002.jpeg"):
+    with pytest.raises(UserError, match=r"forward points to 0002.jpeg"):
         scene.view(1).next("forward")
     with pytest.raises(UserError, match="image file missing"):
         scene.view(1).image()

@@ -8,14 +8,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from layout_factory import tiny_specs, write_original_style_dataset, write_tiny_dataset
 from PIL import Image
-from wide_masks import widen_scene
 
 from davis_ag import cli
 from davis_ag.data.validate import validate_dataset
 from davis_ag.formats.masks import mask_image
 from davis_ag.scene.view_grid import views_per_scene
+from layout_factory import tiny_specs, write_original_style_dataset, write_tiny_dataset
+from wide_masks import widen_scene
 
 SCENE = Path("Single-Strawberry") / "000"
 

@@ -9,9 +9,9 @@ import shutil
 from pathlib import Path
 
 import pytest
-from layout_factory import write_tiny_dataset
 
 from davis_ag.data.validation_stamp import validation_stamp
+from layout_factory import write_tiny_dataset
 
 GROUP = "Single-Strawberry"
 

@@ -9,10 +9,10 @@ import shutil
 from pathlib import Path
 
 import pytest
-from layout_factory import write_tiny_dataset
 from PIL import Image
 
 from davis_ag import cli
+from layout_factory import write_tiny_dataset
 
 VIEW = Path("Single-Strawberry") / "000" / "images" / "0001.jpeg"
 

@@ -7,18 +7,17 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-from layout_factory import write_original_style_dataset, write_tiny_dataset
 from PIL import Image
-from wide_masks import widen_scene
 
 from davis_ag.cli import main
-from davis_ag.scene.specs import CROPS
 from davis_ag.data.reader import open_dataset
 from davis_ag.detection.coco_export import export_coco
 from davis_ag.detection.instances import scenes_by_split
 from davis_ag.detection.yolo_export import export_yolo, flat_name
 from davis_ag.errors import UserError
+from davis_ag.scene.specs import CROPS
+from layout_factory import write_original_style_dataset, write_tiny_dataset
+from wide_masks import widen_scene
 
 
 @pytest.fixture(scope="module")

@@ -6,13 +6,13 @@ from pathlib import Path
 
 import pytest
 import yaml
-from layout_factory import write_tiny_dataset
 
-from davis_ag.scene.specs import CROPS
 from davis_ag.detection.coco_export import export_coco
 from davis_ag.detection.real_sets import PAPER_TEST, PAPER_TRAIN, load_pool, split_sizes, write_split
 from davis_ag.detection.yolo_export import export_yolo
 from davis_ag.errors import UserError
+from davis_ag.scene.specs import CROPS
+from layout_factory import write_tiny_dataset
 
 
 @pytest.fixture(scope="module")

@@ -8,12 +8,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 import torch
-from layout_factory import write_tiny_dataset
 from PIL import Image
 
 from davis_ag.data.reader import open_dataset
 from davis_ag.detection.torch_dataset import DavisAgDetection, collate
 from davis_ag.errors import UserError
+from layout_factory import write_tiny_dataset
 
 
 @pytest.fixture(scope="module")

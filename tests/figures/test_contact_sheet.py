@@ -5,13 +5,13 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from layout_factory import write_original_style_dataset, write_tiny_dataset
 from matplotlib.figure import Figure
 from PIL import Image
 
 from davis_ag.data.reader import Scene, open_dataset
 from davis_ag.errors import UserError
 from davis_ag.figures.contact_sheet import draw_contact_sheet, draw_masks, pick_views
+from layout_factory import write_original_style_dataset, write_tiny_dataset
 
 
 @pytest.fixture(scope="module")
@@ -68,5 +68,5 @@ def test_draw_masks(scene: Scene, tmp_path: Path) -> None:
 def test_draw_masks_without_mask(tmp_path: Path) -> None:
     root = write_original_style_dataset(tmp_path / "orig", "sp", "strawberry", missing_mask=True)
     view = open_dataset(root).scenes[0].view(1)
-    with pytest.raises(UserError, match="0001_seg.png: missing"):
+    with pytest.raises(UserError, match=r"0001_seg.png: missing"):
         draw_masks(view, tmp_path / "mask.png")

@@ -8,7 +8,6 @@ import json
 from pathlib import Path
 
 import pytest
-from layout_factory import write_original_style_dataset
 
 from davis_ag.data.reader import open_dataset
 from davis_ag.errors import UserError
@@ -17,6 +16,7 @@ from davis_ag.figures.dataset_stats import dataset_statistics, format_statistics
 from davis_ag.figures.plots import PlotRequest, make_plot
 from davis_ag.figures.viewer_server import scene_payload
 from davis_ag.figures.visibility_plots import plot_altitude, plot_visibility
+from layout_factory import write_original_style_dataset
 
 
 @pytest.fixture(scope="module")

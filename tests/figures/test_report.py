@@ -6,7 +6,6 @@ import re
 from pathlib import Path
 
 import pytest
-from layout_factory import write_tiny_dataset
 
 from davis_ag.data.reader import open_dataset
 from davis_ag.errors import UserError
@@ -14,6 +13,7 @@ from davis_ag.figures.benchmark_plots import plot_oer
 from davis_ag.figures.report import phenotype_rows, write_report
 from davis_ag.figures.visibility_plots import plot_visibility
 from davis_ag.workflows.demo import Timer, run_baselines
+from layout_factory import write_tiny_dataset
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 

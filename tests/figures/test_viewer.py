@@ -15,11 +15,11 @@ from typing import Any
 import numpy as np
 import pytest
 from chromium_pipe import Chromium, find_chromium
-from layout_factory import write_tiny_dataset
 from PIL import Image
 
 from davis_ag import cli
 from davis_ag.figures.viewer_server import server_url, start_server
+from layout_factory import write_tiny_dataset
 
 
 def _serve(root: Path) -> Any:
@@ -223,7 +223,7 @@ def test_page_in_headless_chromium(real_root: Path, tmp_path: Path) -> None:
         assert browser.evaluate("document.getElementById('depth-toggle').classList.contains('hidden')")
 
         def pose_text(name: str) -> str:
-            x, y, z, yaw, pitch = raw[name]["pose"]
+            x, y, z, _yaw, _pitch = raw[name]["pose"]
             return f"pose x={x:.3f} y={y:.3f} z={z:.2f}"
 
         assert state["pose"].startswith(pose_text(start))

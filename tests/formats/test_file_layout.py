@@ -54,5 +54,5 @@ def test_written_files_read_back(tmp_path: Path) -> None:
     assert written == ["0003.jpeg", "0003_seg.png", "0003_depth.png"]
     assert np.allclose(read_depth(tmp_path / "0003_depth.png"), depth, atol=0.0006)
     (tmp_path / "0004_depth.png").write_bytes(b"not a png")
-    with pytest.raises(UserError, match="0004_depth.png: cannot decode"):
+    with pytest.raises(UserError, match=r"0004_depth.png: cannot decode"):
         read_depth(tmp_path / "0004_depth.png")

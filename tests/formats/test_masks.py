@@ -45,7 +45,7 @@ def test_the_fruit_count_picks_the_mask_type(count: int, dtype: type) -> None:
 
 @pytest.mark.parametrize("count", [-1, 65536, 10**6])
 def test_no_mask_holds_a_negative_count_or_more_than_65535_fruit(count: int) -> None:
-    with pytest.raises(ValueError, match="0..65535"):
+    with pytest.raises(ValueError, match=r"0..65535"):
         mask_dtype(count)
 
 

@@ -21,7 +21,7 @@ from davis_ag.formats.models import (
 def test_one_seed_rule() -> None:
     assert check_seed(0) == 0 and check_seed(MAX_SEED) == MAX_SEED
     for bad in (-1, MAX_SEED + 1, 1.5, True, "7"):
-        with pytest.raises(UserError, match="^--seed: must be a whole number"):
+        with pytest.raises(UserError, match=r"^--seed: must be a whole number"):
             check_seed(bad, "--seed")
 
 

@@ -9,7 +9,6 @@ import sys
 from pathlib import Path
 
 import pytest
-from layout_factory import write_tiny_dataset
 
 from davis_ag import cli
 from davis_ag.errors import UserError
@@ -19,6 +18,7 @@ from davis_ag.formats.outputs import (
     dataset_holding,
     file_lock_path,
 )
+from layout_factory import write_tiny_dataset
 
 
 def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:

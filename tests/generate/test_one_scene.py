@@ -15,8 +15,8 @@ from davis_ag import cli
 from davis_ag.data.reader import open_dataset
 from davis_ag.data.validate import validate_dataset
 from davis_ag.errors import UserError
-from davis_ag.formats.scene_file import read_scene_file
 from davis_ag.formats.layout import ROOT_FILES
+from davis_ag.formats.scene_file import read_scene_file
 from davis_ag.generate.one_scene import SceneRequest, generate_scene
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.plants import Phenotype, in_table_range, require_native_helios
@@ -356,7 +356,7 @@ def test_mock_pyhelios_is_a_clear_error(monkeypatch: pytest.MonkeyPatch) -> None
 
     # Without its native library (no system libGL/libEGL) pyhelios would silently run as a mock.
     monkeypatch.setattr(pyhelios.plugins, "get_library_info", lambda: {"is_mock": True, "library_path": None})
-    with pytest.raises(UserError, match="mock mode.*libgl1"):
+    with pytest.raises(UserError, match=r"mock mode.*libgl1"):
         require_native_helios()
     with pytest.raises(UserError, match="mock mode"):
         build_scene(SCENARIO, CROPS["strawberry"], np.random.default_rng(0))
@@ -543,6 +543,6 @@ def test_a_scene_that_lost_its_labels_is_neither_skipped_nor_drawn_over(
     assert check_scene_slot(root, REQUEST) is True  # whole: skipped
     (root / REQUEST.folder / "annotations.json").unlink()
     before = snapshot(root)
-    with pytest.raises(UserError, match="has lost its annotations.json .* move the folder out of the dataset"):
+    with pytest.raises(UserError, match=r"has lost its annotations.json .* move the folder out of the dataset"):
         check_scene_slot(root, REQUEST)
     assert snapshot(root) == before

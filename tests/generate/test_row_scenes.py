@@ -8,9 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from real_scenes import generate_config
-
 from davis_ag.scene.specs import CROPS
+from real_scenes import generate_config
 
 pytestmark = pytest.mark.slow
 

@@ -164,7 +164,7 @@ def test_bad_configs_name_file_key_and_problem(text: str, message: str) -> None:
 
 
 def test_missing_config_lists_presets(tmp_path: Path) -> None:
-    with pytest.raises(UserError, match="no config file 'papr' and no preset of that name.*mini"):
+    with pytest.raises(UserError, match=r"no config file 'papr' and no preset of that name.*mini"):
         load_dataset_config("papr")
     with pytest.raises(UserError, match="is a folder"):
         load_dataset_config(tmp_path)

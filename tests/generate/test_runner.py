@@ -296,7 +296,7 @@ def test_a_full_disk_midway_leaves_no_half_scene_and_the_next_run_redoes_it(
     root = tmp_path / "data"
     requests = load_dataset_config(tiny_config).requests(["Single-Strawberry/000"])
     with pytest.raises(
-        MachineError, match="1 of 1 scenes failed .*No space left on device.*run the same command again"
+        MachineError, match=r"1 of 1 scenes failed .*No space left on device.*run the same command again"
     ):
         run_dataset(requests, root, RunOptions(workers=1, progress=False))
     assert not list((root / "Single-Strawberry").iterdir())  # no half scene, visible or hidden

@@ -41,9 +41,9 @@ def test_the_continuous_environment_plays_the_library_crop(scene_dir: Path) -> N
     made = gymnasium.make(CONTINUOUS_ID, dataset=str(scene_dir), scenario="sp")
     try:
         check_env(made.unwrapped, skip_render_check=True)
-        observation, info = made.reset(seed=1)
+        observation, _info = made.reset(seed=1)
         assert observation.shape == (224, 224, 4)
-        _, reward, _, _, info = made.step(made.action_space.sample())
+        _, reward, _, _, _info = made.step(made.action_space.sample())
         assert reward >= 0.0
     finally:
         made.close()

@@ -14,16 +14,16 @@ import pytest
 
 from davis_ag import cli
 from davis_ag.benchmark import CONTINUOUS_ID
-from davis_ag.errors import UserError
 from davis_ag.benchmark.evaluation import evaluate_policies
 from davis_ag.benchmark.policies import ModelPolicy
+from davis_ag.errors import UserError
+from davis_ag.figures.result_charts import plot_training_curve
 from davis_ag.live.policies import Greedy, RandomAxes, build_policies
 from davis_ag.live.scene import LiveScene
-from davis_ag.figures.result_charts import plot_training_curve
 from davis_ag.live.training import train_continuous
 from davis_ag.live.tvm_continuous import TVMContinuousEnv
-from davis_ag.workflows.bench import steps_per_second
 from davis_ag.scene.specs import SLIP_SIGMA, with_strawberry_altitudes
+from davis_ag.workflows.bench import steps_per_second
 
 
 @pytest.fixture(scope="module")
@@ -90,7 +90,7 @@ def test_a_seed_fixes_the_start_and_the_slip(env: TVMContinuousEnv) -> None:
     def episode(seed: int) -> tuple[np.ndarray, list]:
         obs, info = env.reset(seed=seed)
         for action in ([0.7, 0.2, 0.5], [-0.3, -0.9, 0.0], [0.0, 0.0, 0.0]):
-            last, _, _, _, info = env.step(np.array(action, dtype=np.float32))
+            _last, _, _, _, info = env.step(np.array(action, dtype=np.float32))
         return obs, info["path"]
 
     first, again, other = episode(3), episode(3), episode(4)
@@ -175,7 +175,7 @@ def test_moves_out_of_the_grid_or_through_the_plant_are_refused(free_env: TVMCon
 
 def test_moves_slip_and_turns_do_not(free_env: TVMContinuousEnv) -> None:
     info = _start(free_env, -1.2, 0.0, 0.3)
-    x, y, z, yaw, pitch = info["path"][0]
+    x, y, z, yaw, _pitch = info["path"][0]
     _, _, _, _, info = free_env.step(np.array([0.0, 0.0, 0.0, 0.05, 0.0], dtype=np.float32))  # 9 degrees
     assert info["refused"] == "" and info["path"][-1][:3] == [x, y, z]
     assert info["path"][-1][3] == pytest.approx(yaw + 9.0, abs=1e-3)
@@ -257,11 +257,11 @@ def test_evaluate_command_takes_the_continuous_environment(
     results = json.loads(Path("r.json").read_text())
     assert results["protocol"]["environment"] == CONTINUOUS_ID and set(results["policies"]) == {"LR", "Rand"}
     assert Path("r.png").is_file()
-    assert cli.main(args[:-1] + ["Oracle"]) == 2
+    assert cli.main([*args[:-1], "Oracle"]) == 2
     assert "not a baseline of --env continuous" in capsys.readouterr().err
     # A policy file written with the grid's move names plays here too (named moves are unit moves).
     Path("mine.py").write_text("def climb(observation, info):\n    return 'up' if info['steps'] < 2 else 'done'\n")
-    assert cli.main(args[:-2] + ["--policies", "Rand", "--policy", "mine.py:climb", "--force"]) == 0
+    assert cli.main([*args[:-2], "--policies", "Rand", "--policy", "mine.py:climb", "--force"]) == 0
     mine = json.loads(Path("r.json").read_text())["policies"]["climb"]
     assert mine["mean_abs_action"]["dz"] == pytest.approx(2 / 3, abs=1e-4) and mine["mean_abs_action"]["dx"] == 0
     assert "Rand" in mine["paired"]

@@ -10,13 +10,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from helios_reference import helios_reference
-
 from davis_ag.labels.fruit_labels import silhouette_pixels
 from davis_ag.render.helios import HeliosRenderer
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.lighting import Lighting
 from davis_ag.scene.view_grid import Viewpoint
+from helios_reference import helios_reference
 
 CAMERA = Camera(96, 54)
 #: Two poses looking roughly along +x, one level and one turned, raised and tilted down.

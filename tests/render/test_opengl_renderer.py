@@ -13,13 +13,12 @@ from collections.abc import Iterator
 import numpy as np
 import pytest
 
-from helios_reference import helios_reference
-
 from davis_ag.labels.fruit_labels import fruit_lookup, label_view
 from davis_ag.render.backends import open_renderer, resolve_look
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import CROPS, SCENARIOS, plant_centres
 from davis_ag.scene.view_grid import build_view_grid
+from helios_reference import helios_reference
 
 #: The size datasets are drawn at (the paper's). At 640x360 the far soil near the horizon, its
 #: texture minified several times over, is sampled differently by the two: a median of 2.1/255 in

@@ -3,6 +3,7 @@ the plug-in puts fruit, organ labels, and the geometry helpers' conventions."""
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -184,7 +185,7 @@ def test_interpolate_tube_walks_the_polyline(points, fraction):
     point = interpolate_tube(nodes, fraction)
     # On some segment of the polyline.
     gaps = []
-    for a, b in zip(nodes[:-1], nodes[1:]):
+    for a, b in itertools.pairwise(nodes):
         t = np.clip(np.dot(point - a, b - a) / np.dot(b - a, b - a), 0, 1)
         gaps.append(np.linalg.norm(a + t * (b - a) - point))
     assert min(gaps) < 1e-9

@@ -8,14 +8,13 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from helios_reference import helios_reference
-
 from davis_ag.labels.fruit_labels import fruit_lookup, label_view
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.library_crops import LIBRARY_RECIPES
 from davis_ag.scene.organs import FLOWER, FRUIT, LEAF, ORGAN_DATA, PEDUNCLE, PETIOLE, SOIL, TRUNK
 from davis_ag.scene.specs import CROPS, plant_centres, scenario_spec
 from davis_ag.scene.view_grid import build_view_grid
+from helios_reference import helios_reference
 
 pytestmark = pytest.mark.slow
 
@@ -132,5 +131,5 @@ def test_every_recipe_change_lands_on_a_shoot_type_of_its_model(name: str) -> No
     changed = shoot_parameters(model.shoot_defaults, LIBRARY_RECIPES[name], factors)  # raises on a miss
     assert set(changed) == set(model.shoot_defaults)
     broken = replace(LIBRARY_RECIPES[name], shoot_changes=(("*", "no.such.parameter", 1.0),))
-    with pytest.raises(ValueError, match="no.such.parameter"):
+    with pytest.raises(ValueError, match=r"no.such.parameter"):
         shoot_parameters(model.shoot_defaults, broken, factors)

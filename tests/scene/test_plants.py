@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import asdict
 
 import numpy as np
@@ -96,7 +97,7 @@ def test_leaf_groups_partition_blades_into_short_consecutive_runs(blades: set[in
     for group in groups:
         assert 1 <= len(group) <= per_leaf
         assert group == list(range(group[0], group[0] + len(group)))
-    for first, second in zip(groups, groups[1:]):
+    for first, second in itertools.pairwise(groups):
         # A leaf ends at a gap in the numbering or when it has all its blades.
         assert second[0] != first[-1] + 1 or len(first) == per_leaf
 

@@ -6,12 +6,12 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from kill_callback import KillAfter
-from layout_factory import write_tiny_dataset
 from stable_baselines3.common.callbacks import CallbackList
 
 from davis_ag.benchmark.progress import TrainingProgress
 from davis_ag.benchmark.training import train_a2c
+from kill_callback import KillAfter
+from layout_factory import write_tiny_dataset
 
 
 def test_progress_of_a_resumed_run_starts_at_its_checkpoint(tmp_path: Path, one_thread: None) -> None:
@@ -94,8 +94,8 @@ def test_ppo_trains_beside_a2c_resumes_a_killed_run_and_reuses_a_finished_one(
     import json
     from dataclasses import replace
 
-    from davis_ag.benchmark.training import training_record_path
     from davis_ag.benchmark.algorithms import A2C_SETTINGS, SB3_SETTINGS
+    from davis_ag.benchmark.training import training_record_path
     from davis_ag.workflows.reproduce_configs import CONFIGS
     from davis_ag.workflows.reproduce_learners import KEEP, learner_stamp, train_learner
     from davis_ag.workflows.results_policies import model_path
@@ -152,10 +152,10 @@ def test_a_whole_run_times_every_stage_on_its_clock_and_a_rerun_adds_no_sitting(
     import json
     from dataclasses import replace
 
+    from davis_ag.provenance import machine_summary
     from davis_ag.workflows.reproduce import reproduce
     from davis_ag.workflows.reproduce_configs import CONFIGS
     from davis_ag.workflows.reproduce_status import run_status
-    from davis_ag.provenance import machine_summary
     from davis_ag.workflows.stage_clock import CLOCK_FILE, read_clock
 
     config = replace(

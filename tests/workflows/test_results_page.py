@@ -169,8 +169,8 @@ def test_a_broken_ordering_names_the_steps_that_break() -> None:
 
 def test_the_page_shows_what_each_policy_does(tmp_path: Path, sp_root: Path, one_thread: None) -> None:
     # A real (tiny) run's records: a model, its training record, an evaluation with every row.
-    from davis_ag.benchmark.training import train_a2c
     from davis_ag.benchmark.algorithms import A2C_SETTINGS
+    from davis_ag.benchmark.training import train_a2c
     from davis_ag.workflows.demo import run_baselines
     from davis_ag.workflows.reproduce import _summary
 
@@ -231,8 +231,8 @@ def test_a_run_with_ppo_shows_its_row_gap_settings_and_stage(tmp_path: Path, sp_
     from dataclasses import replace
 
     from davis_ag.benchmark.training import train_agent
-    from davis_ag.workflows.demo import run_baselines
     from davis_ag.figures.result_charts import plot_results
+    from davis_ag.workflows.demo import run_baselines
     from davis_ag.workflows.reproduce import _reusable_results, _summary, add_train_scores, add_train_split
     from davis_ag.workflows.results_policies import model_path
 

@@ -8,10 +8,10 @@ import socket
 from pathlib import Path
 
 import pytest
-from layout_factory import write_tiny_dataset
 
 from davis_ag.cli import main
 from davis_ag.workflows.transfer import PAPER_TABLE5
+from layout_factory import write_tiny_dataset
 
 
 def test_transfer_runs_end_to_end_offline(

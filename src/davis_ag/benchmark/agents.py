@@ -10,16 +10,17 @@ looks at the image.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import partial
-from typing import Any, Callable
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
 
+from davis_ag.benchmark.exact import action_probabilities
 from davis_ag.benchmark.policies import Policy, SeededPolicy, baselines_by_name, unwrapped
 from davis_ag.benchmark.tvm import TVMEnv
 from davis_ag.environments import TVM_ID
-from davis_ag.benchmark.exact import action_probabilities
 from davis_ag.errors import UserError
 
 #: Section V-B action sets by agent name. Rand uses every action of the environment, which in

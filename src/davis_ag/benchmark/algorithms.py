@@ -117,7 +117,7 @@ def check_setting_values(algo: str, settings: dict[str, Any]) -> None:
     defaults = {k: v.default for k, v in inspect.signature(getattr(stable_baselines3, algo.upper())).parameters.items()}
     for key, value in settings.items():
         default = defaults.get(key)
-        if isinstance(value, str) and value.startswith("lin_") or default is None or isinstance(value, dict):
+        if (isinstance(value, str) and value.startswith("lin_")) or default is None or isinstance(value, dict):
             continue  # schedules are checked by sb3_arguments; None defaults take many kinds
         shown = f"{algo.upper()} setting {key}={value!r}"
         if isinstance(default, bool):
@@ -128,7 +128,7 @@ def check_setting_values(algo: str, settings: dict[str, Any]) -> None:
                 raise UserError(f"{shown}: must be a number")
             if key in COUNTS and (not isinstance(value, int) or value < 1):
                 raise UserError(f"{shown}: must be a whole number, at least 1")
-            if key not in COUNTS + ("sde_sample_freq",) and value < 0:
+            if key not in (*COUNTS, "sde_sample_freq") and value < 0:
                 raise UserError(f"{shown}: must not be negative")
 
 

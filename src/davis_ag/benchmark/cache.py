@@ -184,7 +184,7 @@ def _resized_image(view: View) -> tuple[np.ndarray, tuple[int, int]]:
             size = pil.size
             pil.draft("RGB", (OBS_SIZE, OBS_SIZE))
             small = pil.convert("RGB").resize((OBS_SIZE, OBS_SIZE), Image.Resampling.BILINEAR)
-    except Exception:  # noqa: BLE001 - the reader below reports the real problem
+    except Exception:
         image = view.image()
         size = (image.shape[1], image.shape[0])
         small = Image.fromarray(np.ascontiguousarray(image[..., :3])).resize(
@@ -308,7 +308,7 @@ def _load(folder: Path, fingerprint: str) -> SceneCache | None:
             images=images,
             **tables,
         )
-    except Exception:  # noqa: BLE001 - whatever is wrong with it, the cache is rebuilt
+    except Exception:
         return None
     return cache if _consistent(cache) else None
 

@@ -26,9 +26,9 @@ from __future__ import annotations
 import importlib
 import os
 import traceback
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, cast
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
@@ -37,13 +37,6 @@ from davis_ag.benchmark.agents import FixedActionAgent
 from davis_ag.benchmark.code_digest import code_digest
 from davis_ag.benchmark.paired import FEW_SCENES
 from davis_ag.benchmark.policies import Policy, prepare
-from davis_ag.benchmark.summaries import (
-    PAIRED_BASELINES,
-    action_counts,
-    mean_abs_action,
-    paired_gaps,
-    session_metrics,
-)
 from davis_ag.benchmark.results import (
     PROTOCOL_VERSION,
     EvaluationResults,
@@ -54,6 +47,13 @@ from davis_ag.benchmark.results import (
     identify_dataset,
     split_text,
     table_number,
+)
+from davis_ag.benchmark.summaries import (
+    PAIRED_BASELINES,
+    action_counts,
+    mean_abs_action,
+    paired_gaps,
+    session_metrics,
 )
 from davis_ag.errors import UserError
 from davis_ag.provenance import code_version
@@ -96,7 +96,7 @@ def _act(policy: Policy, observation: Any, info: dict[str, Any]) -> Any:
         return policy.act(observation, info)
     except UserError:
         raise
-    except Exception as error:  # noqa: BLE001 - any failure of someone else's code
+    except Exception as error:
         frame = traceback.extract_tb(error.__traceback__)[-1]
         raise UserError(
             f"act failed with {type(error).__name__}: {error} (at {frame.filename}:{frame.lineno}); "
@@ -399,8 +399,8 @@ def evaluate(
     """
     import gymnasium as gym
 
-    from davis_ag.environments import CONTINUOUS_ID, TVM_ID
     from davis_ag.benchmark.policies import DETERMINISTIC_PLAY, as_policy, policy_from_spec
+    from davis_ag.environments import CONTINUOUS_ID, TVM_ID
 
     if env not in ENVIRONMENTS:
         raise UserError(f"unknown env {env!r}: choose one of {', '.join(ENVIRONMENTS)}")

@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import os
 from dataclasses import asdict, dataclass
-from typing import Any
 from pathlib import Path
+from typing import Any
 
 from davis_ag.benchmark.evaluation import PAIRED_BASELINES
 from davis_ag.benchmark.paired import FEW_SCENES

@@ -27,10 +27,10 @@ import json
 import os
 import sys
 import zipfile
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, Callable, Protocol, TypeVar, runtime_checkable
+from typing import Any, Protocol, TypeVar, runtime_checkable
 
 import numpy as np
 
@@ -221,7 +221,7 @@ def load_model(path: str | os.PathLike[str], device: str = "cpu") -> Any:
     algorithm = model_algorithm(path)
     try:
         return getattr(stable_baselines3, algorithm).load(path, device=device)
-    except Exception as error:  # noqa: BLE001 - any load failure is a bad file
+    except Exception as error:
         raise UserError(
             f"{path}: a {algorithm} model that does not load ({error}); give the .zip `davis-ag train` wrote"
         ) from None

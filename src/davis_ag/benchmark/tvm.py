@@ -96,7 +96,7 @@ def as_dataset(dataset: Dataset | str | os.PathLike[str]) -> Dataset:
 class TVMEnv(gym.Env[np.ndarray, np.int64]):
     """DAVIS-Ag target visibility maximisation; see the module docstring for the rules."""
 
-    metadata = {"render_modes": ["rgb_array"], "render_fps": 2}
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 2}  # noqa: RUF012 - Gymnasium declares it an instance attribute
 
     def __init__(
         self,
@@ -143,7 +143,7 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
         if self.tau < 1:
             raise UserError(f"tau must be at least 1, got {self.tau}")
         #: Action names by index: the scenario's moves, then ``done``.
-        self.action_names: tuple[str, ...] = tuple(spec.actions) + ("done",)
+        self.action_names: tuple[str, ...] = (*tuple(spec.actions), "done")
         self.done_action = len(self.action_names) - 1
         # Column of each move in the cache's pointer table (which follows ALL_ACTIONS).
         self._columns = [ALL_ACTIONS.index(a) for a in spec.actions]
@@ -308,7 +308,7 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
             "dataset": str(self.dataset.root),
             "actions": list(self.action_names),
             "start_rule": self.start_rule,
-            "starts": int(len(self.starts)),
+            "starts": len(self.starts),
         }
 
     def _action_index(self, action: Any) -> int:

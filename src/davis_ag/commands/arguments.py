@@ -9,8 +9,8 @@ those create a temporary file where the output will go, the only test that holds
 from __future__ import annotations
 
 import argparse
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
 
 from davis_ag.atomic_files import prove_writable_file, prove_writable_folder  # noqa: F401 - shared
 from davis_ag.errors import UserError

@@ -7,9 +7,9 @@ import argparse
 import sys
 from pathlib import Path
 
+from davis_ag.atomic_files import write_json_atomic
 from davis_ag.commands import arguments
 from davis_ag.errors import UserError
-from davis_ag.atomic_files import write_json_atomic
 from davis_ag.formats.outputs import LOCK_FILE, claim_output
 
 HELP = "write a dataset as COCO (RLE masks) or YOLO (ultralytics) detection data, or point clouds"

@@ -15,8 +15,8 @@ from PIL import Image, ImageDraw
 from davis_ag.atomic_files import atomic_output
 from davis_ag.commands import arguments
 from davis_ag.errors import UserError
-from davis_ag.formats.outputs import check_outside_datasets, claim_output
 from davis_ag.formats.layout import IMAGE_SUFFIX, JPEG_QUALITY, view_name, view_stem
+from davis_ag.formats.outputs import check_outside_datasets, claim_output
 from davis_ag.generate.one_scene import SceneRequest, grow_scene
 from davis_ag.generate.run_progress import count_views
 from davis_ag.labels.fruit_labels import fruit_lookup, label_view, visible_fractions

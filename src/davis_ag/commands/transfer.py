@@ -68,7 +68,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run the experiment and print the Table-5-style table."""
+    from contextlib import nullcontext
+
     from davis_ag.detection.yolo_training import Budget
+    from davis_ag.formats.outputs import check_outside_datasets, claim_output
     from davis_ag.workflows.transfer import (
         WORK_RECORD,
         TransferConfig,
@@ -76,10 +79,6 @@ def run(args: argparse.Namespace) -> int:
         table5_markdown,
         write_results_md,
     )
-
-    from contextlib import nullcontext
-
-    from davis_ag.formats.outputs import check_outside_datasets, claim_output
 
     # Before any export or training: the work folder and the report never land in a dataset.
     check_outside_datasets(args.out)

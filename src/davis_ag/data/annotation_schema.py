@@ -118,7 +118,7 @@ def parse_box(raw: Any) -> Box:
     if not isinstance(raw, (list, tuple)) or len(raw) < 5:
         raise ValueError(f"a box must be [xmin, ymin, width, height, fruit_id, 0], got {raw!r}")
     names = ("xmin", "ymin", "width", "height", "fruit_id")
-    values = [int(round(_number(v, f"box {n}"))) for v, n in zip(raw, names)]
+    values = [round(_number(v, f"box {n}")) for v, n in zip(raw, names)]
     for value, name in zip(values, names):
         if not -BOX_LIMIT < value < BOX_LIMIT:  # no image is that large; tables hold 32-bit ints
             raise ValueError(f"box {name} {value} is out of range (|value| < {BOX_LIMIT})")

@@ -40,7 +40,7 @@ def class_problems(class_path: Path, mask: np.ndarray | None) -> list[str]:
     if mask is None:  # absent or unreadable: the mask's own check reports it
         return problems
     if mask.shape != classes.shape:
-        return problems + [f"is {classes.shape[1]}x{classes.shape[0]} but its mask is {mask.shape[1]}x{mask.shape[0]}"]
+        return [*problems, f"is {classes.shape[1]}x{classes.shape[0]} but its mask is {mask.shape[1]}x{mask.shape[0]}"]
     fruit = fruit_pixels(mask)
     wrong = int(np.count_nonzero(fruit & (classes != FRUIT)))
     if wrong:

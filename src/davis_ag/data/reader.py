@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import Any, overload
 
 import numpy as np
+from pydantic import ValidationError
 
 from davis_ag.data.annotation_schema import (
     NO_FRUIT,
@@ -33,13 +34,11 @@ from davis_ag.data.annotation_schema import (
     parse_pose,
 )
 from davis_ag.data.safe_read import check_inside, load_pixels, read_json
-from pydantic import ValidationError
-
+from davis_ag.errors import UserError
 from davis_ag.formats.layout import ANNOTATIONS, IMAGES, SCENE_METADATA, read_depth, view_file, view_stem
 from davis_ag.formats.layout import SPLITS_FILE as SPLITS
 from davis_ag.formats.models import SplitsFile, one_line
 from davis_ag.formats.scene_file import SceneFile, parse_scene_file
-from davis_ag.errors import UserError
 from davis_ag.scene import specs as config
 
 __all__ = [

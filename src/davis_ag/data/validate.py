@@ -30,7 +30,7 @@ from davis_ag.data.pixel_checks import (
     mask_type_problems,
     read_mask,
 )
-from davis_ag.formats.scene_file import SceneFile, scene_file_from
+from davis_ag.data.problems import Problem, Report, outside_reason, read_json_file
 from davis_ag.data.reader import (
     ANNOTATIONS,
     SCENE_METADATA,
@@ -40,11 +40,11 @@ from davis_ag.data.reader import (
     open_dataset,
     parse_entry,
 )
-from davis_ag.data.problems import Problem, Report, outside_reason, read_json_file
 from davis_ag.data.validate_pool import in_scene_order
 from davis_ag.formats.layout import IMAGES, view_file, view_of_file
 from davis_ag.formats.masks import MAX_FRUIT_ID, mask_dtype, max_fruit_id
 from davis_ag.formats.models import AnnotationEntry, one_line
+from davis_ag.formats.scene_file import SceneFile, scene_file_from
 
 
 def validate_scene(

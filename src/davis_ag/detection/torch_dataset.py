@@ -27,9 +27,9 @@ import numpy as np
 import torch
 
 from davis_ag.data.reader import open_dataset
-from davis_ag.formats.layout import read_depth
 from davis_ag.detection.instances import label_view, scenes_by_split
 from davis_ag.errors import UserError
+from davis_ag.formats.layout import read_depth
 
 Target = dict[str, Any]
 

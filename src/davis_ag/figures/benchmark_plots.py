@@ -61,7 +61,7 @@ def plot_oer(scenes: list[Scene], out: str | Path, formats: tuple[str, ...] = FO
     return Plotted(
         paths,
         {
-            "boxes": int(len(oers)),
+            "boxes": len(oers),
             "edges": edges.tolist(),
             "counts": counts.tolist(),
             "below_start": below,
@@ -95,7 +95,7 @@ def policy_names(results: dict[str, Any], source: str, wanted: list[str] | None 
     Raises:
         UserError: for a file without policies or a policy it does not hold.
     """
-    known = list((results.get("policies") or {}))
+    known = list(results.get("policies") or {})
     if not known:
         raise UserError(f"{source}: holds no policies; give the JSON `davis-ag evaluate --out` wrote")
     for name in wanted or []:

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from davis_ag.atomic_files import save_figure_atomic as save_figure  # noqa: F401 (the figures' saver)
+from davis_ag.atomic_files import save_figure_atomic as save_figure
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure

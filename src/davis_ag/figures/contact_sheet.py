@@ -14,9 +14,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from davis_ag.data.reader import Scene, View
-from davis_ag.formats.masks import fruit_pixels, no_fruit_value
 from davis_ag.errors import UserError
 from davis_ag.figures.canvas import new_figure, save_figure
+from davis_ag.formats.masks import fruit_pixels, no_fruit_value
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

@@ -237,7 +237,7 @@ def format_statistics(stats: dict[str, Any]) -> str:
                 ],
             ]
         )
-    lines += [""] + _grid(rows)
+    lines += ["", *_grid(rows)]
     missing = sum(fruit[g].get("masks_missing", 0) for g in names)
     if missing:
         lines.append(f"{missing} boxes had no mask and no OER")

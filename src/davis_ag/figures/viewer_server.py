@@ -32,11 +32,11 @@ from urllib.parse import parse_qs, unquote, urlsplit
 import numpy as np
 
 from davis_ag.data.reader import Dataset, Scene, open_dataset
-from davis_ag.formats.masks import no_fruit_value
-from davis_ag.formats.layout import IMAGES, VIEW_FILES, read_depth_millimetres
 from davis_ag.errors import UserError
 from davis_ag.figures.scene_numbers import altitudes
 from davis_ag.figures.visibility_plots import plant_xy
+from davis_ag.formats.layout import IMAGES, VIEW_FILES, read_depth_millimetres
+from davis_ag.formats.masks import no_fruit_value
 
 #: The only file names served: an image, its mask or its depth image.
 FILE_NAME = re.compile(
@@ -192,7 +192,7 @@ def make_handler(viewer: Viewer, page: bytes) -> type[BaseHTTPRequestHandler]:
     class Handler(BaseHTTPRequestHandler):
         server_version = "davis-ag-view"
 
-        def log_message(self, format: str, *args: Any) -> None:  # noqa: A002 (the base's name)
+        def log_message(self, format: str, *args: Any) -> None:
             pass  # a page load is dozens of requests: keep the terminal for the URL
 
         def _send(self, status: int, body: bytes, kind: str, cache: bool = False) -> None:
@@ -207,7 +207,7 @@ def make_handler(viewer: Viewer, page: bytes) -> type[BaseHTTPRequestHandler]:
         def _missing(self, why: str = "not found") -> None:
             self._send(HTTPStatus.NOT_FOUND, why.encode(), "text/plain; charset=utf-8")
 
-        def do_GET(self) -> None:  # noqa: N802 (http.server's name)
+        def do_GET(self) -> None:
             # Only pages that asked for this address: a site rebinding its name to 127.0.0.1
             # sends its own Host, and would otherwise read the dataset through the browser.
             address = self.server.server_address
@@ -226,7 +226,7 @@ def make_handler(viewer: Viewer, page: bytes) -> type[BaseHTTPRequestHandler]:
                 self._send(HTTPStatus.INTERNAL_SERVER_ERROR, str(error).encode(), "text/plain; charset=utf-8")
             except (BrokenPipeError, ConnectionResetError):
                 pass
-            except Exception as error:  # noqa: BLE001 - one request's bug must not end the viewer
+            except Exception as error:
                 message = f"{type(error).__name__}: {error}".encode()
                 self._send(HTTPStatus.INTERNAL_SERVER_ERROR, message, "text/plain; charset=utf-8")
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Any, Union
+from typing import Any
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
@@ -23,7 +23,7 @@ from davis_ag.formats.models import one_line
 #: The ``format`` of a scene.json our generator writes.
 SCENE_FORMAT = "davis-ag-scene/1"
 #: A number as written: a whole number stays an int, so a record dumps back byte for byte.
-Number = Union[int, float]
+Number = int | float
 
 
 class _Record(BaseModel):

@@ -15,7 +15,6 @@ import json
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
-
 from davis_ag.formats.layout import DATASET_FILE
 from davis_ag.scene.specs import CROPS, SCENARIOS, parse_group_name
 from davis_ag.seeds import SPLIT_STREAM, stream_rng
@@ -39,7 +38,7 @@ def split_group(scene_ids: Sequence[str], seed: int) -> dict[str, list[str]]:
     stream = [list(SCENARIOS).index(parsed[0].name), list(CROPS).index(parsed[1].name)] if parsed else [0, 0]
     # A stream of its own (the trailing 1) so the split never correlates with any scene seed.
     order = stream_rng(seed, *stream, SPLIT_STREAM).permutation(len(ids))
-    n_train = int(round(TRAIN_FRACTION * len(ids)))
+    n_train = round(TRAIN_FRACTION * len(ids))
     if len(ids) >= 2:
         n_train = min(max(n_train, 1), len(ids) - 1)
     return {"train": sorted(ids[i] for i in order[:n_train]), "test": sorted(ids[i] for i in order[n_train:])}

@@ -10,12 +10,14 @@ from __future__ import annotations
 import json
 import platform
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
+from davis_ag.errors import UserError
 from davis_ag.formats.layout import published_pointers, view_name
 from davis_ag.formats.masks import segmentation_convention
 from davis_ag.formats.models import AnnotationEntry
@@ -28,11 +30,9 @@ from davis_ag.formats.scene_file import (
     SceneFile,
     ViewPlace,
 )
-from davis_ag.provenance import code_version
-from davis_ag.seeds import derived_seed
-from davis_ag.errors import UserError
 from davis_ag.generate.scene_writer import SceneWriter
 from davis_ag.labels.fruit_labels import fruit_lookup, label_view, visible_fractions
+from davis_ag.provenance import code_version
 from davis_ag.render.backends import ANTIALIASING_DESCRIPTIONS, DEFAULT_RENDERER, open_renderer, resolve_look
 from davis_ag.render.egl_context import renderer_name
 from davis_ag.scene.appearance import draw_appearance, resolve_appearance
@@ -40,16 +40,17 @@ from davis_ag.scene.build import build_scene
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.organs import ORGAN_NAMES, SKY
 from davis_ag.scene.specs import (
-    camera_altitudes,
     CROPS,
     DEFAULT_PLANTS,
     SCENARIOS,
     CropSpec,
     ScenarioSpec,
+    camera_altitudes,
     plant_centres,
     scene_folder,
 )
 from davis_ag.scene.view_grid import build_view_grid
+from davis_ag.seeds import derived_seed
 
 CONVENTIONS = {
     "units": {"length": "m", "angle": "deg"},
@@ -121,7 +122,7 @@ class SceneRequest(SceneSettings):
     crop: CropSpec
     index: int
     dataset_seed: int
-    camera: Camera = Camera()
+    camera: Camera = field(default_factory=Camera)
     classes: bool = field(default=True, kw_only=True)
 
     def __post_init__(self) -> None:

@@ -16,10 +16,11 @@ import os
 import signal
 import sys
 import time
+from collections.abc import Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 from davis_ag.errors import UserError, stops_held
 from davis_ag.generate.one_scene import SceneRequest, generate_scene

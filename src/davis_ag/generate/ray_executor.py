@@ -12,8 +12,9 @@ import logging
 import signal
 import threading
 import time
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 from davis_ag.errors import UserError
 from davis_ag.generate.one_scene import SceneRequest, generate_scene

@@ -56,10 +56,10 @@ from davis_ag.render.backends import DEFAULT_RENDERER, resolve_look
 from davis_ag.scene.appearance import resolve_appearance
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import (
-    camera_altitudes,
     DEFAULT_PLANTS,
     CropSpec,
     ScenarioSpec,
+    camera_altitudes,
     check_plants,
     crop_spec,
     group_name,

@@ -10,10 +10,10 @@ import os
 import sys
 import time
 import traceback
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cache
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 from tqdm import tqdm
@@ -101,7 +101,7 @@ class RunReport:
 # Progress
 
 
-@lru_cache(maxsize=None)
+@cache
 def count_views(scenario: ScenarioSpec, crop: CropSpec) -> int:
     """Views of every scene of a scenario and crop (exclusion uses the nominal grid, not slip)."""
     from davis_ag.scene.specs import plant_centres

@@ -24,8 +24,8 @@ see docs/performance.md for the measurements behind :func:`default_workers`.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 from davis_ag.atomic_files import PROBE_PREFIX, write_json_atomic
 from davis_ag.errors import MachineError, UserError

@@ -185,7 +185,7 @@ class SceneWriter:
             return
         try:
             self._drain()  # views already queued are a few encodings from being kept
-        except Exception:  # noqa: BLE001 - a view that cannot be written is simply not kept
+        except Exception:
             pass
         finally:
             self._pool.shutdown(cancel_futures=True)

@@ -123,7 +123,7 @@ def silhouette_pixels(camera: Camera, view: Viewpoint, polygons: list[np.ndarray
         ]
     )
     inside = ((sides >= 0).all(axis=0) | (sides <= 0).all(axis=0)) & sides.any(axis=0)
-    return int(len(np.unique(py[inside] * camera.width + px[inside])))
+    return len(np.unique(py[inside] * camera.width + px[inside]))
 
 
 def visible_fractions(

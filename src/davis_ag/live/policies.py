@@ -14,8 +14,9 @@ an action array in place of an index; ``prepare(env)`` reads the environment fir
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import partial
-from typing import Any, Callable
+from typing import Any
 
 import gymnasium as gym
 import numpy as np

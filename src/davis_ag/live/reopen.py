@@ -25,10 +25,10 @@ from typing import TYPE_CHECKING, Any, TypeVar
 import numpy as np
 
 from davis_ag.atomic_files import atomic_output
+from davis_ag.errors import UserError
 from davis_ag.formats.layout import ANNOTATIONS, SCENE_METADATA, view_name
 from davis_ag.formats.scene_file import SCENE_FORMAT, GeneratorRecord, SceneFile, read_scene_file
 from davis_ag.render.backends import antialiasing_of
-from davis_ag.errors import UserError
 from davis_ag.scene.appearance import DEFAULT_APPEARANCE, resolve_appearance
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.lighting import Lighting
@@ -330,7 +330,7 @@ def save_cache(path: Path, key: str, assets: SceneAssets) -> None:
         texture_files=np.array([_portable(f, root) for f in geometry.texture_files], dtype=np.str_),
         fruit_ids=np.array(fruit_ids, dtype=np.int64),
         fruit_offsets=np.cumsum([0] + [len(u) for u in uuids]),
-        fruit_uuids=np.concatenate(uuids + [np.zeros(0, np.int64)]).astype(np.int64),
+        fruit_uuids=np.concatenate([*uuids, np.zeros(0, np.int64)]).astype(np.int64),
         uuid_count=np.array(assets.uuid_count),
         aim_height=np.array(assets.aim_height),
         lighting=np.array(json.dumps(_lighting_record(assets.lighting, root))),

@@ -18,8 +18,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -263,7 +263,7 @@ class LiveScene:
             renderer.close()
         self._renderers.clear()
 
-    def __enter__(self) -> "LiveScene":
+    def __enter__(self) -> LiveScene:
         return self
 
     def __exit__(self, *exc) -> None:

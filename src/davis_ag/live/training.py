@@ -18,8 +18,8 @@ import numpy as np
 
 from davis_ag.atomic_files import prove_writable_file, write_or_rescue
 from davis_ag.benchmark.algorithms import console_logger
-from davis_ag.benchmark.networks import ARCHITECTURES
 from davis_ag.benchmark.checkpoints import save_model
+from davis_ag.benchmark.networks import ARCHITECTURES
 from davis_ag.benchmark.training import model_path
 from davis_ag.errors import UserError
 

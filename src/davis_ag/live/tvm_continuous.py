@@ -86,7 +86,7 @@ def scene_folders(source: str | os.PathLike[str], scenario: str, split: str, cro
 class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
     """TVM with a continuous camera pose; see the module docstring for the rules."""
 
-    metadata = {"render_modes": ["rgb_array"], "render_fps": 2}
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 2}  # noqa: RUF012 - Gymnasium declares it an instance attribute
     action_space: spaces.Box
 
     def __init__(

@@ -73,7 +73,7 @@ def create_context():
     options = {"device_index": int(device)} if device else {}
     try:
         return moderngl.create_standalone_context(backend="egl", require=330, **options)
-    except Exception as error:  # noqa: BLE001 - moderngl raises plain Exceptions
+    except Exception as error:
         raise UserError(
             f"cannot open a headless OpenGL context through EGL ({error}): install the "
             "system's EGL and GL libraries (Debian: libegl1 libgl1 libgl1-mesa-dri)"

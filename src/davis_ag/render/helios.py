@@ -120,7 +120,7 @@ class HeliosRenderer:
         if not pointer or size not in (expected, 3 * expected):
             raise RuntimeError(f"Helios returned {size} values for a {self.camera.width}x{self.camera.height} view")
 
-    def __enter__(self) -> "HeliosRenderer":
+    def __enter__(self) -> HeliosRenderer:
         return self
 
     def __exit__(self, *exc) -> None:

@@ -34,7 +34,6 @@ from importlib import resources
 
 import numpy as np
 
-from davis_ag.seeds import view_noise_seed
 from davis_ag.render.egl_context import create_context, egl_current, egl_restore
 from davis_ag.render.projection import camera_matrices, gl_matrix, helios_shadow_box, light_matrix, matmul32
 from davis_ag.render.scene_geometry import SceneGeometry, read_scene_geometry
@@ -44,6 +43,7 @@ from davis_ag.render.vertices import GROUND_REPEAT, SHADOW_FORMAT, VERTEX_FORMAT
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.lighting import Lighting
 from davis_ag.scene.view_grid import Viewpoint
+from davis_ag.seeds import view_noise_seed
 
 LOOKS = ("default", "helios")
 #: Helios's shading constants (its Visualizer's defaults): Phong weights and shininess, the
@@ -404,7 +404,7 @@ class OpenGLRenderer:
             ctx.release()
             egl_restore(previous)
 
-    def __enter__(self) -> "OpenGLRenderer":
+    def __enter__(self) -> OpenGLRenderer:
         return self
 
     def __exit__(self, *exc) -> None:

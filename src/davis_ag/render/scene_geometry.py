@@ -85,7 +85,7 @@ class SceneGeometry:
         )
 
     @classmethod
-    def load(cls, path: Path) -> "SceneGeometry":
+    def load(cls, path: Path) -> SceneGeometry:
         """Read what :meth:`save` wrote."""
         with np.load(path, allow_pickle=True) as data:
             fields = {k: data[k] for k in data.files if k != "texture_files"}

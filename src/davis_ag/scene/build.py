@@ -7,8 +7,8 @@ drawn from the generator handed in.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -141,7 +141,7 @@ def add_ground(context, soil_texture: str = "dirt.jpg") -> None:
     from davis_ag.scene.organ_labels import label_soil
 
     texture = helios_texture(soil_texture)
-    patches = int(round(NEAR_SIZE / NEAR_PATCH))
+    patches = round(NEAR_SIZE / NEAR_PATCH)
     tiles = [
         context.addTileObject(
             center=vec3(0.0, 0.0, 0.0),

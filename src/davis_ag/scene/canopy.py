@@ -269,7 +269,7 @@ def grape_cluster(top: np.ndarray, berry: float, cluster: float, rng: np.random.
             ring = cluster * 0.5 ** (2 - count)
         elif count == 3:
             ring = cluster
-        per_ring = int(math.floor(PI * ring / berry)) + 1
+        per_ring = math.floor(PI * ring / berry) + 1
         step = 2 * PI / per_ring
         for _ in range(per_ring):
             jitter = rng.random(3) * 0.25 * berry

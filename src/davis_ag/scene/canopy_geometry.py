@@ -112,7 +112,7 @@ class LeafMesh:
     triangles: np.ndarray
     uvs: np.ndarray
 
-    def transformed(self, scale: np.ndarray, steps: list[tuple[float, str]], offset: np.ndarray) -> "LeafMesh":
+    def transformed(self, scale: np.ndarray, steps: list[tuple[float, str]], offset: np.ndarray) -> LeafMesh:
         """A copy scaled per axis, rotated by each (angle, axis) in turn, then moved by ``offset``."""
         points = self.triangles * np.asarray(scale, dtype=float)
         for angle, axis in steps:

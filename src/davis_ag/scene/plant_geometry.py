@@ -15,7 +15,7 @@ def primitive_vertices(context, uuids: list[int]) -> list[np.ndarray]:
         return []
     flat, offsets = context.getPrimitiveVertices(list(uuids))
     flat = np.asarray(flat, dtype=np.float64).reshape(-1, 3)
-    bounds = list(np.asarray(offsets, dtype=np.int64) // 3) + [len(flat)]
+    bounds = [*list(np.asarray(offsets, dtype=np.int64) // 3), len(flat)]
     return [flat[bounds[i] : bounds[i + 1]] for i in range(len(uuids))]
 
 

@@ -34,7 +34,7 @@ grapevine library's own.
 from __future__ import annotations
 
 import copy
-from typing import Callable
+from collections.abc import Callable
 
 from davis_ag.scene.specs import CropSpec
 

@@ -15,7 +15,7 @@ from davis_ag.scene.library_crops import LIBRARY_CROPS
 #: Actions of the single-plant scenario, in the order the environment numbers them.
 SP_ACTIONS: tuple[str, ...] = ("forward", "backward", "left", "right", "up", "down")
 #: Multi-plant adds the two rotations of 30 degrees.
-MP_ACTIONS: tuple[str, ...] = SP_ACTIONS + ("rotate_cw", "rotate_ccw")
+MP_ACTIONS: tuple[str, ...] = (*SP_ACTIONS, "rotate_cw", "rotate_ccw")
 #: Every pointer key an annotations.json entry may carry.
 ALL_ACTIONS: tuple[str, ...] = MP_ACTIONS
 

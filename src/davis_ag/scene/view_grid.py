@@ -132,7 +132,7 @@ def lattice_size(extent: float, step: float) -> int:
     Returns:
         ``floor(extent / step) + 1`` (a small tolerance absorbs floating-point error).
     """
-    return int(math.floor(extent / step + 1e-9)) + 1
+    return math.floor(extent / step + 1e-9) + 1
 
 
 def lattice_point(ix: int, iy: int, shape: tuple[int, int], step: float) -> tuple[float, float]:

@@ -7,9 +7,8 @@ Shared by the renderer bench (:mod:`davis_ag.workflows.bench`) and the crops ben
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Callable
 
 from davis_ag.generate.one_scene import SceneRequest, draw_scene
 from davis_ag.scene.view_grid import Viewpoint

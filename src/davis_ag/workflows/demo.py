@@ -20,8 +20,8 @@ from tqdm import tqdm
 
 from davis_ag.atomic_files import prove_writable_folder, write_or_rescue
 from davis_ag.errors import UserError
-from davis_ag.formats.models import check_image_size, check_seed
 from davis_ag.formats.layout import SPLITS_FILE
+from davis_ag.formats.models import check_image_size, check_seed
 from davis_ag.generate.one_scene import SceneRequest
 from davis_ag.generate.run_progress import RunOptions, default_workers
 from davis_ag.generate.runner import run_dataset

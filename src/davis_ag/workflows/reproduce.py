@@ -66,12 +66,12 @@ def reproduce(
     from davis_ag.benchmark.evaluation import format_table, write_json
     from davis_ag.figures.result_charts import plot_results
     from davis_ag.generate.one_scene import SceneRequest
-    from davis_ag.scene.camera import Camera
     from davis_ag.provenance import code_version, machine_summary
+    from davis_ag.scene.camera import Camera
     from davis_ag.workflows.demo import evaluation_split, generate_scenes, run_baselines
     from davis_ag.workflows.reproduce_learners import train_learner
-    from davis_ag.workflows.stage_clock import CLOCK_FILE, StageClock, generation_seconds
     from davis_ag.workflows.results_policies import model_path
+    from davis_ag.workflows.stage_clock import CLOCK_FILE, StageClock, generation_seconds
 
     pairs = config.pairs if pairs is None else pairs
     check_disk(config, Path(out).expanduser().absolute(), pairs)

@@ -19,8 +19,7 @@ def learner_stamp(algo: str, timesteps: int, settings: dict[str, Any] | None = N
     """What a finished model of ``algo`` must have been made with to be reused (its stamp
     ``MODEL.json``): steps, settings (``settings``, default ours: A2C's tuned ones, the zoo's Atari
     settings for PPO) and keep rule. A2C's stamp keeps the keys it had before PPO, so its models are reused."""
-    from davis_ag.benchmark.algorithms import SB3_SETTINGS
-    from davis_ag.benchmark.algorithms import A2C_SETTINGS
+    from davis_ag.benchmark.algorithms import A2C_SETTINGS, SB3_SETTINGS
 
     if algo == "a2c":
         return {"timesteps": timesteps, "a2c_settings": A2C_SETTINGS if settings is None else settings, "keep": KEEP}

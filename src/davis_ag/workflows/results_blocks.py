@@ -12,8 +12,6 @@ from typing import Any
 
 from davis_ag.benchmark.exact import BEST_FIXED
 from davis_ag.benchmark.paired import CONFIDENCE, FEW_SCENES, paired_key
-from davis_ag.workflows.reproduce_configs import beside_table4
-from davis_ag.workflows.stage_clock import machines
 from davis_ag.workflows.paper_table4 import (
     PAPER_ORDERINGS,
     PAPER_TABLE4,
@@ -23,10 +21,12 @@ from davis_ag.workflows.paper_table4 import (
     ordering_failures,
     signed,
 )
+from davis_ag.workflows.reproduce_configs import beside_table4
 from davis_ag.workflows.results_gaps import scenes_ahead
-from davis_ag.workflows.results_provenance import one_whole_hours
 from davis_ag.workflows.results_policies import LEARNERS, learners_run, train_split_gap
+from davis_ag.workflows.results_provenance import one_whole_hours
 from davis_ag.workflows.run_groups import GROUPS
+from davis_ag.workflows.stage_clock import machines
 
 #: The README's block that holds the run's OER_tau beside Table 4's (see :func:`readme_block`).
 README_MARKER = "results-table4"

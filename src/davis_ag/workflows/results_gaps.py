@@ -101,7 +101,7 @@ def per_scene_table(gaps: dict[str, dict[str, Any]]) -> list[str]:
         cells = [signed(row[learner]) if learner in row else "-" for learner in gaps]
         lines.append(f"| {name} | {row['episodes']} | {row['starts']:,} | " + " | ".join(cells) + " |")
     lines.append("| ahead on | | | " + " | ".join("{} of {}".format(*scenes_ahead(p)) for p in gaps.values()) + " |")
-    return lines + [""]
+    return [*lines, ""]
 
 
 def scene_gap_figure(scenario: str, result: dict[str, Any], gaps: dict[str, dict[str, Any]], page: Path) -> str | None:

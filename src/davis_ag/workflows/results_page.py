@@ -32,8 +32,8 @@ from davis_ag.workflows.results_policies import (
     policy_sections,
     training_record,
 )
-from davis_ag.workflows.run_groups import GROUPS
 from davis_ag.workflows.results_provenance import how_made, stage_rows
+from davis_ag.workflows.run_groups import GROUPS
 
 
 def _a2c_play(state: dict[str, Any]) -> str:
@@ -156,10 +156,10 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
         ``path``.
     """
     from davis_ag.atomic_files import write_text_atomic
-    from davis_ag.workflows.results_blocks import write_blocks_beside
-    from davis_ag.workflows.stage_clock import CLOCK_FILE, machines, read_clock
     from davis_ag.scene.specs import crop_spec, scenario_spec
     from davis_ag.scene.view_grid import views_per_scene
+    from davis_ag.workflows.results_blocks import write_blocks_beside
+    from davis_ag.workflows.stage_clock import CLOCK_FILE, machines, read_clock
 
     strawberry, vine = crop_spec("strawberry"), crop_spec("vine")
     sp_views = views_per_scene(scenario_spec("sp", strawberry), strawberry)

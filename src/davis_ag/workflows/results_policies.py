@@ -105,7 +105,7 @@ def exact_table(policies: dict[str, Any], fixed: dict[str, dict[str, float]] | N
             + ", ".join(f"{action} {cell(v['oer_tau'])}" for action, v in fixed.items())
             + ".",
         ]
-    return lines + [""]
+    return [*lines, ""]
 
 
 def action_table(policies: dict[str, Any], actions: list[str]) -> list[str]:
@@ -123,7 +123,7 @@ def action_table(policies: dict[str, Any], actions: list[str]) -> list[str]:
         counts = policies[name]["action_counts"]
         total = max(sum(counts.values()), 1)
         lines.append(f"| {name} | " + " | ".join(f"{100 * counts.get(a, 0) / total:.0f}" for a in actions) + " |")
-    return lines + [""]
+    return [*lines, ""]
 
 
 def a2c_line(scenario: str, policies: dict[str, Any], out: Path | None, learner: str = "A2C") -> str | None:
@@ -321,7 +321,7 @@ def learning_curve_section(out: Path | None, page: Path, results: dict[str, Any]
                 f"- {key}: rolling mean {cell(smoothed[0])} at {data['steps'][0]:,} steps, "
                 f"{cell(smoothed[-1])} at {data['steps'][-1]:,} steps."
             )
-    return lines + [""]
+    return [*lines, ""]
 
 
 def policy_sections(scenario: str, result: dict[str, Any], out: Path | None, page: Path) -> list[str]:

@@ -11,8 +11,8 @@ from typing import Any
 
 from davis_ag.formats.layout import SCENE_METADATA
 from davis_ag.formats.scene_file import CameraRecord, RendererRecord, read_scene_file_or_empty
-from davis_ag.workflows.run_groups import GROUPS
 from davis_ag.workflows.results_policies import LEARNERS, training_record
+from davis_ag.workflows.run_groups import GROUPS
 
 #: Steps that a later sitting does whole again (a validation whose code changed, an evaluation),
 #: where generation and training resume: their clock adds up the repeats.
@@ -118,7 +118,7 @@ def how_made(state: dict[str, Any], out: Path | None) -> list[str]:
     """The "How this run was made" section, from scene.json files, training records and stages."""
     lines = ["## How this run was made", ""]
     if out is None:
-        return lines + ["No work folder was given, so the run's records were not read.", ""]
+        return [*lines, "No work folder was given, so the run's records were not read.", ""]
     for scenario, key in GROUPS.items():
         scenes = state.get("scene_folders", {}).get(key, [])
         if not scenes:
@@ -129,7 +129,7 @@ def how_made(state: dict[str, Any], out: Path | None) -> list[str]:
             record = training_record(out, key, learner)
             if record:
                 lines.append(f"  - {learner}: {training_provenance(record)}")
-    return lines + [""]
+    return [*lines, ""]
 
 
 def stage_rows(state: dict[str, Any], out: Path | None) -> list[tuple[str, float, str, str]]:

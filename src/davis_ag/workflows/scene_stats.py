@@ -99,7 +99,7 @@ def measure_findings(count: int, size: tuple[int, int], step: float) -> dict:
         root = Path(folder)
         for index in range(count):
             request = SceneRequest(scenario, seeable(crop), index, 0, Camera(*size))
-            scene_dir, stats = generate_scene(request, root)
+            _scene_dir, stats = generate_scene(request, root)
             scene = open_dataset(root).scene(f"Single-Strawberry/{index:03d}")
             scenes.append(
                 {

@@ -13,8 +13,8 @@ import numpy as np
 
 from davis_ag.atomic_files import read_page, write_json_atomic, write_text_atomic
 from davis_ag.errors import UserError
-from davis_ag.workflows.library_crops_table import CROPS_FILE, library_crops_table, library_recipes_table
 from davis_ag.scene.specs import CROPS, PHENOTYPE_SPREAD, SEEABLE_FRUIT_PIXELS
+from davis_ag.workflows.library_crops_table import CROPS_FILE, library_crops_table, library_recipes_table
 
 #: The measurements' folder below the docs folder.
 DATA = "data"
@@ -205,7 +205,7 @@ def recipes_table(docs: Path) -> list[str]:
             f"{fig2} of {len(row['scenes'])} | {share:.1%} | {'yes' if 0.02 <= share <= 0.08 else 'no'} | "
             f"{np.mean(by_fruit):.0%} | {np.median(low_vf):.2f} |"
         )
-    return lines + [""]
+    return [*lines, ""]
 
 
 def skewness(values: np.ndarray) -> float:
