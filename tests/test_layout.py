@@ -158,6 +158,39 @@ def test_no_module_imports_another_modules_private_names() -> None:
             assert not (module.startswith("davis_ag") and private), f"{path}:{line}: imports {private} from {module}"
 
 
+#: The roles inside workflows/: each imports only the shared stage helpers and its own modules.
+WORKFLOW_ROLES = ("stages", "demo", "transfer", "reproduce", "bench", "scene_stats")
+#: Longest module, in lines: past it a module holds two things (docs/architecture.md).
+MAX_MODULE_LINES = 450
+
+
+def workflow_role(module: str) -> str:
+    return module.split(".")[2] if module.startswith("davis_ag.workflows.") else ""
+
+
+@pytest.mark.parametrize("name", [n for n in MODULES if workflow_role(n)])
+def test_each_workflow_imports_only_the_shared_stages_and_its_own_role(name: str) -> None:
+    role = workflow_role(name)
+    assert role in WORKFLOW_ROLES, f"{MODULES[name]}: add its role to WORKFLOW_ROLES and docs/architecture.md"
+    for module, line, _ in imports(MODULES[name]):
+        other = workflow_role(module)
+        assert other in ("", "stages", role), f"{MODULES[name]}:{line}: the {role} workflow imports {module}"
+        # reproduce's pages read the run's records; the run writes the pages, never the reverse
+        if name.startswith("davis_ag.workflows.reproduce.pages"):
+            assert not module.startswith(("davis_ag.workflows.reproduce.run", "davis_ag.workflows.reproduce.status")), (
+                f"{MODULES[name]}:{line}: a page imports {module}, the run that writes it"
+            )
+
+
+def test_no_module_is_longer_than_its_limit() -> None:
+    long = {
+        str(p.relative_to(PACKAGE)): n
+        for p in MODULES.values()
+        if (n := len(p.read_text().splitlines())) > MAX_MODULE_LINES
+    }
+    assert not long, f"split these modules (over {MAX_MODULE_LINES} lines): {long}"
+
+
 def test_the_layout_reads_as_the_pipeline() -> None:
     """`ls src/davis_ag` shows every stage as a folder."""
     folders = {p.name for p in PACKAGE.iterdir() if p.is_dir() and (p / "__init__.py").exists()}

@@ -14,10 +14,10 @@ from davis_ag.benchmark.agents import build_agents
 from davis_ag.benchmark.evaluation import (
     episode_seeds,
     evaluate_policies,
-    format_table,
     run_episode,
     write_json,
 )
+from davis_ag.benchmark.results_table import format_table
 from davis_ag.cli import add_command
 from davis_ag.errors import UserError
 from davis_ag.figures.result_charts import plot_results

@@ -45,7 +45,7 @@ def test_compare_ranks_methods_with_their_gaps(
 
 def test_gaps_over_several_scenes_give_the_interval_over_scenes_too(sp_root: Path, tmp_path: Path) -> None:
     # With two scenes or more, each gap also says whether it would hold on other scenes like these.
-    from davis_ag.benchmark.evaluation import format_table
+    from davis_ag.benchmark.results_table import format_table
 
     results = evaluate([_always("up")], sp_root, "sp", split="all", sessions=2, episodes=8)
     scenes = {e.scene for e in results.policies["always_up"].episodes}

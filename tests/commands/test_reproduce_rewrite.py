@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from davis_ag import cli
-from davis_ag.workflows.reproduce_configs import CONFIGS
+from davis_ag.workflows.reproduce.configs import CONFIGS
 
 
 def test_a_run_from_before_ppo_is_rewritten_without_claiming_ppo(

@@ -12,7 +12,8 @@ from davis_ag.errors import UserError
 from davis_ag.figures.benchmark_plots import plot_oer
 from davis_ag.figures.report import phenotype_rows, write_report
 from davis_ag.figures.visibility_plots import plot_visibility
-from davis_ag.workflows.demo import Timer, run_baselines
+from davis_ag.stage_timer import Timer
+from davis_ag.workflows.stages import run_baselines
 from layout_factory import write_tiny_dataset
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
@@ -117,8 +118,8 @@ def test_report_of_a_folder_without_a_dataset_is_a_user_error(tmp_path: Path) ->
 
 
 def test_results_markdown_puts_ours_beside_the_paper(tmp_path: Path) -> None:
-    from davis_ag.workflows.reproduce_configs import CONFIGS
-    from davis_ag.workflows.results_page import write_results_md
+    from davis_ag.workflows.reproduce.configs import CONFIGS
+    from davis_ag.workflows.reproduce.pages.results import write_results_md
 
     stat = {"mean": 0.5, "std": 0.01}
     state = {

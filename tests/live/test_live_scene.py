@@ -14,8 +14,10 @@ from PIL import Image
 from davis_ag.data.reader import open_dataset
 from davis_ag.data.validate import validate_dataset
 from davis_ag.errors import UserError
+from davis_ag.formats.layout import LIVE_GEOMETRY
 from davis_ag.generate.one_scene import SceneRequest, draw_scene, grow_scene
-from davis_ag.live.reopen import CACHE_FILE, read_settings, regrow
+from davis_ag.generate.recorded_settings import read_settings
+from davis_ag.live.reopen import regrow
 from davis_ag.live.scene import LiveScene, merge_ground, open_live_scene
 
 
@@ -56,7 +58,7 @@ def test_reopening_uses_the_cache_and_a_tampered_cache_is_rebuilt(
     (copy / "scene.json").write_text(json.dumps(meta))
     with pytest.raises(UserError, match="seed"):
         open_live_scene(copy)
-    assert (copy / CACHE_FILE).read_bytes() == (live_scene_dir / CACHE_FILE).read_bytes()  # left alone
+    assert (copy / LIVE_GEOMETRY).read_bytes() == (live_scene_dir / LIVE_GEOMETRY).read_bytes()  # left alone
 
 
 def test_a_scene_that_regrows_differently_is_refused(
@@ -141,7 +143,7 @@ def test_merged_soil_draws_the_same_image(live_scene: LiveScene) -> None:
 
 
 def test_the_cache_is_no_stranger_to_the_dataset(live_root: Path) -> None:
-    assert (live_root / "Single-Strawberry" / "000" / CACHE_FILE).is_file()
+    assert (live_root / "Single-Strawberry" / "000" / LIVE_GEOMETRY).is_file()
     assert validate_dataset(live_root).ok
 
 
@@ -158,15 +160,15 @@ def test_a_scene_whose_cache_cannot_be_written_reopens_uncached(
 
     copy = tmp_path / "Single-Strawberry" / "000"
     shutil.copytree(live_scene_dir, copy)
-    (copy / CACHE_FILE).unlink()
-    (copy / CACHE_FILE).mkdir()
-    (copy / CACHE_FILE / "keep").write_text("mine")
+    (copy / LIVE_GEOMETRY).unlink()
+    (copy / LIVE_GEOMETRY).mkdir()
+    (copy / LIVE_GEOMETRY / "keep").write_text("mine")
     monkeypatch.setattr(one_scene, "grow_scene", lambda request: grown)
     with open_live_scene(copy) as scene:
         assert not scene.assets.from_cache and scene.assets.grid_views
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "cannot cache" in err[0]
-    assert (copy / CACHE_FILE / "keep").read_text() == "mine"
+    assert (copy / LIVE_GEOMETRY / "keep").read_text() == "mine"
 
 
 def test_a_random_appearance_scene_reopens_in_its_own_light(

@@ -23,7 +23,7 @@ from davis_ag.live.scene import LiveScene
 from davis_ag.live.training import train_continuous
 from davis_ag.live.tvm_continuous import TVMContinuousEnv
 from davis_ag.scene.specs import SLIP_SIGMA, with_strawberry_altitudes
-from davis_ag.workflows.bench import steps_per_second
+from davis_ag.workflows.bench.run import steps_per_second
 
 
 @pytest.fixture(scope="module")

@@ -16,7 +16,6 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-from davis_ag.benchmark.evaluation import PAIRED_BASELINES
 from davis_ag.benchmark.paired import FEW_SCENES
 from davis_ag.benchmark.results import (
     DatasetIdentity,
@@ -27,6 +26,7 @@ from davis_ag.benchmark.results import (
     split_text,
     table_number,
 )
+from davis_ag.benchmark.summaries import PAIRED_BASELINES
 from davis_ag.errors import UserError
 
 

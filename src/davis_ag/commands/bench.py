@@ -1,6 +1,6 @@
 """``davis-ag bench``: what a labelled view costs with our renderer against pyhelios's documented
 path, the environments' steps per second, and what the paper-scale dataset would take
-(:mod:`davis_ag.workflows.bench`). ``make bench`` runs it and writes docs/performance.md."""
+(:mod:`davis_ag.workflows.bench.run`). ``make bench`` runs it and writes docs/performance.md."""
 
 from __future__ import annotations
 
@@ -79,10 +79,10 @@ def run(args: argparse.Namespace) -> int:
     """Measure, print and write the report (and the doc's sections)."""
     from davis_ag.atomic_files import prove_writable_folder, read_page, write_marked_section
     from davis_ag.errors import UserError
-    from davis_ag.workflows.bench import run as run_bench
-    from davis_ag.workflows.bench import run_only, training_devices
-    from davis_ag.workflows.bench_report import doc_section, is_gpu_machine, table, write_continuous
-    from davis_ag.workflows.bench_training import write_training
+    from davis_ag.workflows.bench.report import doc_section, is_gpu_machine, table, write_continuous
+    from davis_ag.workflows.bench.run import run as run_bench
+    from davis_ag.workflows.bench.run import run_only, training_devices
+    from davis_ag.workflows.bench.training import write_training
 
     # Minutes of measuring come before anything is written: refuse a bad output first, and never
     # replace a file that is not an earlier report.

@@ -144,8 +144,9 @@ def _spec_files(spec: str) -> list[Path]:
 
 def _evaluate(args: argparse.Namespace, names: list[str], specs: list[str], out: Path, plot: Path) -> int:
     """Evaluate the baselines ``names`` and the ``--policy`` specs on the claimed ``out`` and ``plot``."""
-    from davis_ag.benchmark.evaluation import evaluate, format_table, write_json
+    from davis_ag.benchmark.evaluation import evaluate, write_json
     from davis_ag.benchmark.policies import policy_from_spec
+    from davis_ag.benchmark.results_table import format_table
     from davis_ag.figures.result_charts import plot_results
 
     policies = [

@@ -15,9 +15,9 @@ from pathlib import Path
 
 from davis_ag.commands import arguments
 from davis_ag.errors import UserError
-from davis_ag.workflows.reproduce import load_state, reproduce, write_page
-from davis_ag.workflows.reproduce_configs import CONFIGS
-from davis_ag.workflows.reproduce_status import format_status, run_config
+from davis_ag.workflows.reproduce.configs import CONFIGS
+from davis_ag.workflows.reproduce.run import load_state, reproduce, write_page
+from davis_ag.workflows.reproduce.status import format_status, run_config
 
 HELP = "reproduce Table 4: generate, train A2C and PPO, benchmark, write results.md"
 DESCRIPTION = __doc__
@@ -75,7 +75,7 @@ def check_results_path(results: Path, out: Path) -> None:
         UserError: naming what the page would replace.
     """
     from davis_ag.formats.outputs import check_outside_datasets, resolved
-    from davis_ag.workflows.stage_clock import CLOCK_FILE
+    from davis_ag.workflows.reproduce.clock import CLOCK_FILE
 
     # Resolved, as the file system will take them: `run/x/../state.json` or a link to the run
     # folder name its records too.

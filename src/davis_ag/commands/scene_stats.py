@@ -60,7 +60,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     """Measure (if asked) and rewrite the pages."""
     from davis_ag.errors import UserError
-    from davis_ag.workflows.scene_stats_page import write_measurement
+    from davis_ag.workflows.scene_stats.page import write_measurement
 
     if not (args.docs / "architecture.md").is_file():
         raise UserError(

@@ -68,7 +68,7 @@ def run(args: argparse.Namespace) -> int:
         return verify_results(args.scenes, args.dataset, args.cache_dir)
     if files := [p for p in args.scenes if p.suffix == ".json"]:
         raise UserError(f"{files[0]}: to verify results, give the dataset they evaluated: --dataset DATA")
-    from davis_ag.workflows.regenerate import verify_scene
+    from davis_ag.generate.regenerate import verify_scene
 
     check_before_making(args.scenes, args.keep)
     verdicts = []
@@ -122,8 +122,8 @@ def check_before_making(scenes: list[Path], keep: Path | None) -> None:
 
     from davis_ag.errors import UserError
     from davis_ag.formats.outputs import check_outside_datasets
+    from davis_ag.generate.regenerate import request_for, scene_folder_of
     from davis_ag.generate.run_config import grid_settings
-    from davis_ag.workflows.regenerate import request_for, scene_folder_of
 
     requests = [request_for(scene) for scene in scenes]
     folders = [os.path.realpath(scene_folder_of(scene)) for scene in scenes]

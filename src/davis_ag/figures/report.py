@@ -121,7 +121,7 @@ def write_report(
         results: What :func:`davis_ag.benchmark.evaluation.evaluate_policies` returned (as JSON), for the table and chart.
         validation: The validation summary line.
         timer: Stage timings.
-        generated: Per-scene generation statistics (:func:`davis_ag.workflows.demo.generate_scenes`).
+        generated: Per-scene generation statistics (:func:`davis_ag.workflows.stages.generate_scenes`).
         title: Page title.
 
     Returns:
@@ -130,7 +130,7 @@ def write_report(
     Raises:
         UserError: when ``root`` holds no dataset.
     """
-    from davis_ag.benchmark.evaluation import format_table
+    from davis_ag.benchmark.results_table import format_table
     from davis_ag.figures.result_charts import plot_results
 
     dataset = open_dataset(root)

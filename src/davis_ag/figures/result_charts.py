@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from davis_ag.atomic_files import save_figure_atomic
-from davis_ag.benchmark.evaluation import METRICS
+from davis_ag.benchmark.results_table import METRICS
 
 
 def plot_results(results: dict[str, Any], path: str | os.PathLike[str]) -> Path:

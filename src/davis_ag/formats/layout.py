@@ -33,6 +33,8 @@ ANNOTATIONS = "annotations.json"
 SCENE_METADATA = "scene.json"
 DATASET_FILE = "dataset.json"
 SPLITS_FILE = "splits.json"
+#: The live environments' cache of a scene's grown geometry, in its scene folder (not the generator's).
+LIVE_GEOMETRY = "live_geometry.npz"
 #: Folder under the dataset root that holds the benchmark's default observation caches.
 CACHE_FOLDER = ".davis_ag_cache"
 #: The generator's lock, held for a whole run.

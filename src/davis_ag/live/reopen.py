@@ -18,183 +18,44 @@ import hashlib
 import importlib.util
 import json
 import sys
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, TypeVar
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from davis_ag.atomic_files import atomic_output
 from davis_ag.errors import UserError
-from davis_ag.formats.layout import ANNOTATIONS, SCENE_METADATA, view_name
-from davis_ag.formats.scene_file import SCENE_FORMAT, GeneratorRecord, SceneFile, read_scene_file
-from davis_ag.render.backends import antialiasing_of
-from davis_ag.scene.appearance import DEFAULT_APPEARANCE, resolve_appearance
-from davis_ag.scene.camera import Camera
+from davis_ag.formats.layout import ANNOTATIONS, LIVE_GEOMETRY, view_name
+from davis_ag.formats.scene_file import GeneratorRecord
+from davis_ag.generate.recorded_settings import RecordedSettings
 from davis_ag.scene.lighting import Lighting
-from davis_ag.scene.specs import (
-    DEFAULT_PLANTS,
-    STRAWBERRY_ALTITUDES,
-    CropSpec,
-    ScenarioSpec,
-    crop_spec,
-    regrowing_plants,
-    scenario_spec,
-    with_strawberry_altitudes,
-)
 from davis_ag.scene.view_grid import Viewpoint
 
 if TYPE_CHECKING:
-    from davis_ag.generate.one_scene import SceneRequest
     from davis_ag.render.scene_geometry import SceneGeometry
 
-T = TypeVar("T")
-CACHE_FILE = "live_geometry.npz"
 #: Bump when the cache's content changes (2: the whole lighting, appearance included).
 CACHE_VERSION = 2
 _GEOMETRY_FIELDS = ("positions", "uvs", "normals", "uuids", "colours", "texture", "mode", "caster", "patch")
 
 
-@dataclass
-class SceneSettings:
-    """What scene.json says about how a scene was made.
-
-    Attributes:
-        folder: The scene folder.
-        metadata: scene.json as read.
-        scenario, crop: The scene's grid (as generated, reduced grids included) and crop.
-        index, seed, dataset_seed: Which scene.
-        camera: The camera its views were drawn with.
-        renderer, look, antialiasing: How its views were drawn.
-        plants: The plant generator (scenes from before the choice grew ``architecture`` plants).
-        appearance: ``paper`` or ``random`` (soil, sun, sky, exposure and noise drawn from the seed).
-    """
-
-    folder: Path
-    metadata: SceneFile
-    scenario: ScenarioSpec
-    crop: CropSpec
-    index: int
-    seed: int
-    dataset_seed: int
-    camera: Camera
-    renderer: str
-    look: str
-    antialiasing: str
-    plants: str = DEFAULT_PLANTS
-    appearance: str = DEFAULT_APPEARANCE
-
-    def request(self, **drawing: Any) -> SceneRequest:
-        """The generate request these settings describe; ``drawing`` adds what only drawing and
-        writing need (``depth``, ``antialiasing``, ``classes``)."""
-        from davis_ag.generate.one_scene import SceneRequest
-
-        return SceneRequest(
-            self.scenario,
-            self.crop,
-            self.index,
-            self.dataset_seed,
-            self.camera,
-            renderer=self.renderer,
-            look=self.look,
-            plants=self.plants,
-            appearance=self.appearance,
-            **drawing,
-        )
-
-    @property
-    def cache_key(self) -> str:
-        """Digest of everything that shapes the grown geometry and the grid."""
-        meta = self.metadata
-        keyed = {
-            "version": CACHE_VERSION,
-            "seed": self.seed,
-            "dataset_seed": self.dataset_seed,
-            "scenario": meta.scenario,
-            "crop": meta.crop,
-            "scene": meta.scene,
-            "grid": meta.grid.as_written() if meta.grid else None,
-            "generator": meta.generator.as_written() if meta.generator else None,
-            "plants": self.plants,
-            "appearance": self.appearance,
-        }
-        return hashlib.sha256(json.dumps(keyed, sort_keys=True).encode()).hexdigest()[:20]
-
-
-def _crop_with_altitudes(crop: CropSpec, altitudes: list[float]) -> tuple[CropSpec, tuple[int, ...]]:
-    """The crop whose camera altitudes hold the recorded ones (strawberry has two choices,
-    ``--strawberry-altitudes``), and the levels they are.
-
-    Raises:
-        ValueError: when no choice holds them.
-    """
-    for choice in (None, *STRAWBERRY_ALTITUDES):
-        candidate = crop if choice is None else with_strawberry_altitudes(crop, choice)
-        if all(a in candidate.altitudes for a in altitudes):
-            return candidate, tuple(candidate.altitudes.index(a) for a in altitudes)
-    raise ValueError(f"grid.altitudes_m {altitudes} are not {crop.name}'s camera altitudes {list(crop.altitudes)}")
-
-
-def _needed(value: T | None, key: str) -> T:
-    """``value``, or a ValueError naming the scene.json key it should have come from."""
-    if value is None:
-        raise ValueError(f"no {key}")
-    return value
-
-
-def read_settings(scene_dir: str | Path) -> SceneSettings:
-    """Read and check a scene's scene.json.
-
-    Raises:
-        UserError: when the folder holds no scene made by davis-ag generate, or scene.json is damaged.
-    """
-    folder = Path(scene_dir)
-    path = folder / SCENE_METADATA
-    if not path.is_file():
-        raise UserError(f"{path}: missing; only scenes made by `davis-ag generate` can be regrown")
-    metadata = read_scene_file(path)
-    if not metadata.ours:
-        raise UserError(
-            f"{path}: not a scene.json written by `davis-ag generate` ({SCENE_FORMAT}); "
-            "only our own scenes can be regrown"
-        )
-    try:
-        grid, renderer = _needed(metadata.grid, "grid"), _needed(metadata.renderer, "renderer")
-        crop, levels = _crop_with_altitudes(
-            crop_spec(_needed(metadata.crop, "crop")), _needed(grid.altitudes_m, "grid.altitudes_m")
-        )
-        scenario = scenario_spec(_needed(metadata.scenario, "scenario"), crop)
-        extent_x, extent_y = _needed(grid.extent_m, "grid.extent_m")
-        scenario = replace(
-            scenario,
-            extent=(extent_x, extent_y),
-            step=float(_needed(grid.step_m, "grid.step_m")),
-            altitude_levels=levels,
-            headings=int(grid.headings or scenario.headings),  # reduced grids may have fewer
-        )
-        width, height = _needed(metadata.image_size(), "camera.width and height")
-        assert metadata.camera is not None  # image_size() read the size from it
-        camera = Camera(width, height, float(_needed(metadata.camera.vfov_deg, "camera.vfov_deg")))
-        settings = SceneSettings(
-            folder,
-            metadata,
-            scenario,
-            crop,
-            _needed(metadata.index, "scene"),
-            _needed(metadata.seed, "seed"),
-            _needed(metadata.dataset_seed, "dataset_seed"),
-            camera,
-            str(renderer.name),
-            str(renderer.look),
-            antialiasing_of(renderer),
-            regrowing_plants(metadata.plant_generator),
-            resolve_appearance((metadata.appearance or {}).get("mode", "paper")),
-        )
-    except (ValueError, TypeError, UserError, AttributeError) as error:
-        raise UserError(
-            f"{path}: lacks or mangles a setting needed to regrow the scene ({error}); generate the scene again"
-        ) from None
-    return settings
+def cache_key(settings: RecordedSettings) -> str:
+    """Digest of everything that shapes a scene's grown geometry and grid: the cache's key."""
+    meta = settings.metadata
+    keyed = {
+        "version": CACHE_VERSION,
+        "seed": settings.seed,
+        "dataset_seed": settings.dataset_seed,
+        "scenario": meta.scenario,
+        "crop": meta.crop,
+        "scene": meta.scene,
+        "grid": meta.grid.as_written() if meta.grid else None,
+        "generator": meta.generator.as_written() if meta.generator else None,
+        "plants": settings.plants,
+        "appearance": settings.appearance,
+    }
+    return hashlib.sha256(json.dumps(keyed, sort_keys=True).encode()).hexdigest()[:20]
 
 
 @dataclass
@@ -254,7 +115,7 @@ def _lighting_from(record: dict, root: Path | None) -> Lighting:
     return Lighting(**record, sky_texture=sky, white_balance=balance)
 
 
-def regrow(settings: SceneSettings) -> SceneAssets:
+def regrow(settings: RecordedSettings) -> SceneAssets:
     """Grow a scene again from its seed and settings and check it against scene.json.
 
     Raises:
@@ -301,7 +162,7 @@ def assets_from_model(model, grid) -> SceneAssets:
     )
 
 
-def check_grid(settings: SceneSettings, views: list[Viewpoint]) -> None:
+def check_grid(settings: RecordedSettings, views: list[Viewpoint]) -> None:
     """The grid's views must be the stored ones: same names, same poses as annotations.json."""
     path = settings.folder / ANNOTATIONS
     try:
@@ -390,15 +251,15 @@ def load_cache(path: Path, key: str) -> SceneAssets | None:
         return None
 
 
-def reopen_assets(settings: SceneSettings, use_cache: bool = True) -> SceneAssets:
+def reopen_assets(settings: RecordedSettings, use_cache: bool = True) -> SceneAssets:
     """The scene's assets from its cache if current, else regrown (and cached where possible).
 
     Args:
         settings: From :func:`read_settings`.
         use_cache: False regrows even when a current cache exists (and rewrites it).
     """
-    path = settings.folder / CACHE_FILE
-    key = settings.cache_key
+    path = settings.folder / LIVE_GEOMETRY
+    key = cache_key(settings)
     if use_cache:
         cached = load_cache(path, key)
         if cached is not None:

@@ -24,8 +24,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from davis_ag.formats.layout import view_name
+from davis_ag.generate.recorded_settings import RecordedSettings, read_settings
 from davis_ag.labels.fruit_labels import fruit_lookup, label_view, visible_fractions
-from davis_ag.live.reopen import SceneAssets, SceneSettings, read_settings, reopen_assets
+from davis_ag.live.reopen import SceneAssets, reopen_assets
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import plant_centres
 from davis_ag.scene.view_grid import Viewpoint
@@ -70,7 +71,7 @@ def exposure_rates(labels_boxes: list[list[int]], visible_pixels: dict[int, int]
     return {b[4]: visible_pixels[b[4]] / float(b[2] * b[3]) for b in labels_boxes}
 
 
-def min_pixels_for(settings: SceneSettings, width: int, height: int) -> int:
+def min_pixels_for(settings: RecordedSettings, width: int, height: int) -> int:
     """The box threshold at an image size: scene.json's at its own size, else the crop's scaled."""
     if (width, height) == (
         settings.camera.width,
@@ -132,7 +133,7 @@ def merge_ground(geometry):
 class LiveScene:
     """A reopened scene; draw it with :meth:`render`. Holds one renderer per image size."""
 
-    def __init__(self, settings: SceneSettings, assets: SceneAssets) -> None:
+    def __init__(self, settings: RecordedSettings, assets: SceneAssets) -> None:
         """Args:
         settings: The scene's scene.json settings.
         assets: Its geometry, fruit and grid (:func:`davis_ag.live.reopen.reopen_assets`).

@@ -48,39 +48,22 @@ from gymnasium import spaces
 from davis_ag.benchmark.cache import OBS_SIZE
 from davis_ag.benchmark.tvm import MAX_START_OER, can_start, episode_reward
 from davis_ag.errors import UserError
-from davis_ag.formats.layout import ANNOTATIONS, SCENE_METADATA
-from davis_ag.live.reopen import SceneSettings
+from davis_ag.generate.recorded_settings import RecordedSettings
+from davis_ag.live.continuous_moves import (
+    NAMED_MOVES,
+    PITCH_RANGE,
+    blocked_move,
+    grid_bounds,
+    grid_climb,
+    grid_turn,
+    scene_folders,
+)
 from davis_ag.live.scene import LiveScene, LiveView, open_live_scene
-from davis_ag.scene.specs import SLIP_SIGMA, camera_altitudes, scenario_spec
+from davis_ag.scene.specs import SLIP_SIGMA, scenario_spec
 from davis_ag.scene.view_grid import Viewpoint, excluded
 
 #: Random poses tried per reset before giving up on a scene.
 START_TRIES = 200
-#: Pitch limits of a free camera, degrees above the horizon.
-PITCH_RANGE = (-85.0, 45.0)
-#: The grid's move names as (action component, sign) (:meth:`TVMContinuousEnv.action_for`).
-NAMED_MOVES: dict[str, tuple[int, float]] = {
-    "left": (0, -1.0),
-    "right": (0, 1.0),
-    "backward": (1, -1.0),
-    "forward": (1, 1.0),
-    "down": (2, -1.0),
-    "up": (2, 1.0),
-    "rotate_ccw": (3, 1.0),
-    "rotate_cw": (3, -1.0),
-}
-
-
-def scene_folders(source: str | os.PathLike[str], scenario: str, split: str, crop: str | None) -> list[Path]:
-    """The scene folders an environment opens: ``source`` itself when it is a scene folder, else
-    the dataset's scenes of the scenario and split (:func:`davis_ag.benchmark.splits.select_scenes`)."""
-    path = Path(os.fspath(source))
-    if (path / SCENE_METADATA).is_file() and (path / ANNOTATIONS).is_file():
-        return [path]
-    from davis_ag.benchmark.splits import select_scenes
-    from davis_ag.benchmark.tvm import as_dataset
-
-    return [scene.path for scene in select_scenes(as_dataset(path), scenario, split, crop)]
 
 
 class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
@@ -185,27 +168,11 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
     def bounds(self, scene: LiveScene | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Lower and upper corners (x, y, z) of where the camera may be: the grid's area (its odd
         rows reach half a step further east) and altitude range."""
-        settings = (scene or self.scene).settings
-        ex, ey = settings.scenario.extent
-        altitudes = camera_altitudes(settings.scenario, settings.crop)
-        return (
-            np.array([-ex / 2, -ey / 2, min(altitudes)]),
-            np.array([ex / 2 + settings.scenario.step / 2, ey / 2, max(altitudes)]),
-        )
+        return grid_bounds((scene or self.scene).settings)
 
     def blocked(self, start: np.ndarray, end: np.ndarray) -> str:
         """Why a straight move from ``start`` to ``end`` is not allowed ("" when it is)."""
-        lo, hi = self.bounds()
-        if np.any(end < lo - 1e-9) or np.any(end > hi + 1e-9):
-            return "bounds"
-        radius = self.scene.settings.crop.exclusion_radius
-        a, b = start[:2], end[:2]
-        ab = b - a
-        for stem in self.scene.stems:
-            along = float(np.clip(np.dot(stem - a, ab) / max(float(np.dot(ab, ab)), 1e-12), 0.0, 1.0))
-            if np.hypot(*(a + along * ab - stem)) <= radius + 1e-9:
-                return "collision"
-        return ""
+        return blocked_move(self.bounds(), self.scene.stems, self.scene.settings.crop.exclusion_radius, start, end)
 
     def _pose(self, position: np.ndarray, yaw: float, pitch: float) -> Viewpoint:
         if self.aim == "plant":
@@ -328,7 +295,7 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         }
 
     @property
-    def _grid(self) -> SceneSettings:
+    def _grid(self) -> RecordedSettings:
         """The current scene's settings (the first scene's before any reset)."""
         return self.scenes[max(self._scene, 0)].settings
 
@@ -344,9 +311,7 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         given = self._given_scales[1]
         if given is not None:
             return float(given)
-        grid = self._grid
-        altitudes = camera_altitudes(grid.scenario, grid.crop)
-        return (max(altitudes) - min(altitudes)) / 2
+        return grid_climb(self._grid)
 
     @property
     def max_turn(self) -> float:
@@ -355,8 +320,7 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         given = self._given_scales[2]
         if given is not None:
             return float(given)
-        headings = self._grid.scenario.headings
-        return 360.0 / headings if headings > 1 else 30.0
+        return grid_turn(self._grid)
 
     def _action(self, action: Any) -> np.ndarray:
         a = np.asarray(action, dtype=np.float64).reshape(-1)

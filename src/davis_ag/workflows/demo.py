@@ -1,4 +1,4 @@
-"""``davis-ag demo`` orchestration, and the stage helpers ``davis-ag reproduce`` shares.
+"""``davis-ag demo`` orchestration (its stages are :mod:`davis_ag.workflows.stages`'s, shared with ``reproduce``).
 
 The demo: generate a small single-plant strawberry dataset, validate it, write a 70/30 split by
 scene, run the paper's baselines (LRD, UDD, Rand and the exact Oracle) on the test split, print
@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Any
 
 from tqdm import tqdm
 
@@ -23,124 +22,13 @@ from davis_ag.errors import UserError
 from davis_ag.formats.layout import SPLITS_FILE
 from davis_ag.formats.models import check_image_size, check_seed
 from davis_ag.generate.one_scene import SceneRequest
-from davis_ag.generate.run_progress import RunOptions, default_workers
-from davis_ag.generate.runner import run_dataset
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import CropSpec, ScenarioSpec, crop_spec, scenario_spec
 from davis_ag.stage_timer import Timer
+from davis_ag.workflows.stages import evaluation_split, generate_scenes, run_baselines
 
-#: The baselines of Table 4 plus the exact upper bound; A2C needs training (``reproduce``).
-BASELINES: tuple[str, ...] = ("LRD", "UDD", "Rand", "Oracle")
 #: Default image size of the demo: the paper's (2 scenes took 5.6 min in all on 2 CPU cores).
 DEMO_SIZE: tuple[int, int] = (1280, 720)
-
-
-def generate_scenes(
-    requests: list[SceneRequest], root: Path, workers: int | None = None, progress: bool = True
-) -> list[dict[str, Any]]:
-    """Make the scenes not yet complete under ``root`` through the one dataset runner.
-
-    :func:`davis_ag.generate.runner.run_dataset` locks the folder (a second run on it is
-    refused), skips finished scenes, clears and redoes a crashed one, spreads scenes over worker
-    processes and writes dataset.json and splits.json (the seeded 70/30 split by scene).
-
-    Args:
-        requests: The scenes wanted (one dataset seed and image size).
-        root: The dataset root.
-        workers: Scene processes (default: one per core as memory allows, at most one per scene).
-        progress: Show progress (bars on a terminal, a line per scene otherwise).
-
-    Returns:
-        One dict per request: ``scene``, ``skipped`` and, for scenes made now, the timing
-        statistics of :func:`davis_ag.generate.one_scene.generate_scene`.
-
-    Raises:
-        UserError: for an unusable root, another run on it, finished scenes made with other
-            settings, or scenes that failed (the finished ones are kept).
-    """
-    workers = workers or max(1, min(default_workers(requests), len(requests)))
-    report = run_dataset(requests, root, RunOptions(workers=workers, progress=progress))
-    return [
-        {"scene": r.folder, "skipped": r.folder in report.skipped, **report.stats.get(r.folder, {})} for r in requests
-    ]
-
-
-def evaluation_split(root: Path, scenario: str, crop: str) -> str:
-    """``test`` when the dataset's split has test scenes of this scenario and crop, else ``all``.
-
-    Args:
-        root: The dataset root.
-        scenario: ``sp`` or ``mp``.
-        crop: Crop name.
-
-    Returns:
-        The split to evaluate on.
-    """
-    from davis_ag.benchmark.splits import select_scenes
-    from davis_ag.data.reader import open_dataset
-
-    try:
-        select_scenes(open_dataset(root), scenario, "test", crop)
-    except UserError:
-        return "all"
-    return "test"
-
-
-def run_baselines(
-    root: Path,
-    scenario: str,
-    crop: str,
-    split: str,
-    episodes: int,
-    sessions: int,
-    seed: int = 0,
-    model: Path | None = None,
-    learners: tuple[Path, ...] = (),
-) -> dict[str, Any]:
-    """Evaluate LRD, UDD, Rand, Oracle, the Best fixed action (and A2C when ``model`` is given,
-    and other learners' models beside it) as in Table 4.
-
-    A2C plays as :data:`davis_ag.benchmark.policies.DETERMINISTIC_PLAY` says (sampled); the same model
-    taking its most likely action is the extra row ``A2C (deterministic)``.
-
-    Args:
-        root: The dataset root.
-        scenario: ``sp`` or ``mp``.
-        crop: Crop to evaluate on.
-        split: ``train``, ``test`` or ``all``.
-        episodes: Episodes per session.
-        sessions: Sessions.
-        seed: Base seed of the episodes.
-        model: A trained A2C ``.zip``; adds the A2C column.
-        learners: Other trained models (e.g. PPO's ``.zip``), each a row named by its algorithm,
-            played as A2C is. Every policy plays the same seeded episodes with its own seeded
-            randomness, so adding one leaves the other rows' numbers as they were.
-
-    Returns:
-        What :func:`davis_ag.benchmark.evaluation.evaluate_policies` returns, as its JSON.
-    """
-    from davis_ag.benchmark.evaluation import evaluate
-    from davis_ag.benchmark.policies import ModelPolicy
-
-    policies = []
-    if model:
-        sampled = ModelPolicy(model)
-        deterministic = ModelPolicy(sampled.model, deterministic=True, name="A2C (deterministic)")
-        deterministic.path = sampled.path  # one zip: one digest on both rows
-        policies = [sampled, deterministic]
-    policies += [ModelPolicy(path) for path in learners]
-    results = evaluate(
-        policies,
-        root,
-        scenario=scenario,
-        split=split,
-        sessions=sessions,
-        episodes=episodes,
-        seed=seed,
-        crop=crop,
-        baselines=list(BASELINES),
-    )
-    return results.as_json()
 
 
 def run_demo(
@@ -175,7 +63,8 @@ def run_demo(
     Raises:
         UserError: for bad arguments or an unusable output folder.
     """
-    from davis_ag.benchmark.evaluation import format_table, write_json
+    from davis_ag.benchmark.evaluation import write_json
+    from davis_ag.benchmark.results_table import format_table
     from davis_ag.data.validate import validate_dataset
     from davis_ag.figures.report import write_report
 

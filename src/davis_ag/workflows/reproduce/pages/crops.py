@@ -1,0 +1,145 @@
+"""The ``crops`` run's page: a ladder of how hard each plant-library crop is for active vision.
+
+Written from the run's records (``state.json``) after every benchmark: per crop and scenario, the
+test split's scenes and eligible starts, the mean start OER (OER_0), Rand, the Best fixed action,
+the exact Oracle and each learner with its paired gap to the Best fixed action (95 % bootstrap
+interval over the same test episodes). Into docs/crops.md it goes between the ``crops-run``
+markers; any other path gets a page of its own.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from davis_ag.atomic_files import write_marked_section, write_text_atomic
+from davis_ag.benchmark.exact import BEST_FIXED
+from davis_ag.benchmark.paired import CONFIDENCE, paired_key
+from davis_ag.workflows.reproduce.groups import group_key
+from davis_ag.workflows.reproduce.pages.paper_table4 import cell, signed
+from davis_ag.workflows.reproduce.pages.provenance import stage_rows
+
+#: The marker of docs/crops.md's run table.
+CROPS_MARKER = "crops-run"
+
+
+def _mean(policies: dict[str, Any], name: str, metric: str = "oer_tau") -> float | None:
+    value = policies.get(name, {}).get(metric, {})
+    return value.get("mean") if isinstance(value, dict) else None
+
+
+def _score(policies: dict[str, Any], name: str) -> str:
+    row = policies.get(name, {}).get("oer_tau")
+    return f"{cell(row['mean'])} ± {cell(row['std'])}" if row else "–"
+
+
+def _learner(result: dict[str, Any], learner: str) -> str:
+    policies = result.get("policies", {})
+    if learner not in policies:
+        return "–"
+    paired = result.get(paired_key(learner))
+    gap = f" ({signed(paired['gap'])}, {signed(paired['low'])} to {signed(paired['high'])})" if paired else ""
+    return _score(policies, learner) + gap
+
+
+def boxed_share(root: Path | None, folders: list[str]) -> str:
+    """The share of a group's views with at least one fruit boxed, and its fewest fruit on a plant,
+    read from the scenes' annotations.json and scene.json (``–`` where they are not there)."""
+    import json
+
+    if root is None:
+        return "–"
+    views = boxed = 0
+    fewest: list[int] = []
+    for folder in folders:
+        try:
+            annotations = json.loads((root / folder / "annotations.json").read_text())
+            plants = json.loads((root / folder / "scene.json").read_text()).get("plants", [])
+        except (OSError, ValueError):
+            continue
+        views += len(annotations)
+        boxed += sum(1 for entry in annotations.values() if entry.get("bounding_boxes"))
+        fewest += [int(plant.get("fruit_count", 0)) for plant in plants]
+    return f"{boxed / views:.0%} / {min(fewest)}" if views and fewest else "–"
+
+
+def crops_table(config: Any, state: dict[str, Any], root: Path | None = None) -> str:
+    """The run's table, hardest group first (the lowest Best fixed action).
+
+    Args:
+        config: The run's :class:`~davis_ag.workflows.reproduce.configs.ReproduceConfig`.
+        state: Its ``state.json``.
+        root: Its dataset (``OUT/dataset``), for the share of views with a fruit boxed.
+
+    Returns:
+        Markdown: a line on the run, the table, the groups not evaluated yet.
+    """
+    results = state.get("results", {})
+    learners = [algo.upper() for algo in config.learners]
+    rows, waiting = [], []
+    for scenario, crop in config.pairs:
+        result = results.get(config.result_key(scenario, crop))
+        if not result:
+            waiting.append(group_key(scenario, crop))
+            continue
+        protocol, policies = result["protocol"], result["policies"]
+        best = _mean(policies, BEST_FIXED)
+        oracle = _mean(policies, "Oracle")
+        start = _mean(policies, "LRD", "oer_0")
+        rows.append(
+            (
+                best if best is not None else 1.0,
+                [
+                    crop,
+                    scenario,
+                    boxed_share(root, state.get("scene_folders", {}).get(group_key(scenario, crop), [])),
+                    str(len(protocol.get("scenes", []))),
+                    f"{protocol['starts']:,}" if "starts" in protocol else "–",
+                    cell(start) if start is not None else "–",
+                    _score(policies, "Rand"),
+                    _score(policies, BEST_FIXED),
+                    _score(policies, "Oracle"),
+                    signed(oracle - best) if oracle is not None and best is not None else "–",
+                    *[_learner(result, learner) for learner in learners],
+                ],
+            )
+        )
+    head = (
+        f"`{config.name}` run: {config.sp_scenes} SP and {config.mp_scenes} row scenes per crop at "
+        f"{config.size[0]}x{config.size[1]}, {' and '.join(learners)} {config.sp_timesteps:,} steps per "
+        f"group; OER_tau, mean ± std over {config.sessions} sessions of {config.episodes} test episodes. "
+        f"Each learner's gap to the {BEST_FIXED} on the same episodes follows its score "
+        f"({CONFIDENCE:.0%} bootstrap interval over episodes). Hardest first: the lowest {BEST_FIXED}."
+    )
+    columns = ["crop", "scenario", "views with a fruit boxed / fewest fruit on a plant", "test scenes"]
+    columns += ["eligible starts", "OER_0", "Rand", BEST_FIXED, "Oracle"]
+    columns += ["Oracle − best fixed", *learners]
+    lines = [head, "", "| " + " | ".join(columns) + " |", "|---" * len(columns) + "|"]
+    lines += ["| " + " | ".join(cells) + " |" for _, cells in sorted(rows, key=lambda row: row[0])]
+    if not rows:
+        lines.append("| not run yet |" + " |" * (len(columns) - 1))
+    if waiting:
+        lines += ["", f"Not evaluated yet: {', '.join(waiting)}."]
+    return "\n".join(lines)
+
+
+def write_crops_md(path: Path, config: Any, state: dict[str, Any], out: Path | None) -> Path:
+    """Write the crops run's table: into a page's ``crops-run`` block where it has one (docs/crops.md),
+    else as a page of its own with the wall time of every stage.
+
+    Returns:
+        The path written.
+    """
+    table = crops_table(config, state, None if out is None else Path(out) / "dataset")
+    path = Path(path)
+    if path.is_file() and f"<!-- {CROPS_MARKER}:start -->" in path.read_text(errors="replace"):
+        write_marked_section(path, CROPS_MARKER, table)
+        return path
+    lines = ["# The plant-library crops: the crops run", "", table, "", "## Wall time per stage", ""]
+    lines += ["| Stage | Seconds | Hours | Code | Note |", "|---|---|---|---|---|"]
+    total = 0.0
+    for stage, seconds, code, note in stage_rows(state, out):
+        total += seconds
+        lines.append(f"| {stage} | {seconds:.0f} | {seconds / 3600:.2f} | {code} | {note} |")
+    lines += [f"| total | {total:.0f} | {total / 3600:.2f} | | |", ""]
+    return write_text_atomic(path, "\n".join(lines) + "\n")

@@ -1,0 +1,135 @@
+"""The crops run: its configuration, its records and docs/crops.md's tables written from them."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict
+from pathlib import Path
+
+from davis_ag.scene.crop_literature import LITERATURE
+from davis_ag.scene.library_crops import LIBRARY_CROPS, LIBRARY_RECIPES
+from davis_ag.workflows.reproduce.configs import CONFIGS
+from davis_ag.workflows.reproduce.pages.crops import crops_table, write_crops_md
+from davis_ag.workflows.reproduce.status import run_config
+from davis_ag.workflows.scene_stats.library_crops import library_crops_table, library_recipes_table
+
+CROPS_RUN = CONFIGS["crops"]
+
+
+def result(best: float, oracle: float, a2c: float | None, starts: int) -> dict:
+    """A group's results summary as reproduce keeps it in state.json."""
+    row = {"oer_tau": {"mean": 0.4, "std": 0.01}, "oer_0": {"mean": 0.2, "std": 0.01}}
+    policies = {
+        "LRD": row,
+        "Rand": row,
+        "Best fixed action": {"oer_tau": {"mean": best, "std": 0.01}},
+        "Oracle": {"oer_tau": {"mean": oracle, "std": 0.01}},
+    }
+    summary = {"protocol": {"split": "test", "scenes": ["a", "b", "c"], "starts": starts}, "policies": policies}
+    if a2c is not None:
+        policies["A2C"] = {"oer_tau": {"mean": a2c, "std": 0.01}}
+        summary["a2c_vs_best_fixed"] = {"gap": a2c - best, "low": a2c - best - 0.01, "high": a2c - best + 0.01}
+    return summary
+
+
+def test_the_crops_run_covers_every_library_crop_alone_and_in_its_row() -> None:
+    assert CROPS_RUN.pairs == tuple((s, c) for c in LIBRARY_CROPS for s in ("sp", "row"))
+    assert (CROPS_RUN.scenes("sp"), CROPS_RUN.scenes("row"), CROPS_RUN.size) == (10, 4, (640, 360))
+    assert CROPS_RUN.scenes_in_words() == "10 SP and 4 row scenes of each of 10 crops"
+    assert CONFIGS["medium"].scenes_in_words() == "10 SP strawberry and 10 MP vine scenes"
+    # state.json keeps each group's results apart (Table 4's runs keep theirs by scenario).
+    assert CROPS_RUN.result_key("row", "olive") == "row-olive" and CONFIGS["small"].result_key("sp", "x") == "sp"
+    # A resumed run reads its configuration back from state.json, pairs included.
+    saved = json.loads(json.dumps({"config": asdict(CROPS_RUN)}))
+    assert run_config(saved, Path("state.json")) == CROPS_RUN
+
+
+def test_the_table_ranks_groups_hardest_first_and_names_those_not_run(tmp_path: Path) -> None:
+    state = {
+        "results": {
+            "sp-olive": result(best=0.50, oracle=0.70, a2c=0.55, starts=1234),
+            "row-apple": result(best=0.30, oracle=0.60, a2c=None, starts=56),
+        }
+    }
+    table = crops_table(CROPS_RUN, state)
+    rows = [line for line in table.splitlines() if line.startswith("| ") and "---" not in line][1:]
+    assert [row.split(" | ")[0:2] for row in rows] == [["| apple", "row"], ["| olive", "sp"]]
+    assert "1,234" in rows[1] and "+.200" in rows[1] and "+.050" in rows[1]  # headroom and A2C's gap
+    assert rows[0].rstrip(" |").endswith("–")  # no learner yet: a dash, not a number
+    assert "Not evaluated yet: sp-apple, " in table
+    page = tmp_path / "crops.md"
+    page.write_text("# Crops\n\nbefore\n<!-- crops-run:start -->\nold\n<!-- crops-run:end -->\nafter\n")
+    write_crops_md(page, CROPS_RUN, state, None)
+    text = page.read_text()
+    assert text.startswith("# Crops\n\nbefore\n") and text.endswith("after\n") and "old" not in text
+    assert "| apple | row |" in text
+    alone = write_crops_md(tmp_path / "run.md", CROPS_RUN, state, None)  # no markers: a page of its own
+    assert "Wall time per stage" in alone.read_text()
+    # With the run's dataset: the share of views with a fruit boxed and the fewest fruit on a plant.
+    scene = tmp_path / "run" / "dataset" / "Single-Olive" / "000"
+    scene.mkdir(parents=True)
+    (scene / "annotations.json").write_text(
+        json.dumps({"0001.jpeg": {"bounding_boxes": [[1, 1, 2, 2, 0, 0]]}, "0002.jpeg": {"bounding_boxes": []}})
+    )
+    (scene / "scene.json").write_text(json.dumps({"plants": [{"fruit_count": 12}]}))
+    state["scene_folders"] = {"sp-olive": ["Single-Olive/000"]}
+    write_crops_md(page, CROPS_RUN, state, tmp_path / "run")
+    assert "| olive | sp | 50% / 12 |" in page.read_text()
+
+
+def test_the_measured_crops_sit_beside_the_literature(tmp_path: Path) -> None:
+    plant = {
+        "fruit_count": 40,
+        "phenotype_measured": {"plant_height": 3.6, "fruit_radius": 0.04, "leaf_length": 0.09},
+        "library": {"width_m": [2.8, 2.9], "fruit_length_m": 0.081, "fruit_diameter_m": 0.079},
+        "primitives": 125_000,
+        "build_s": 40.0,
+    }
+    data = {"plants_per_crop": 2, "machine": "test", "crops": {"apple": [plant, {**plant, "fruit_count": 50}]}}
+    path = tmp_path / "scenes-crops.json"
+    path.write_text(json.dumps(data))
+    lines = library_crops_table(path)
+    (row,) = [line for line in lines if line.startswith("| apple |")]
+    assert f"40-50 (median 45) [{LITERATURE['apple'].fruit_per_plant}]" in row
+    assert "81-81 x 79-79 [-]" in row and "125-125K" in row
+    assert any(LITERATURE["apple"].source in line for line in lines)
+    assert library_crops_table(tmp_path / "missing.json") == []
+    recipes = library_recipes_table()
+    assert all(
+        any(line.startswith(f"| {name} | {LIBRARY_RECIPES[name].model} |") for line in recipes)
+        for name in LIBRARY_RECIPES
+    )
+
+
+def test_the_crops_bench_table_gives_each_scene_beside_the_strawberry() -> None:
+    from davis_ag.workflows.bench.crops import crops_table as bench_table
+
+    row = {
+        "plants": 12,
+        "primitives": 3_816_534,
+        "fruit": 322,
+        "views_in_scene": 768,
+        "grow_s": 150.0,
+        "seconds_per_view": 0.9,
+        "over_strawberry": 9.0,
+        "peak_gb": 10.5,
+        "bytes_per_primitive": 2760,
+    }
+    sp = {**row, "boxes_compared": 30, "max_corner_px": 1, "boxed_by_one": 2}
+    crops = {"vsp-vine": {"sp": sp, "row": row}}
+    table = bench_table({"image_size": [640, 360], "views": 6, "crops": crops}, (1.0, 2.0))
+    assert "| vsp-vine | row | 12 | 3,816,534 | 322 | 768 | 150 | 0.900 | 9.0 | 10.5 (11.5) | 2,760 | – |" in table
+    assert "| vsp-vine | sp | 12 | 3,816,534 | 322 | 768 | 150 | 0.900 | 9.0 | 10.5 (1.7) | 2,760 | 30, 1, 2 |" in table
+
+
+def test_a_crop_measured_again_alone_keeps_the_others_rows(tmp_path: Path) -> None:
+    from davis_ag.workflows.bench.crops import merged
+
+    earlier = {"image_size": [640, 360], "crops": {"wye-vine": {"sp": 1}, "apple": {"sp": 2}}}
+    report = tmp_path / "bench-crops.json"
+    report.write_text(json.dumps({"crops": earlier}))
+    fresh = {"image_size": [640, 360], "crops": {"wye-vine": {"sp": 3}}}
+    assert merged(report, fresh)["crops"] == {"apple": {"sp": 2}, "wye-vine": {"sp": 3}}  # specs.CROPS's order
+    other_size = {**fresh, "image_size": [1280, 720]}
+    assert merged(report, other_size)["crops"] == {"wye-vine": {"sp": 3}}
+    assert merged(tmp_path / "none.json", fresh)["crops"] == fresh["crops"]

@@ -1,0 +1,130 @@
+"""The README's Table 4 block and docs/benchmark.md's run block are written from the run's records."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from davis_ag.workflows.reproduce.configs import CONFIGS
+from davis_ag.workflows.reproduce.pages.results import write_results_md
+
+
+def sp_result(oer: dict[str, float], gap: dict, **extra: object) -> dict:
+    """An SP strawberry evaluation as state.json keeps it: each policy's OER_tau, A2C's paired gap."""
+    policies = {
+        name: {
+            "oer_tau": {"mean": m, "std": 0.01},
+            "reward": {"mean": 0.5, "std": 0.01},
+            "length": {"mean": 0.5, "std": 0.01},
+        }
+        for name, m in oer.items()
+    }
+    protocol = {"split": "test", "tau": 3, "sessions": 3, "episodes": 200, "scenes": ["Single-Strawberry/003", "b"]}
+    return {"protocol": protocol, "policies": policies, "a2c_vs_best_fixed": dict(gap, episodes=600), **extra}
+
+
+def test_the_readme_block_beside_docs_is_rewritten_from_the_run(tmp_path: Path) -> None:
+    # A results page in a project's docs/ writes the README's block too: no number copied by hand.
+    (tmp_path / "docs").mkdir()
+    readme = tmp_path / "README.md"
+    readme.write_text("# p\n\nbefore\n<!-- results-table4:start -->\nstale .999\n<!-- results-table4:end -->\nafter\n")
+    per_scene = [{"scene": "Single-Strawberry/003", "gap": -0.2, "episodes": 22, "starts": 1}]
+    gap = {"gap": 0.027, "low": 0.01, "high": 0.04, "per_scene": per_scene}
+    state = {"results": {"sp": sp_result({"A2C": 0.6, "Rand": 0.45, "LRD": 0.44, "UDD": 0.3}, gap)}}
+    page = write_results_md(tmp_path / "docs" / "results.md", CONFIGS["medium"], state, tmp_path).read_text()
+    assert (
+        "A2C minus `Best fixed action`: +.027, 95% bootstrap interval over episodes +.010 to +.040 (10,000 "
+        "resamples), above zero. A2C is ahead on 0 of the 1 test scenes played (the table below)."
+    ) in page
+    assert "| Scene | Episodes | Distinct starts | A2C |" in page
+    assert "| Single-Strawberry/003 | 22 | 1 | -.200 |" in page and "| ahead on | | | 0 of 1 |" in page
+    text = readme.read_text()
+    assert "stale" not in text and text.startswith("# p\n\nbefore\n") and text.endswith("after\n")
+    assert "PPO" not in text and "PPO" not in page  # a run without PPO (medium's), whatever CONFIGS now lists
+    assert "| SP strawberry, ours (2 test scenes) | .600 ± .010 | .440 ± .010 | .300 ± .010 | .450 ± .010 | – |" in text
+    assert "| SP strawberry, paper (Table 4) | .520 ± .004 | .433 ± .007 | .371 ± .008 | .438 ± .101 | - |" in text
+    assert "| MP vine, ours | not run yet |" in text and "| MP vine, paper (Table 4) | .369 ± .009 |" in text
+    assert "SP strawberry: A2C > Rand ~ LRD > UDD **holds**." in text
+    assert "SP strawberry +.027 (+.010 to +.040), ahead on 0 of the 1 test scenes played." in text
+    # A page written elsewhere (a work folder beside the README) leaves the README alone.
+    other = tmp_path / "work"
+    other.mkdir()
+    write_results_md(other / "results.md", CONFIGS["medium"], {"results": {}}, other)
+    assert readme.read_text() == text
+
+
+def test_the_blocks_beside_docs_give_the_train_gap_and_the_measured_hours(tmp_path: Path) -> None:
+    # Issue 32: the README says how far each learner is from the best fixed action on train as on
+    # test, and docs/benchmark.md which run results.md shows and the hours its stages took, all
+    # from the run's records.
+    docs = tmp_path / "docs"
+    docs.mkdir()
+    (tmp_path / "README.md").write_text("<!-- results-table4:start -->\n<!-- results-table4:end -->\n")
+    (docs / "benchmark.md").write_text("a\n<!-- results-run:start -->\nold\n<!-- results-run:end -->\nb\n")
+    (tmp_path / "models").mkdir()
+    selection = {"kept_step": 90_000, "episodes": 200, "play": "sampled"}
+    selection["scores"] = [{"step": 90_000, "oer_tau": 0.459}, {"step": 300_000, "oer_tau": 0.442}]
+    (tmp_path / "models" / "a2c_sp-strawberry.training.json").write_text(json.dumps({"selection": selection}))
+    fixed = {"up": {"oer_tau": 0.42, "reward": 0.0, "length": 3.0}}
+    per_scene = [
+        {"scene": f"Single-Strawberry/{i:03d}", "gap": g, "episodes": 1, "starts": 1}
+        for i, g in ((3, 0.1), (4, -0.1), (9, 0.2))
+    ]
+    gap = {"gap": 0.03, "low": 0.02, "high": 0.039, "per_scene": per_scene, "scene_low": -0.1, "scene_high": 0.2}
+    result = sp_result(dict.fromkeys(("A2C", "Rand", "LRD", "UDD"), 0.45), gap)
+    result["protocol"]["starts"] = 507
+    result["train_split"] = {"split": "train", "starts": 1280, "fixed_actions": fixed}
+    state = {
+        "results": {"sp": result},
+        "stages": {
+            "sp-strawberry: generate": {"seconds": 8460.0, "note": "86 scene(s)"},
+            "sp-strawberry: validate": {"seconds": 900.0, "note": "sound", "check_seconds": 330.0},
+            "sp-strawberry: evaluate": {"seconds": 36.0, "note": "split test"},
+        },
+    }
+    sitting = {
+        "started": "2026-11-25T01:45:02+00:00",
+        "seconds": 36.0,
+        "code": "x",
+        "machine": "2 CPU cores (AMD EPYC), no GPU",
+    }
+    # Validation ran whole twice (its code changed between sittings): its cost is one whole check's.
+    checks = [dict(sitting, seconds=540.0), dict(sitting, seconds=360.0)]
+    clock = {"sp-strawberry: evaluate": [sitting], "sp-strawberry: validate": checks}
+    (tmp_path / "clock.json").write_text(json.dumps({"stages": clock}))
+    write_results_md(docs / "results.md", CONFIGS["paper-scale"], state, tmp_path)
+    assert (
+        "- A2C: SP strawberry +.030 (+.020 to +.039; over scenes -.100 to +.200, coarse with 3), ahead on 2 of "
+        "the 3 test scenes played, train +.039." in (tmp_path / "README.md").read_text()
+    )
+    page = (docs / "results.md").read_text()
+    assert (
+        "Resampling the 3 test scenes played instead says little with so few: its 95% interval, -.100 to "
+        "+.200, is about the range of their own gaps"
+    ) in page
+    # With enough test scenes the interval over them is the verdict on other scenes like them.
+    from davis_ag.workflows.reproduce.pages.gaps import paired_line
+
+    many = [dict(per_scene[0], scene=f"Single-Strawberry/{i:03d}") for i in range(12)]
+    line = paired_line(
+        {"a2c_vs_best_fixed": dict(gap, per_scene=many, scene_low=0.016, scene_high=0.048, episodes=600)}
+    )
+    assert line.endswith(
+        "Resampling the 12 test scenes played instead (each with all its episodes: would the gap hold on other "
+        "scenes like these?), the 95% interval is +.016 to +.048, above zero."
+    )
+    benchmark = (docs / "benchmark.md").read_text()
+    assert benchmark.startswith("a\n<!-- results-run:start -->\n[results.md](results.md) shows the `paper-scale` run")
+    assert "old" not in benchmark and benchmark.endswith("<!-- results-run:end -->\nb\n")
+    assert "(Table 3's scenes and images): 86 SP strawberry and 44 MP vine scenes at 1280x720" in benchmark
+    assert "evaluated on SP strawberry 2 test scenes, 507 eligible starts; MP vine not evaluated yet" in benchmark
+    assert (
+        "took 2.6 hours of wall time by the run's clock (SP strawberry: generate 2.35 h, validate 0.09 h (2 "
+        "sittings, each doing it whole: 0.25 h in all), evaluate 0.01 h; MP vine: no stage finished yet), "
+        "on 2 CPU cores (AMD EPYC), no GPU; results.md" in benchmark
+    )
+    assert (
+        "| sp-strawberry: validate | 900 | 0.25 | 2 CPU cores (AMD EPYC), no GPU | unrecorded | sound; 2 sittings on "
+        "the run's clock, each doing the whole validate again (its code changed, or a sitting was stopped): one "
+        "whole validate took 0.09 h |" in page
+    )

@@ -1,0 +1,181 @@
+"""``davis-ag reproduce --status``: where a run stands, stage by stage, from its files alone.
+
+The run's folder is laid out here as ``reproduce`` and ``train`` leave it part way (the end of a
+whole run is checked in ``test_reproduce.py``), so that every kind of stage shows."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from dataclasses import asdict, replace
+from pathlib import Path
+
+import pytest
+
+from davis_ag import cli
+from davis_ag.generate.run_progress import default_workers
+from davis_ag.workflows.reproduce.configs import CONFIGS
+from davis_ag.workflows.reproduce.status import run_status
+
+CONFIG = replace(CONFIGS["small"], sp_scenes=3, sp_timesteps=30_000)
+
+
+def a_run_part_way(out: Path) -> Path:
+    """SP: 2 of 3 scenes made, A2C at 20,000 of 30,000 steps after a sitting of 400 s for 10,000."""
+    folders = [f"Single-Strawberry/{i:03d}" for i in range(3)]
+    for folder in folders[:2]:
+        (out / "dataset" / folder).mkdir(parents=True)
+        (out / "dataset" / folder / "annotations.json").write_text("{}")
+    (out / "dataset" / "Single-Strawberry" / ".002.partial").mkdir()  # under way: not a scene
+    timings = [
+        {"grow": 10.0, "draw_and_label": 590.0},
+        {"grow": 1.0, "draw_and_label": 20.0, "views_from_an_earlier_run": 9},
+    ]
+    for folder, timing in zip(folders, timings):  # the second was resumed: its time is partial
+        (out / "dataset" / folder / "scene.json").write_text(json.dumps({"timing_s": timing}))
+    state = {
+        "config": asdict(CONFIG),
+        "scene_folders": {"sp-strawberry": folders},
+        "stages": {"sp-strawberry: generate": {"seconds": 7200.0, "note": "", "code": "x"}},
+    }
+    (out / "state.json").write_text(json.dumps(state))
+    sittings = [{"started": "t", "seconds": 600.0, "code": "x"}, {"started": "t", "seconds": 300.0, "code": "x"}]
+    clock = {"stages": {"sp-strawberry: train A2C": sittings}}
+    (out / "clock.json").write_text(json.dumps(clock))
+    (out / "models").mkdir()
+    checkpoint = {
+        "timesteps_done": 20_000,
+        "sittings": [
+            {"code": "x", "from_step": 0, "to_step": 10_000, "seconds": 900.0},
+            {"code": "x", "from_step": 10_000, "to_step": 20_000, "seconds": 400.0},
+        ],
+        "selection": [{"step": 10_000, "oer_tau": 0.41}, {"step": 20_000, "oer_tau": 0.452}],
+    }
+    (out / "models" / "a2c_sp-strawberry.checkpoint.json").write_text(json.dumps(checkpoint))
+    return out
+
+
+def test_each_stage_says_what_its_files_show(tmp_path: Path) -> None:
+    config, stages = run_status(a_run_part_way(tmp_path))
+    assert config == CONFIG
+    by_name = {s.stage: s for s in stages}
+    assert list(by_name)[:5] == [
+        "sp-strawberry: generate",
+        "sp-strawberry: validate",
+        "sp-strawberry: train A2C",
+        "sp-strawberry: train PPO",
+        "sp-strawberry: evaluate",
+    ]
+    made = by_name["sp-strawberry: generate"]
+    assert (made.done, made.progress, made.seconds) == (False, "2 of 3 scenes", 7200.0)
+    assert made.left_s == pytest.approx(600.0 / default_workers())  # one scene left, at the whole scene's time
+    a2c = by_name["sp-strawberry: train A2C"]
+    assert not a2c.done and a2c.seconds == 900.0  # both sittings on the clock
+    assert a2c.progress.startswith("20,000 of 30,000 steps at its last checkpoint (67 %)")
+    assert a2c.progress.endswith("best train-split OER_tau 0.452 at 20,000 steps")
+    assert a2c.left_s == pytest.approx(10_000 * 400.0 / 10_000)  # the last sitting's rate
+    assert all(s.progress == "not started" and s.seconds is None for s in stages if s.stage.startswith("mp-"))
+
+
+def test_the_status_prints_and_a_folder_without_a_run_gets_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = a_run_part_way(tmp_path / "run")
+    assert cli.main(["reproduce", "--out", str(out), "--status"]) == 0
+    printed = capsys.readouterr().out
+    assert "| sp-strawberry: train A2C | no | 20,000 of 30,000 steps" in printed and "| 0.25 | 0.1 |" in printed
+    assert not (tmp_path / "docs").exists()  # --status writes nothing, the results page included
+    assert cli.main(["reproduce", "--out", str(tmp_path / "none"), "--status"]) == 2
+    assert "no reproduce run started there" in capsys.readouterr().err
+
+
+def test_a_reader_that_goes_away_stops_the_output_without_an_error(tmp_path: Path) -> None:
+    """``davis-ag reproduce --status | head -1``: the exit a pipe's writer gets, nothing on stderr."""
+    out = a_run_part_way(tmp_path / "run")
+    read, write = os.pipe()
+    os.close(read)
+    done = subprocess.run(
+        [sys.executable, "-m", "davis_ag.cli", "reproduce", "--out", str(out), "--status"],
+        stdout=write,
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=tmp_path,
+    )
+    os.close(write)
+    assert (done.returncode, done.stderr) == (141, "")
+
+
+def test_a_learner_not_started_is_timed_at_its_rate_on_the_other_group(tmp_path: Path) -> None:
+    """Once SP's A2C has trained, MP's is timed at its rate; what has no rate yet is named, not guessed."""
+    from davis_ag.workflows.reproduce.status import format_status
+
+    out = a_run_part_way(tmp_path)
+    record = {"timesteps": 30_000, "seconds": 600.0, "steps_per_second": 50.0}
+    (out / "models" / "a2c_sp-strawberry.training.json").write_text(json.dumps(record))
+    by_name = {s.stage: s for s in run_status(out)[1]}
+    mp_a2c = by_name["mp-vine: train A2C"]
+    assert mp_a2c.progress == "not started; timed at sp-strawberry's 50.0 steps/s"
+    assert mp_a2c.left_s == pytest.approx(CONFIG.mp_timesteps / 50.0)
+    assert by_name["mp-vine: train PPO"].left_s is None  # SP's PPO has no record yet
+    last = format_status(out).splitlines()[-1]
+    timed = by_name["sp-strawberry: generate"].left_s + 400.0 + CONFIG.mp_timesteps / 50.0
+    assert last.startswith(f"About {timed / 3600:.1f} hours left in the stages timed above, and ")
+    assert "mp-vine: generate" in last and "mp-vine: train PPO" in last and "train A2C" not in last
+
+
+def test_a_generate_stage_shows_its_views_before_its_first_scene_ends(tmp_path: Path) -> None:
+    # A paper-scale MP vine scene takes about half an hour: the stage showed "not started" and no
+    # time left for its first scenes. The journals of the scenes under way give both.
+    from davis_ag.scene.view_grid import views_per_scene
+
+    out = a_run_part_way(tmp_path)
+    for index, views in ((0, 200), (1, 100)):
+        partial = out / "dataset" / "Multi-Vine" / f".{index:03d}.partial"
+        partial.mkdir(parents=True)
+        (partial / "views.jsonl").write_text('{"name": "x"}\n' * views)
+    clock = json.loads((out / "clock.json").read_text())
+    clock["stages"]["mp-vine: generate"] = [{"started": "t", "seconds": 600.0, "code": "x"}]
+    (out / "clock.json").write_text(json.dumps(clock))
+    stage = {s.stage: s for s in run_status(out)[1]}["mp-vine: generate"]
+    assert (stage.done, stage.progress, stage.seconds) == (
+        False,
+        "0 of 2 scenes; 2 more under way (300 views drawn)",
+        600.0,
+    )
+    views = views_per_scene(*CONFIG.specs("mp", "vine"))
+    assert stage.left_s == pytest.approx((2 * views - 300) * 600.0 / 300)
+
+
+def test_a_validation_not_started_is_timed_at_the_other_groups_last_check(tmp_path: Path) -> None:
+    # SP strawberry was checked whole twice (its validator changed); MP vine reads at the views per
+    # second of the last check, not of the two added up.
+    from davis_ag.scene.view_grid import views_per_scene
+
+    out = a_run_part_way(tmp_path)
+    state = json.loads((out / "state.json").read_text())
+    state["stages"]["sp-strawberry: validate"] = {
+        "seconds": 900.0,
+        "note": "checked 3 scenes: sound",
+        "code": "x",
+        "check_seconds": 300.0,
+    }
+    (out / "state.json").write_text(json.dumps(state))
+    clock = json.loads((out / "clock.json").read_text())
+    clock["stages"]["sp-strawberry: validate"] = [
+        {"started": "t", "seconds": 600.0, "code": "x"},
+        {"started": "t", "seconds": 300.0, "code": "y"},
+        {"started": "t", "seconds": 20.0, "code": "z"},  # a re-check stopped early: not a whole check
+    ]
+    (out / "clock.json").write_text(json.dumps(clock))
+    sp_views = CONFIG.sp_scenes * views_per_scene(*CONFIG.specs("sp", "strawberry"))
+    mp_views = CONFIG.mp_scenes * views_per_scene(*CONFIG.specs("mp", "vine"))
+    stage = {s.stage: s for s in run_status(out)[1]}["mp-vine: validate"]
+    assert not stage.done and stage.progress.startswith(f"not started; {mp_views:,} views, timed at sp-strawberry's")
+    assert stage.left_s == pytest.approx(mp_views * 300.0 / sp_views)
+    # Once MP's own check is on the clock (running, or stopped part way), it is no longer "not started".
+    clock["stages"]["mp-vine: validate"] = [{"started": "t", "seconds": 60.0, "code": "x"}]
+    (out / "clock.json").write_text(json.dumps(clock))
+    stage = {s.stage: s for s in run_status(out)[1]}["mp-vine: validate"]
+    assert (stage.done, stage.progress, stage.seconds) == (False, "started, not finished", 60.0)
