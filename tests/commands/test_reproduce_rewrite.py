@@ -10,6 +10,8 @@ import pytest
 
 from davis_ag import cli
 from davis_ag.workflows.reproduce.configs import CONFIGS
+from davis_ag.workflows.reproduce.state import RunState, StageRecord
+from results_factory import results
 
 
 def test_a_run_from_before_ppo_is_rewritten_without_claiming_ppo(
@@ -17,20 +19,14 @@ def test_a_run_from_before_ppo_is_rewritten_without_claiming_ppo(
 ) -> None:
     # Issue 32: medium's state.json predates ReproduceConfig.learners; its page still renders, and
     # nothing on it says PPO ran, although the configuration now trains it.
-    config = asdict(CONFIGS["medium"])
+    config = json.loads(json.dumps(asdict(CONFIGS["medium"])))
     del config["learners"]
-    stat = {"mean": 0.5, "std": 0.01}
-    policies = {
-        name: {"oer_tau": dict(stat, mean=m), "reward": stat, "length": stat}
-        for name, m in (("A2C", 0.6), ("Rand", 0.45), ("LRD", 0.44), ("UDD", 0.3))
-    }
-    protocol = {"split": "test", "tau": 3, "sessions": 3, "episodes": 200, "scenes": ["Single-Strawberry/003"]}
-    state = {
-        "config": config,
-        "results": {"sp": {"protocol": protocol, "policies": policies}},
-        "stages": {"sp-strawberry: train A2C": {"seconds": 7200.0, "note": "300000 steps", "code": "x"}},
-    }
-    (tmp_path / "state.json").write_text(json.dumps(state))
+    evaluated = results({"A2C": 0.6, "Rand": 0.45, "LRD": 0.44, "UDD": 0.3}, scenes=["Single-Strawberry/003"])
+    RunState(
+        config=config,
+        results={"sp": evaluated},
+        stages={"sp-strawberry: train A2C": StageRecord(seconds=7200.0, note="300000 steps", code="x")},
+    ).save(tmp_path / "state.json")
     page = tmp_path / "results.md"
     elsewhere = tmp_path / "clone"
     elsewhere.mkdir()

@@ -41,7 +41,7 @@ def test_report_writes_pngs_and_links_resolve(tiny_root: Path, tmp_path: Path) -
     index = write_report(
         tiny_root,
         out,
-        results=results,
+        results=results.as_json(),
         validation="checked 3 scenes: sound",
         timer=timer,
         generated=[{"scene": "Single-Strawberry/000", "skipped": True}],
@@ -120,26 +120,14 @@ def test_report_of_a_folder_without_a_dataset_is_a_user_error(tmp_path: Path) ->
 def test_results_markdown_puts_ours_beside_the_paper(tmp_path: Path) -> None:
     from davis_ag.workflows.reproduce.configs import CONFIGS
     from davis_ag.workflows.reproduce.pages.results import write_results_md
+    from davis_ag.workflows.reproduce.state import RunState, StageRecord
+    from results_factory import results
 
-    stat = {"mean": 0.5, "std": 0.01}
-    state = {
-        "results": {
-            "sp": {
-                "protocol": {
-                    "split": "test",
-                    "tau": 3,
-                    "sessions": 3,
-                    "episodes": 200,
-                    "scenes": ["Single-Strawberry/002"],
-                },
-                "policies": {
-                    name: {"oer_tau": stat, "reward": stat, "length": stat}
-                    for name in ("LRD", "UDD", "Rand", "Oracle", "A2C")
-                },
-            }
-        },
-        "stages": {"sp-strawberry: generate": {"seconds": 12.0, "note": "1 scene"}},
-    }
+    evaluated = results(dict.fromkeys(("LRD", "UDD", "Rand", "Oracle", "A2C"), 0.5), scenes=["Single-Strawberry/002"])
+    state = RunState(
+        results={"sp": evaluated},
+        stages={"sp-strawberry: generate": StageRecord(seconds=12.0, note="1 scene")},
+    )
     text = write_results_md(tmp_path / "results.md", CONFIGS["small"], state, tmp_path).read_text()
     assert "| A2C | .500 ± .010 | .520 ± .004 |" in text
     assert "## MP vine" in text and "Not evaluated yet" in text

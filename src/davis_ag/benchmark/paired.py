@@ -35,15 +35,6 @@ CONFIDENCE = 0.95
 FEW_SCENES = 10
 
 
-def paired_key(learner: str) -> str:
-    """Key of a learner (``A2C``, ``PPO``) against the Best fixed action in a results summary."""
-    return f"{learner.lower()}_vs_best_fixed"
-
-
-#: Key of A2C against the Best fixed action (:func:`a2c_against_best_fixed`) in a results summary.
-PAIRED_KEY = paired_key("A2C")
-
-
 @dataclass(frozen=True)
 class SceneGap:
     """The mean gap on one test scene.

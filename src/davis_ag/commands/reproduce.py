@@ -16,8 +16,9 @@ from pathlib import Path
 from davis_ag.commands import arguments
 from davis_ag.errors import UserError
 from davis_ag.workflows.reproduce.configs import CONFIGS
-from davis_ag.workflows.reproduce.run import load_state, reproduce, write_page
-from davis_ag.workflows.reproduce.status import format_status, run_config
+from davis_ag.workflows.reproduce.run import reproduce, write_page
+from davis_ag.workflows.reproduce.state import RunState, run_config
+from davis_ag.workflows.reproduce.status import format_status
 
 HELP = "reproduce Table 4: generate, train A2C and PPO, benchmark, write results.md"
 DESCRIPTION = __doc__
@@ -106,8 +107,8 @@ def run(args: argparse.Namespace) -> int:
     check_results_path(args.results, args.out)
     arguments.prove_writable_file(args.results, "--results")
     if args.rewrite_results:
-        state = load_state(args.out / "state.json")
-        if not state.get("config"):
+        state = RunState.load(args.out / "state.json")
+        if not state.config:
             raise UserError(f"{args.out / 'state.json'}: no finished run to write results from")
         write_page(args.results, run_config(state, args.out / "state.json"), state, args.out)
         print(f"wrote {args.results}")

@@ -115,7 +115,7 @@ def run_demo(
         index = write_report(
             root,
             report_dir,
-            results=results,
+            results=results.as_json(),
             validation=report.summary(),
             timer=timer,
             generated=generated,

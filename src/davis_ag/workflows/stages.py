@@ -8,12 +8,15 @@ a scene, a split or a baseline row means the same thing in each.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from davis_ag.errors import UserError
 from davis_ag.generate.one_scene import SceneRequest
 from davis_ag.generate.run_progress import RunOptions, default_workers
 from davis_ag.generate.runner import run_dataset
+
+if TYPE_CHECKING:
+    from davis_ag.benchmark.results import EvaluationResults
 
 #: The baselines of Table 4 plus the exact upper bound; A2C needs training (``reproduce``).
 BASELINES: tuple[str, ...] = ("LRD", "UDD", "Rand", "Oracle")
@@ -80,7 +83,7 @@ def run_baselines(
     seed: int = 0,
     model: Path | None = None,
     learners: tuple[Path, ...] = (),
-) -> dict[str, Any]:
+) -> EvaluationResults:
     """Evaluate LRD, UDD, Rand, Oracle, the Best fixed action (and A2C when ``model`` is given,
     and other learners' models beside it) as in Table 4.
 
@@ -101,7 +104,7 @@ def run_baselines(
             randomness, so adding one leaves the other rows' numbers as they were.
 
     Returns:
-        What :func:`davis_ag.benchmark.evaluation.evaluate_policies` returns, as its JSON.
+        What :func:`davis_ag.benchmark.evaluation.evaluate` returns (``as_json()`` is its JSON).
     """
     from davis_ag.benchmark.evaluation import evaluate
     from davis_ag.benchmark.policies import ModelPolicy
@@ -113,7 +116,7 @@ def run_baselines(
         deterministic.path = sampled.path  # one zip: one digest on both rows
         policies = [sampled, deterministic]
     policies += [ModelPolicy(path) for path in learners]
-    results = evaluate(
+    return evaluate(
         policies,
         root,
         scenario=scenario,
@@ -124,4 +127,3 @@ def run_baselines(
         crop=crop,
         baselines=list(BASELINES),
     )
-    return results.as_json()

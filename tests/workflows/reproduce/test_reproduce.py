@@ -53,14 +53,18 @@ def test_the_configurations_table_in_the_docs_is_the_codes() -> None:
 
 def test_an_evaluation_gets_the_train_split_yardstick_once(sp_root: Path) -> None:
     # A reused evaluation from before the yardstick gets it; one that has it is not recomputed.
+    from davis_ag.benchmark import evaluate
     from davis_ag.benchmark.exact import split_fixed_actions
-    from davis_ag.workflows.reproduce.run import _summary, add_train_split
+    from davis_ag.workflows.reproduce.run import add_train_split
+    from davis_ag.workflows.reproduce.state import without_episodes
 
-    results = {"protocol": {"split": "test"}, "policies": {}}
+    results = evaluate([], sp_root, "sp", sessions=1, episodes=2, baselines=["Rand"])
+    assert results.train_split is None
     assert add_train_split(results, sp_root, "sp", "strawberry")
-    assert results["train_split"] == split_fixed_actions(sp_root, "sp", "train", "strawberry")
+    assert results.train_split == split_fixed_actions(sp_root, "sp", "train", "strawberry")
     assert not add_train_split(results, sp_root, "sp", "strawberry")
-    assert _summary(results)["train_split"] == results["train_split"]
+    # The run's state keeps it with the evaluation, for the page.
+    assert without_episodes(results).train_split == results.train_split
 
 
 def test_a_run_the_disk_cannot_hold_is_refused_before_anything_is_written(tmp_path: Path) -> None:

@@ -15,34 +15,30 @@ import time
 from dataclasses import asdict
 from functools import partial
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Protocol
 
-from davis_ag.atomic_files import write_json_atomic
+from davis_ag.benchmark.results import EvaluationResults
 from davis_ag.workflows.reproduce.configs import ReproduceConfig, check_disk
 from davis_ag.workflows.reproduce.groups import group_key
+from davis_ag.workflows.reproduce.state import RunState, StageRecord, without_episodes
+
+if TYPE_CHECKING:
+    from davis_ag.workflows.reproduce.clock import StageClock
 
 
-def load_state(path: Path) -> dict[str, Any]:
-    """A run's ``state.json``: ``{}`` where there is none yet.
+class Record(Protocol):
+    """Writes a stage's record into the run's state (:class:`StageRecord`'s fields) and saves it."""
 
-    Raises:
-        UserError: for a file that is there but not a JSON object: a run that took it for no
-            run would start its records afresh over it.
-    """
-    from davis_ag.errors import UserError
-
-    if not path.exists():
-        return {}
-    try:
-        state = json.loads(path.read_text())
-    except (OSError, ValueError) as error:
-        state = error
-    if not isinstance(state, dict):
-        raise UserError(
-            f"{path}: not a reproduce state file (damaged or not JSON): move it aside to start the "
-            "run's records afresh (scenes and models already made are reused)"
-        )
-    return state
+    def __call__(
+        self,
+        stage: str,
+        seconds: float,
+        note: str = "",
+        code: str | None = None,
+        check_seconds: float | None = None,
+        stamp: str | None = None,
+    ) -> None:
+        """Record ``stage``; ``code`` None: the code running now."""
 
 
 def reproduce(
@@ -79,21 +75,33 @@ def reproduce(
     results_md = prove_writable_file(results_md, "--results")
     root = out / "dataset"
     state_path = out / "state.json"
-    state = load_state(state_path)
-    if state.get("config") and state["config"] != json.loads(json.dumps(asdict(config))):
+    state = RunState.load(state_path)
+    configured = json.loads(json.dumps(asdict(config)))
+    if state.config and state.config != configured:
         print(
             f"note: {out} was started with another configuration; finished stages are reused "
             "only where their files match",
             flush=True,
         )
-    state["config"] = asdict(config)
-    state.setdefault("stages", {})
-    state.setdefault("results", {})
+    state.config = configured
     clock = StageClock(out / CLOCK_FILE, code_version(), machine=machine_summary())
 
-    def record(stage: str, seconds: float, note: str = "", code: str | None = None, **extra: Any) -> None:
-        state["stages"][stage] = {"seconds": round(seconds, 1), "note": note, "code": code or code_version(), **extra}
-        write_json_atomic(state_path, state, indent=2)
+    def record(
+        stage: str,
+        seconds: float,
+        note: str = "",
+        code: str | None = None,
+        check_seconds: float | None = None,
+        stamp: str | None = None,
+    ) -> None:
+        state.stages[stage] = StageRecord(
+            seconds=round(seconds, 1),
+            note=note,
+            code=code or code_version(),
+            check_seconds=check_seconds,
+            stamp=stamp,
+        )
+        state.save(state_path)
 
     camera = Camera(*config.size)
     for scenario_name, crop_name in pairs:
@@ -101,7 +109,7 @@ def reproduce(
         n = config.scenes(scenario_name)
         key = group_key(scenario_name, crop_name)
         requests = [SceneRequest(scenario, crop, i, config.seed, camera) for i in range(n)]
-        state.setdefault("scene_folders", {})[key] = [r.folder for r in requests]
+        state.scene_folders[key] = [r.folder for r in requests]
         print(f"== {key}: {n} scene(s) at {config.size[0]}x{config.size[1]}", flush=True)
         with clock.timing(f"{key}: generate") as sitting:
             generated = generate_scenes(requests, root)  # also writes splits.json
@@ -143,7 +151,7 @@ def reproduce(
                     learners=tuple(path for algo, path in models.items() if algo != "a2c"),
                 )
                 write_or_rescue(results_json, partial(write_json, results), "the results")
-                plot_results(results, results_json.with_suffix(".png"))
+                plot_results(results.as_json(), results_json.with_suffix(".png"))
             record(f"{key}: evaluate", clock.seconds(f"{key}: evaluate"), f"split {split}")
         else:
             print(f"reusing {results_json}", flush=True)
@@ -151,17 +159,24 @@ def reproduce(
         if add_train_scores(results, root, scenario_name, crop_name, models, config) or added:
             write_or_rescue(results_json, partial(write_json, results), "the results")
         print(format_table(results), flush=True)
-        state["results"][config.result_key(scenario_name, crop_name)] = _summary(results)
-        evaluated = state["stages"][f"{key}: evaluate"]
+        state.results[config.result_key(scenario_name, crop_name)] = without_episodes(results)
+        evaluated = state.stages[f"{key}: evaluate"]
         # A reused evaluation keeps the code that ran it.
-        record(f"{key}: evaluate", evaluated["seconds"], evaluated["note"], evaluated.get("code"))
+        record(f"{key}: evaluate", evaluated.seconds, evaluated.note, evaluated.code)
         write_page(results_md, config, state, out)
         print(f"wrote {results_md}", flush=True)
     return 0
 
 
-def write_page(path: Path, config: ReproduceConfig, state: dict[str, Any], out: Path) -> None:
-    """Write the run's page from its records: Table 4's results page, or the crops run's."""
+def write_page(path: Path, config: ReproduceConfig, state: RunState, out: Path | None) -> None:
+    """Write the run's page from its records: Table 4's results page, or the crops run's.
+
+    Args:
+        path: The page.
+        config: The run's configuration (its ``page`` says which).
+        state: The run's records.
+        out: The run's folder, for the records beside its state (None: not read).
+    """
     if config.page == "crops":
         from davis_ag.workflows.reproduce.pages.crops import write_crops_md
 
@@ -172,10 +187,17 @@ def write_page(path: Path, config: ReproduceConfig, state: dict[str, Any], out: 
         write_results_md(path, config, state, out)
 
 
-def validate_once(group: Path, state: dict[str, Any], stage: str, clock: Any, record: Any) -> bool:
+def validate_once(group: Path, state: RunState, stage: str, clock: StageClock, record: Record) -> bool:
     """Validate ``group`` on the run's ``clock`` unless the last sitting validated the same files
     with the same code (:func:`davis_ag.data.validation_stamp.validation_stamp`): a sound report
     is reused, so a resumed paper-scale run does not re-read 9 GB of views at every sitting.
+
+    Args:
+        group: The group's scenes (``DATA/Single-Strawberry``).
+        state: The run's records (the stage's stamp of its last sound validation).
+        stage: The stage's name (``sp-strawberry: validate``).
+        clock: The run's clock.
+        record: Writes the stage's record (:func:`reproduce`'s).
 
     Returns:
         Whether the data is sound (the problems are printed where it is not).
@@ -184,9 +206,9 @@ def validate_once(group: Path, state: dict[str, Any], stage: str, clock: Any, re
     from davis_ag.data.validation_stamp import validation_stamp
 
     stamp = validation_stamp(group)
-    earlier = state["stages"].get(stage, {})
-    if earlier.get("stamp") == stamp:
-        print(f"{earlier['note']} (validated before; its files and the validator are unchanged)", flush=True)
+    earlier = state.stages.get(stage)
+    if earlier is not None and earlier.stamp == stamp:
+        print(f"{earlier.note} (validated before; its files and the validator are unchanged)", flush=True)
         return True
     with clock.timing(stage):
         began = time.perf_counter()
@@ -194,9 +216,9 @@ def validate_once(group: Path, state: dict[str, Any], stage: str, clock: Any, re
         # A check is done whole at each sitting whose code changed: its own time is the stage's
         # cost, where the clock adds up every such sitting. Timed inside the sitting, so it never
         # counts the clock's own file writes (slow on a busy disk).
-        check = {"check_seconds": round(time.perf_counter() - began, 1)}
+        check = round(time.perf_counter() - began, 1)
     print(report.summary(), flush=True)
-    record(stage, clock.seconds(stage), report.summary(), **check, **({"stamp": stamp} if report.ok else {}))
+    record(stage, clock.seconds(stage), report.summary(), check_seconds=check, stamp=stamp if report.ok else None)
     for problem in report.problems[:20]:
         print(problem, flush=True)
     return report.ok
@@ -212,7 +234,7 @@ def split_scene_ids(root: Path, scenario: str, split: str, crop: str) -> list[st
 
 def _reusable_results(
     path: Path, models: list[Path], split: str, scenes: list[str], config: ReproduceConfig
-) -> dict[str, Any] | None:
+) -> EvaluationResults | None:
     """An earlier evaluation of the same models, protocol and split scenes (``scenes``: a group
     that grew moves scenes between the splits), or ``None`` to evaluate anew.
 
@@ -225,40 +247,34 @@ def _reusable_results(
             (:func:`davis_ag.benchmark.summaries.check_summaries`): the page is never written
             from an edited summary, and the file is left for its owner to look at.
     """
+    from davis_ag.benchmark.exact import BEST_FIXED
     from davis_ag.benchmark.results import load_results
     from davis_ag.benchmark.summaries import check_summaries
     from davis_ag.errors import UserError
 
     try:
-        results = json.loads(path.read_text())
-    except (OSError, ValueError):
-        return None
-    if not isinstance(results, dict):
+        results = load_results(path, check=False)
+    except UserError:  # missing, not JSON or not results of this schema: evaluated anew
         return None
     try:
-        typed = load_results(path, check=False)
-    except UserError:  # not results of this schema: evaluated anew, as a damaged file is
-        return None
-    try:
-        check_summaries(typed, str(path))
+        check_summaries(results, str(path))
     except UserError as error:
         raise UserError(f"{error}; or move it aside to evaluate the run anew") from None
-    protocol = results.get("protocol", {})
+    protocol = results.protocol
     try:
         fresh = all(path.stat().st_mtime >= model.stat().st_mtime for model in models)
     except OSError:
         return None
     same = (
-        protocol.get("split") == split
-        and sorted(protocol.get("scenes") or []) == sorted(scenes)
-        and protocol.get("episodes") == config.episodes
-        and protocol.get("sessions") == config.sessions
-        and protocol.get("seed") == config.seed
+        protocol.split == split
+        and sorted(protocol.scenes) == sorted(scenes)
+        and protocol.episodes == config.episodes
+        and protocol.sessions == config.sessions
+        and protocol.seed == config.seed
     )
     # Evaluations from before the Best fixed action row and the uniform start rule are run anew.
-    current = protocol.get("start_rule") == "pairs" and "Best fixed action" in results.get("policies", {})
-    rows = results.get("policies", {})
-    every = all(_row_name(model) in rows for model in models)
+    current = protocol.start_rule == "pairs" and BEST_FIXED in results.policies
+    every = all(_row_name(model) in results.policies for model in models)
     return results if fresh and same and current and every else None
 
 
@@ -267,30 +283,44 @@ def _row_name(model: Path) -> str:
     return model.name.split("_", 1)[0].upper()
 
 
-def add_train_split(results: dict[str, Any], root: Path, scenario: str, crop: str) -> bool:
+def add_train_split(results: EvaluationResults, root: Path, scenario: str, crop: str) -> bool:
     """Add the yardstick of the split A2C's snapshot was chosen on: every fixed action's exact
-    expectations on train (``results["train_split"]``); an evaluation that has it is left alone.
+    expectations on train (``results.train_split``); an evaluation that has it is left alone.
+
+    Args:
+        results: The evaluation (changed in place).
+        root: The dataset root.
+        scenario: ``sp``, ``mp`` or ``row``.
+        crop: The group's crop.
 
     Returns:
         Whether it was added (the results file needs writing).
     """
     from davis_ag.benchmark.exact import split_fixed_actions
 
-    if "train_split" in results:
+    if results.train_split is not None:
         return False
-    results["train_split"] = split_fixed_actions(root, scenario, "train", crop)
+    results.train_split = split_fixed_actions(root, scenario, "train", crop)
     return True
 
 
 def add_train_scores(
-    results: dict[str, Any], root: Path, scenario: str, crop: str, models: dict[str, Path], config: ReproduceConfig
+    results: EvaluationResults, root: Path, scenario: str, crop: str, models: dict[str, Path], config: ReproduceConfig
 ) -> bool:
     """Score each learner's kept model on the train split with the test's protocol, on episodes of
-    its own (``results["train_split"]["learners"]``); learners scored already are left alone.
+    its own (``results.train_split["learners"]``); learners scored already are left alone.
 
     A snapshot is kept for the best of its train-split scores, so that score is the largest of
     many noisy ones and runs high (the winner's curse); fresh episodes give the train score to set
     beside the test's.
+
+    Args:
+        results: The evaluation (changed in place).
+        root: The dataset root.
+        scenario: ``sp``, ``mp`` or ``row``.
+        crop: The group's crop.
+        models: Each learner's model (``a2c``: its zip).
+        config: The run's configuration (sessions, episodes, seed).
 
     Returns:
         Whether a score was added (the results file needs writing).
@@ -298,7 +328,7 @@ def add_train_scores(
     from davis_ag.benchmark.evaluation import evaluate
     from davis_ag.benchmark.policies import ModelPolicy
 
-    train = results.get("train_split")
+    train = results.train_split
     if train is None:
         return False
     scored = train.setdefault("learners", {})
@@ -316,43 +346,11 @@ def add_train_scores(
         crop=crop,
         baselines=False,
         keep_episodes=False,
-    ).as_json()
-    for name, row in fresh["policies"].items():
+    )
+    for name, row in fresh.policies.items():
         scored[name] = {
-            "oer_tau": {k: row["oer_tau"][k] for k in ("mean", "std", "sem") if k in row["oer_tau"]},
+            "oer_tau": {"mean": row.oer_tau.mean, "std": row.oer_tau.std, "sem": row.oer_tau.sem},
             "sessions": config.sessions,
             "episodes": config.episodes,
         }
     return True
-
-
-def _summary(results: dict[str, Any]) -> dict[str, Any]:
-    """The part of the evaluation results that results.md needs: per policy the metrics' mean, std
-    and standard error, the exact expectations, action counts, how A2C played, the fixed action;
-    the exact values of every fixed action, on the evaluated split and on train; and A2C against
-    the Best fixed action episode by episode."""
-    from davis_ag.benchmark.paired import a2c_against_best_fixed, paired_key
-    from davis_ag.workflows.reproduce.learners import LEARNERS
-
-    kept = ("exact", "action_counts", "play", "action")
-    summary = {
-        "protocol": results["protocol"],
-        "policies": {
-            name: {
-                **{
-                    k: {s: v[s] for s in ("mean", "std", "sem") if s in v}
-                    for k, v in stats.items()
-                    if isinstance(v, dict) and "mean" in v
-                },
-                **{k: stats[k] for k in kept if k in stats},
-            }
-            for name, stats in results["policies"].items()
-        },
-    }
-    for key in ("fixed_actions", "train_split"):
-        if key in results:
-            summary[key] = results[key]
-    for learner in LEARNERS:
-        if paired := a2c_against_best_fixed(results, learner):  # needs the episodes, which the summary lacks
-            summary[paired_key(learner)] = paired
-    return summary

@@ -18,10 +18,9 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from davis_ag.errors import UserError
 from davis_ag.workflows.reproduce.configs import ReproduceConfig
-from davis_ag.workflows.reproduce.groups import SCENARIO_CROPS, group_key
-from davis_ag.workflows.reproduce.run import load_state
+from davis_ag.workflows.reproduce.groups import group_key
+from davis_ag.workflows.reproduce.state import RunState, StageRecord, run_config
 
 
 @dataclass(frozen=True)
@@ -45,31 +44,6 @@ class StageStatus:
     left_s: float | None = None
 
 
-def run_config(state: dict[str, Any], path: Path) -> ReproduceConfig:
-    """The configuration a run's ``state.json`` records.
-
-    Raises:
-        UserError: when ``state.json`` records none (no run started in that folder).
-    """
-    saved = state.get("config")
-    if not saved:
-        raise UserError(f"{path}: no reproduce run started there (no configuration in its state.json)")
-    try:
-        saved = dict(saved)
-        saved.update(
-            size=tuple(saved["size"]),
-            mp_extent=tuple(saved["mp_extent"]) if saved.get("mp_extent") else None,
-            learners=tuple(saved.get("learners", ("a2c",))),  # a run from before PPO trained A2C alone
-            pairs=tuple(tuple(pair) for pair in saved.get("pairs", SCENARIO_CROPS)),
-        )
-        return ReproduceConfig(**saved)
-    except (TypeError, KeyError, ValueError) as error:
-        raise UserError(
-            f"{path}: its configuration is damaged ({type(error).__name__}: {error}): move the file aside "
-            "to start the run's records afresh"
-        ) from None
-
-
 def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
     """Every stage of the run in ``out``, in the order the run takes them.
 
@@ -85,14 +59,14 @@ def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
     from davis_ag.generate.dataset_files import complete_scenes
     from davis_ag.workflows.reproduce.clock import CLOCK_FILE, read_clock
 
-    state = load_state(out / "state.json")
+    state = RunState.load(out / "state.json")
     config = run_config(state, out / "state.json")
-    recorded: dict[str, dict[str, Any]] = state.get("stages", {})
+    recorded = state.stages
     clock = read_clock(out / CLOCK_FILE)
 
     def seconds(stage: str) -> float | None:
         if stage in recorded and stage.endswith((": generate", ": validate")):
-            return float(recorded[stage]["seconds"])  # scenes made before the clock are counted there
+            return recorded[stage].seconds  # scenes made before the clock are counted there
         sittings = clock.get(stage)
         return sum(s["seconds"] for s in sittings) if sittings else None
 
@@ -103,7 +77,7 @@ def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
         stage = f"{key}: generate"
         stages.append(_generation_status(out / "dataset", config, scenario, crop, state, made, seconds(stage)))
         stage = f"{key}: validate"
-        note = recorded.get(stage, {}).get("note")
+        note = recorded[stage].note if stage in recorded else None
         stages.append(
             StageStatus(stage, bool(note and note.endswith(": sound")), note or "not started", seconds(stage))
         )
@@ -129,7 +103,7 @@ def _generation_status(
     config: ReproduceConfig,
     scenario: str,
     crop: str,
-    state: dict[str, Any],
+    state: RunState,
     made: set[str],
     seconds: float | None,
 ) -> StageStatus:
@@ -143,7 +117,7 @@ def _generation_status(
 
     key, wanted = group_key(scenario, crop), config.scenes(scenario)
     scenario_spec, crop_spec = config.specs(scenario, crop)
-    recorded = state.get("scene_folders", {}).get(key, [])
+    recorded = state.scene_folders.get(key, [])
     # The run records its folders as the stage starts; before that they are the first `wanted` of the group.
     folders = recorded or [scene_folder(scenario_spec, crop_spec, i) for i in range(wanted)]
     count = sum(folder in made for folder in folders)
@@ -234,7 +208,7 @@ def _estimated_from_elsewhere(
 def _validation_from_elsewhere(
     config: ReproduceConfig,
     clock: dict[str, list[dict[str, Any]]],
-    recorded: dict[str, dict[str, Any]],
+    recorded: dict[str, StageRecord],
     scenario: str,
     crop: str,
     status: StageStatus,
@@ -251,7 +225,8 @@ def _validation_from_elsewhere(
         if other == group_key(scenario, crop) or not sittings or f"{other}: validate" not in recorded:
             continue
         checked = config.scenes(other_scenario) * views_per_scene(*config.specs(other_scenario, other_crop))
-        took = recorded[f"{other}: validate"].get("check_seconds", sittings[-1]["seconds"])  # one whole check
+        check = recorded[f"{other}: validate"].check_seconds  # one whole check (None: a record from before it)
+        took = sittings[-1]["seconds"] if check is None else check
         rate = checked / max(float(took), 1e-9)
         return replace(
             status,

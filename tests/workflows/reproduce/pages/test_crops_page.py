@@ -6,30 +6,25 @@ import json
 from dataclasses import asdict
 from pathlib import Path
 
+from davis_ag.benchmark.results import EvaluationResults
 from davis_ag.scene.crop_literature import LITERATURE
 from davis_ag.scene.library_crops import LIBRARY_CROPS, LIBRARY_RECIPES
 from davis_ag.workflows.reproduce.configs import CONFIGS
 from davis_ag.workflows.reproduce.pages.crops import crops_table, write_crops_md
-from davis_ag.workflows.reproduce.status import run_config
+from davis_ag.workflows.reproduce.state import RunState, run_config
 from davis_ag.workflows.scene_stats.library_crops import library_crops_table, library_recipes_table
+from results_factory import gap, results
 
 CROPS_RUN = CONFIGS["crops"]
 
 
-def result(best: float, oracle: float, a2c: float | None, starts: int) -> dict:
-    """A group's results summary as reproduce keeps it in state.json."""
-    row = {"oer_tau": {"mean": 0.4, "std": 0.01}, "oer_0": {"mean": 0.2, "std": 0.01}}
-    policies = {
-        "LRD": row,
-        "Rand": row,
-        "Best fixed action": {"oer_tau": {"mean": best, "std": 0.01}},
-        "Oracle": {"oer_tau": {"mean": oracle, "std": 0.01}},
-    }
-    summary = {"protocol": {"split": "test", "scenes": ["a", "b", "c"], "starts": starts}, "policies": policies}
-    if a2c is not None:
-        policies["A2C"] = {"oer_tau": {"mean": a2c, "std": 0.01}}
-        summary["a2c_vs_best_fixed"] = {"gap": a2c - best, "low": a2c - best - 0.01, "high": a2c - best + 0.01}
-    return summary
+def result(best: float, oracle: float, a2c: float | None, starts: int) -> EvaluationResults:
+    """A group's evaluation as reproduce keeps it in state.json."""
+    oer = {"LRD": 0.4, "Rand": 0.4, "Best fixed action": best, "Oracle": oracle}
+    if a2c is None:
+        return results(oer, scenes=["a", "b", "c"], starts=starts)
+    paired = gap(a2c - best, a2c - best - 0.01, a2c - best + 0.01)
+    return results({**oer, "A2C": a2c}, {"A2C": paired}, ["a", "b", "c"], starts=starts)
 
 
 def test_the_crops_run_covers_every_library_crop_alone_and_in_its_row() -> None:
@@ -40,17 +35,17 @@ def test_the_crops_run_covers_every_library_crop_alone_and_in_its_row() -> None:
     # state.json keeps each group's results apart (Table 4's runs keep theirs by scenario).
     assert CROPS_RUN.result_key("row", "olive") == "row-olive" and CONFIGS["small"].result_key("sp", "x") == "sp"
     # A resumed run reads its configuration back from state.json, pairs included.
-    saved = json.loads(json.dumps({"config": asdict(CROPS_RUN)}))
+    saved = RunState.model_validate(json.loads(json.dumps({"config": asdict(CROPS_RUN)})))
     assert run_config(saved, Path("state.json")) == CROPS_RUN
 
 
 def test_the_table_ranks_groups_hardest_first_and_names_those_not_run(tmp_path: Path) -> None:
-    state = {
-        "results": {
+    state = RunState(
+        results={
             "sp-olive": result(best=0.50, oracle=0.70, a2c=0.55, starts=1234),
             "row-apple": result(best=0.30, oracle=0.60, a2c=None, starts=56),
         }
-    }
+    )
     table = crops_table(CROPS_RUN, state)
     rows = [line for line in table.splitlines() if line.startswith("| ") and "---" not in line][1:]
     assert [row.split(" | ")[0:2] for row in rows] == [["| apple", "row"], ["| olive", "sp"]]
@@ -72,7 +67,7 @@ def test_the_table_ranks_groups_hardest_first_and_names_those_not_run(tmp_path: 
         json.dumps({"0001.jpeg": {"bounding_boxes": [[1, 1, 2, 2, 0, 0]]}, "0002.jpeg": {"bounding_boxes": []}})
     )
     (scene / "scene.json").write_text(json.dumps({"plants": [{"fruit_count": 12}]}))
-    state["scene_folders"] = {"sp-olive": ["Single-Olive/000"]}
+    state.scene_folders = {"sp-olive": ["Single-Olive/000"]}
     write_crops_md(page, CROPS_RUN, state, tmp_path / "run")
     assert "| olive | sp | 50% / 12 |" in page.read_text()
 

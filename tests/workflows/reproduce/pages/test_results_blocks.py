@@ -7,20 +7,10 @@ from pathlib import Path
 
 from davis_ag.workflows.reproduce.configs import CONFIGS
 from davis_ag.workflows.reproduce.pages.results import write_results_md
+from davis_ag.workflows.reproduce.state import RunState, StageRecord
+from results_factory import gap, results
 
-
-def sp_result(oer: dict[str, float], gap: dict, **extra: object) -> dict:
-    """An SP strawberry evaluation as state.json keeps it: each policy's OER_tau, A2C's paired gap."""
-    policies = {
-        name: {
-            "oer_tau": {"mean": m, "std": 0.01},
-            "reward": {"mean": 0.5, "std": 0.01},
-            "length": {"mean": 0.5, "std": 0.01},
-        }
-        for name, m in oer.items()
-    }
-    protocol = {"split": "test", "tau": 3, "sessions": 3, "episodes": 200, "scenes": ["Single-Strawberry/003", "b"]}
-    return {"protocol": protocol, "policies": policies, "a2c_vs_best_fixed": dict(gap, episodes=600), **extra}
+SP_SCENES = ["Single-Strawberry/003", "b"]
 
 
 def test_the_readme_block_beside_docs_is_rewritten_from_the_run(tmp_path: Path) -> None:
@@ -28,9 +18,9 @@ def test_the_readme_block_beside_docs_is_rewritten_from_the_run(tmp_path: Path) 
     (tmp_path / "docs").mkdir()
     readme = tmp_path / "README.md"
     readme.write_text("# p\n\nbefore\n<!-- results-table4:start -->\nstale .999\n<!-- results-table4:end -->\nafter\n")
-    per_scene = [{"scene": "Single-Strawberry/003", "gap": -0.2, "episodes": 22, "starts": 1}]
-    gap = {"gap": 0.027, "low": 0.01, "high": 0.04, "per_scene": per_scene}
-    state = {"results": {"sp": sp_result({"A2C": 0.6, "Rand": 0.45, "LRD": 0.44, "UDD": 0.3}, gap)}}
+    paired = gap(0.027, 0.01, 0.04, [("Single-Strawberry/003", -0.2, 22, 1)])
+    oer = {"A2C": 0.6, "Rand": 0.45, "LRD": 0.44, "UDD": 0.3}
+    state = RunState(results={"sp": results(oer, {"A2C": paired}, SP_SCENES)})
     page = write_results_md(tmp_path / "docs" / "results.md", CONFIGS["medium"], state, tmp_path).read_text()
     assert (
         "A2C minus `Best fixed action`: +.027, 95% bootstrap interval over episodes +.010 to +.040 (10,000 "
@@ -49,7 +39,7 @@ def test_the_readme_block_beside_docs_is_rewritten_from_the_run(tmp_path: Path) 
     # A page written elsewhere (a work folder beside the README) leaves the README alone.
     other = tmp_path / "work"
     other.mkdir()
-    write_results_md(other / "results.md", CONFIGS["medium"], {"results": {}}, other)
+    write_results_md(other / "results.md", CONFIGS["medium"], RunState(), other)
     assert readme.read_text() == text
 
 
@@ -66,22 +56,19 @@ def test_the_blocks_beside_docs_give_the_train_gap_and_the_measured_hours(tmp_pa
     selection["scores"] = [{"step": 90_000, "oer_tau": 0.459}, {"step": 300_000, "oer_tau": 0.442}]
     (tmp_path / "models" / "a2c_sp-strawberry.training.json").write_text(json.dumps({"selection": selection}))
     fixed = {"up": {"oer_tau": 0.42, "reward": 0.0, "length": 3.0}}
-    per_scene = [
-        {"scene": f"Single-Strawberry/{i:03d}", "gap": g, "episodes": 1, "starts": 1}
-        for i, g in ((3, 0.1), (4, -0.1), (9, 0.2))
-    ]
-    gap = {"gap": 0.03, "low": 0.02, "high": 0.039, "per_scene": per_scene, "scene_low": -0.1, "scene_high": 0.2}
-    result = sp_result(dict.fromkeys(("A2C", "Rand", "LRD", "UDD"), 0.45), gap)
-    result["protocol"]["starts"] = 507
-    result["train_split"] = {"split": "train", "starts": 1280, "fixed_actions": fixed}
-    state = {
-        "results": {"sp": result},
-        "stages": {
-            "sp-strawberry: generate": {"seconds": 8460.0, "note": "86 scene(s)"},
-            "sp-strawberry: validate": {"seconds": 900.0, "note": "sound", "check_seconds": 330.0},
-            "sp-strawberry: evaluate": {"seconds": 36.0, "note": "split test"},
+    per_scene = [(f"Single-Strawberry/{i:03d}", g, 1, 1) for i, g in ((3, 0.1), (4, -0.1), (9, 0.2))]
+    paired = gap(0.03, 0.02, 0.039, per_scene, scene_low=-0.1, scene_high=0.2)
+    train = {"split": "train", "starts": 1280, "fixed_actions": fixed}
+    oer = dict.fromkeys(("A2C", "Rand", "LRD", "UDD"), 0.45)
+    result = results(oer, {"A2C": paired}, SP_SCENES, starts=507, train_split=train)
+    state = RunState(
+        results={"sp": result},
+        stages={
+            "sp-strawberry: generate": StageRecord(seconds=8460.0, note="86 scene(s)"),
+            "sp-strawberry: validate": StageRecord(seconds=900.0, note="sound", check_seconds=330.0),
+            "sp-strawberry: evaluate": StageRecord(seconds=36.0, note="split test"),
         },
-    }
+    )
     sitting = {
         "started": "2026-11-25T01:45:02+00:00",
         "seconds": 36.0,
@@ -105,10 +92,10 @@ def test_the_blocks_beside_docs_give_the_train_gap_and_the_measured_hours(tmp_pa
     # With enough test scenes the interval over them is the verdict on other scenes like them.
     from davis_ag.workflows.reproduce.pages.gaps import paired_line
 
-    many = [dict(per_scene[0], scene=f"Single-Strawberry/{i:03d}") for i in range(12)]
-    line = paired_line(
-        {"a2c_vs_best_fixed": dict(gap, per_scene=many, scene_low=0.016, scene_high=0.048, episodes=600)}
-    )
+    many = [(f"Single-Strawberry/{i:03d}", 0.1, 1, 1) for i in range(12)]
+    wide = gap(0.03, 0.02, 0.039, many, scene_low=0.016, scene_high=0.048)
+    line = paired_line(results(oer, {"A2C": wide}, [scene for scene, *_ in many]))
+    assert line is not None
     assert line.endswith(
         "Resampling the 12 test scenes played instead (each with all its episodes: would the gap hold on other "
         "scenes like these?), the 95% interval is +.016 to +.048, above zero."

@@ -8,8 +8,10 @@ from pathlib import Path
 import numpy as np
 
 from davis_ag.workflows.reproduce.configs import CONFIGS
-from davis_ag.workflows.reproduce.pages.paper_table4 import PAPER_ORDERINGS, ordering_failures
+from davis_ag.workflows.reproduce.pages.paper_table4 import PAPER_ORDERINGS, PaperCell, ordering_failures
 from davis_ag.workflows.reproduce.pages.results import write_results_md
+from davis_ag.workflows.reproduce.state import RunState, StageRecord, without_episodes
+from results_factory import results as made_results
 
 
 def write_scene(root: Path, folder: str, version: str, plants: str | None = None) -> None:
@@ -42,25 +44,19 @@ def test_a_run_resumed_across_code_changes_says_so(tmp_path: Path) -> None:
         ],
     }
     (tmp_path / "models" / "a2c_sp-strawberry.training.json").write_text(json.dumps(record))
-    stat = {"mean": 0.5, "std": 0.01}
-    state = {
-        "scene_folders": {"sp-strawberry": folders},
-        "results": {
-            "sp": {
-                "protocol": {"split": "test", "tau": 3, "sessions": 3, "episodes": 200, "scenes": folders[1:]},
-                "policies": {
-                    name: {"oer_tau": dict(stat, mean=m), "reward": stat, "length": stat}
-                    for name, m in (("A2C", 0.6), ("Rand", 0.45), ("LRD", 0.44), ("UDD", 0.3))
-                },
-            }
-        },
+    oer = {"A2C": 0.6, "Rand": 0.45, "LRD": 0.44, "UDD": 0.3}
+    state = RunState(
+        scene_folders={"sp-strawberry": folders},
+        results={"sp": made_results(oer, scenes=folders[1:])},
         # What a resuming sitting (code bbbb) leaves in state.json: it re-records the generate
         # stage it only skipped, and times only its own part of the training.
-        "stages": {
-            "sp-strawberry: generate": {"seconds": 12.0, "note": "2 scenes", "code": "0.1.0+bbbb"},
-            "sp-strawberry: train A2C": {"seconds": 4200.0, "note": "300000 steps, 71.4 steps/s", "code": "0.1.0+bbbb"},
+        stages={
+            "sp-strawberry: generate": StageRecord(seconds=12.0, note="2 scenes", code="0.1.0+bbbb"),
+            "sp-strawberry: train A2C": StageRecord(
+                seconds=4200.0, note="300000 steps, 71.4 steps/s", code="0.1.0+bbbb"
+            ),
         },
-    }
+    )
     text = write_results_md(tmp_path / "results.md", CONFIGS["medium"], state, tmp_path).read_text()
     assert "0.1.0+aaaa (1 scene); 0.1.0+bbbb (1 scene) — made by more than one version of the code" in text
     assert "300,000 steps in 2 sitting(s)" in text and "the code changed between sittings" in text
@@ -94,7 +90,7 @@ def test_how_the_run_was_made_names_the_plants_and_the_a2c_settings(tmp_path: Pa
         "sittings": [{"code": "0.1.0+aaaa", "from_step": 0, "to_step": 300_000, "seconds": 6000.0}],
     }
     (tmp_path / "models" / "a2c_sp-strawberry.training.json").write_text(json.dumps(record))
-    state = {"scene_folders": {"sp-strawberry": folders}, "results": {}, "stages": {}}
+    state = RunState(scene_folders={"sp-strawberry": folders})
     text = write_results_md(tmp_path / "results.md", CONFIGS["medium"], state, tmp_path).read_text()
     how = text.split("## How this run was made", 1)[1]
     assert "plants grown by `--plants canopy` (2 scenes); `--plants architecture` (1 scene)" in how
@@ -136,19 +132,21 @@ def test_the_kept_snapshot_is_set_beside_the_best_fixed_action_on_train(tmp_path
     }
     (tmp_path / "models" / "a2c_sp-strawberry.training.json").write_text(json.dumps(record))
     fixed = {a: {"oer_tau": v, "reward": 0.0, "length": 3.0} for a, v in (("up", 0.41), ("backward", 0.434))}
-    result = {"train_split": {"split": "train", "starts": 176, "fixed_actions": fixed}}
-    assert train_split_line("sp", result, tmp_path).startswith(
+    train = {"split": "train", "starts": 176, "fixed_actions": fixed}
+    result = made_results({"A2C": 0.5}, train_split=train)
+    assert str(train_split_line("sp", result, tmp_path)).startswith(
         "On the train split (176 eligible starts), where the snapshot was chosen: A2C's kept snapshot "
         "(240,000 steps) scores OER_tau .565 (200 sampled episodes), the best fixed action there (always "
         "`backward`) .434 exactly, .131 above it; the last snapshot (300,000 steps) .444."
     )
     fixed["backward"]["oer_tau"] = 0.6
-    assert ".035 below it" in train_split_line("sp", result, tmp_path)
+    assert ".035 below it" in str(train_split_line("sp", result, tmp_path))
     # Without the yardstick (an evaluation from before it) or a scored run, no line.
-    assert train_split_line("sp", {}, tmp_path) is None
+    before = made_results({"A2C": 0.5})
+    assert train_split_line("sp", before, tmp_path) is None
     assert train_split_line("mp", result, tmp_path) is None
     # The same yardstick is drawn across the learning curve's snapshot panel.
-    assert train_split_references({"sp": result, "mp": {}}) == {
+    assert train_split_references({"sp": result, "mp": before}) == {
         "sp-strawberry: best fixed action (always backward), exact": 0.6
     }
 
@@ -157,7 +155,7 @@ def test_a_broken_ordering_names_the_steps_that_break() -> None:
     # Our medium run's SP numbers: A2C .405 > Rand .388, but Rand and LRD are .030 apart with
     # stds .003 and .002, and UDD .360 is above LRD .358.
     stats = {
-        name: {"oer_tau": {"mean": m, "std": sd}}
+        name: PaperCell(m, sd)
         for name, m, sd in (("A2C", 0.405, 0.002), ("Rand", 0.388, 0.003), ("LRD", 0.358, 0.002), ("UDD", 0.360, 0.005))
     }
     assert ordering_failures(PAPER_ORDERINGS["sp"], stats) == [
@@ -171,7 +169,6 @@ def test_the_page_shows_what_each_policy_does(tmp_path: Path, sp_root: Path, one
     # A real (tiny) run's records: a model, its training record, an evaluation with every row.
     from davis_ag.benchmark.algorithms import A2C_SETTINGS
     from davis_ag.benchmark.training import train_a2c
-    from davis_ag.workflows.reproduce.run import _summary
     from davis_ag.workflows.stages import run_baselines
 
     (tmp_path / "docs").mkdir()
@@ -187,35 +184,35 @@ def test_the_page_shows_what_each_policy_does(tmp_path: Path, sp_root: Path, one
         checkpoint_every=0,
     )
     results = run_baselines(sp_root, "sp", "strawberry", "test", 20, 3, model=model)
-    (tmp_path / "results").mkdir()
-    (tmp_path / "results" / "sp-strawberry.json").write_text(json.dumps(results))
-    state = {"results": {"sp": _summary(results)}}
+    results.write(tmp_path / "results" / "sp-strawberry.json")
+    state = RunState(results={"sp": without_episodes(results)})
     page = tmp_path / "docs" / "results.md"
     text = write_results_md(page, CONFIGS["medium"], state, tmp_path).read_text()
-    policies = results["policies"]
+    policies = results.policies
     best = policies["Best fixed action"]
-    assert best["action"] in results["protocol"]["actions"] and policies["A2C"]["play"] == "sampled"
-    assert "| Best fixed action |" in text and f"(always `{best['action']}`)" in text
+    assert best.action in results.protocol.actions and policies["A2C"].play == "sampled"
+    assert "| Best fixed action |" in text and f"(always `{best.action}`)" in text
     assert "A2C **beats** it" in text or "A2C **does not beat** it" in text
     assert ", ".join(f"{k}={v}" for k, v in A2C_SETTINGS.items()) in text
     assert "plays actions sampled from the policy" in text
     assert "uniform over every eligible (view, target) pair" in text
     # Exact beside sampled, and each policy's action shares.
     lrd = policies["LRD"]
-    assert (
-        f"| LRD | {_c(lrd['oer_tau']['mean'])} ± {_c(lrd['oer_tau']['sem'])} | {_c(lrd['exact']['oer_tau'])} |" in text
-    )
+    assert lrd.exact is not None
+    assert f"| LRD | {_c(lrd.oer_tau.mean)} ± {_c(lrd.oer_tau.sem)} | {_c(lrd.exact['oer_tau'])} |" in text
     assert "| Policy | forward | backward | left | right | up | down | done |" in text
     # The episodes' drawn starts beside every start's mean OER_0 (always `done` ends where it starts).
+    assert results.fixed_actions is not None
     assert (
-        f"Mean start OER (OER_0) of these episodes: {_c(policies['LRD']['oer_0']['mean'])}, against "
-        f"{_c(results['fixed_actions']['done']['oer_tau'])} over every eligible start of the split (exact)"
+        f"Mean start OER (OER_0) of these episodes: {_c(lrd.oer_0.mean)}, against "
+        f"{_c(results.fixed_actions['done']['oer_tau'])} over every eligible start of the split (exact)"
     ) in text
     # Played as the benchmark plays it (sampled), the trained A2C is not one move repeated.
-    shares = np.array(list(policies["A2C"]["action_counts"].values())) / sum(policies["A2C"]["action_counts"].values())
-    assert (shares >= 0.05).sum() >= 2, policies["A2C"]["action_counts"]
-    counts = best["action_counts"]
-    assert "| Best fixed action | " + " | ".join("100" if a == best["action"] else "0" for a in counts) + " |" in text
+    played = policies["A2C"].action_counts or {}
+    shares = np.array(list(played.values())) / sum(played.values())
+    assert (shares >= 0.05).sum() >= 2, played
+    counts = best.action_counts or {}
+    assert "| Best fixed action | " + " | ".join("100" if a == best.action else "0" for a in counts) + " |" in text
     for picture in (
         "results-sp-strawberry-actions.png",
         "results-learning-curve.png",
@@ -233,7 +230,7 @@ def test_a_run_with_ppo_shows_its_row_gap_settings_and_stage(tmp_path: Path, sp_
     from davis_ag.benchmark.training import train_agent
     from davis_ag.figures.result_charts import plot_results
     from davis_ag.workflows.reproduce.learners import model_path
-    from davis_ag.workflows.reproduce.run import _reusable_results, _summary, add_train_scores, add_train_split
+    from davis_ag.workflows.reproduce.run import _reusable_results, add_train_scores, add_train_split
     from davis_ag.workflows.stages import run_baselines
 
     (tmp_path / "docs").mkdir()
@@ -257,53 +254,56 @@ def test_a_run_with_ppo_shows_its_row_gap_settings_and_stage(tmp_path: Path, sp_
         )
     before = run_baselines(sp_root, "sp", "strawberry", "test", 20, 3, model=models["a2c"])
     both = run_baselines(sp_root, "sp", "strawberry", "test", 20, 3, model=models["a2c"], learners=(models["ppo"],))
-    assert set(both["policies"]) - set(before["policies"]) == {"PPO"}
-    for name, row in before["policies"].items():  # seeded episodes: the rows of before PPO, unchanged
-        assert both["policies"][name] == row, name
+    assert set(both.policies) - set(before.policies) == {"PPO"}
+    for name, row in before.policies.items():  # seeded episodes: the rows of before PPO, unchanged
+        assert both.policies[name] == row, name
     # An evaluation from before PPO is not reused for a run that trains it.
     results_json = tmp_path / "results" / "sp-strawberry.json"
-    results_json.parent.mkdir()
-    results_json.write_text(json.dumps(before))
+    before.write(results_json)
     config = replace(CONFIGS["small"], episodes=20, sessions=3)
     test_scenes = ["Single-Strawberry/001"]
     assert _reusable_results(results_json, [models["a2c"]], "test", test_scenes, config) is not None
     assert _reusable_results(results_json, [models["a2c"], models["ppo"]], "test", test_scenes, config) is None
-    results_json.write_text(json.dumps(both))
+    both.write(results_json)
     assert _reusable_results(results_json, [models["a2c"], models["ppo"]], "test", test_scenes, config) is not None
     # A group that grew has another test split: evaluated anew.
     grown = [*test_scenes, "Single-Strawberry/002"]
     assert _reusable_results(results_json, [models["a2c"], models["ppo"]], "test", grown, config) is None
-    assert plot_results(both, results_json.with_suffix(".png")).is_file()  # the stage's chart, PPO's bar in it
+    assert plot_results(
+        both.as_json(), results_json.with_suffix(".png")
+    ).is_file()  # the stage's chart, PPO's bar in it
     add_train_split(both, sp_root, "sp", "strawberry")
     # The kept snapshots scored again on fresh train episodes, as on test: their selection scores run high.
     assert add_train_scores(both, sp_root, "sp", "strawberry", models, config)
     assert not add_train_scores(both, sp_root, "sp", "strawberry", models, config)  # scored once
-    fresh = both["train_split"]["learners"]
+    assert both.train_split is not None
+    fresh = both.train_split["learners"]
     assert set(fresh) == {"A2C", "PPO"} and all(0 <= f["oer_tau"]["mean"] <= 1 for f in fresh.values())
     assert fresh["A2C"]["sessions"] == 3 and fresh["A2C"]["episodes"] == 20
 
-    state = {
-        "scene_folders": {"sp-strawberry": ["Single-Strawberry/000", "Single-Strawberry/001"]},
-        "results": {"sp": _summary(both)},
-        "stages": {
-            "sp-strawberry: train A2C": {"seconds": 1.0, "note": "64 steps", "code": "x"},
-            "sp-strawberry: train PPO": {"seconds": 1.0, "note": "64 steps", "code": "x"},
+    state = RunState(
+        scene_folders={"sp-strawberry": ["Single-Strawberry/000", "Single-Strawberry/001"]},
+        results={"sp": without_episodes(both)},
+        stages={
+            "sp-strawberry: train A2C": StageRecord(seconds=1.0, note="64 steps", code="x"),
+            "sp-strawberry: train PPO": StageRecord(seconds=1.0, note="64 steps", code="x"),
         },
-    }
+    )
     text = write_results_md(tmp_path / "docs" / "results.md", config, state, tmp_path).read_text()
-    ppo = both["policies"]["PPO"]
-    assert f"| PPO | {_c(ppo['oer_tau']['mean'])} ± {_c(ppo['oer_tau']['std'])} | – |" in text
-    gap = state["results"]["sp"]["ppo_vs_best_fixed"]
-    ahead = sum(s["gap"] > 0 for s in gap["per_scene"])
-    assert f"PPO minus `Best fixed action`: {'+' if gap['gap'] >= 0 else '-'}{_c(abs(gap['gap']))}" in text
+    ppo = both.policies["PPO"]
+    assert f"| PPO | {_c(ppo.oer_tau.mean)} ± {_c(ppo.oer_tau.std)} | – |" in text
+    gap = ppo.paired["Best fixed action"]  # the evaluation's own, on the same episodes
+    assert state.results["sp"].policies["PPO"].paired["Best fixed action"] == gap
+    ahead = sum(s.gap > 0 for s in gap.per_scene)
+    assert f"PPO minus `Best fixed action`: {'+' if gap.gap >= 0 else '-'}{_c(abs(gap.gap))}" in text
     assert f"PPO is ahead on {ahead} of the 1 test scenes played" in text and "A2C is ahead on" in text
     assert "PPO: trained with n_steps=16, n_epochs=4, batch_size=32, learning_rate=lin_2.5e-4" in text
     assert "PPO beside it (RL Baselines3 Zoo's Atari settings" in text
     # Beside PPO, A2C's curve says it is A2C's.
     assert "- sp-strawberry (A2C): rolling mean" in text and "- sp-strawberry (PPO): rolling mean" in text
-    train_starts = state["results"]["sp"]["train_split"]["starts"]
+    train_starts = both.train_split["starts"]
     assert (
-        f"Split `test` (1 scene(s), {both['protocol']['starts']:,} eligible starts; the train split: "
+        f"Split `test` (1 scene(s), {both.protocol.starts:,} eligible starts; the train split: "
         f"{train_starts:,} eligible starts), tau = 3" in text
     )
     assert "where the snapshot was chosen: A2C's kept snapshot (70 steps)" in text

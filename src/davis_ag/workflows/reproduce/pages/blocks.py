@@ -11,12 +11,13 @@ from pathlib import Path
 from typing import Any
 
 from davis_ag.benchmark.exact import BEST_FIXED
-from davis_ag.benchmark.paired import CONFIDENCE, FEW_SCENES, paired_key
+from davis_ag.benchmark.paired import CONFIDENCE, FEW_SCENES
+from davis_ag.benchmark.results import EvaluationResults
 from davis_ag.workflows.reproduce.clock import machines
-from davis_ag.workflows.reproduce.configs import beside_table4
+from davis_ag.workflows.reproduce.configs import ReproduceConfig, beside_table4
 from davis_ag.workflows.reproduce.groups import GROUPS
 from davis_ag.workflows.reproduce.learners import LEARNERS
-from davis_ag.workflows.reproduce.pages.gaps import scenes_ahead
+from davis_ag.workflows.reproduce.pages.gaps import learner_gap, scenes_ahead
 from davis_ag.workflows.reproduce.pages.paper_table4 import (
     PAPER_ORDERINGS,
     PAPER_TABLE4,
@@ -28,6 +29,7 @@ from davis_ag.workflows.reproduce.pages.paper_table4 import (
 )
 from davis_ag.workflows.reproduce.pages.policies import learners_run, train_split_gap
 from davis_ag.workflows.reproduce.pages.provenance import one_whole_hours
+from davis_ag.workflows.reproduce.state import RunState, StageRecord
 
 #: The README's block that holds the run's OER_tau beside Table 4's (see :func:`readme_block`).
 README_MARKER = "results-table4"
@@ -35,19 +37,19 @@ README_MARKER = "results-table4"
 RUN_MARKER = "results-run"
 
 
-def readme_block(config: Any, state: dict[str, Any], out: Path | None = None) -> str:
+def readme_block(config: ReproduceConfig, state: RunState, out: Path | None = None) -> str:
     """The README's short Table 4: OER_tau, ours beside the paper's, whether the orderings hold,
     and each learner against the best fixed action on test and on train.
 
     Args:
         config: The run's :class:`~davis_ag.workflows.reproduce.configs.ReproduceConfig`.
-        state: The run's ``state.json`` (its ``results``).
+        state: The run's records (its ``results``).
         out: The run's folder, for the learners' training records (the train-split gap).
 
     Returns:
         Markdown: a line on the run, a table, a line per ordering, a line per learner.
     """
-    results = state.get("results", {})
+    results = state.results
     learners = [n for n in LEARNERS if n == "A2C" or n in learners_run(state)]
     head = (
         f"`{config.name}` run (docs/results.md): {config.sp_scenes} SP strawberry and {config.mp_scenes} "
@@ -69,13 +71,11 @@ def readme_block(config: Any, state: dict[str, Any], out: Path | None = None) ->
     verdicts = []
     for scenario in ("sp", "mp"):
         result = results.get(scenario)
-        if result:
-            policies = result["policies"]
-            scenes, split = len(result["protocol"].get("scenes", [])), result["protocol"]["split"]
+        if result is not None:
+            policies = result.policies
+            scenes, split = len(result.protocol.scenes), result.protocol.split
             cells = [
-                f"{cell(policies[n]['oer_tau']['mean'])} ± {cell(policies[n]['oer_tau']['std'])}"
-                if n in policies
-                else "–"
+                f"{cell(policies[n].oer_tau.mean)} ± {cell(policies[n].oer_tau.std)}" if n in policies else "–"
                 for n in columns
             ]
             lines.append(
@@ -83,7 +83,7 @@ def readme_block(config: Any, state: dict[str, Any], out: Path | None = None) ->
                 + " | ".join(cells)
                 + " |"
             )
-            failures = ordering_failures(PAPER_ORDERINGS[scenario], policies)
+            failures = ordering_failures(PAPER_ORDERINGS[scenario], {n: p.oer_tau for n, p in policies.items()})
             verdict = (
                 "not checked"
                 if failures is None
@@ -112,7 +112,7 @@ def readme_block(config: Any, state: dict[str, Any], out: Path | None = None) ->
     gaps = {
         learner: found
         for learner in learners
-        if (found := [g for s in ("sp", "mp") if (g := _learner_gaps(s, results.get(s, {}), out, learner))])
+        if (found := [g for s in ("sp", "mp") if (g := _learner_gaps(s, results.get(s), out, learner))])
     }
     if gaps:
         lines += [
@@ -129,54 +129,54 @@ def readme_block(config: Any, state: dict[str, Any], out: Path | None = None) ->
     return "\n".join(lines)
 
 
-def _learner_gaps(scenario: str, result: dict[str, Any], out: Path | None, learner: str) -> str | None:
+def _learner_gaps(scenario: str, result: EvaluationResults | None, out: Path | None, learner: str) -> str | None:
     """``SP strawberry +.030 (+.020 to +.039; over scenes +.016 to +.048), ahead on 18 of the 23
     test scenes played, train +.040``."""
-    paired = result.get(paired_key(learner))
-    if not paired:
+    paired = learner_gap(result, learner) if result is not None else None
+    if result is None or paired is None:
         return None
-    scenes = paired.get("per_scene", [])
-    intervals = f"{signed(paired['low'])} to {signed(paired['high'])}"
-    if paired.get("scene_low") is not None:
-        intervals += f"; over scenes {signed(paired['scene_low'])} to {signed(paired['scene_high'])}"
+    scenes = paired.per_scene
+    intervals = f"{signed(paired.low)} to {signed(paired.high)}"
+    if paired.scene_low is not None and paired.scene_high is not None:
+        intervals += f"; over scenes {signed(paired.scene_low)} to {signed(paired.scene_high)}"
         if len(scenes) < FEW_SCENES:
             intervals += f", coarse with {len(scenes)}"
-    text = f"{TITLES[scenario]} {signed(paired['gap'])} ({intervals})"
+    text = f"{TITLES[scenario]} {signed(paired.gap)} ({intervals})"
     if scenes:
         text += ", ahead on {} of the {} test scenes played".format(*scenes_ahead(paired))
     train = train_split_gap(scenario, result, out, learner)
     if train is not None:
-        text += f", train {signed(train['kept'] - train['best'])}"
+        text += f", train {signed(train.kept - train.best)}"
     return text
 
 
-def run_block(config: Any, state: dict[str, Any], stages: list[tuple[str, float, list[dict[str, Any]]]]) -> str:
+def run_block(config: ReproduceConfig, state: RunState, stages: list[tuple[str, float, list[dict[str, Any]]]]) -> str:
     """docs/benchmark.md's line on the run results.md shows: its configuration, test splits and the
     wall time of every stage, as the run's clock measured them.
 
     Args:
         config: The run's :class:`~davis_ag.workflows.reproduce.configs.ReproduceConfig`.
-        state: The run's ``state.json`` (its ``results``).
+        state: The run's records (its ``results`` and ``stages``).
         stages: ``(stage, seconds, sittings)`` per stage in the run's order, as results.md's
             "Wall time per stage" table has them, with the run's clock's sittings of each.
 
     Returns:
         One Markdown paragraph.
     """
-    results = state.get("results", {})
     splits = []
     for scenario in ("sp", "mp"):
-        protocol = results.get(scenario, {}).get("protocol")
-        if protocol:
-            starts = f", {protocol['starts']:,} eligible starts" if "starts" in protocol else ""
-            splits.append(f"{TITLES[scenario]} {len(protocol.get('scenes', []))} {protocol['split']} scenes{starts}")
+        result = state.results.get(scenario)
+        if result is not None:
+            protocol = result.protocol
+            starts = f", {protocol.starts:,} eligible starts" if protocol.starts is not None else ""
+            splits.append(f"{TITLES[scenario]} {len(protocol.scenes)} {protocol.split} scenes{starts}")
         else:
             splits.append(f"{TITLES[scenario]} not evaluated yet")
     per_group = []
     for scenario, key in GROUPS.items():
         times = (
             ", ".join(
-                _stage_hours(stage.partition(": ")[2], seconds, state.get("stages", {}).get(stage, {}), sittings)
+                _stage_hours(stage.partition(": ")[2], seconds, state.stages.get(stage), sittings)
                 for stage, seconds, sittings in stages
                 if stage.startswith(f"{key}: ")
             )
@@ -195,7 +195,7 @@ def run_block(config: Any, state: dict[str, Any], stages: list[tuple[str, float,
     )
 
 
-def _stage_hours(step: str, seconds: float, entry: dict[str, Any], sittings: list[dict[str, Any]]) -> str:
+def _stage_hours(step: str, seconds: float, entry: StageRecord | None, sittings: list[dict[str, Any]]) -> str:
     """``validate 0.43 h``; a stage done whole again by later sittings reads by one whole run of it."""
     one = one_whole_hours(step, entry, sittings)
     if one is None:
@@ -203,7 +203,13 @@ def _stage_hours(step: str, seconds: float, entry: dict[str, Any], sittings: lis
     return f"{step} {one:.2f} h ({len(sittings)} sittings, each doing it whole: {seconds / 3600:.2f} h in all)"
 
 
-def write_blocks_beside(page: Path, config: Any, state: dict[str, Any], out: Path | None, stages: list) -> None:
+def write_blocks_beside(
+    page: Path,
+    config: ReproduceConfig,
+    state: RunState,
+    out: Path | None,
+    stages: list[tuple[str, float, list[dict[str, Any]]]],
+) -> None:
     """Rewrite the README's and docs/benchmark.md's blocks of a results page in a project's ``docs/``.
 
     A page written elsewhere (a work folder) leaves both alone, as does a page whose README or
@@ -212,7 +218,7 @@ def write_blocks_beside(page: Path, config: Any, state: dict[str, Any], out: Pat
     Args:
         page: The results page just written.
         config: The run's configuration.
-        state: The run's ``state.json``.
+        state: The run's records.
         out: The run's folder.
         stages: ``(stage, seconds, sittings)`` per stage (:func:`run_block`).
     """

@@ -9,37 +9,44 @@ markers; any other path gets a page of its own.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
 
 from davis_ag.atomic_files import write_marked_section, write_text_atomic
 from davis_ag.benchmark.exact import BEST_FIXED
-from davis_ag.benchmark.paired import CONFIDENCE, paired_key
+from davis_ag.benchmark.paired import CONFIDENCE
+from davis_ag.benchmark.results import EvaluationResults, PolicyResult
+from davis_ag.workflows.reproduce.configs import ReproduceConfig
 from davis_ag.workflows.reproduce.groups import group_key
+from davis_ag.workflows.reproduce.pages.gaps import learner_gap
 from davis_ag.workflows.reproduce.pages.paper_table4 import cell, signed
 from davis_ag.workflows.reproduce.pages.provenance import stage_rows
+from davis_ag.workflows.reproduce.state import RunState
 
 #: The marker of docs/crops.md's run table.
 CROPS_MARKER = "crops-run"
 
 
-def _mean(policies: dict[str, Any], name: str, metric: str = "oer_tau") -> float | None:
-    value = policies.get(name, {}).get(metric, {})
-    return value.get("mean") if isinstance(value, dict) else None
+def _oer(policies: Mapping[str, PolicyResult], name: str) -> float | None:
+    """A policy's mean OER_tau, None where it was not played."""
+    return policies[name].oer_tau.mean if name in policies else None
 
 
-def _score(policies: dict[str, Any], name: str) -> str:
-    row = policies.get(name, {}).get("oer_tau")
-    return f"{cell(row['mean'])} ± {cell(row['std'])}" if row else "–"
-
-
-def _learner(result: dict[str, Any], learner: str) -> str:
-    policies = result.get("policies", {})
-    if learner not in policies:
+def _score(policies: Mapping[str, PolicyResult], name: str) -> str:
+    """A policy's OER_tau, mean ± std over sessions (``–`` where it was not played)."""
+    if name not in policies:
         return "–"
-    paired = result.get(paired_key(learner))
-    gap = f" ({signed(paired['gap'])}, {signed(paired['low'])} to {signed(paired['high'])})" if paired else ""
-    return _score(policies, learner) + gap
+    score = policies[name].oer_tau
+    return f"{cell(score.mean)} ± {cell(score.std)}"
+
+
+def _learner(result: EvaluationResults, learner: str) -> str:
+    """A learner's OER_tau and its paired gap to the Best fixed action with the interval."""
+    if learner not in result.policies:
+        return "–"
+    paired = learner_gap(result, learner)
+    gap = f" ({signed(paired.gap)}, {signed(paired.low)} to {signed(paired.high)})" if paired else ""
+    return _score(result.policies, learner) + gap
 
 
 def boxed_share(root: Path | None, folders: list[str]) -> str:
@@ -63,38 +70,37 @@ def boxed_share(root: Path | None, folders: list[str]) -> str:
     return f"{boxed / views:.0%} / {min(fewest)}" if views and fewest else "–"
 
 
-def crops_table(config: Any, state: dict[str, Any], root: Path | None = None) -> str:
+def crops_table(config: ReproduceConfig, state: RunState, root: Path | None = None) -> str:
     """The run's table, hardest group first (the lowest Best fixed action).
 
     Args:
-        config: The run's :class:`~davis_ag.workflows.reproduce.configs.ReproduceConfig`.
-        state: Its ``state.json``.
+        config: The run's configuration.
+        state: Its records.
         root: Its dataset (``OUT/dataset``), for the share of views with a fruit boxed.
 
     Returns:
         Markdown: a line on the run, the table, the groups not evaluated yet.
     """
-    results = state.get("results", {})
     learners = [algo.upper() for algo in config.learners]
     rows, waiting = [], []
     for scenario, crop in config.pairs:
-        result = results.get(config.result_key(scenario, crop))
-        if not result:
+        result = state.results.get(config.result_key(scenario, crop))
+        if result is None:
             waiting.append(group_key(scenario, crop))
             continue
-        protocol, policies = result["protocol"], result["policies"]
-        best = _mean(policies, BEST_FIXED)
-        oracle = _mean(policies, "Oracle")
-        start = _mean(policies, "LRD", "oer_0")
+        protocol, policies = result.protocol, result.policies
+        best = _oer(policies, BEST_FIXED)
+        oracle = _oer(policies, "Oracle")
+        start = policies["LRD"].oer_0.mean if "LRD" in policies else None
         rows.append(
             (
                 best if best is not None else 1.0,
                 [
                     crop,
                     scenario,
-                    boxed_share(root, state.get("scene_folders", {}).get(group_key(scenario, crop), [])),
-                    str(len(protocol.get("scenes", []))),
-                    f"{protocol['starts']:,}" if "starts" in protocol else "–",
+                    boxed_share(root, state.scene_folders.get(group_key(scenario, crop), [])),
+                    str(len(protocol.scenes)),
+                    f"{protocol.starts:,}" if protocol.starts is not None else "–",
                     cell(start) if start is not None else "–",
                     _score(policies, "Rand"),
                     _score(policies, BEST_FIXED),
@@ -123,9 +129,15 @@ def crops_table(config: Any, state: dict[str, Any], root: Path | None = None) ->
     return "\n".join(lines)
 
 
-def write_crops_md(path: Path, config: Any, state: dict[str, Any], out: Path | None) -> Path:
+def write_crops_md(path: Path, config: ReproduceConfig, state: RunState, out: Path | None) -> Path:
     """Write the crops run's table: into a page's ``crops-run`` block where it has one (docs/crops.md),
     else as a page of its own with the wall time of every stage.
+
+    Args:
+        path: The page (docs/crops.md, or a page of the run's own).
+        config: The run's configuration.
+        state: Its records.
+        out: Its folder, for the dataset and the training records (None: not read).
 
     Returns:
         The path written.

@@ -7,7 +7,9 @@ against our runs.
 
 from __future__ import annotations
 
-from typing import Any
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Protocol
 
 #: Table 4 of the paper: scenario -> metric -> policy -> value.
 PAPER_TABLE4: dict[str, dict[str, dict[str, float]]] = {
@@ -46,43 +48,86 @@ PAPER_TIMESTEPS = 300_000
 TITLES = {"sp": "SP strawberry", "mp": "MP vine"}
 
 
-def ordering_failures(
-    order: tuple[str, ...], policies: dict[str, dict[str, Any]], metric: str = "oer_tau"
-) -> list[str] | None:
+class MeanStd(Protocol):
+    """A mean and its std over sessions: a measured :class:`~davis_ag.benchmark.results.Metric`,
+    or one of Table 4's cells (:class:`PaperCell`)."""
+
+    @property
+    def mean(self) -> float:
+        """The mean over sessions."""
+        ...
+
+    @property
+    def std(self) -> float:
+        """The std of the session means."""
+        ...
+
+
+@dataclass(frozen=True)
+class PaperCell:
+    """One of Table 4's numbers: the mean and std over the paper's three sessions."""
+
+    mean: float
+    std: float
+
+
+def paper_cells(scenario: str, metric: str = "oer_tau") -> dict[str, PaperCell]:
+    """Table 4's column of one scenario and metric, each policy's mean with its std.
+
+    Args:
+        scenario: ``sp`` or ``mp``.
+        metric: ``oer_tau``, ``reward`` or ``length``.
+
+    Returns:
+        Per policy, its cell.
+    """
+    return {
+        name: PaperCell(value, PAPER_TABLE4_STD[scenario][metric][name])
+        for name, value in PAPER_TABLE4[scenario][metric].items()
+    }
+
+
+def ordering_failures(order: tuple[str, ...], stats: Mapping[str, MeanStd]) -> list[str] | None:
     """The steps of an ordering such as ``A2C > Rand ~ LRD > UDD`` that measured means and stds break.
 
     ``a > b`` holds when a's mean exceeds b's; ``a ~ b`` when the means differ by no more than the
     two standard deviations (over sessions) added.
 
+    Args:
+        order: The ordering, policies and relations in turn.
+        stats: Each policy's mean and std of the metric ordered (OER_tau).
+
     Returns:
         One sentence per broken step (empty when the ordering holds); None when a policy in the
         ordering was not measured.
     """
-    try:
-        stats = {name: policies[name][metric] for name in order[::2]}
-    except KeyError:
+    if any(name not in stats for name in order[::2]):
         return None
     failures = []
     for left, relation, right in zip(order[0::2], order[1::2], order[2::2]):
         a, b = stats[left], stats[right]
-        if relation == ">" and not a["mean"] > b["mean"]:
-            failures.append(f"{left} > {right} fails: {cell(a['mean'])} is not above {cell(b['mean'])}")
-        gap, spread = abs(a["mean"] - b["mean"]), a["std"] + b["std"]
+        if relation == ">" and not a.mean > b.mean:
+            failures.append(f"{left} > {right} fails: {cell(a.mean)} is not above {cell(b.mean)}")
+        gap, spread = abs(a.mean - b.mean), a.std + b.std
         if relation == "~" and gap > spread:
             failures.append(
-                f"{left} ~ {right} fails: {cell(a['mean'])} and {cell(b['mean'])} are "
+                f"{left} ~ {right} fails: {cell(a.mean)} and {cell(b.mean)} are "
                 f"{cell(gap)} apart, more than their stds added ({cell(spread)})"
             )
     return failures
 
 
-def ordering_holds(order: tuple[str, ...], policies: dict[str, dict[str, Any]], metric: str = "oer_tau") -> bool | None:
+def ordering_holds(order: tuple[str, ...], stats: Mapping[str, MeanStd]) -> bool | None:
     """Whether an ordering holds for measured means and stds (:func:`ordering_failures`).
+
+    Args:
+        order: The ordering, policies and relations in turn.
+        stats: Each policy's mean and std of the metric ordered.
 
     Returns:
         True or False; None when a policy in the ordering was not measured.
     """
-    failures = ordering_failures(order, policies, metric)
+    failures = ordering_failures(order, stats)
     return None if failures is None else not failures
 
 

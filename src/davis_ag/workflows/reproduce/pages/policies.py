@@ -10,10 +10,13 @@ Pictures go to ``images/`` beside the page.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from davis_ag.benchmark.exact import BEST_FIXED, best_fixed_action
+from davis_ag.benchmark.results import EvaluationResults, PolicyResult
 from davis_ag.workflows.reproduce.groups import GROUPS
 from davis_ag.workflows.reproduce.learners import LEARNERS, load_json_object, training_record
 from davis_ag.workflows.reproduce.pages.gaps import (
@@ -24,6 +27,7 @@ from davis_ag.workflows.reproduce.pages.gaps import (
     versus_best_fixed,
 )
 from davis_ag.workflows.reproduce.pages.paper_table4 import cell
+from davis_ag.workflows.reproduce.state import RunState
 
 #: Row order of the policies on the page.
 POLICY_ORDER = ("A2C", "A2C (deterministic)", "PPO", "LRD", "UDD", "Rand", BEST_FIXED, "Oracle")
@@ -34,10 +38,10 @@ SB3_DEFAULTS_TEXT = {
 }
 
 
-def learners_run(state: dict[str, Any], out: Path | None = None) -> list[str]:
+def learners_run(state: RunState, out: Path | None = None) -> list[str]:
     """The learners (:data:`LEARNERS`) this run evaluated or trained, from its records only (a run
     from before PPO names A2C alone, whatever the configuration now lists)."""
-    rows = {name for result in state.get("results", {}).values() for name in result.get("policies", {})}
+    rows = {name for result in state.results.values() for name in result.policies}
     return [
         learner
         for learner in LEARNERS
@@ -45,19 +49,19 @@ def learners_run(state: dict[str, Any], out: Path | None = None) -> list[str]:
     ]
 
 
-def learners_in(policies: dict[str, Any]) -> list[str]:
+def learners_in(policies: Mapping[str, PolicyResult]) -> list[str]:
     """The learners (:data:`LEARNERS`) an evaluation has a row of, in page order."""
     return [name for name in LEARNERS if name in policies]
 
 
-def ordered(policies: dict[str, Any]) -> list[str]:
+def ordered(policies: Mapping[str, PolicyResult]) -> list[str]:
     """The run's policy names in page order (unknown names last, as they came)."""
     return [n for n in POLICY_ORDER if n in policies] + [n for n in policies if n not in POLICY_ORDER]
 
 
-def exact_table(policies: dict[str, Any], fixed: dict[str, dict[str, float]] | None) -> list[str]:
+def exact_table(policies: Mapping[str, PolicyResult], fixed: dict[str, dict[str, float]] | None) -> list[str]:
     """Sampled mean ± standard error beside the exact expectation, per image-blind policy."""
-    names = [n for n in ordered(policies) if "exact" in policies[n]]
+    names = [n for n in ordered(policies) if policies[n].exact is not None]
     if not names:
         return []
     lines = [
@@ -69,10 +73,10 @@ def exact_table(policies: dict[str, Any], fixed: dict[str, dict[str, float]] | N
         "|---|---|---|---|---|---|---|",
     ]
     for name in names:
-        row = [name]
-        for key in ("oer_tau", "reward", "length"):
-            stat = policies[name][key]
-            row += [f"{cell(stat['mean'])} ± {cell(stat.get('sem'))}", cell(policies[name]["exact"][key])]
+        policy, row = policies[name], [name]
+        exact = policy.exact or {}
+        for key, stat in (("oer_tau", policy.oer_tau), ("reward", policy.reward), ("length", policy.length)):
+            row += [f"{cell(stat.mean)} ± {cell(stat.sem)}", cell(exact[key])]
         lines.append("| " + " | ".join(row) + " |")
     if fixed:
         lines += [
@@ -84,9 +88,9 @@ def exact_table(policies: dict[str, Any], fixed: dict[str, dict[str, float]] | N
     return [*lines, ""]
 
 
-def action_table(policies: dict[str, Any], actions: list[str]) -> list[str]:
+def action_table(policies: Mapping[str, PolicyResult], actions: list[str]) -> list[str]:
     """Share of each action per policy over every episode played (Fig. 4c as a table)."""
-    names = [n for n in ordered(policies) if "action_counts" in policies[n]]
+    names = [n for n in ordered(policies) if policies[n].action_counts is not None]
     if not names or not actions:
         return []
     lines = [
@@ -96,13 +100,13 @@ def action_table(policies: dict[str, Any], actions: list[str]) -> list[str]:
         "|---" * (len(actions) + 1) + "|",
     ]
     for name in names:
-        counts = policies[name]["action_counts"]
+        counts = policies[name].action_counts or {}
         total = max(sum(counts.values()), 1)
         lines.append(f"| {name} | " + " | ".join(f"{100 * counts.get(a, 0) / total:.0f}" for a in actions) + " |")
     return [*lines, ""]
 
 
-def a2c_line(scenario: str, policies: dict[str, Any], out: Path | None, learner: str = "A2C") -> str | None:
+def a2c_line(scenario: str, policies: Mapping[str, PolicyResult], out: Path | None, learner: str = "A2C") -> str | None:
     """How A2C (or another ``learner``) was trained (its settings, from the training record) and how
     it played."""
     from davis_ag.benchmark.algorithms import SB3_DEFAULT_SETTINGS
@@ -121,7 +125,7 @@ def a2c_line(scenario: str, policies: dict[str, Any], out: Path | None, learner:
         else (f"{changed} over " if changed else "")
         + f"Stable-Baselines3's {learner} defaults ({SB3_DEFAULTS_TEXT.get(learner, 'as SB3 sets them')})"
     )
-    play = policies[learner].get("play", "deterministic")
+    play = policies[learner].play or "deterministic"
     how = (
         "actions sampled from the policy"
         if play == "sampled"
@@ -143,9 +147,33 @@ def a2c_line(scenario: str, policies: dict[str, Any], out: Path | None, learner:
     return text
 
 
+@dataclass(frozen=True)
+class TrainSplitGap:
+    """A learner's kept snapshot against the best fixed action on the train split.
+
+    Attributes:
+        kept: The kept snapshot's OER_tau on fresh train episodes where the run scored it so,
+            else its selection score.
+        fresh: That fresh score's record (``oer_tau``, ``sessions``, ``episodes``), or None.
+        best: The best fixed action's exact OER_tau on the train split.
+        action: That action.
+        starts: The train split's eligible starts.
+        selection: The training record's ``selection`` (its kept step, episodes, play).
+        scores: Its snapshot scores, OER_tau by step.
+    """
+
+    kept: float
+    fresh: dict[str, Any] | None
+    best: float
+    action: str
+    starts: int
+    selection: dict[str, Any]
+    scores: dict[int, float]
+
+
 def train_split_gap(
-    scenario: str, result: dict[str, Any], out: Path | None, learner: str = "A2C"
-) -> dict[str, Any] | None:
+    scenario: str, result: EvaluationResults, out: Path | None, learner: str = "A2C"
+) -> TrainSplitGap | None:
     """A learner's kept snapshot against the best fixed action on the train split, where it was chosen.
 
     Args:
@@ -155,12 +183,9 @@ def train_split_gap(
         learner: ``A2C`` or ``PPO``.
 
     Returns:
-        ``kept`` (the kept snapshot's OER_tau on fresh train episodes where the run scored it
-        so, else its selection score), ``fresh`` (that score's record, or None), ``best`` (the
-        best fixed action's exact OER_tau), ``action``, ``starts``, the record's ``selection``
-        and its snapshot ``scores`` by step; None when the run has no train-split record for it.
+        The gap; None when the run has no train-split record for the learner.
     """
-    train = result.get("train_split")
+    train = result.train_split
     record = training_record(out, GROUPS[scenario], learner)
     selection = record.get("selection") or {}
     scores = {s["step"]: s["oer_tau"] for s in selection.get("scores", [])}
@@ -169,18 +194,18 @@ def train_split_gap(
     fixed = train["fixed_actions"]
     action = best_fixed_action(fixed)
     fresh = (train.get("learners") or {}).get(learner)
-    return {
-        "kept": fresh["oer_tau"]["mean"] if fresh else scores[selection["kept_step"]],
-        "fresh": fresh,
-        "best": fixed[action]["oer_tau"],
-        "action": action,
-        "starts": train["starts"],
-        "selection": selection,
-        "scores": scores,
-    }
+    return TrainSplitGap(
+        kept=fresh["oer_tau"]["mean"] if fresh else scores[selection["kept_step"]],
+        fresh=fresh,
+        best=fixed[action]["oer_tau"],
+        action=action,
+        starts=train["starts"],
+        selection=selection,
+        scores=scores,
+    )
 
 
-def train_split_line(scenario: str, result: dict[str, Any], out: Path | None, learner: str = "A2C") -> str | None:
+def train_split_line(scenario: str, result: EvaluationResults, out: Path | None, learner: str = "A2C") -> str | None:
     """A learner's (A2C's) kept snapshot against the best fixed action on the train split, where it
     was chosen.
 
@@ -190,11 +215,11 @@ def train_split_line(scenario: str, result: dict[str, Any], out: Path | None, le
     found = train_split_gap(scenario, result, out, learner)
     if found is None:
         return None
-    selection, scores = found["selection"], found["scores"]
-    gap = found["kept"] - found["best"]
+    selection, scores = found.selection, found.scores
+    gap = found.kept - found.best
     last_step = max(scores)
     chosen_by = f"{selection['episodes']} {selection['play']} episodes"
-    fresh = found["fresh"]
+    fresh = found.fresh
     if fresh:
         # The selection score is the best of many noisy ones, so it runs high: fresh episodes say more.
         played = f"{fresh['sessions']} x {fresh['episodes']} fresh episodes, as on test"
@@ -203,10 +228,10 @@ def train_split_line(scenario: str, result: dict[str, Any], out: Path | None, le
             f"{len(scores)} such scores, which runs high"
         )
     return (
-        f"On the train split ({found['starts']:,} eligible starts), where the snapshot was chosen: {learner}'s "
-        f"kept snapshot ({selection['kept_step']:,} steps) scores OER_tau {cell(found['kept'])} "
+        f"On the train split ({found.starts:,} eligible starts), where the snapshot was chosen: {learner}'s "
+        f"kept snapshot ({selection['kept_step']:,} steps) scores OER_tau {cell(found.kept)} "
         f"({chosen_by}), the best fixed action there "
-        f"(always `{found['action']}`) {cell(found['best'])} exactly, {cell(abs(gap))} "
+        f"(always `{found.action}`) {cell(found.best)} exactly, {cell(abs(gap))} "
         f"{'above' if gap >= 0 else 'below'} it; "
         f"the last snapshot ({last_step:,} steps) {cell(scores[last_step])}. "
         "Above it on train but not on test: a policy that does not carry over to unseen scenes; "
@@ -230,19 +255,21 @@ def action_figure(scenario: str, out: Path | None, page: Path) -> str | None:
     return f"![actions per policy and A2C's choices, {GROUPS[scenario]}](images/{target.name}.png)"
 
 
-def train_split_references(results: dict[str, Any]) -> dict[str, float]:
+def train_split_references(results: Mapping[str, EvaluationResults]) -> dict[str, float]:
     """The best fixed action's exact train-split OER_tau per group, labelled for the learning
-    curve's snapshot panel, from each scenario's evaluation (``result["train_split"]``)."""
+    curve's snapshot panel, from each scenario's evaluation (``result.train_split``)."""
     references = {}
     for scenario, result in results.items():
-        fixed = (result.get("train_split") or {}).get("fixed_actions")
+        fixed = (result.train_split or {}).get("fixed_actions")
         if fixed and scenario in GROUPS:
             action = best_fixed_action(fixed)
             references[f"{GROUPS[scenario]}: best fixed action (always {action}), exact"] = fixed[action]["oer_tau"]
     return references
 
 
-def learning_curve_section(out: Path | None, page: Path, results: dict[str, Any] | None = None) -> list[str]:
+def learning_curve_section(
+    out: Path | None, page: Path, results: Mapping[str, EvaluationResults] | None = None
+) -> list[str]:
     """Fig. 4a from the run's training records, drawn into ``images/`` beside the page, with the
     best fixed action's train-split score across the snapshots where ``results`` (the run's
     evaluations by scenario) hold it."""
@@ -300,9 +327,9 @@ def learning_curve_section(out: Path | None, page: Path, results: dict[str, Any]
     return [*lines, ""]
 
 
-def policy_sections(scenario: str, result: dict[str, Any], out: Path | None, page: Path) -> list[str]:
+def policy_sections(scenario: str, result: EvaluationResults, out: Path | None, page: Path) -> list[str]:
     """Everything the page shows per scenario about what the policies do."""
-    policies = result["policies"]
+    policies = result.policies
     learners = learners_in(policies) or ["A2C"]
     lines: list[str] = []
     for learner in learners:
@@ -325,8 +352,8 @@ def policy_sections(scenario: str, result: dict[str, Any], out: Path | None, pag
         for line in (train_split_line(scenario, result, out, learner), a2c_line(scenario, policies, out, learner)):
             if line:
                 lines += [line, ""]
-    lines += exact_table(policies, result.get("fixed_actions"))
-    lines += action_table(policies, list(result["protocol"].get("actions", [])))
+    lines += exact_table(policies, result.fixed_actions)
+    lines += action_table(policies, list(result.protocol.actions))
     figure = action_figure(scenario, out, page)
     if figure:
         lines += [figure, ""]

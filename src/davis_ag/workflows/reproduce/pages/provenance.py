@@ -13,25 +13,31 @@ from davis_ag.formats.layout import SCENE_METADATA
 from davis_ag.formats.scene_file import CameraRecord, RendererRecord, read_scene_file_or_empty
 from davis_ag.workflows.reproduce.groups import GROUPS
 from davis_ag.workflows.reproduce.learners import LEARNERS, training_record
+from davis_ag.workflows.reproduce.state import RunState, StageRecord
 
 #: Steps that a later sitting does whole again (a validation whose code changed, an evaluation),
 #: where generation and training resume: their clock adds up the repeats.
 REDONE_WHOLE = ("validate", "evaluate")
 
 
-def one_whole_hours(step: str, entry: dict[str, Any], sittings: list[dict[str, Any]]) -> float | None:
+def one_whole_hours(step: str, entry: StageRecord | None, sittings: list[dict[str, Any]]) -> float | None:
     """Hours one whole run of a step that each sitting does whole (``validate``) took, when the
     clock holds more than one sitting of it; None otherwise (the clock's total is then its cost).
 
     Args:
         step: The stage's step (``validate``).
-        entry: The stage's record in ``state.json``: its ``check_seconds`` where the run recorded it.
+        entry: The stage's record in ``state.json`` (None: none yet): its ``check_seconds`` where
+            the run recorded it.
         sittings: The stage's sittings on the run's clock; a record without ``check_seconds`` (a
             run from before it) is read by the last, which completed the stage.
+
+    Returns:
+        The hours, or None.
     """
     if step not in REDONE_WHOLE or len(sittings) < 2:
         return None
-    seconds = entry.get("check_seconds", sittings[-1]["seconds"])
+    check = entry.check_seconds if entry is not None else None
+    seconds = sittings[-1]["seconds"] if check is None else check
     return float(seconds) / 3600
 
 
@@ -114,13 +120,13 @@ def training_provenance(record: dict[str, Any]) -> str:
     return text
 
 
-def how_made(state: dict[str, Any], out: Path | None) -> list[str]:
+def how_made(state: RunState, out: Path | None) -> list[str]:
     """The "How this run was made" section, from scene.json files, training records and stages."""
     lines = ["## How this run was made", ""]
     if out is None:
         return [*lines, "No work folder was given, so the run's records were not read.", ""]
     for scenario, key in GROUPS.items():
-        scenes = state.get("scene_folders", {}).get(key, [])
+        scenes = state.scene_folders.get(key, [])
         if not scenes:
             continue
         lines.append(f"- **{key}**, {len(scenes)} scene(s):")
@@ -132,7 +138,7 @@ def how_made(state: dict[str, Any], out: Path | None) -> list[str]:
     return [*lines, ""]
 
 
-def stage_rows(state: dict[str, Any], out: Path | None) -> list[tuple[str, float, str, str]]:
+def stage_rows(state: RunState, out: Path | None) -> list[tuple[str, float, str, str]]:
     """The wall time per stage, each with the code that did its work and a note.
 
     A stage's entry in ``state.json`` is rewritten by every sitting that passes it, even one that
@@ -149,15 +155,12 @@ def stage_rows(state: dict[str, Any], out: Path | None) -> list[tuple[str, float
 
     clock = read_clock(out / CLOCK_FILE) if out is not None else {}
     rows = []
-    for stage, entry in state.get("stages", {}).items():
+    for stage, entry in state.stages.items():
         key, _, step = stage.partition(": ")
-        seconds, code, note = entry["seconds"], entry.get("code", "unrecorded"), entry["note"]
-        if out is not None and step == "generate" and state.get("scene_folders", {}).get(key):
-            code = _counted(
-                Counter(
-                    _code_version(out / "dataset" / scene / SCENE_METADATA) for scene in state["scene_folders"][key]
-                )
-            )
+        seconds, code, note = entry.seconds, entry.code or "unrecorded", entry.note
+        scenes = state.scene_folders.get(key)
+        if out is not None and step == "generate" and scenes:
+            code = _counted(Counter(_code_version(out / "dataset" / scene / SCENE_METADATA) for scene in scenes))
         record: dict[str, Any] = {}
         learner = step.removeprefix("train ")
         if step.startswith("train ") and learner in LEARNERS and out is not None:  # only training has a record

@@ -1,6 +1,7 @@
 """``docs/results.md`` of a ``davis-ag reproduce`` run, written wholly from the run's own records.
 
-What it reads: the run's ``state.json`` (configuration, stage times, evaluation summaries), each
+What it reads: the run's ``state.json`` (configuration, stage times, each evaluation without its
+episodes: :class:`~davis_ag.workflows.reproduce.state.RunState`), each
 scene's ``scene.json`` (the code version, renderer and image size that made it), each model's
 ``NAME.training.json`` (the sittings a training run took, with their code versions) and this
 machine. Nothing in the file is typed by hand, so a re-run rewrites all of it, and a run resumed
@@ -9,11 +10,13 @@ across code changes says so itself.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
 
+from davis_ag.benchmark.results import PolicyResult
 from davis_ag.provenance import machine_description
 from davis_ag.scene.specs import PAPER_TABLE3
+from davis_ag.workflows.reproduce.configs import ReproduceConfig
 from davis_ag.workflows.reproduce.groups import GROUPS
 from davis_ag.workflows.reproduce.learners import LEARNERS, training_record
 from davis_ag.workflows.reproduce.pages.paper_table4 import (
@@ -25,6 +28,7 @@ from davis_ag.workflows.reproduce.pages.paper_table4 import (
     cell,
     ordering_failures,
     ordering_holds,
+    paper_cells,
 )
 from davis_ag.workflows.reproduce.pages.policies import (
     learners_run,
@@ -33,15 +37,12 @@ from davis_ag.workflows.reproduce.pages.policies import (
     policy_sections,
 )
 from davis_ag.workflows.reproduce.pages.provenance import how_made, stage_rows
+from davis_ag.workflows.reproduce.state import RunState
 
 
-def _a2c_play(state: dict[str, Any]) -> str:
+def _a2c_play(state: RunState) -> str:
     """How the run's A2C played: ``sampled``, ``deterministic`` (the default before it was recorded)."""
-    plays = {
-        r["policies"]["A2C"].get("play", "deterministic")
-        for r in state.get("results", {}).values()
-        if "A2C" in r.get("policies", {})
-    }
+    plays = {r.policies["A2C"].play or "deterministic" for r in state.results.values() if "A2C" in r.policies}
     if not plays:
         return "not evaluated yet"
     return (
@@ -53,7 +54,7 @@ def _a2c_play(state: dict[str, Any]) -> str:
     )
 
 
-def _notes(config: Any, state: dict[str, Any], out: Path | None) -> list[str]:
+def _notes(config: ReproduceConfig, state: RunState, out: Path | None) -> list[str]:
     """Plain statements of where this run differs from the paper's, from what it measured."""
     notes = []
     for scenario, key in GROUPS.items():
@@ -66,11 +67,11 @@ def _notes(config: Any, state: dict[str, Any], out: Path | None) -> list[str]:
                     f"of the paper's 300K, at {rate:.1f} steps/s on this machine: the {learner} row is an "
                     "under-trained agent" + (", not the paper's." if learner == "A2C" else ".")
                 )
-        result = state.get("results", {}).get(scenario)
-        if result:
-            protocol = result["protocol"]
-            scenes = protocol.get("scenes", [])
-            if protocol["split"] == "all":
+        result = state.results.get(scenario)
+        if result is not None:
+            protocol = result.protocol
+            scenes = protocol.scenes
+            if protocol.split == "all":
                 notes.append(
                     f"{key}: only {len(scenes)} scene(s), so no test scene exists; the "
                     "benchmark ran on split `all`, i.e. on the scene(s) A2C trained on "
@@ -81,8 +82,8 @@ def _notes(config: Any, state: dict[str, Any], out: Path | None) -> list[str]:
                     f"{key}: evaluated on the test split, {len(scenes)} scene(s): "
                     f"{', '.join(scenes)} (70/30 split by scene, seeded)."
                 )
-    for scenario, result in state.get("results", {}).items():
-        lengths = {n: p.get("length", {}).get("mean") for n, p in result["policies"].items()}
+    for scenario, result in state.results.items():
+        lengths = {n: p.length.mean for n, p in result.policies.items()}
         if lengths.get("LRD") is not None and lengths.get("LRD") == lengths.get("UDD"):
             notes.append(
                 f"{scenario.upper()}: LRD and UDD have the same episode lengths because every "
@@ -100,16 +101,16 @@ def _notes(config: Any, state: dict[str, Any], out: Path | None) -> list[str]:
         "Oracle is not in the paper: it plays the best reachable final OER within tau "
         "steps from the environment's tables, an upper bound for any policy."
     )
-    for scenario, result in state.get("results", {}).items():
-        protocol = result["protocol"]
-        rule = protocol.get("start_rule", "scene")
+    for scenario, result in state.results.items():
+        protocol = result.protocol
+        rule = protocol.start_rule or "scene"
         how = (
             "uniform over every eligible (view, target) pair of the split's scenes"
             if rule == "pairs"
             else "a scene first, then a view of it, then a target, each uniformly (the rule before; a scene "
             "with few eligible starts gets as many episodes as one with many)"
         )
-        count = f" ({protocol['starts']} eligible starts)" if "starts" in protocol else ""
+        count = f" ({protocol.starts} eligible starts)" if protocol.starts is not None else ""
         notes.append(
             f"{scenario.upper()} episode starts{count}: {how}. Eligible (section V-D): a boxed target "
             "with OER < 0.4 and at least the crop's pixel threshold; reward max(OER_end - OER_0, 0)^2 "
@@ -118,22 +119,17 @@ def _notes(config: Any, state: dict[str, Any], out: Path | None) -> list[str]:
     return notes
 
 
-def _comparison(scenario: str, policies: dict[str, dict[str, Any]]) -> str:
+def _comparison(scenario: str, policies: Mapping[str, PolicyResult]) -> str:
     order = PAPER_ORDERINGS[scenario]
-    paper = {
-        name: {"oer_tau": {"mean": value, "std": PAPER_TABLE4_STD[scenario]["oer_tau"][name]}}
-        for name, value in PAPER_TABLE4[scenario]["oer_tau"].items()
-    }
-    failures = ordering_failures(order, policies)
+    failures = ordering_failures(order, {name: policy.oer_tau for name, policy in policies.items()})
     text = " ".join(order)
     if failures is None:
         return f"The paper's ordering of OER_tau, {text}, cannot be checked: a policy was not run."
     measured = ", ".join(
-        f"{name} {cell(policies[name]['oer_tau']['mean'])} ± {cell(policies[name]['oer_tau']['std'])}"
-        for name in order[::2]
+        f"{name} {cell(policies[name].oer_tau.mean)} ± {cell(policies[name].oer_tau.std)}" for name in order[::2]
     )
     verdict = "holds" if not failures else "does not hold"
-    paper_note = "" if ordering_holds(order, paper) else " (nor does it hold in Table 4's own numbers)"
+    paper_note = "" if ordering_holds(order, paper_cells(scenario)) else " (nor does it hold in Table 4's own numbers)"
     where = "" if not failures else " " + "; ".join(failures) + "."
     return (
         f"The paper's ordering of OER_tau, {text} (`>`: higher mean; `~`: means within the two standard "
@@ -141,13 +137,13 @@ def _comparison(scenario: str, policies: dict[str, dict[str, Any]]) -> str:
     )
 
 
-def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path | None = None) -> Path:
+def write_results_md(path: Path, config: ReproduceConfig, state: RunState, out: Path | None = None) -> Path:
     """Write the Markdown results: our Table 4 beside the paper's, how the run was made, the timings.
 
     Args:
         path: The Markdown file.
         config: The run's :class:`~davis_ag.workflows.reproduce.configs.ReproduceConfig`.
-        state: The run's ``state.json``: ``results`` (per scenario), ``stages`` (seconds, notes,
+        state: The run's records: ``results`` (per scenario), ``stages`` (seconds, notes,
             code) and ``scene_folders`` (per group).
         out: The work folder, for the scene and training records.
 
@@ -198,18 +194,19 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
     ]
     for scenario in ("sp", "mp"):
         lines += [f"## {TITLES[scenario]}", ""]
-        result = state.get("results", {}).get(scenario)
-        if not result:
+        result = state.results.get(scenario)
+        if result is None:
             lines += ["Not evaluated yet: the run had not reached this benchmark when this page was written.", ""]
             continue
-        protocol, policies = result["protocol"], result["policies"]
-        starts = f", {protocol['starts']:,} eligible starts" if "starts" in protocol else ""
-        if "starts" in result.get("train_split", {}):
-            starts += f"; the train split: {result['train_split']['starts']:,} eligible starts"
+        protocol, policies = result.protocol, result.policies
+        starts = f", {protocol.starts:,} eligible starts" if protocol.starts is not None else ""
+        train = result.train_split or {}
+        if "starts" in train:
+            starts += f"; the train split: {train['starts']:,} eligible starts"
         lines += [
-            f"Split `{protocol['split']}` ({len(protocol.get('scenes', []))} scene(s){starts}), "
-            f"tau = {protocol['tau']}; ours: mean ± std over {protocol['sessions']} "
-            f"sessions of {protocol['episodes']} episodes.",
+            f"Split `{protocol.split}` ({len(protocol.scenes)} scene(s){starts}), "
+            f"tau = {protocol.tau}; ours: mean ± std over {protocol.sessions} "
+            f"sessions of {protocol.episodes} episodes.",
             "",
             "| Policy | OER_tau ours | OER_tau paper | Cum. reward ours | Cum. reward paper "
             "| Ep. length ours | Ep. length paper |",
@@ -217,9 +214,9 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
         ]
         for name in ordered(policies):
             cells = [name]
-            for metric in ("oer_tau", "reward", "length"):
-                stat = policies[name][metric]
-                cells.append(f"{cell(stat['mean'])} ± {cell(stat['std'])}")
+            row = policies[name]
+            for metric, stat in (("oer_tau", row.oer_tau), ("reward", row.reward), ("length", row.length)):
+                cells.append(f"{cell(stat.mean)} ± {cell(stat.std)}")
                 paper_mean = PAPER_TABLE4[scenario][metric].get(name)
                 cells.append(
                     cell(paper_mean)
@@ -228,9 +225,9 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
                 )
             lines.append("| " + " | ".join(cells) + " |")
         lines += ["", _comparison(scenario, policies)]
-        if "oer_0" in policies.get("LRD", {}):
-            text = f"Mean start OER (OER_0) of these episodes: {cell(policies['LRD']['oer_0']['mean'])}"
-            done = result.get("fixed_actions", {}).get("done")
+        if "LRD" in policies:
+            text = f"Mean start OER (OER_0) of these episodes: {cell(policies['LRD'].oer_0.mean)}"
+            done = (result.fixed_actions or {}).get("done")
             if done:
                 # Always `done` ends where it starts: its exact OER_tau is the mean OER_0 of all starts.
                 text += (
@@ -241,7 +238,7 @@ def write_results_md(path: Path, config: Any, state: dict[str, Any], out: Path |
             lines += ["", text + "."]
         lines.append("")
         lines += policy_sections(scenario, result, out, Path(path))
-    lines += learning_curve_section(out, Path(path), state.get("results", {}))
+    lines += learning_curve_section(out, Path(path), state.results)
     lines += ["## Notes", ""] + [f"- {note}" for note in _notes(config, state, out)] + [""]
     lines += how_made(state, out)
     lines += [
