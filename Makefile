@@ -25,11 +25,13 @@ $(STAMP): pyproject.toml
 demo: $(STAMP)
 	$(BIN)/davis-ag demo --out $(OUT)/demo
 
+# One pytest worker per core (pytest-xdist); a test file stays on one worker, so its module
+# fixtures (a generated dataset, a trained model) are made once.
 test: $(STAMP)
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n auto --dist loadfile
 
-# ruff (pyflakes, pycodestyle, bugbear, import order, pyupgrade, RUF, and the formatter's check) over the code and tests, mypy
-# over src/ (settings in pyproject.toml). `ruff format src tests` makes the format check pass.
+# ruff (pyflakes, pycodestyle, bugbear, import order, pyupgrade, RUF, and the formatter's check)
+# over the code and tests, mypy over src/ (settings in pyproject.toml). `ruff format src tests` makes the format check pass.
 lint: $(STAMP)
 	$(BIN)/ruff check src tests
 	$(BIN)/ruff format --check src tests

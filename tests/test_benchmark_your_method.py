@@ -24,6 +24,7 @@ def blocks(text: str) -> list[tuple[str, str | None, str]]:
     return found
 
 
+@pytest.mark.slow
 def test_the_page_runs_as_written(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str], one_thread: None
 ) -> None:

@@ -40,7 +40,7 @@ def test_the_file_is_the_object(sp_root: Path, tmp_path: Path) -> None:
 def test_a_file_that_is_not_results_is_one_line(tmp_path: Path) -> None:
     bad = tmp_path / "bad.json"
     bad.write_text(json.dumps({"protocol": {"scenario": "sp"}, "policies": {}}))
-    with pytest.raises(UserError, match=r"not davis-ag evaluation results \\(protocol.split"):
+    with pytest.raises(UserError, match=r"not davis-ag evaluation results \(protocol.split"):
         load_results(bad)
     bad.write_text("{")
     with pytest.raises(UserError, match="not JSON"):

@@ -45,11 +45,11 @@ def never_grow(monkeypatch: pytest.MonkeyPatch) -> None:
     import davis_ag.benchmark.training as training
     import davis_ag.commands.generate as generate
     import davis_ag.commands.preview as preview
-    import davis_ag.workflows.demo as demo
+    import davis_ag.workflows.stages as stages
 
     monkeypatch.setattr(preview, "grow_scene", forbidden)
     monkeypatch.setattr(generate, "run_dataset", forbidden)
-    monkeypatch.setattr(demo, "run_dataset", forbidden)
+    monkeypatch.setattr(stages, "run_dataset", forbidden)
     monkeypatch.setattr(training, "make_vec_tvm", forbidden)
 
 

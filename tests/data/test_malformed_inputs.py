@@ -37,7 +37,8 @@ def _edit_json(path: Path, change: Callable[[dict], None]) -> None:
 
 def _with_depth(scene: Path, pose: list | None = None) -> None:
     """A depth image for view 0001 as our writer records it, and optionally another pose."""
-    size = Image.open(scene / "images" / "0001.jpeg").size
+    with Image.open(scene / "images" / "0001.jpeg") as image:
+        size = image.size
     Image.fromarray(np.full(size[::-1], 500, np.uint16)).save(scene / "images" / "0001_depth.png")
     _edit_json(scene / "scene.json", lambda d: d.update(depth={"file": "images/NNNN_depth.png", "unit": "mm"}))
     if pose is not None:

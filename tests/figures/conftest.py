@@ -24,7 +24,7 @@ groups:
 @pytest.fixture(scope="session")
 def real_root(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The dataset root of the tiny real scene."""
-    return generate_config(tmp_path_factory.mktemp("real"), TINY_REAL)
+    return generate_config(tmp_path_factory, "real", TINY_REAL)
 
 
 @pytest.fixture(scope="session")

@@ -45,6 +45,10 @@ FRUIT_SLACK = 2
 POSITIONS = 30
 
 
+#: One real scene grown and drawn at the paper's grid: over 20 s.
+pytestmark = pytest.mark.slow
+
+
 @pytest.fixture(scope="module")
 def scene(tmp_path_factory: pytest.TempPathFactory) -> dict:
     """Per view: the fruit ids boxed; plus the scene's fruit count and box OERs."""
