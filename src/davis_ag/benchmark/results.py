@@ -175,6 +175,33 @@ class Protocol(_Model):
     aim: str | None = None
 
 
+class MeanScore(_Model):
+    """A score's mean, population std over sessions and standard error over episodes."""
+
+    mean: float
+    std: float
+    sem: float
+
+
+class TrainScore(_Model):
+    """A learner's kept model scored on the train split, on fresh episodes of its own."""
+
+    oer_tau: MeanScore
+    sessions: int = Field(ge=1)
+    episodes: int = Field(ge=1)
+
+
+class TrainSplit(_Model):
+    """The yardstick on the split a learner's snapshot is chosen on (train): every fixed action's
+    exact expectations there, the split's eligible starts, and each learner's kept model scored
+    there (``davis-ag reproduce`` adds these)."""
+
+    split: str
+    starts: int = Field(ge=0)
+    fixed_actions: dict[str, dict[str, float]]
+    learners: dict[str, TrainScore] | None = None
+
+
 class EvaluationResults(_Model):
     """An evaluation: its protocol, the dataset's identity, the code, one row per policy."""
 
@@ -184,7 +211,7 @@ class EvaluationResults(_Model):
     code: str | None = None
     policies: dict[str, PolicyResult] = Field(min_length=1)
     fixed_actions: dict[str, dict[str, float]] | None = None
-    train_split: dict[str, Any] | None = None
+    train_split: TrainSplit | None = None
 
     def as_json(self) -> dict[str, Any]:
         """The results as the JSON file holds them (unset optional fields left out)."""

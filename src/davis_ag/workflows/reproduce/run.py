@@ -17,7 +17,7 @@ from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING, Protocol
 
-from davis_ag.benchmark.results import EvaluationResults
+from davis_ag.benchmark.results import EvaluationResults, MeanScore, TrainScore, TrainSplit
 from davis_ag.workflows.reproduce.configs import ReproduceConfig, check_disk
 from davis_ag.workflows.reproduce.groups import group_key
 from davis_ag.workflows.reproduce.state import RunState, StageRecord, without_episodes
@@ -300,7 +300,7 @@ def add_train_split(results: EvaluationResults, root: Path, scenario: str, crop:
 
     if results.train_split is not None:
         return False
-    results.train_split = split_fixed_actions(root, scenario, "train", crop)
+    results.train_split = TrainSplit.model_validate(split_fixed_actions(root, scenario, "train", crop))
     return True
 
 
@@ -308,7 +308,7 @@ def add_train_scores(
     results: EvaluationResults, root: Path, scenario: str, crop: str, models: dict[str, Path], config: ReproduceConfig
 ) -> bool:
     """Score each learner's kept model on the train split with the test's protocol, on episodes of
-    its own (``results.train_split["learners"]``); learners scored already are left alone.
+    its own (``results.train_split.learners``); learners scored already are left alone.
 
     A snapshot is kept for the best of its train-split scores, so that score is the largest of
     many noisy ones and runs high (the winner's curse); fresh episodes give the train score to set
@@ -331,7 +331,9 @@ def add_train_scores(
     train = results.train_split
     if train is None:
         return False
-    scored = train.setdefault("learners", {})
+    if train.learners is None:
+        train.learners = {}
+    scored = train.learners
     todo = [path for algo, path in models.items() if algo.upper() not in scored and Path(path).is_file()]
     if not todo:
         return False
@@ -348,9 +350,9 @@ def add_train_scores(
         keep_episodes=False,
     )
     for name, row in fresh.policies.items():
-        scored[name] = {
-            "oer_tau": {"mean": row.oer_tau.mean, "std": row.oer_tau.std, "sem": row.oer_tau.sem},
-            "sessions": config.sessions,
-            "episodes": config.episodes,
-        }
+        scored[name] = TrainScore(
+            oer_tau=MeanScore(mean=row.oer_tau.mean, std=row.oer_tau.std, sem=row.oer_tau.sem),
+            sessions=config.sessions,
+            episodes=config.episodes,
+        )
     return True

@@ -139,7 +139,8 @@ def test_the_kept_snapshot_is_set_beside_the_best_fixed_action_on_train(tmp_path
         "(240,000 steps) scores OER_tau .565 (200 sampled episodes), the best fixed action there (always "
         "`backward`) .434 exactly, .131 above it; the last snapshot (300,000 steps) .444."
     )
-    fixed["backward"]["oer_tau"] = 0.6
+    assert result.train_split is not None
+    result.train_split.fixed_actions["backward"]["oer_tau"] = 0.6
     assert ".035 below it" in str(train_split_line("sp", result, tmp_path))
     # Without the yardstick (an evaluation from before it) or a scored run, no line.
     before = made_results({"A2C": 0.5})
@@ -277,9 +278,10 @@ def test_a_run_with_ppo_shows_its_row_gap_settings_and_stage(tmp_path: Path, sp_
     assert add_train_scores(both, sp_root, "sp", "strawberry", models, config)
     assert not add_train_scores(both, sp_root, "sp", "strawberry", models, config)  # scored once
     assert both.train_split is not None
-    fresh = both.train_split["learners"]
-    assert set(fresh) == {"A2C", "PPO"} and all(0 <= f["oer_tau"]["mean"] <= 1 for f in fresh.values())
-    assert fresh["A2C"]["sessions"] == 3 and fresh["A2C"]["episodes"] == 20
+    fresh = both.train_split.learners
+    assert fresh is not None
+    assert set(fresh) == {"A2C", "PPO"} and all(0 <= f.oer_tau.mean <= 1 for f in fresh.values())
+    assert fresh["A2C"].sessions == 3 and fresh["A2C"].episodes == 20
 
     state = RunState(
         scene_folders={"sp-strawberry": ["Single-Strawberry/000", "Single-Strawberry/001"]},
@@ -301,13 +303,13 @@ def test_a_run_with_ppo_shows_its_row_gap_settings_and_stage(tmp_path: Path, sp_
     assert "PPO beside it (RL Baselines3 Zoo's Atari settings" in text
     # Beside PPO, A2C's curve says it is A2C's.
     assert "- sp-strawberry (A2C): rolling mean" in text and "- sp-strawberry (PPO): rolling mean" in text
-    train_starts = both.train_split["starts"]
+    train_starts = both.train_split.starts
     assert (
         f"Split `test` (1 scene(s), {both.protocol.starts:,} eligible starts; the train split: "
         f"{train_starts:,} eligible starts), tau = 3" in text
     )
     assert "where the snapshot was chosen: A2C's kept snapshot (70 steps)" in text
-    assert f"scores OER_tau {_c(fresh['A2C']['oer_tau']['mean'])} (3 x 20 fresh episodes, as on test; " in text
+    assert f"scores OER_tau {_c(fresh['A2C'].oer_tau.mean)} (3 x 20 fresh episodes, as on test; " in text
     assert "where the snapshot was chosen: PPO's kept snapshot (64 steps)" in text
     how = text.split("## How this run was made", 1)[1]
     assert "  - A2C: 70 steps in 1 sitting(s)" in how and "  - PPO: 64 steps in 1 sitting(s)" in how

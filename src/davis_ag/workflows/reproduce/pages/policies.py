@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from davis_ag.benchmark.exact import BEST_FIXED, best_fixed_action
-from davis_ag.benchmark.results import EvaluationResults, PolicyResult
+from davis_ag.benchmark.results import EvaluationResults, PolicyResult, TrainScore
 from davis_ag.workflows.reproduce.groups import GROUPS
 from davis_ag.workflows.reproduce.learners import LEARNERS, load_json_object, training_record
 from davis_ag.workflows.reproduce.pages.gaps import (
@@ -163,7 +163,7 @@ class TrainSplitGap:
     """
 
     kept: float
-    fresh: dict[str, Any] | None
+    fresh: TrainScore | None
     best: float
     action: str
     starts: int
@@ -189,17 +189,17 @@ def train_split_gap(
     record = training_record(out, GROUPS[scenario], learner)
     selection = record.get("selection") or {}
     scores = {s["step"]: s["oer_tau"] for s in selection.get("scores", [])}
-    if not train or not train.get("fixed_actions") or selection.get("kept_step") not in scores:
+    if not train or not train.fixed_actions or selection.get("kept_step") not in scores:
         return None
-    fixed = train["fixed_actions"]
+    fixed = train.fixed_actions
     action = best_fixed_action(fixed)
-    fresh = (train.get("learners") or {}).get(learner)
+    fresh = (train.learners or {}).get(learner)
     return TrainSplitGap(
-        kept=fresh["oer_tau"]["mean"] if fresh else scores[selection["kept_step"]],
+        kept=fresh.oer_tau.mean if fresh else scores[selection["kept_step"]],
         fresh=fresh,
         best=fixed[action]["oer_tau"],
         action=action,
-        starts=train["starts"],
+        starts=train.starts,
         selection=selection,
         scores=scores,
     )
@@ -222,7 +222,7 @@ def train_split_line(scenario: str, result: EvaluationResults, out: Path | None,
     fresh = found.fresh
     if fresh:
         # The selection score is the best of many noisy ones, so it runs high: fresh episodes say more.
-        played = f"{fresh['sessions']} x {fresh['episodes']} fresh episodes, as on test"
+        played = f"{fresh.sessions} x {fresh.episodes} fresh episodes, as on test"
         chosen_by = (
             f"{played}; {cell(scores[selection['kept_step']])} in the {chosen_by} that chose it, the best of "
             f"{len(scores)} such scores, which runs high"
@@ -260,7 +260,7 @@ def train_split_references(results: Mapping[str, EvaluationResults]) -> dict[str
     curve's snapshot panel, from each scenario's evaluation (``result.train_split``)."""
     references = {}
     for scenario, result in results.items():
-        fixed = (result.train_split or {}).get("fixed_actions")
+        fixed = result.train_split.fixed_actions if result.train_split else None
         if fixed and scenario in GROUPS:
             action = best_fixed_action(fixed)
             references[f"{GROUPS[scenario]}: best fixed action (always {action}), exact"] = fixed[action]["oer_tau"]

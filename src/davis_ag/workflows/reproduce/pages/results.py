@@ -200,9 +200,8 @@ def write_results_md(path: Path, config: ReproduceConfig, state: RunState, out: 
             continue
         protocol, policies = result.protocol, result.policies
         starts = f", {protocol.starts:,} eligible starts" if protocol.starts is not None else ""
-        train = result.train_split or {}
-        if "starts" in train:
-            starts += f"; the train split: {train['starts']:,} eligible starts"
+        if result.train_split is not None:
+            starts += f"; the train split: {result.train_split.starts:,} eligible starts"
         lines += [
             f"Split `{protocol.split}` ({len(protocol.scenes)} scene(s){starts}), "
             f"tau = {protocol.tau}; ours: mean ± std over {protocol.sessions} "
