@@ -75,7 +75,8 @@ def test_organ_classes_are_a_layer_where_the_scene_has_them(served: tuple[Path, 
     assert scene["views"]["0001.jpeg"]["classes"] is False
     assert _get(port, "/overlay/classes/Single-Strawberry/000/0001.jpeg")[0] == 404
     images = root / "Single-Strawberry/000/images"
-    width, height = Image.open(images / "0001.jpeg").size
+    with Image.open(images / "0001.jpeg") as image:
+        width, height = image.size
     classes = np.zeros((height, width), np.uint8)
     classes[height // 2 :] = 1  # soil below the horizon, a fruit in the middle
     classes[height // 2 - 2 : height // 2 + 2, width // 2 - 2 : width // 2 + 2] = 2
@@ -185,7 +186,8 @@ def _with_depth(real_root: Path, folder: Path) -> Path:
     copy = folder / "with-depth"
     shutil.copytree(real_root, copy, ignore=shutil.ignore_patterns(".davis_ag_cache"))
     for jpeg in (copy / "Single-Strawberry/000/images").glob("*.jpeg"):
-        width, height = Image.open(jpeg).size
+        with Image.open(jpeg) as image:
+            width, height = image.size
         depth = np.tile(np.linspace(500, 4000, width, dtype=np.uint16), (height, 1))
         Image.fromarray(depth).save(jpeg.with_name(jpeg.stem + "_depth.png"))
     return copy
@@ -258,7 +260,8 @@ def test_page_in_headless_chromium(real_root: Path, tmp_path: Path) -> None:
         browser.wait_for(f"viewer.view === {json.dumps(target[0])}")
         assert raw[target[0]]["pose"][2] == pytest.approx(raw[up]["pose"][2])
         shot = browser.screenshot(tmp_path / "viewer.png")
-        assert Image.open(shot).size == (1400, 860)
+        with Image.open(shot) as picture:
+            assert picture.size == (1400, 860)
         if os.environ.get("DAVIS_AG_VIEWER_SCREENSHOT"):  # how docs/images/viewer.png is made
             shutil.copy(shot, os.environ["DAVIS_AG_VIEWER_SCREENSHOT"])
         # With depth images the toggle appears and Z shows them.
