@@ -69,7 +69,7 @@ def test_importing_davis_ag_loads_no_stage_and_no_heavy_library() -> None:
         "import sys, davis_ag; "
         f"print(sorted(m for m in sys.modules if m.split('.')[0] in {HEAVY!r} or m.startswith('davis_ag.')))"
     )
-    assert loaded == "[]"
+    assert loaded == "['davis_ag.environments']"  # the ids, registered by name: a helper, no stage
 
 
 def test_a_public_name_loads_its_own_stage_only() -> None:
@@ -99,6 +99,24 @@ def test_the_readme_imports_make_the_environment(sp_root: Path) -> None:
         "print(type(env.unwrapped).__name__)"
     )
     assert out == "TVMEnv"
+
+
+@pytest.mark.parametrize(
+    "imports",
+    [
+        "import davis_ag; import gymnasium as gym",
+        "import gymnasium as gym; import davis_ag",
+        "from davis_ag import open_dataset; from gymnasium.envs.registration import registry; import gymnasium as gym",
+    ],
+)
+def test_the_ids_are_registered_whichever_is_imported_first(imports: str) -> None:
+    """No import order to remember: davis_ag registers at once, or the moment Gymnasium loads."""
+    out = run_python(f"{imports}; print(sorted(i for i in gym.registry if i.startswith('davis_ag/')))")
+    assert out == "['davis_ag/TVM-v0', 'davis_ag/TVMContinuous-v0']"
+
+
+def test_importing_davis_ag_alone_loads_no_gymnasium() -> None:
+    assert run_python("import sys, davis_ag; print('gymnasium' in sys.modules)") == "False"
 
 
 SUBPACKAGES = sorted(p.parent.name for p in PACKAGE.glob("*/__init__.py"))

@@ -5,21 +5,19 @@ used, so importing the package loads no stage (nor numpy, pydantic, Gymnasium or
 
     from davis_ag import open_dataset, exposure_rate, evaluate, TVMEnv
 
-The Gymnasium environments are registered by name (:mod:`davis_ag.environments`) when Gymnasium is
-already imported, as in ``import gymnasium; import davis_ag``; ``import davis_ag.benchmark``
-registers them in any order.
+The Gymnasium environments are registered by name (:mod:`davis_ag.environments`): at once when
+Gymnasium is imported already, else as soon as it is, so ``import davis_ag`` and ``import
+gymnasium`` may come in either order and neither loads the other's stages.
 """
 
 import importlib as _importlib
-import sys as _sys
 from typing import TYPE_CHECKING, Any
 
 __version__ = "0.2.0"
 
-if "gymnasium" in _sys.modules:  # without Gymnasium nothing could make the environments anyway
-    from davis_ag.environments import register_environments as _register_environments
+from davis_ag.environments import register_when_gymnasium_loads as _register_when_gymnasium_loads
 
-    _register_environments()
+_register_when_gymnasium_loads()
 
 #: Each public name and where it is defined, as ``"module:attribute"``; imported on first use.
 _PUBLIC: dict[str, str] = {

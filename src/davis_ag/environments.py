@@ -2,12 +2,21 @@
 
 Registration names each environment's class as a ``"module:Class"`` string: registering imports
 Gymnasium's registry, not the benchmark (numpy caches, torch) nor the live renderer (Helios).
-``import davis_ag`` registers them when Gymnasium is already imported (``import gymnasium`` first,
-as the README does); ``import davis_ag.benchmark`` always does, and so does
-``gymnasium.make("davis_ag:davis_ag/TVM-v0")`` (Gymnasium imports the module before the id).
+``import davis_ag`` registers them in either order: at once when Gymnasium is imported already,
+else the moment Gymnasium is (:func:`register_when_gymnasium_loads`), so importing davis_ag never
+loads Gymnasium itself. ``gymnasium.make("davis_ag:davis_ag/TVM-v0")`` imports davis_ag first.
+Gymnasium 1.x reads no plugin entry points, so an id cannot be registered with no import at all.
 """
 
 from __future__ import annotations
+
+import importlib.abc
+import importlib.machinery
+import importlib.util
+import sys
+from collections.abc import Sequence
+from types import ModuleType
+from typing import Any
 
 #: The grid environment (:class:`davis_ag.benchmark.tvm.TVMEnv`).
 TVM_ID = "davis_ag/TVM-v0"
@@ -30,3 +39,44 @@ def register_environments() -> None:
             # terminated=True (a TimeLimit would report truncated and make learners bootstrap past
             # the final reward).
             register(id=env_id, entry_point=entry_point)
+
+
+class _RegisteringLoader(importlib.abc.Loader):
+    """Gymnasium's own loader, which registers the environments once Gymnasium's module has run;
+    everything else (resources, code) is asked of the loader it wraps."""
+
+    def __init__(self, loader: importlib.abc.Loader) -> None:
+        self._loader = loader
+
+    def create_module(self, spec: importlib.machinery.ModuleSpec) -> ModuleType | None:
+        return self._loader.create_module(spec)
+
+    def exec_module(self, module: ModuleType) -> None:
+        self._loader.exec_module(module)
+        register_environments()
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._loader, name)
+
+
+class _RegisterAfterGymnasium(importlib.abc.MetaPathFinder):
+    """Finds Gymnasium as the other finders do, with a loader that registers the environments."""
+
+    def find_spec(
+        self, fullname: str, path: Sequence[str] | None, target: ModuleType | None = None
+    ) -> importlib.machinery.ModuleSpec | None:
+        if fullname != "gymnasium":
+            return None
+        sys.meta_path.remove(self)  # once: the search below, and every later import, go without it
+        spec = importlib.util.find_spec(fullname)
+        if spec is not None and spec.loader is not None:
+            spec.loader = _RegisteringLoader(spec.loader)
+        return spec
+
+
+def register_when_gymnasium_loads() -> None:
+    """Register the environments now if Gymnasium is imported, else right after it is imported."""
+    if "gymnasium" in sys.modules:
+        register_environments()
+    elif not any(isinstance(finder, _RegisterAfterGymnasium) for finder in sys.meta_path):
+        sys.meta_path.insert(0, _RegisterAfterGymnasium())
