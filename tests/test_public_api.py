@@ -107,6 +107,7 @@ def test_the_readme_imports_make_the_environment(sp_root: Path) -> None:
         "import davis_ag; import gymnasium as gym",
         "import gymnasium as gym; import davis_ag",
         "from davis_ag import open_dataset; from gymnasium.envs.registration import registry; import gymnasium as gym",
+        "import davis_ag, importlib.util; importlib.util.find_spec('gymnasium'); import gymnasium as gym",
     ],
 )
 def test_the_ids_are_registered_whichever_is_imported_first(imports: str) -> None:

@@ -42,11 +42,13 @@ def register_environments() -> None:
 
 
 class _RegisteringLoader(importlib.abc.Loader):
-    """Gymnasium's own loader, which registers the environments once Gymnasium's module has run;
-    everything else (resources, code) is asked of the loader it wraps."""
+    """Gymnasium's own loader, which registers the environments once Gymnasium's module has run
+    (and then takes the finder off ``sys.meta_path``); everything else (resources, code) is asked
+    of the loader it wraps."""
 
-    def __init__(self, loader: importlib.abc.Loader) -> None:
+    def __init__(self, loader: importlib.abc.Loader, finder: _RegisterAfterGymnasium) -> None:
         self._loader = loader
+        self._finder = finder
 
     def create_module(self, spec: importlib.machinery.ModuleSpec) -> ModuleType | None:
         return self._loader.create_module(spec)
@@ -54,23 +56,34 @@ class _RegisteringLoader(importlib.abc.Loader):
     def exec_module(self, module: ModuleType) -> None:
         self._loader.exec_module(module)
         register_environments()
+        if self._finder in sys.meta_path:
+            sys.meta_path.remove(self._finder)
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self._loader, name)
 
 
 class _RegisterAfterGymnasium(importlib.abc.MetaPathFinder):
-    """Finds Gymnasium as the other finders do, with a loader that registers the environments."""
+    """Finds Gymnasium as the other finders do, with a loader that registers the environments.
+
+    It stays on ``sys.meta_path`` until Gymnasium has run, so a look that imports nothing
+    (``importlib.util.find_spec("gymnasium")``) leaves the import after it registering."""
+
+    def __init__(self) -> None:
+        self._searching = False
 
     def find_spec(
         self, fullname: str, path: Sequence[str] | None, target: ModuleType | None = None
     ) -> importlib.machinery.ModuleSpec | None:
-        if fullname != "gymnasium":
+        if fullname != "gymnasium" or self._searching:
             return None
-        sys.meta_path.remove(self)  # once: the search below, and every later import, go without it
-        spec = importlib.util.find_spec(fullname)
+        self._searching = True  # the search below asks every finder, this one too
+        try:
+            spec = importlib.util.find_spec(fullname)
+        finally:
+            self._searching = False
         if spec is not None and spec.loader is not None:
-            spec.loader = _RegisteringLoader(spec.loader)
+            spec.loader = _RegisteringLoader(spec.loader, self)
         return spec
 
 

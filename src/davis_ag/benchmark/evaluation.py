@@ -15,7 +15,7 @@ ignore the image (LRD, UDD, Rand, fixed actions), the exact expectation over the
 row :data:`BEST_FIXED` is added (``best_fixed_action``): of the policies that always play the
 same action, the one with the highest exact OER_tau on this split, played on the same episodes,
 so that a learner that collapsed to one move is seen beside it. Every policy gets its paired
-gap (:mod:`davis_ag.benchmark.paired`) to each of :data:`PAIRED_BASELINES` present.
+gap (:mod:`davis_ag.benchmark.paired`) to each of :data:`~davis_ag.benchmark.summaries.PAIRED_BASELINES` present.
 
 Policies follow :class:`davis_ag.benchmark.policies.Policy`; a policy may answer with an action
 name, which the environment's ``action_for`` turns into its action.

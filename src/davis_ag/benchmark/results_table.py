@@ -20,7 +20,7 @@ def format_table(results: EvaluationResults | dict[str, Any]) -> str:
     gaps, and what the numbers rest on (the split's scenes and eligible starts).
 
     Args:
-        results: What :func:`evaluate_policies` returned (or its JSON).
+        results: What :func:`~davis_ag.benchmark.evaluation.evaluate_policies` returned (or its JSON).
 
     Returns:
         The table, lines joined by newlines.

@@ -147,7 +147,7 @@ def train_agent(
     A2C's hyperparameters (the paper gives none) are Stable-Baselines3's A2C defaults, learning rate
     7e-4, ``n_steps=5`` per environment and update, ``gamma=0.99``, ``gae_lambda=1``,
     ``vf_coef=0.5``, ``max_grad_norm=0.5``, RMSprop (alpha 0.99, eps 1e-5), changed by
-    ``settings``: by default :data:`A2C_SETTINGS` (``ent_coef=0.01``, normalised advantages);
+    ``settings``: by default :data:`~davis_ag.benchmark.algorithms.A2C_SETTINGS` (``ent_coef=0.01``, normalised advantages);
     ``"sb3"`` keeps SB3's ``ent_coef=0`` and raw advantages. CnnPolicy scales the uint8
     observation by 1/255. ``n_envs`` (8) is ours; the paper's 300K timesteps count
     environment steps over all environments. By default the saved model is the snapshot that
@@ -172,8 +172,8 @@ def train_agent(
         checkpoint_every: Environment steps between checkpoints (0: none). A checkpoint of a run
             with the same settings beside ``out_path`` is resumed; it is removed once the final
             model is saved.
-        settings: A name of :data:`SETTINGS_PRESETS` (``ours``, ``sb3``) or a dict of SB3 A2C
-            arguments among :data:`TUNABLE`, applied over SB3's defaults.
+        settings: A name of :data:`~davis_ag.benchmark.algorithms.SETTINGS_PRESETS` (``ours``, ``sb3``) or a dict of SB3 A2C
+            arguments among :data:`~davis_ag.benchmark.algorithms.TUNABLE`, applied over SB3's defaults.
         keep: ``best-train`` (default): save the snapshot with the best train-split OER_tau,
             scored every ``select_every`` steps and at the end; ``last``: the last one.
         select_every: Environment steps between train-split scores (``best-train`` only).

@@ -58,7 +58,7 @@ def plot_training_curve(records: list[dict], path: str | os.PathLike[str], title
     """Reward and final OER per episode against environment steps, with a moving mean, as PNG.
 
     Args:
-        records: What :func:`train_continuous` returned.
+        records: What :func:`davis_ag.live.training.train_continuous` returned.
         path: The PNG.
         title: The figure's title.
         window: Episodes in the moving mean.

@@ -192,7 +192,7 @@ def compare_scenes(ours: Path, again: Path) -> tuple[list[str], int]:
 
 def _files(folder: Path) -> list[str]:
     """A scene's files, relative to it: hidden ones and the live geometry cache (written beside a
-    scene by ``davis-ag live``, not by ``generate``) left out."""
+    scene by the live environments, not by ``generate``) left out."""
     return sorted(
         str(path.relative_to(folder))
         for path in folder.rglob("*")

@@ -18,7 +18,7 @@ A run is safe to kill at any moment and to start again with the same command:
 
 Scenes run one after the other in this process (``workers=1``), on a pool of local processes
 (:mod:`davis_ag.generate.pool_executor`), or as Ray tasks on a cluster (:mod:`davis_ag.generate.ray_executor`);
-see docs/performance.md for the measurements behind :func:`default_workers`.
+see docs/performance.md for the measurements behind :func:`~davis_ag.generate.run_progress.default_workers`.
 """
 
 from __future__ import annotations

@@ -15,7 +15,7 @@ from davis_ag.scene.specs import camera_altitudes
 
 #: Pitch limits of a free camera, degrees above the horizon.
 PITCH_RANGE = (-85.0, 45.0)
-#: The grid's move names as (action component, sign) (:meth:`TVMContinuousEnv.action_for`).
+#: The grid's move names as (action component, sign) (:meth:`~davis_ag.live.tvm_continuous.TVMContinuousEnv.action_for`).
 NAMED_MOVES: dict[str, tuple[int, float]] = {
     "left": (0, -1.0),
     "right": (0, 1.0),

@@ -255,7 +255,7 @@ def reopen_assets(settings: RecordedSettings, use_cache: bool = True) -> SceneAs
     """The scene's assets from its cache if current, else regrown (and cached where possible).
 
     Args:
-        settings: From :func:`read_settings`.
+        settings: From :func:`~davis_ag.generate.recorded_settings.read_settings`.
         use_cache: False regrows even when a current cache exists (and rewrites it).
     """
     path = settings.folder / LIVE_GEOMETRY

@@ -1,7 +1,7 @@
 """Draw views of a Helios scene with pyhelios's Visualizer: colour, primitive ids and depth from
 native buffers. The reference backend (``--renderer helios``); :mod:`davis_ag.render.opengl` is ours.
 
-The camera (:mod:`davis_ag.scene.build.camera`) is an ideal pinhole. Helios' field of view is vertical; pixel (column u, row v) covers
+The camera (:mod:`davis_ag.scene.camera`) is an ideal pinhole. Helios' field of view is vertical; pixel (column u, row v) covers
 [u, u+1) x [v, v+1) with row 0 at the top, so a point at camera coordinates (right, up, forward)
 lands at u = cx + fx * right / forward, v = cy - fy * up / forward with cx = width / 2,
 cy = height / 2 (measured against rendered spheres to within half a pixel).

@@ -91,6 +91,21 @@ def test_a_damaged_state_is_one_line_and_left_alone(tmp_path: Path, text: str) -
     assert "\n" not in message and path.read_text() == text
 
 
+def test_a_state_from_before_0_2_0_keeps_its_stages_without_its_scene_timings(tmp_path: Path) -> None:
+    """Runs before the clock (clock.json) timed each scene under ``scenes``; their state still reads."""
+    path = tmp_path / "state.json"
+    stage = {"seconds": 61.5, "note": "2 scenes", "code": "0.1.0+abc"}
+    scene = {"seconds": 30.2, "views": 348, "s_per_view": 0.08}
+    path.write_text(
+        json.dumps({"stages": {"sp-strawberry: generate": stage}, "scenes": {"Single-Strawberry/000": scene}})
+    )
+    state = RunState.load(path)
+    assert (
+        state.stages["sp-strawberry: generate"].seconds == 61.5
+        and state.stages["sp-strawberry: generate"].note == "2 scenes"
+    )
+
+
 def test_a_state_round_trips_and_keeps_no_episodes(tmp_path: Path, evaluated: EvaluationResults) -> None:
     kept = without_episodes(evaluated)
     assert all(row.episodes is None for row in kept.policies.values())

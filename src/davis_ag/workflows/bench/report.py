@@ -37,7 +37,7 @@ def projection(
     longest scene left (longest-first list scheduling). With ``floor`` and ``grow`` (seconds per
     view of the draw and read-back alone, seconds to grow one plant), also the hours that growing
     plus drawing alone would take on one machine: what no work around the draw can go below.
-    ``gain`` replaces :data:`POOL_GAIN` with a measured one (:func:`pool_gain`).
+    ``gain`` replaces :data:`POOL_GAIN` with a measured one (:func:`davis_ag.workflows.bench.run.pool_gain`).
     """
     gain = gain or POOL_GAIN
     config = load_dataset_config("paper")

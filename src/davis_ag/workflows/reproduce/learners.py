@@ -72,7 +72,7 @@ def train_learner(
         algo: ``a2c`` or ``ppo`` (:data:`davis_ag.benchmark.algorithms.ALGORITHMS`).
         root: The dataset root.
         scenario, crop: What to train on.
-        model: The model's ``.zip`` (:func:`davis_ag.workflows.reproduce.pages.policies.model_path`).
+        model: The model's ``.zip`` (:func:`model_path`).
         timesteps: Environment steps.
         config: The run's :class:`~davis_ag.workflows.reproduce.configs.ReproduceConfig` (seed, environments).
         settings: The algorithm's settings over ours (tests: a short PPO rollout); None: ours.

@@ -1,10 +1,12 @@
-"""The ``davis-ag reproduce`` workflow: the paper's Table 4 (section VI) end to end, at a size that fits.
+"""The ``davis-ag reproduce`` workflow: the paper's Table 4 (section VI), or the ``crops`` ladder,
+end to end at a size that fits.
 
-Stages (each resumable: finished scenes are skipped, a trained model's zip and an evaluation's
-JSON are reused, a killed training resumes from its checkpoint): SP strawberry data, its
-validation and split, A2C (and PPO beside it, same budget) on SP, the SP benchmark, then the same
-for MP vine; ``--results`` (Markdown) is rewritten after every benchmark, so a
-run cut short still leaves what it measured.
+Stages, for each group of the configuration in turn (Table 4: SP strawberry, then MP vine; the
+crops run: every plant-library crop's ``sp`` and ``row``), each resumable (finished scenes are
+skipped, a trained model's zip and an evaluation's JSON are reused, a killed training resumes from
+its checkpoint): the data, its validation and split, A2C and PPO beside it with the same budget,
+the benchmark. ``--results`` (docs/results.md or docs/crops.md) is rewritten after every
+benchmark, so a run cut short still leaves what it measured.
 """
 
 from __future__ import annotations

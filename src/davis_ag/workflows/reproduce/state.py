@@ -98,6 +98,7 @@ class RunState(BaseModel):
         if not isinstance(data, dict) or not isinstance(data.get("results", {}), dict):
             raise damaged
         stored: dict[str, Any] = data.pop("results", {})
+        data.pop("scenes", None)  # runs before 0.2.0 timed their scenes here; clock.json does now
         try:
             state = cls.model_validate(data)
         except ValidationError:

@@ -1,4 +1,4 @@
-"""docs/scenes.md and the marked tables of docs/dataset-format.md and docs/plants.md, written from the
+"""docs/scenes.md and the marked tables of docs/dataset-format.md, docs/plants.md and docs/crops.md, written from the
 measurements ``davis-ag scene-stats`` keeps in ``docs/data/`` (:mod:`davis_ag.workflows.scene_stats.stats`)."""
 
 from __future__ import annotations
