@@ -170,7 +170,7 @@ def _evaluate(args: argparse.Namespace, names: list[str], specs: list[str], out:
     # The JSON is the result: keep it somewhere even when --out fails at the end.
     write_or_rescue(out, lambda path: write_json(results, path), "the results")
     try:
-        plot_results(results.as_json(), plot)
+        plot_results(results, plot)
     except OSError as error:
         raise MachineError(
             f"the results are in {out}, but the chart could not be written to {plot} "

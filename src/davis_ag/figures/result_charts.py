@@ -12,15 +12,16 @@ from typing import Any
 import numpy as np
 
 from davis_ag.atomic_files import save_figure_atomic
+from davis_ag.benchmark.results import EvaluationResults, as_results
 from davis_ag.benchmark.results_table import METRICS
 
 
-def plot_results(results: dict[str, Any], path: str | os.PathLike[str]) -> Path:
+def plot_results(results: EvaluationResults | dict[str, Any], path: str | os.PathLike[str]) -> Path:
     """Bar chart of the three Table 4 metrics per policy, with the std over sessions as error
     bars, saved as PNG.
 
     Args:
-        results: What :func:`davis_ag.benchmark.evaluation.evaluate_policies` returned, as JSON.
+        results: What :func:`davis_ag.benchmark.evaluation.evaluate_policies` returned (or its JSON).
         path: The PNG to write.
 
     Returns:
@@ -31,21 +32,22 @@ def plot_results(results: dict[str, Any], path: str | os.PathLike[str]) -> Path:
     matplotlib.use("Agg")  # files only: no display on servers
     import matplotlib.pyplot as plt
 
-    policies = results["policies"]
+    results = as_results(results)
+    policies = results.policies
     names = list(policies)
     fig, axes = plt.subplots(1, len(METRICS), figsize=(4 * len(METRICS), 3.2))
     for ax, (key, title) in zip(axes, METRICS.items()):
-        means = [policies[n][key]["mean"] for n in names]
-        stds = [policies[n][key]["std"] for n in names]
+        means = [getattr(policies[n], key).mean for n in names]
+        stds = [getattr(policies[n], key).std for n in names]
         ax.bar(names, means, yerr=stds, capsize=4, color=[f"C{i}" for i in range(len(names))])
         ax.set_title(title)
         ax.tick_params(axis="x", labelrotation=30)
-    protocol = results["protocol"]
+    protocol = results.protocol
     # What the bars rest on: the split's scenes and eligible starts (the grid's; drawn live otherwise).
-    starts = f", {protocol['starts']} eligible starts" if protocol.get("starts") is not None else ""
+    starts = f", {protocol.starts} eligible starts" if protocol.starts is not None else ""
     fig.suptitle(
-        f"{protocol['scenario'].upper()} {protocol['split']}: {len(protocol.get('scenes', []))} scene(s)"
-        f"{starts}, {protocol['sessions']} x {protocol['episodes']} episodes"
+        f"{protocol.scenario.upper()} {protocol.split}: {len(protocol.scenes)} scene(s)"
+        f"{starts}, {protocol.sessions} x {protocol.episodes} episodes"
     )
     fig.tight_layout()
     try:

@@ -153,7 +153,7 @@ def reproduce(
                     learners=tuple(path for algo, path in models.items() if algo != "a2c"),
                 )
                 write_or_rescue(results_json, partial(write_json, results), "the results")
-                plot_results(results.as_json(), results_json.with_suffix(".png"))
+                plot_results(results, results_json.with_suffix(".png"))
             record(f"{key}: evaluate", clock.seconds(f"{key}: evaluate"), f"split {split}")
         else:
             print(f"reusing {results_json}", flush=True)

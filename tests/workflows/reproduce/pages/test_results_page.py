@@ -270,9 +270,7 @@ def test_a_run_with_ppo_shows_its_row_gap_settings_and_stage(tmp_path: Path, sp_
     # A group that grew has another test split: evaluated anew.
     grown = [*test_scenes, "Single-Strawberry/002"]
     assert _reusable_results(results_json, [models["a2c"], models["ppo"]], "test", grown, config) is None
-    assert plot_results(
-        both.as_json(), results_json.with_suffix(".png")
-    ).is_file()  # the stage's chart, PPO's bar in it
+    assert plot_results(both, results_json.with_suffix(".png")).is_file()  # the stage's chart, PPO's bar in it
     add_train_split(both, sp_root, "sp", "strawberry")
     # The kept snapshots scored again on fresh train episodes, as on test: their selection scores run high.
     assert add_train_scores(both, sp_root, "sp", "strawberry", models, config)
