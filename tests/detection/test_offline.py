@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import importlib.util
 import subprocess
 import sys
 from pathlib import Path
@@ -10,6 +11,11 @@ from pathlib import Path
 import pytest
 
 SRC = Path(__file__).parents[2] / "src"
+
+#: Whether ultralytics is installed, asked without importing it: an import here, before
+#: prepare_ultralytics(), would replace PIL.Image.open for every later test in this process.
+HAS_ULTRALYTICS = importlib.util.find_spec("ultralytics") is not None
+needs_ultralytics = pytest.mark.skipif(not HAS_ULTRALYTICS, reason="ultralytics is not installed")
 
 #: Three boxes: the second overlaps the first (IoU 0.81) and scores lower, the third stands apart.
 #: NMS at IoU 0.5 keeps the first and the third, in score order.
@@ -25,8 +31,8 @@ print(compiled, torchvision.ops.nms(boxes, scores, 0.5).tolist())
 """
 
 
+@needs_ultralytics
 def test_torchvision_imports_and_its_nms_keeps_the_right_boxes() -> None:
-    pytest.importorskip("ultralytics")
     # A fresh interpreter: the operators must be defined before torchvision's first import.
     done = subprocess.run(
         [sys.executable, "-c", CHECK],
@@ -55,11 +61,11 @@ except PIL.UnidentifiedImageError:
 """
 
 
+@needs_ultralytics
 def test_a_damaged_image_after_ultralytics_gets_pils_own_error() -> None:
     """Importing ultralytics replaced PIL.Image.open for the whole process: a damaged JPEG read
     after it raised ModuleNotFoundError (pi_heif) instead of PIL's error, which davis-ag turns
     into one line, and tried to install a package from the network."""
-    pytest.importorskip("ultralytics")
     done = subprocess.run(
         [sys.executable, "-c", DAMAGED],
         capture_output=True,
