@@ -35,6 +35,7 @@ import numpy as np
 from davis_ag.benchmark import exact
 from davis_ag.benchmark.agents import FixedActionAgent
 from davis_ag.benchmark.code_digest import code_digest
+from davis_ag.benchmark.lockstep import episode_record, play_lockstep
 from davis_ag.benchmark.policies import Policy, prepare
 from davis_ag.benchmark.results import (
     PROTOCOL_VERSION,
@@ -139,19 +140,21 @@ def run_episode(
         refused += bool(info.get("refused"))
         if terminated or truncated:
             break
-    record = {
-        "oer_0": float(info["oer_0"]),
-        "oer_tau": float(info["oer_t"]),
-        "reward": total,
-        "length": len(actions),
-        "scene": info["scene"],
-        "target_fruit": int(info["target_fruit"]),
-        "path": list(info["path"]),
-        "actions": actions,
-    }
-    if "refused" in info:
-        record["refused"] = refused
-    return record
+    return episode_record(info, total, actions, refused if "refused" in info else None)
+
+
+def play_episodes(env: Any, policy: Policy, resets: list[int], draws: list[int]) -> list[dict[str, Any]]:
+    """Play episode ``i`` from reset seed ``resets[i]`` with policy seed ``draws[i]``: a trained
+    model's episodes in step, one forward pass for all (:mod:`davis_ag.benchmark.lockstep`), any
+    other policy's one after another; the policy was prepared for ``env`` before.
+
+    Returns:
+        One record per episode, as :func:`run_episode` returns it.
+    """
+    played = play_lockstep(env, policy, resets, draws)
+    if played is None:
+        played = [run_episode(env, policy, r, d, prepared=True) for r, d in zip(resets, draws)]
+    return played
 
 
 def play_sessions(
@@ -167,7 +170,7 @@ def play_sessions(
     records: list[dict[str, Any]] = []
     for session in range(sessions):
         env_seeds, policy_seeds = episode_seeds(seed, session, episodes)
-        runs = [run_episode(env, policy, r, a, prepared=True) for r, a in zip(env_seeds, policy_seeds)]
+        runs = play_episodes(env, policy, env_seeds, policy_seeds)
         records.extend({"session": session, **run} for run in runs)
     summary: dict[str, Any] = session_metrics(records, keys, sessions)
     return summary, records

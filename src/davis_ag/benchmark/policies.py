@@ -232,7 +232,11 @@ def _space_text(space: Any) -> str:
 
 
 class ModelPolicy:
-    """A trained Stable-Baselines3 model (any algorithm with ``predict``) as a :class:`Policy`."""
+    """A trained Stable-Baselines3 model (any algorithm with ``predict``) as a :class:`Policy`.
+
+    Evaluations play its episodes in step (:meth:`act_batch`, :mod:`davis_ag.benchmark.lockstep`):
+    the episodes :meth:`reset` and :meth:`act` would play one at a time, for one forward pass a step.
+    """
 
     def __init__(
         self, model: Any, deterministic: bool = DETERMINISTIC_PLAY, name: str | None = None, device: str = "cpu"
@@ -314,6 +318,48 @@ class ModelPolicy:
         """The model's action for ``observation``."""
         action, _ = self.model.predict(observation, deterministic=self.deterministic)
         return action
+
+    @property
+    def batches(self) -> bool:
+        """Whether :meth:`act_batch` can play this model: deterministic play of any model, sampled
+        play of a model whose policy gives a distribution over discrete actions (A2C, PPO)."""
+        return hasattr(self.model.action_space, "n") and (
+            self.deterministic or hasattr(self.model.policy, "get_distribution")
+        )
+
+    def streams(self, seeds: list[int]) -> list[Any]:
+        """One torch generator per episode, on the model's device, seeded as :meth:`reset` seeds
+        torch's own: episode ``i`` of a batch draws what it would draw played alone."""
+        import torch
+
+        device = getattr(self.model, "device", torch.device("cpu"))
+        return [torch.Generator(device=device).manual_seed(int(seed)) for seed in seeds]
+
+    def act_batch(self, observations: list[np.ndarray], streams: list[Any]) -> list[int]:
+        """The model's actions for many episodes' observations, from one forward pass.
+
+        Sampled play draws each episode's action from its own stream with what SB3's
+        ``predict`` does for one observation (``Categorical.sample``: a one-row
+        ``torch.multinomial``), so the draws are those of :meth:`act` after ``reset(seed)``.
+
+        Args:
+            observations: One observation per episode.
+            streams: The episodes' generators (:meth:`streams`), in the same order.
+
+        Returns:
+            One action index per observation.
+        """
+        import torch
+
+        if self.deterministic:
+            actions, _ = self.model.predict(np.stack(observations), deterministic=True)
+            return [int(a) for a in np.asarray(actions).reshape(-1)]
+        policy = self.model.policy
+        policy.set_training_mode(False)
+        tensor, _ = policy.obs_to_tensor(np.stack(observations))
+        with torch.no_grad():
+            probs = policy.get_distribution(tensor).distribution.probs
+            return [int(torch.multinomial(probs[i : i + 1], 1, True, generator=g)) for i, g in enumerate(streams)]
 
 
 def _import_target(target: str, spec: str) -> Any:

@@ -62,7 +62,7 @@ def train_split_score(
     Returns:
         ``{"oer_tau", "reward", "length"}``, means over the episodes.
     """
-    from davis_ag.benchmark.evaluation import episode_seeds, run_episode
+    from davis_ag.benchmark.evaluation import episode_seeds, play_episodes
     from davis_ag.benchmark.policies import DETERMINISTIC_PLAY, ModelPolicy, prepare
 
     agent = ModelPolicy(model, deterministic=DETERMINISTIC_PLAY)
@@ -72,7 +72,7 @@ def train_split_score(
     # that device's generator, so it is saved and restored too, not only the CPU's.
     device = getattr(model, "device", torch.device("cpu"))
     with torch.random.fork_rng(devices=[device] if device.type == "cuda" else []):
-        records = [run_episode(env, agent, r, d, prepared=True) for r, d in zip(resets, draws)]
+        records = play_episodes(env, agent, resets, draws)
     return {key: round(float(np.mean([r[key] for r in records])), 6) for key in ("oer_tau", "reward", "length")}
 
 

@@ -34,6 +34,7 @@ An episode (section V-D):
 
 from __future__ import annotations
 
+import copy
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -232,6 +233,16 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
         self._path = [cache.view_names[self._view]]
         self._over = False
         return self._observation(), self._info()
+
+    def fork(self) -> TVMEnv:
+        """An environment over the same scenes, starts and caches (shared, read only) with an
+        episode and a random generator of its own: what lets many episodes be played in step
+        (:mod:`davis_ag.benchmark.lockstep`) without a second copy of the images."""
+        twin = copy.copy(self)
+        twin._np_random = None  # reset(seed=...) makes its own; never the original's generator
+        twin._scene = twin._view = twin._box = twin._fruit = twin._t = -1
+        twin._path, twin._over = [], True
+        return twin
 
     def start_probabilities(self) -> np.ndarray:
         """The probability that ``reset`` starts from each row of :attr:`starts` under the rule."""

@@ -314,11 +314,14 @@ def run_only(
     ``--only training``: the learners' training rates, about 8 minutes, on each of ``devices``;
     ``--only crops``: the plant-library crops' SP and row scenes, :mod:`davis_ag.workflows.bench.crops`,
     ``crops`` of them, the others' rows kept from an earlier report at ``out``; ``--only verify``:
-    how fast a results file is checked, :mod:`davis_ag.workflows.bench.verify`, about a minute):
+    how fast a results file is checked, :mod:`davis_ag.workflows.bench.verify`, about a minute;
+    ``--only play``: a trained model's episodes one at a time and in step,
+    :mod:`davis_ag.workflows.bench.play`, about a minute):
     JSON, the doc's section (its GPU section on a ``gpu_machine``) and the line another page shows
     of it."""
     from davis_ag.scene.library_crops import LIBRARY_CROPS
     from davis_ag.workflows.bench.crops import crops_speed, crops_table, merged, write_crops
+    from davis_ag.workflows.bench.play import play_speed, play_table, write_play
     from davis_ag.workflows.bench.verify import verify_speed, verify_table, write_verify
 
     measurements: dict[str, tuple[str, Any, Any, Any]] = {
@@ -331,6 +334,7 @@ def run_only(
             write_crops,
         ),
         "verify": ("verify", verify_speed, verify_table, write_verify),
+        "play": ("play", play_speed, play_table, write_play),
     }
     key, measure, table_of, write = measurements[what]
     start = os.getloadavg()[0]
