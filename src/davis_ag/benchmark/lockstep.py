@@ -12,7 +12,8 @@ the same reset seeds, and each episode's actions drawn from a torch generator se
 policy seed, as :meth:`ModelPolicy.reset` seeds torch's own (:meth:`ModelPolicy.act_batch`). The
 records are the same but where a batch's forward pass rounds a probability differently in its
 last bit and a draw falls within that bit of a boundary between two actions (the tests play both
-ways and compare). This applies to a :class:`ModelPolicy` that batches on TVM-v0, bare or under
+ways on the CPU and compare; on a GPU each generator is the device's, seeded as torch seeds its
+own, which no test here can run). This applies to a :class:`ModelPolicy` that batches on TVM-v0, bare or under
 Gymnasium's own wrappers that change nothing an episode sees; any other policy or environment
 plays one episode at a time.
 """

@@ -128,3 +128,37 @@ def test_a_crop_measured_again_alone_keeps_the_others_rows(tmp_path: Path) -> No
     other_size = {**fresh, "image_size": [1280, 720]}
     assert merged(report, other_size)["crops"] == {"wye-vine": {"sp": 3}}
     assert merged(tmp_path / "none.json", fresh)["crops"] == fresh["crops"]
+
+
+def test_the_page_gives_the_runs_wall_time_by_kind_of_stage(tmp_path: Path) -> None:
+    """What a researcher plans a night by: the hours of every sitting, by kind of stage, and where
+    they ran; "so far" until every group is evaluated."""
+    from davis_ag.workflows.reproduce.clock import CLOCK_FILE
+    from davis_ag.workflows.reproduce.state import StageRecord
+
+    run = tmp_path / "run"
+    run.mkdir()
+    stages = {
+        "sp-olive: generate": 5400,
+        "sp-olive: validate": 360,
+        "sp-olive: train A2C": 1800,
+        "sp-olive: train PPO": 3600,
+        "sp-olive: evaluate": 720,
+    }
+    state = RunState(
+        results={"sp-olive": result(best=0.5, oracle=0.7, a2c=0.55, starts=99)},
+        stages={stage: StageRecord(seconds=seconds, note="") for stage, seconds in stages.items()},
+    )
+    machine = "2 CPU cores (Some CPU), no GPU"
+    sitting = {"started": "2026-11-27T12:00:00+00:00", "code": "x", "machine": machine}
+    (run / CLOCK_FILE).write_text(json.dumps({"stages": {s: [{**sitting, "seconds": v}] for s, v in stages.items()}}))
+    page = tmp_path / "crops.md"
+    page.write_text("<!-- crops-run:start -->\n<!-- crops-run:end -->\n")
+    write_crops_md(page, CROPS_RUN, state, run)
+    line = "Wall time so far: **3.3 h** on the run's clock, every sitting (generate 1.5, validate 0.1, train 1.5, evaluate 0.2 h)"
+    assert f"{line}, on {machine}, with other work" in page.read_text()
+    state.results = {CROPS_RUN.result_key(s, c): state.results["sp-olive"] for s, c in CROPS_RUN.pairs}
+    write_crops_md(page, CROPS_RUN, state, run)  # every group evaluated: the run's whole time
+    assert "Wall time: **3.3 h**" in page.read_text()
+    write_crops_md(page, CROPS_RUN, RunState(), run)  # nothing run yet: no line
+    assert "Wall time" not in page.read_text()

@@ -9,6 +9,7 @@ markers; any other path gets a page of its own.
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -129,6 +130,32 @@ def crops_table(config: ReproduceConfig, state: RunState, root: Path | None = No
     return "\n".join(lines)
 
 
+def wall_time_line(config: ReproduceConfig, state: RunState, out: Path | None) -> str:
+    """The run's wall time so far by kind of stage (generate, validate, train, evaluate) and the
+    machines its clock names, from every sitting on the clock (:func:`stage_rows`); ``""`` before
+    any stage.
+
+    The clock counts what each stage took where it ran, other work on the machine included: what
+    a researcher running the same command should plan for, not a measurement of the code alone.
+    """
+    from davis_ag.workflows.reproduce.clock import CLOCK_FILE, read_clock
+
+    hours: Counter[str] = Counter()
+    for stage, seconds, _, _ in stage_rows(state, out):
+        hours[stage.partition(": ")[2].split(" ")[0]] += seconds / 3600
+    if not hours:
+        return ""
+    clock = read_clock(Path(out) / CLOCK_FILE) if out is not None else {}
+    machines = Counter(str(s.get("machine") or "a machine unrecorded") for sittings in clock.values() for s in sittings)
+    where = f", on {' and '.join(machines)}" if machines else ""
+    parts = ", ".join(f"{kind} {value:.1f}" for kind, value in hours.items())
+    finished = all(config.result_key(scenario, crop) in state.results for scenario, crop in config.pairs)
+    return (
+        f"Wall time{'' if finished else ' so far'}: **{sum(hours.values()):.1f} h** on the run's clock, every "
+        f"sitting ({parts} h){where}, with other work sharing the machine at times."
+    )
+
+
 def write_crops_md(path: Path, config: ReproduceConfig, state: RunState, out: Path | None) -> Path:
     """Write the crops run's table: into a page's ``crops-run`` block where it has one (docs/crops.md),
     else as a page of its own with the wall time of every stage.
@@ -145,7 +172,8 @@ def write_crops_md(path: Path, config: ReproduceConfig, state: RunState, out: Pa
     table = crops_table(config, state, None if out is None else Path(out) / "dataset")
     path = Path(path)
     if path.is_file() and f"<!-- {CROPS_MARKER}:start -->" in path.read_text(errors="replace"):
-        write_marked_section(path, CROPS_MARKER, table)
+        spent = wall_time_line(config, state, out)
+        write_marked_section(path, CROPS_MARKER, table + (f"\n\n{spent}" if spent else ""))
         return path
     lines = ["# The plant-library crops: the crops run", "", table, "", "## Wall time per stage", ""]
     lines += ["| Stage | Seconds | Hours | Code | Note |", "|---|---|---|---|---|"]
