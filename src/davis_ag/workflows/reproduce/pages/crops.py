@@ -140,9 +140,10 @@ def wall_time_line(config: ReproduceConfig, state: RunState, out: Path | None) -
     """
     from davis_ag.workflows.reproduce.clock import CLOCK_FILE, read_clock
 
-    hours: Counter[str] = Counter()
+    hours: dict[str, float] = {}
     for stage, seconds, _, _ in stage_rows(state, out):
-        hours[stage.partition(": ")[2].split(" ")[0]] += seconds / 3600
+        kind = stage.partition(": ")[2].split(" ")[0]
+        hours[kind] = hours.get(kind, 0.0) + seconds / 3600
     if not hours:
         return ""
     clock = read_clock(Path(out) / CLOCK_FILE) if out is not None else {}
