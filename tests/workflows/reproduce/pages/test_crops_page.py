@@ -156,7 +156,7 @@ def test_the_page_gives_the_runs_wall_time_by_kind_of_stage(tmp_path: Path) -> N
     page.write_text("<!-- crops-run:start -->\n<!-- crops-run:end -->\n")
     write_crops_md(page, CROPS_RUN, state, run)
     line = "Wall time so far: **3.3 h** on the run's clock, every sitting (generate 1.5, validate 0.1, train 1.5, evaluate 0.2 h)"
-    assert f"{line}, on {machine}, with other work" in page.read_text()
+    assert f"{line}, on {machine}; wall time" in page.read_text()
     state.results = {CROPS_RUN.result_key(s, c): state.results["sp-olive"] for s, c in CROPS_RUN.pairs}
     write_crops_md(page, CROPS_RUN, state, run)  # every group evaluated: the run's whole time
     assert "Wall time: **3.3 h**" in page.read_text()

@@ -3,8 +3,8 @@
 Written from the run's records (``state.json``) after every benchmark: per crop and scenario, the
 test split's scenes and eligible starts, the mean start OER (OER_0), Rand, the Best fixed action,
 the exact Oracle and each learner with its paired gap to the Best fixed action (95 % bootstrap
-interval over the same test episodes). Into docs/crops.md it goes between the ``crops-run``
-markers; any other path gets a page of its own.
+interval over the same test episodes), and under it the run's wall time by kind of stage. Into
+docs/crops.md it goes between the ``crops-run`` markers; any other path gets a page of its own.
 """
 
 from __future__ import annotations
@@ -153,7 +153,7 @@ def wall_time_line(config: ReproduceConfig, state: RunState, out: Path | None) -
     finished = all(config.result_key(scenario, crop) in state.results for scenario, crop in config.pairs)
     return (
         f"Wall time{'' if finished else ' so far'}: **{sum(hours.values()):.1f} h** on the run's clock, every "
-        f"sitting ({parts} h){where}, with other work sharing the machine at times."
+        f"sitting ({parts} h){where}; wall time, so any other work sharing the machine counts too."
     )
 
 
