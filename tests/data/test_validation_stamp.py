@@ -88,6 +88,25 @@ def test_another_group_gaining_scenes_leaves_a_groups_stamp(dataset: Path) -> No
     assert validation_stamp(dataset / GROUP) != before
 
 
+def test_another_group_recorded_in_dataset_json_leaves_a_groups_stamp(dataset: Path) -> None:
+    # Each generate of a new group adds its entry to dataset.json: the crops run validated every
+    # finished group again at each sitting while the whole file counted.
+    recorded = {"format": "davis-ag-dataset/1", "seed": 0, "groups": {GROUP: {"grid": {"step": 0.25}}}}
+    (dataset / "dataset.json").write_text(json.dumps(recorded, indent=2))  # as generate writes it
+    before, whole = validation_stamp(dataset / GROUP), validation_stamp(dataset)
+    recorded["groups"]["Row-Olive"] = {"grid": {"step": 0.5}}
+    (dataset / "dataset.json").write_text(json.dumps(recorded, indent=2))
+    assert validation_stamp(dataset / GROUP) == before
+    assert validation_stamp(dataset) != whole  # the whole dataset's validation reads the file
+    recorded["groups"][GROUP]["grid"]["step"] = 0.123  # its own entry: a new stamp
+    (dataset / "dataset.json").write_text(json.dumps(recorded, indent=2))
+    assert validation_stamp(dataset / GROUP) != before
+    (dataset / "dataset.json").write_text("{ damaged")  # a file no one can read counts by its bytes
+    damaged = validation_stamp(dataset / GROUP)
+    (dataset / "dataset.json").write_text("{ damaged again")
+    assert validation_stamp(dataset / GROUP) != damaged
+
+
 def test_another_validator_gives_another_stamp(dataset: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     from davis_ag.data import validation_stamp as module
 

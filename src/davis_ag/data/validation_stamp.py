@@ -1,5 +1,6 @@
 """A stamp of what validating a dataset folder would read: the validator's code, the root files it
-checks (their bytes) and every scene file's name, size and modification time, as one SHA-256.
+checks (their bytes; for a group opened alone, its own entries in them) and every scene file's
+name, size and modification time, as one SHA-256.
 
 A long run that resumes (``davis-ag reproduce``) would validate its data at every sitting; at the
 paper's scale that reads 9 GB of SP strawberry views, minutes on 2 cores. Two equal stamps mean the
@@ -70,8 +71,7 @@ def validation_stamp(path: str | os.PathLike[str]) -> str:
     dataset = open_dataset(path)
     digest = hashlib.sha256(validator_digest())
     digest.update(_own_split_entries(dataset))
-    file = dataset.root / DATASET_FILE  # small, and rewritten with the same bytes by each generate
-    digest.update(f"{DATASET_FILE}\0".encode() + (file.read_bytes() if file.is_file() else b"-"))
+    digest.update(_own_dataset_entries(dataset))
     for scene in dataset.scenes:
         for folder, subfolders, files in os.walk(scene.path):
             subfolders[:] = sorted(d for d in subfolders if not d.startswith("."))
@@ -80,6 +80,31 @@ def validation_stamp(path: str | os.PathLike[str]) -> str:
                 relative = os.path.relpath(os.path.join(folder, name), dataset.root)
                 digest.update(f"{relative}\0{stat.st_size}\0{stat.st_mtime_ns}\n".encode())
     return digest.hexdigest()
+
+
+def _own_dataset_entries(dataset: Dataset) -> bytes:
+    """What of the root's ``dataset.json`` may bear on validating ``dataset``: every byte for a whole
+    dataset; for a group or scene opened alone, the file without the other groups' ``groups``
+    entries (a group's validation reads none of it; the rest is kept, to be safe).
+
+    Each generate of a new group adds its entry: hashing the whole file gave every finished group
+    of the crops run a new stamp, so each sitting validated all of them again.
+    """
+    file = dataset.root / DATASET_FILE
+    if not file.is_file():
+        return f"{DATASET_FILE}\0-".encode()
+    raw = file.read_bytes()
+    if dataset.opened == dataset.root:
+        return f"{DATASET_FILE}\0".encode() + raw
+    try:
+        data = json.loads(raw.decode("utf-8"))
+    except (ValueError, RecursionError):
+        return f"{DATASET_FILE}\0".encode() + raw
+    if not isinstance(data, dict) or not isinstance(data.get("groups"), dict):
+        return f"{DATASET_FILE}\0".encode() + raw
+    own = {scene.group for scene in dataset.scenes}
+    data["groups"] = {name: entry for name, entry in data["groups"].items() if name in own}
+    return f"{DATASET_FILE} of these groups\0{json.dumps(data, sort_keys=True)}".encode()
 
 
 def _own_split_entries(dataset: Dataset) -> bytes:
