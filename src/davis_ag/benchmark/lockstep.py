@@ -13,9 +13,9 @@ policy seed, as :meth:`ModelPolicy.reset` seeds torch's own (:meth:`ModelPolicy.
 records are the same but where a batch's forward pass rounds a probability differently in its
 last bit and a draw falls within that bit of a boundary between two actions (the tests play both
 ways on the CPU and compare; on a GPU each generator is the device's, seeded as torch seeds its
-own, which no test here can run). This applies to a :class:`ModelPolicy` that batches on TVM-v0, bare or under
-Gymnasium's own wrappers that change nothing an episode sees; any other policy or environment
-plays one episode at a time.
+own, which no test here can run). This applies to a :class:`ModelPolicy` that batches on TVM-v0,
+bare or under Gymnasium's own wrappers that change nothing an episode sees; any other policy or
+environment plays one episode at a time.
 """
 
 from __future__ import annotations
