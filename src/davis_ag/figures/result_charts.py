@@ -41,7 +41,8 @@ def plot_results(results: EvaluationResults | dict[str, Any], path: str | os.Pat
         stds = [getattr(policies[n], key).std for n in names]
         ax.bar(names, means, yerr=stds, capsize=4, color=[f"C{i}" for i in range(len(names))])
         ax.set_title(title)
-        ax.tick_params(axis="x", labelrotation=30)
+        # Anchored at their right end, long names ("A2C (deterministic)") end under their own bar.
+        plt.setp(ax.get_xticklabels(), rotation=30, ha="right", rotation_mode="anchor")
     protocol = results.protocol
     # What the bars rest on: the split's scenes and eligible starts (the grid's; drawn live otherwise).
     starts = f", {protocol.starts} eligible starts" if protocol.starts is not None else ""
