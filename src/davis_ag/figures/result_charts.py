@@ -1,6 +1,7 @@
 """Charts of benchmark results and training runs: the Table 4 bar chart of an evaluation, each
-learner's gap to the Best fixed action scene by scene, and the training curve of a
-continuous-pose PPO run, each saved atomically as PNG.
+learner's gap to the Best fixed action scene by scene, a ladder of groups from hardest to
+easiest (the crops run's), and the training curve of a continuous-pose PPO run, each saved
+atomically as PNG.
 """
 
 from __future__ import annotations
@@ -147,6 +148,85 @@ def plot_scene_gaps(gaps: dict[str, dict[str, Any]], path: str | os.PathLike[str
     ax.set_title(f"{title}: bands, 95 % intervals over episodes (dark) and over scenes (light)", fontsize=9)
     fig.legend(fontsize=7, loc="lower center", ncol=columns, frameon=False, markerscale=0.5)
     fig.tight_layout(rect=(0, 0.02 + 0.06 * rows, 1, 1))  # the legend's rows below the axes
+    try:
+        return save_figure_atomic(fig, path, dpi=120)
+    finally:
+        plt.close(fig)
+
+
+def plot_ladder(rows: list[dict[str, Any]], path: str | os.PathLike[str], title: str) -> Path:
+    """A ladder of groups (a crop in a scenario), hardest at the top, as PNG: each group's line runs
+    from its start OER (OER_0) to the exact Oracle, the shaded part is the headroom above the Best
+    fixed action, and each learner is a dot with its paired interval to the Best fixed action.
+
+    Args:
+        rows: Per group, top first: ``label``, ``oer_0``, ``rand``, ``best_fixed``, ``oracle``
+            (None where not played) and ``learners``: per learner its ``mean`` OER_tau and, where
+            paired, ``low`` and ``high``, the interval of its gap to the Best fixed action.
+        path: The PNG to write.
+        title: The chart's title.
+
+    Returns:
+        ``path``.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")  # files only: no display on servers
+    import matplotlib.pyplot as plt
+
+    learners = list(dict.fromkeys(name for row in rows for name in row["learners"]))
+    fig, ax = plt.subplots(figsize=(8.0, 2.0 + 0.42 * len(rows)))
+    marks = (
+        ("oer_0", "x", "grey", "OER_0 (the start)"),
+        ("rand", "o", "none", "Rand"),
+        ("best_fixed", "|", "black", "Best fixed action"),
+        ("oracle", "D", "black", "Oracle (exact)"),
+    )
+    labelled: set[str] = set()
+
+    def once(name: str) -> str:
+        """The legend's label the first time a mark is drawn, none after."""
+        first = name not in labelled
+        labelled.add(name)
+        return name if first else "_"
+
+    for y, row in enumerate(rows):
+        present = [row[key] for key, *_ in marks if row.get(key) is not None]
+        if present:
+            ax.plot([min(present), max(present)], [y, y], color="lightgrey", linewidth=1, zorder=1)
+        if row.get("best_fixed") is not None and row.get("oracle") is not None:
+            ax.fill_betweenx(
+                [y - 0.3, y + 0.3], row["best_fixed"], row["oracle"], color="0.9", zorder=0, label=once("headroom")
+            )
+        for key, marker, face, name in marks:
+            if row.get(key) is not None:
+                size = 14 if marker == "|" else 6
+                ax.plot(row[key], y, marker, ms=size, mfc=face, mec="black", color="black", label=once(name), zorder=3)
+        for i, learner in enumerate(learners):
+            score = row["learners"].get(learner)
+            if score is None:
+                continue
+            dy = 0.16 * (i - (len(learners) - 1) / 2)
+            colour = f"C{i}"
+            if score.get("low") is not None and row.get("best_fixed") is not None:
+                ax.plot(
+                    [row["best_fixed"] + score["low"], row["best_fixed"] + score["high"]],
+                    [y + dy] * 2,
+                    color=colour,
+                    linewidth=2.5,
+                    zorder=4,
+                )
+            ax.plot(score["mean"], y + dy, "o", ms=5, color=colour, label=once(learner), zorder=5)
+    ax.set_yticks(range(len(rows)))
+    ax.set_yticklabels([row["label"] for row in rows], fontsize=8)
+    ax.set_ylim(len(rows) - 0.5, -0.5)  # the first row at the top
+    ax.set_xlim(0.0, 1.0)
+    ax.set_xlabel("OER_tau on the test split (learners: mean, and Best fixed action + the 95 % interval of the gap)")
+    ax.grid(axis="x", color="0.92")
+    ax.set_title(title, fontsize=9)
+    fig.legend(fontsize=7, loc="lower center", ncol=4, frameon=False, markerscale=0.7)
+    legend_rows = -(-len(labelled) // 4)
+    fig.tight_layout(rect=(0, (0.02 + 0.16 * legend_rows) / fig.get_figheight(), 1, 1))  # the legend below
     try:
         return save_figure_atomic(fig, path, dpi=120)
     finally:

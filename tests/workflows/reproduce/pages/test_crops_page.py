@@ -58,6 +58,9 @@ def test_the_table_ranks_groups_hardest_first_and_names_those_not_run(tmp_path: 
     text = page.read_text()
     assert text.startswith("# Crops\n\nbefore\n") and text.endswith("after\n") and "old" not in text
     assert "| apple | row |" in text
+    # The table drawn beside it, its picture linked from the page.
+    assert "![the crops run as a ladder, hardest at the top](images/crops-ladder.png)" in text
+    assert (tmp_path / "images" / "crops-ladder.png").stat().st_size > 10_000
     alone = write_crops_md(tmp_path / "run.md", CROPS_RUN, state, None)  # no markers: a page of its own
     assert "Wall time per stage" in alone.read_text()
     # With the run's dataset: the share of views with a fruit boxed and the fewest fruit on a plant.
@@ -160,5 +163,5 @@ def test_the_page_gives_the_runs_wall_time_by_kind_of_stage(tmp_path: Path) -> N
     state.results = {CROPS_RUN.result_key(s, c): state.results["sp-olive"] for s, c in CROPS_RUN.pairs}
     write_crops_md(page, CROPS_RUN, state, run)  # every group evaluated: the run's whole time
     assert "Wall time: **3.3 h**" in page.read_text()
-    write_crops_md(page, CROPS_RUN, RunState(), run)  # nothing run yet: no line
-    assert "Wall time" not in page.read_text()
+    write_crops_md(page, CROPS_RUN, RunState(), run)  # nothing run yet: no line, no picture
+    assert "Wall time" not in page.read_text() and "crops-ladder" not in page.read_text()

@@ -3,8 +3,9 @@
 Written from the run's records (``state.json``) after every benchmark: per crop and scenario, the
 test split's scenes and eligible starts, the mean start OER (OER_0), Rand, the Best fixed action,
 the exact Oracle and each learner with its paired gap to the Best fixed action (95 % bootstrap
-interval over the same test episodes), and under it the run's wall time by kind of stage. Into
-docs/crops.md it goes between the ``crops-run`` markers; any other path gets a page of its own.
+interval over the same test episodes), the same as a ladder chart (PNG), and under it the run's
+wall time by kind of stage. Into docs/crops.md it goes between the ``crops-run`` markers; any other
+path gets a page of its own.
 """
 
 from __future__ import annotations
@@ -71,6 +72,24 @@ def boxed_share(root: Path | None, folders: list[str]) -> str:
     return f"{boxed / views:.0%} / {min(fewest)}" if views and fewest else "–"
 
 
+def _evaluated(config: ReproduceConfig, state: RunState) -> tuple[list[tuple[str, str, EvaluationResults]], list[str]]:
+    """The groups evaluated, hardest first (the lowest Best fixed action; one without it last), and
+    the keys of those not evaluated yet, in the run's order."""
+    evaluated, waiting = [], []
+    for scenario, crop in config.pairs:
+        result = state.results.get(config.result_key(scenario, crop))
+        if result is None:
+            waiting.append(group_key(scenario, crop))
+        else:
+            evaluated.append((scenario, crop, result))
+
+    def hardness(group: tuple[str, str, EvaluationResults]) -> float:
+        best = _oer(group[2].policies, BEST_FIXED)
+        return 1.0 if best is None else best
+
+    return sorted(evaluated, key=hardness), waiting
+
+
 def crops_table(config: ReproduceConfig, state: RunState, root: Path | None = None) -> str:
     """The run's table, hardest group first (the lowest Best fixed action).
 
@@ -83,33 +102,27 @@ def crops_table(config: ReproduceConfig, state: RunState, root: Path | None = No
         Markdown: a line on the run, the table, the groups not evaluated yet.
     """
     learners = [algo.upper() for algo in config.learners]
-    rows, waiting = [], []
-    for scenario, crop in config.pairs:
-        result = state.results.get(config.result_key(scenario, crop))
-        if result is None:
-            waiting.append(group_key(scenario, crop))
-            continue
+    evaluated, waiting = _evaluated(config, state)
+    rows = []
+    for scenario, crop, result in evaluated:
         protocol, policies = result.protocol, result.policies
         best = _oer(policies, BEST_FIXED)
         oracle = _oer(policies, "Oracle")
         start = policies["LRD"].oer_0.mean if "LRD" in policies else None
         rows.append(
-            (
-                best if best is not None else 1.0,
-                [
-                    crop,
-                    scenario,
-                    boxed_share(root, state.scene_folders.get(group_key(scenario, crop), [])),
-                    str(len(protocol.scenes)),
-                    f"{protocol.starts:,}" if protocol.starts is not None else "–",
-                    cell(start) if start is not None else "–",
-                    _score(policies, "Rand"),
-                    _score(policies, BEST_FIXED),
-                    _score(policies, "Oracle"),
-                    signed(oracle - best) if oracle is not None and best is not None else "–",
-                    *[_learner(result, learner) for learner in learners],
-                ],
-            )
+            [
+                crop,
+                scenario,
+                boxed_share(root, state.scene_folders.get(group_key(scenario, crop), [])),
+                str(len(protocol.scenes)),
+                f"{protocol.starts:,}" if protocol.starts is not None else "–",
+                cell(start) if start is not None else "–",
+                _score(policies, "Rand"),
+                _score(policies, BEST_FIXED),
+                _score(policies, "Oracle"),
+                signed(oracle - best) if oracle is not None and best is not None else "–",
+                *[_learner(result, learner) for learner in learners],
+            ]
         )
     head = (
         f"`{config.name}` run: {config.sp_scenes} SP and {config.mp_scenes} row scenes per crop at "
@@ -122,12 +135,58 @@ def crops_table(config: ReproduceConfig, state: RunState, root: Path | None = No
     columns += ["eligible starts", "OER_0", "Rand", BEST_FIXED, "Oracle"]
     columns += ["Oracle − best fixed", *learners]
     lines = [head, "", "| " + " | ".join(columns) + " |", "|---" * len(columns) + "|"]
-    lines += ["| " + " | ".join(cells) + " |" for _, cells in sorted(rows, key=lambda row: row[0])]
+    lines += ["| " + " | ".join(cells) + " |" for cells in rows]
     if not rows:
         lines.append("| not run yet |" + " |" * (len(columns) - 1))
     if waiting:
         lines += ["", f"Not evaluated yet: {', '.join(waiting)}."]
     return "\n".join(lines)
+
+
+def ladder_figure(config: ReproduceConfig, state: RunState, page: Path) -> str | None:
+    """Draw the table as a ladder (:func:`davis_ag.figures.result_charts.plot_ladder`) into
+    ``images/crops-ladder.png`` beside the page; its Markdown link (None before any group).
+
+    Args:
+        config: The run's configuration.
+        state: Its records.
+        page: The page the link goes in.
+
+    Returns:
+        The Markdown image line, or None.
+    """
+    from davis_ag.figures.result_charts import plot_ladder
+
+    evaluated, _ = _evaluated(config, state)
+    if not evaluated:
+        return None
+    learners = [algo.upper() for algo in config.learners]
+    rows = []
+    for scenario, crop, result in evaluated:
+        policies = result.policies
+        scores = {}
+        for learner in (name for name in learners if name in policies):
+            paired = learner_gap(result, learner)
+            scores[learner] = {"mean": _oer(policies, learner)}
+            if paired is not None:
+                scores[learner] |= {"low": paired.low, "high": paired.high}
+        rows.append(
+            {
+                "label": f"{crop} {scenario}",
+                "oer_0": policies["LRD"].oer_0.mean if "LRD" in policies else None,
+                "rand": _oer(policies, "Rand"),
+                "best_fixed": _oer(policies, BEST_FIXED),
+                "oracle": _oer(policies, "Oracle"),
+                "learners": scores,
+            }
+        )
+    target = page.parent / "images" / "crops-ladder.png"
+    title = (
+        f"{config.name} run, {len(rows)} of {len(config.pairs)} groups: how hard each crop is, "
+        f"hardest (lowest {BEST_FIXED}) at the top"
+    )
+    plot_ladder(rows, target, title)
+    return f"![the crops run as a ladder, hardest at the top](images/{target.name})"
 
 
 def wall_time_line(config: ReproduceConfig, state: RunState, out: Path | None) -> str:
@@ -158,8 +217,9 @@ def wall_time_line(config: ReproduceConfig, state: RunState, out: Path | None) -
 
 
 def write_crops_md(path: Path, config: ReproduceConfig, state: RunState, out: Path | None) -> Path:
-    """Write the crops run's table: into a page's ``crops-run`` block where it has one (docs/crops.md),
-    else as a page of its own with the wall time of every stage.
+    """Write the crops run's table and its ladder chart (in ``images/`` beside the page): into a
+    page's ``crops-run`` block where it has one (docs/crops.md), else as a page of its own with the
+    wall time of every stage.
 
     Args:
         path: The page (docs/crops.md, or a page of the run's own).
@@ -172,6 +232,8 @@ def write_crops_md(path: Path, config: ReproduceConfig, state: RunState, out: Pa
     """
     table = crops_table(config, state, None if out is None else Path(out) / "dataset")
     path = Path(path)
+    figure = ladder_figure(config, state, path)
+    table += f"\n\n{figure}" if figure else ""
     if path.is_file() and f"<!-- {CROPS_MARKER}:start -->" in path.read_text(errors="replace"):
         spent = wall_time_line(config, state, out)
         write_marked_section(path, CROPS_MARKER, table + (f"\n\n{spent}" if spent else ""))
