@@ -8,7 +8,7 @@ from typing import Any
 
 from davis_ag.benchmark.exact import BEST_FIXED
 from davis_ag.benchmark.paired import FEW_SCENES
-from davis_ag.benchmark.results import EvaluationResults, as_results, split_text, table_number
+from davis_ag.benchmark.results import EvaluationResults, Protocol, as_results, split_text, table_number
 from davis_ag.benchmark.summaries import PAIRED_BASELINES
 
 #: Table 4's metrics: key in the results, row label.
@@ -82,6 +82,13 @@ def format_table(results: EvaluationResults | dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
+def replays_few_starts(protocol: Protocol) -> bool:
+    """Whether an evaluation's episodes replay its split's eligible starts, each about twice or
+    more: its intervals over episodes then say how sure the means are over those starts only.
+    Section V-D's 3 x 200 episodes draw each start about once on a test split of Table 3's size."""
+    return protocol.starts is not None and 2 * protocol.starts < protocol.episodes * protocol.sessions
+
+
 def _warnings(results: EvaluationResults) -> list[str]:
     """What a reader could mistake in the table: a policy that plays one action only (a collapsed
     learner looks like a method), and episodes that replay a few starts (the interval over
@@ -96,8 +103,7 @@ def _warnings(results: EvaluationResults) -> list[str]:
     protocol = results.protocol
     if protocol.sessions == 1:
         notes.append("note: one session, so every ± (the spread of session means) is 0; section V-D plays 3")
-    # Section V-D's 3 x 200 episodes draw each start about once on a test split of Table 3's size.
-    if protocol.starts is not None and 2 * protocol.starts < protocol.episodes * protocol.sessions:
+    if replays_few_starts(protocol):
         notes.append(
             f"note: {protocol.sessions * protocol.episodes} episodes replay {protocol.starts} eligible starts: "
             "the intervals say how sure the means are over these starts, not over other scenes; "

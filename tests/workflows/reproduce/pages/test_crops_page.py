@@ -52,6 +52,8 @@ def test_the_table_ranks_groups_hardest_first_and_names_those_not_run(tmp_path: 
     assert "1,234" in rows[1] and "+.200" in rows[1] and "+.050" in rows[1]  # headroom and A2C's gap
     assert rows[0].rstrip(" |").endswith("–")  # no learner yet: a dash, not a number
     assert "Not evaluated yet: sp-apple, " in table
+    # row-apple's 600 episodes replay its 56 starts; sp-olive's 1,234 are each drawn about once.
+    assert "Few starts (row-apple: 600 episodes, 56 starts): their episodes replay" in table
     page = tmp_path / "crops.md"
     page.write_text("# Crops\n\nbefore\n<!-- crops-run:start -->\nold\n<!-- crops-run:end -->\nafter\n")
     write_crops_md(page, CROPS_RUN, state, None)
@@ -63,16 +65,24 @@ def test_the_table_ranks_groups_hardest_first_and_names_those_not_run(tmp_path: 
     assert (tmp_path / "images" / "crops-ladder.png").stat().st_size > 10_000
     alone = write_crops_md(tmp_path / "run.md", CROPS_RUN, state, None)  # no markers: a page of its own
     assert "Wall time per stage" in alone.read_text()
-    # With the run's dataset: the share of views with a fruit boxed and the fewest fruit on a plant.
+    # With the run's dataset: the share of views with a fruit boxed, the fewest fruit on a plant and
+    # the median box's longer side.
     scene = tmp_path / "run" / "dataset" / "Single-Olive" / "000"
     scene.mkdir(parents=True)
     (scene / "annotations.json").write_text(
-        json.dumps({"0001.jpeg": {"bounding_boxes": [[1, 1, 2, 2, 0, 0]]}, "0002.jpeg": {"bounding_boxes": []}})
+        json.dumps(
+            {
+                "0001.jpeg": {"bounding_boxes": [[1, 1, 2, 5, 3, 0], [9, 9, 4, 1, 4, 0]]},  # x, y, width, height
+                "0002.jpeg": {"bounding_boxes": [[1, 1, 7, 6, 3, 0]]},
+                "0003.jpeg": {"bounding_boxes": []},
+                "0004.jpeg": {"bounding_boxes": []},
+            }
+        )
     )
     (scene / "scene.json").write_text(json.dumps({"plants": [{"fruit_count": 12}]}))
     state.scene_folders = {"sp-olive": ["Single-Olive/000"]}
     write_crops_md(page, CROPS_RUN, state, tmp_path / "run")
-    assert "| olive | sp | 50% / 12 |" in page.read_text()
+    assert "| olive | sp | 50% / 12 / 5 |" in page.read_text()  # sides 5, 4 and 7
 
 
 def test_the_measured_crops_sit_beside_the_literature(tmp_path: Path) -> None:

@@ -18,6 +18,7 @@ from davis_ag.atomic_files import write_marked_section, write_text_atomic
 from davis_ag.benchmark.exact import BEST_FIXED
 from davis_ag.benchmark.paired import CONFIDENCE
 from davis_ag.benchmark.results import EvaluationResults, PolicyResult
+from davis_ag.benchmark.results_table import replays_few_starts
 from davis_ag.workflows.reproduce.configs import ReproduceConfig
 from davis_ag.workflows.reproduce.groups import group_key
 from davis_ag.workflows.reproduce.pages.gaps import learner_gap
@@ -51,15 +52,20 @@ def _learner(result: EvaluationResults, learner: str) -> str:
     return _score(result.policies, learner) + gap
 
 
-def boxed_share(root: Path | None, folders: list[str]) -> str:
-    """The share of a group's views with at least one fruit boxed, and its fewest fruit on a plant,
-    read from the scenes' annotations.json and scene.json (``–`` where they are not there)."""
+def group_fruit(root: Path | None, folders: list[str]) -> str:
+    """What a group's fruit look like in its views: the share of views with at least one fruit
+    boxed, the fewest fruit on a plant and the median box's longer side in pixels (how large a
+    target is: a few pixels make its OER coarse), read from the scenes' annotations.json and
+    scene.json (``–`` where they are not there)."""
     import json
+
+    import numpy as np
 
     if root is None:
         return "–"
     views = boxed = 0
     fewest: list[int] = []
+    sides: list[int] = []
     for folder in folders:
         try:
             annotations = json.loads((root / folder / "annotations.json").read_text())
@@ -67,9 +73,15 @@ def boxed_share(root: Path | None, folders: list[str]) -> str:
         except (OSError, ValueError):
             continue
         views += len(annotations)
-        boxed += sum(1 for entry in annotations.values() if entry.get("bounding_boxes"))
+        for entry in annotations.values():
+            boxes = entry.get("bounding_boxes") or []
+            boxed += bool(boxes)
+            sides += [max(int(box[2]), int(box[3])) for box in boxes]  # x, y, width, height, id, class
         fewest += [int(plant.get("fruit_count", 0)) for plant in plants]
-    return f"{boxed / views:.0%} / {min(fewest)}" if views and fewest else "–"
+    if not views or not fewest:
+        return "–"
+    side = f" / {np.median(sides):g}" if sides else " / –"
+    return f"{boxed / views:.0%} / {min(fewest)}{side}"
 
 
 def _evaluated(config: ReproduceConfig, state: RunState) -> tuple[list[tuple[str, str, EvaluationResults]], list[str]]:
@@ -96,7 +108,7 @@ def crops_table(config: ReproduceConfig, state: RunState, root: Path | None = No
     Args:
         config: The run's configuration.
         state: Its records.
-        root: Its dataset (``OUT/dataset``), for the share of views with a fruit boxed.
+        root: Its dataset (``OUT/dataset``), for how the group's fruit look in its views.
 
     Returns:
         Markdown: a line on the run, the table, the groups not evaluated yet.
@@ -113,7 +125,7 @@ def crops_table(config: ReproduceConfig, state: RunState, root: Path | None = No
             [
                 crop,
                 scenario,
-                boxed_share(root, state.scene_folders.get(group_key(scenario, crop), [])),
+                group_fruit(root, state.scene_folders.get(group_key(scenario, crop), [])),
                 str(len(protocol.scenes)),
                 f"{protocol.starts:,}" if protocol.starts is not None else "–",
                 cell(start) if start is not None else "–",
@@ -131,13 +143,22 @@ def crops_table(config: ReproduceConfig, state: RunState, root: Path | None = No
         f"Each learner's gap to the {BEST_FIXED} on the same episodes follows its score "
         f"({CONFIDENCE:.0%} bootstrap interval over episodes). Hardest first: the lowest {BEST_FIXED}."
     )
-    columns = ["crop", "scenario", "views with a fruit boxed / fewest fruit on a plant", "test scenes"]
+    columns = ["crop", "scenario", "views with a fruit boxed / fewest fruit on a plant / median box side, px"]
+    columns += ["test scenes"]
     columns += ["eligible starts", "OER_0", "Rand", BEST_FIXED, "Oracle"]
     columns += ["Oracle − best fixed", *learners]
     lines = [head, "", "| " + " | ".join(columns) + " |", "|---" * len(columns) + "|"]
     lines += ["| " + " | ".join(cells) + " |" for cells in rows]
     if not rows:
         lines.append("| not run yet |" + " |" * (len(columns) - 1))
+    few = [(group_key(s, c), r.protocol) for s, c, r in evaluated if replays_few_starts(r.protocol)]
+    if few:
+        replays = "; ".join(f"{key}: {p.sessions * p.episodes} episodes, {p.starts:,} starts" for key, p in few)
+        lines += [
+            "",
+            f"Few starts ({replays}): their episodes replay each eligible start about twice or more, so "
+            "their intervals say how sure the means are over these starts, not over other scenes.",
+        ]
     if waiting:
         lines += ["", f"Not evaluated yet: {', '.join(waiting)}."]
     return "\n".join(lines)
