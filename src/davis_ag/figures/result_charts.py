@@ -221,7 +221,7 @@ def plot_ladder(rows: list[dict[str, Any]], path: str | os.PathLike[str], title:
     ax.set_yticklabels([row["label"] for row in rows], fontsize=8)
     ax.set_ylim(len(rows) - 0.5, -0.5)  # the first row at the top
     ax.set_xlim(0.0, 1.0)
-    ax.set_xlabel("OER_tau on the test split (learners: mean, and Best fixed action + the 95 % interval of the gap)")
+    ax.set_xlabel("OER_tau on the test split; a learner's bar: Best fixed action + its gap's 95 % interval", fontsize=8)
     ax.grid(axis="x", color="0.92")
     ax.set_title(title, fontsize=9)
     fig.legend(fontsize=7, loc="lower center", ncol=4, frameon=False, markerscale=0.7)

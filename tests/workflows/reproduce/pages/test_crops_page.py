@@ -6,11 +6,13 @@ import json
 from dataclasses import asdict
 from pathlib import Path
 
+import pytest
+
 from davis_ag.benchmark.results import EvaluationResults
 from davis_ag.scene.crop_literature import LITERATURE
 from davis_ag.scene.library_crops import LIBRARY_CROPS, LIBRARY_RECIPES
 from davis_ag.workflows.reproduce.configs import CONFIGS
-from davis_ag.workflows.reproduce.pages.crops import crops_table, write_crops_md
+from davis_ag.workflows.reproduce.pages.crops import crops_table, ladder_rows, write_crops_md
 from davis_ag.workflows.reproduce.state import RunState, run_config
 from davis_ag.workflows.scene_stats.library_crops import library_crops_table, library_recipes_table
 from results_factory import gap, results
@@ -54,6 +56,11 @@ def test_the_table_ranks_groups_hardest_first_and_names_those_not_run(tmp_path: 
     assert "Not evaluated yet: sp-apple, " in table
     # row-apple's 600 episodes replay its 56 starts; sp-olive's 1,234 are each drawn about once.
     assert "Few starts (row-apple: 600 episodes, 56 starts): their episodes replay" in table
+    # The ladder draws the same groups in the same order, the few starts named beside their dots.
+    ladder = ladder_rows(CROPS_RUN, state)
+    assert [row["label"] for row in ladder] == ["apple row (56 starts)", "olive sp"]
+    assert ladder[1]["learners"]["A2C"] == pytest.approx({"mean": 0.55, "low": 0.04, "high": 0.06})
+    assert ladder[0]["learners"] == {} and ladder[0]["oracle"] == 0.60
     page = tmp_path / "crops.md"
     page.write_text("# Crops\n\nbefore\n<!-- crops-run:start -->\nold\n<!-- crops-run:end -->\nafter\n")
     write_crops_md(page, CROPS_RUN, state, None)

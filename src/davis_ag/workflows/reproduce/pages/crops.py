@@ -13,6 +13,7 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 from davis_ag.atomic_files import write_marked_section, write_text_atomic
 from davis_ag.benchmark.exact import BEST_FIXED
@@ -164,9 +165,44 @@ def crops_table(config: ReproduceConfig, state: RunState, root: Path | None = No
     return "\n".join(lines)
 
 
+def ladder_rows(config: ReproduceConfig, state: RunState) -> list[dict[str, Any]]:
+    """The table's groups as :func:`davis_ag.figures.result_charts.plot_ladder` draws them, in
+    the table's order; a group whose episodes replay few starts has their number in its label.
+
+    Args:
+        config: The run's configuration.
+        state: Its records.
+
+    Returns:
+        One row per group evaluated, hardest first.
+    """
+    learners = [algo.upper() for algo in config.learners]
+    rows = []
+    for scenario, crop, result in _evaluated(config, state)[0]:
+        policies = result.policies
+        scores: dict[str, dict[str, float | None]] = {}
+        for learner in (name for name in learners if name in policies):
+            paired = learner_gap(result, learner)
+            scores[learner] = {"mean": _oer(policies, learner)}
+            if paired is not None:
+                scores[learner] |= {"low": paired.low, "high": paired.high}
+        few = replays_few_starts(result.protocol)  # said where its dots are, not only under the table
+        rows.append(
+            {
+                "label": f"{crop} {scenario}" + (f" ({result.protocol.starts} starts)" if few else ""),
+                "oer_0": policies["LRD"].oer_0.mean if "LRD" in policies else None,
+                "rand": _oer(policies, "Rand"),
+                "best_fixed": _oer(policies, BEST_FIXED),
+                "oracle": _oer(policies, "Oracle"),
+                "learners": scores,
+            }
+        )
+    return rows
+
+
 def ladder_figure(config: ReproduceConfig, state: RunState, page: Path) -> str | None:
-    """Draw the table as a ladder (:func:`davis_ag.figures.result_charts.plot_ladder`) into
-    ``images/crops-ladder.png`` beside the page; its Markdown link (None before any group).
+    """Draw the table as a ladder (:func:`ladder_rows`) into ``images/crops-ladder.png`` beside
+    the page; its Markdown link (None before any group).
 
     Args:
         config: The run's configuration.
@@ -178,29 +214,9 @@ def ladder_figure(config: ReproduceConfig, state: RunState, page: Path) -> str |
     """
     from davis_ag.figures.result_charts import plot_ladder
 
-    evaluated, _ = _evaluated(config, state)
-    if not evaluated:
+    rows = ladder_rows(config, state)
+    if not rows:
         return None
-    learners = [algo.upper() for algo in config.learners]
-    rows = []
-    for scenario, crop, result in evaluated:
-        policies = result.policies
-        scores = {}
-        for learner in (name for name in learners if name in policies):
-            paired = learner_gap(result, learner)
-            scores[learner] = {"mean": _oer(policies, learner)}
-            if paired is not None:
-                scores[learner] |= {"low": paired.low, "high": paired.high}
-        rows.append(
-            {
-                "label": f"{crop} {scenario}",
-                "oer_0": policies["LRD"].oer_0.mean if "LRD" in policies else None,
-                "rand": _oer(policies, "Rand"),
-                "best_fixed": _oer(policies, BEST_FIXED),
-                "oracle": _oer(policies, "Oracle"),
-                "learners": scores,
-            }
-        )
     target = page.parent / "images" / "crops-ladder.png"
     title = (
         f"{config.name} run, {len(rows)} of {len(config.pairs)} groups: how hard each crop is, "
