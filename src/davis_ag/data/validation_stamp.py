@@ -94,14 +94,15 @@ def _own_dataset_entries(dataset: Dataset) -> bytes:
     if not file.is_file():
         return f"{DATASET_FILE}\0-".encode()
     raw = file.read_bytes()
+    whole = f"{DATASET_FILE}\0".encode() + raw
     if dataset.opened == dataset.root:
-        return f"{DATASET_FILE}\0".encode() + raw
+        return whole
     try:
         data = json.loads(raw.decode("utf-8"))
     except (ValueError, RecursionError):
-        return f"{DATASET_FILE}\0".encode() + raw
+        return whole
     if not isinstance(data, dict) or not isinstance(data.get("groups"), dict):
-        return f"{DATASET_FILE}\0".encode() + raw
+        return whole
     own = {scene.group for scene in dataset.scenes}
     data["groups"] = {name: entry for name, entry in data["groups"].items() if name in own}
     return f"{DATASET_FILE} of these groups\0{json.dumps(data, sort_keys=True)}".encode()

@@ -36,6 +36,12 @@ def _oer(policies: Mapping[str, PolicyResult], name: str) -> float | None:
     return policies[name].oer_tau.mean if name in policies else None
 
 
+def _start_oer(policies: Mapping[str, PolicyResult]) -> float | None:
+    """The mean OER at the episodes' starts (OER_0, the same for every policy: LRD's row), None
+    where LRD was not played."""
+    return policies["LRD"].oer_0.mean if "LRD" in policies else None
+
+
 def _score(policies: Mapping[str, PolicyResult], name: str) -> str:
     """A policy's OER_tau, mean ± std over sessions (``–`` where it was not played)."""
     if name not in policies:
@@ -121,7 +127,7 @@ def crops_table(config: ReproduceConfig, state: RunState, root: Path | None = No
         protocol, policies = result.protocol, result.policies
         best = _oer(policies, BEST_FIXED)
         oracle = _oer(policies, "Oracle")
-        start = policies["LRD"].oer_0.mean if "LRD" in policies else None
+        start = _start_oer(policies)
         rows.append(
             [
                 crop,
@@ -190,7 +196,7 @@ def ladder_rows(config: ReproduceConfig, state: RunState) -> list[dict[str, Any]
         rows.append(
             {
                 "label": f"{crop} {scenario}" + (f" ({result.protocol.starts} starts)" if few else ""),
-                "oer_0": policies["LRD"].oer_0.mean if "LRD" in policies else None,
+                "oer_0": _start_oer(policies),
                 "rand": _oer(policies, "Rand"),
                 "best_fixed": _oer(policies, BEST_FIXED),
                 "oracle": _oer(policies, "Oracle"),
