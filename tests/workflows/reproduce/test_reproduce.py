@@ -89,6 +89,30 @@ def test_a_run_the_disk_cannot_hold_is_refused_before_anything_is_written(tmp_pa
     assert not out.exists() and not (tmp_path / "results.md").exists()
 
 
+def test_the_status_of_a_run_stopped_in_its_first_stage_says_where_it_stands(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A crops run's first stage (ten apple trees grown and drawn) takes half an hour: ``--status``
+    answered "no reproduce run started there" all that while, as after a kill in it."""
+    from davis_ag.workflows import stages
+    from davis_ag.workflows.reproduce.configs import CONFIGS
+    from davis_ag.workflows.reproduce.run import reproduce
+    from davis_ag.workflows.reproduce.status import run_status
+
+    def killed(*args: object, **kwargs: object) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(stages, "generate_scenes", killed)
+    out = tmp_path / "run"
+    with pytest.raises(KeyboardInterrupt):
+        reproduce(CONFIGS["crops"], out, tmp_path / "crops.md")
+    config, status = run_status(out)
+    assert config == CONFIGS["crops"]
+    first = status[0]
+    assert (first.stage, first.done, first.progress) == ("sp-apple: generate", False, "not started")
+    assert not any(s.done for s in status)
+
+
 #: PPO at a test's size: a rollout of 16 steps per environment instead of the zoo's 128.
 SHORT_PPO = {"n_steps": 16, "batch_size": 32}
 

@@ -86,6 +86,7 @@ def reproduce(
             flush=True,
         )
     state.config = configured
+    state.save(state_path)  # `--status` reads the run from its first stage on, not after it
     clock = StageClock(out / CLOCK_FILE, code_version(), machine=machine_summary())
 
     def record(
