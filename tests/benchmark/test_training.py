@@ -200,6 +200,42 @@ def test_runs_of_different_seeds_share_no_episode_stream(tmp_path: Path) -> None
     assert new[0] == states(0, "streams")  # and each run as reproducible as before
 
 
+@pytest.mark.parametrize("algo", ["a2c", "ppo"])
+def test_a_seed_makes_the_same_model_bit_for_bit_and_another_seed_another(
+    algo: str, tmp_path: Path, one_thread: None
+) -> None:
+    """Every random choice of a training run flows from its seed: two uninterrupted runs of the
+    same seed on the same machine keep the same snapshot with the same weights (what lets a
+    reproduce run's learner rows be made again), and another seed trains another model."""
+    from davis_ag.benchmark.policies import load_model
+    from davis_ag.benchmark.training import train_agent
+
+    root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=3)
+    settings = "ours" if algo == "a2c" else {"n_steps": 16, "batch_size": 32}
+
+    def weights(seed: int, name: str) -> list[np.ndarray]:
+        out = train_agent(
+            root,
+            "sp",
+            total_timesteps=192,
+            seed=seed,
+            out_path=tmp_path / name,
+            n_envs=2,
+            arch="pooled",
+            device="cpu",
+            algo=algo,
+            settings=settings,
+            select_every=96,
+            progress=False,
+        )
+        model = load_model(out)
+        return [p.detach().numpy().copy() for p in model.policy.parameters()]
+
+    first, again, other = weights(0, "first"), weights(0, "again"), weights(1, "other")
+    assert all(np.array_equal(a, b) for a, b in zip(first, again, strict=True))
+    assert not all(np.array_equal(a, b) for a, b in zip(first, other, strict=True))
+
+
 def test_other_settings_never_resume_a_checkpoint(
     tmp_path: Path, one_thread: None, capsys: pytest.CaptureFixture[str]
 ) -> None:
