@@ -95,6 +95,8 @@ def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
         written = (out / "results" / f"{key}.json").is_file()
         progress = f"{config.sessions} x {config.episodes} episodes written" if written else "not started"
         stages.append(StageStatus(stage, written, progress, seconds(stage)))
+        if not written and seconds(stage) is None:
+            stages[-1] = _evaluation_from_elsewhere(config, clock, out, scenario, crop, stages[-1])
     return config, stages
 
 
@@ -236,6 +238,27 @@ def _validation_from_elsewhere(
     return status
 
 
+def _evaluation_from_elsewhere(
+    config: ReproduceConfig,
+    clock: dict[str, list[dict[str, Any]]],
+    out: Path,
+    scenario: str,
+    crop: str,
+    status: StageStatus,
+) -> StageStatus:
+    """An evaluation not started, timed at what another group's took (the same policies and
+    episodes; the scenes differ), one of the same scenario first, where one has been written."""
+    key = group_key(scenario, crop)
+    others = sorted(config.pairs, key=lambda pair: pair[0] != scenario)  # the same scenario first
+    for other in (group_key(s, c) for s, c in others):
+        sittings = clock.get(f"{other}: evaluate")
+        if other == key or not sittings or not (out / "results" / f"{other}.json").is_file():
+            continue
+        took = sum(float(s["seconds"]) for s in sittings)
+        return replace(status, progress=f"not started; timed at {other}'s {took:.0f} s", left_s=took)
+    return status
+
+
 def _best(scores: Any) -> str:
     """``; best train-split OER_tau .459 at 90,000 steps`` from a run's snapshot scores, or ``""``."""
     if not isinstance(scores, list) or not scores:
@@ -263,6 +286,12 @@ def format_status(out: Path) -> str:
     if timed or untimed:
         lines += ["", f"About {sum(s.left_s or 0.0 for s in timed) / 3600:.1f} hours left in the stages timed above"]
         if untimed:
-            lines[-1] += f", and {len(untimed)} not timed yet (no rate measured for them): {', '.join(untimed)}"
+            # By step, in the order a group's stages run: "generate of 18 groups' keys; evaluate of ...".
+            by_step: dict[str, list[str]] = {s.stage.partition(": ")[2]: [] for s in stages}
+            for stage in untimed:
+                key, _, step = stage.partition(": ")
+                by_step.setdefault(step, []).append(key)
+            named = "; ".join(f"{step} of {', '.join(keys)}" for step, keys in by_step.items() if keys)
+            lines[-1] += f", and {len(untimed)} not timed yet (no rate measured for them): {named}"
         lines[-1] += "."
     return "\n".join(lines)
