@@ -254,7 +254,7 @@ def _evaluation_from_elsewhere(
         sittings = clock.get(f"{other}: evaluate")
         if other == key or not sittings or not (out / "results" / f"{other}.json").is_file():
             continue
-        took = sum(float(s["seconds"]) for s in sittings)
+        took = sum(float(sitting["seconds"]) for sitting in sittings)
         return replace(status, progress=f"not started; timed at {other}'s {took:.0f} s", left_s=took)
     return status
 
@@ -286,7 +286,7 @@ def format_status(out: Path) -> str:
     if timed or untimed:
         lines += ["", f"About {sum(s.left_s or 0.0 for s in timed) / 3600:.1f} hours left in the stages timed above"]
         if untimed:
-            # By step, in the order a group's stages run: "generate of 18 groups' keys; evaluate of ...".
+            # By step, in the order a group's stages run: "generate of sp-olive, row-olive; evaluate of ...".
             by_step: dict[str, list[str]] = {s.stage.partition(": ")[2]: [] for s in stages}
             for stage in untimed:
                 key, _, step = stage.partition(": ")
