@@ -20,7 +20,7 @@ from davis_ag.workflows.reproduce.run import reproduce, write_page
 from davis_ag.workflows.reproduce.state import RunState, run_config
 from davis_ag.workflows.reproduce.status import format_status
 
-HELP = "reproduce Table 4: generate, train A2C and PPO, benchmark, write results.md"
+HELP = "reproduce Table 4 or the crops ladder: generate, train A2C and PPO, benchmark, write the page"
 DESCRIPTION = __doc__
 FORMATTER_CLASS = argparse.RawDescriptionHelpFormatter
 
