@@ -54,6 +54,8 @@ def test_the_table_ranks_groups_hardest_first_and_names_those_not_run(tmp_path: 
     assert "1,234" in rows[1] and "+.200" in rows[1] and "+.050" in rows[1]  # headroom and A2C's gap
     assert rows[0].rstrip(" |").endswith("–")  # no learner yet: a dash, not a number
     assert "Not evaluated yet: sp-apple, " in table
+    # A learner's interval is over the test episodes of its one trained model, and says so.
+    assert "bootstrap interval over episodes: the one model trained, seed 0, not another training" in table
     # row-apple's 600 episodes replay its 56 starts; sp-olive's 1,234 are each drawn about once.
     assert "Few starts (row-apple: 600 episodes, 56 starts): their episodes replay" in table
     # The ladder draws the same groups in the same order, the few starts named beside their dots.
