@@ -85,6 +85,24 @@ def test_compare_refuses_another_dataset_or_split(
         assert what in err and "cannot be ranked together" in err and "\n" not in err
 
 
+def test_compare_ranks_files_made_before_and_after_the_dataset_gained_a_group(
+    sp_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The crops run adds a group at a time: its results of a group made before the next group was
+    added were refused beside an evaluation of the same scenes made after."""
+    grown = shutil.copytree(sp_root, tmp_path / "grown")
+    before = evaluate([], grown, "sp", crop="strawberry", sessions=1, episodes=3).write(tmp_path / "before.json")
+    write_tiny_dataset(grown, "sp", "tomato", scenes=2)
+    after = evaluate([], grown, "sp", crop="strawberry", sessions=1, episodes=3).write(tmp_path / "after.json")
+    assert cli.main(["compare", str(before), str(after)]) == 0
+    capsys.readouterr()
+    # A scene it played that is now another (here: drawn from another seed) is still refused.
+    write_tiny_dataset(grown, "sp", "strawberry", scenes=2, seed=7)
+    redrawn = evaluate([], grown, "sp", crop="strawberry", sessions=1, episodes=3).write(tmp_path / "redrawn.json")
+    assert cli.main(["compare", str(before), str(redrawn)]) == 2
+    assert "differ in dataset: scene Single-Strawberry/001 has seed 7001 against 1" in capsys.readouterr().err
+
+
 def test_compare_refuses_the_same_seeds_drawn_otherwise(
     sp_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -103,7 +121,7 @@ def test_compare_refuses_the_same_seeds_drawn_otherwise(
     capsys.readouterr()
     assert cli.main(["compare", str(ours), str(other)]) == 2
     err = capsys.readouterr().err.strip()
-    assert "scene Single-Strawberry/000 was drawn otherwise" in err and "\n" not in err
+    assert "scene Single-Strawberry/001 was drawn otherwise" in err and "\n" not in err  # the scene played
     # A file from before the identity said how scenes were drawn: evaluate it again.
     for name in ("ours", "old"):
         data = json.loads((tmp_path / "ours.json").read_text())

@@ -1,8 +1,10 @@
 """A leaderboard from results files (``davis-ag compare``): one row per method, ranked by OER_tau.
 
 Results are ranked together only when they measure the same thing: the same protocol version,
-the same dataset (its identity, :class:`davis_ag.benchmark.results.DatasetIdentity`), environment,
-scenario, crop, split (hence scenes and eligible starts). Anything else is refused in one line.
+the same evaluated scenes (each one's identity in :class:`davis_ag.benchmark.results.DatasetIdentity`:
+seed, code, how it was drawn; scenes the dataset gained since, another crop's group, change nothing
+a file measured), environment, scenario, crop, split (hence scenes and eligible starts). Anything
+else is refused in one line.
 Files may differ in sessions, episodes or seed; then their means are still comparable (each an
 estimate of the same expectation), but their episodes are not the same, and a paired gap is
 given only between policies that played the same episodes: within one file, or across files of
@@ -47,16 +49,30 @@ def _identity(results: EvaluationResults) -> dict[str, object]:
     p = results.protocol
     return {
         "protocol version": p.version,
-        "dataset": results.dataset.fingerprint if results.dataset else None,
         "environment": p.environment,
         "scenario": p.scenario,
         "crop": p.crop,
         "split": p.split,
         "test scenes": tuple(p.scenes),
+        # After the split and its scenes: another split plays other scenes, and is named as such.
+        "dataset": _evaluated_scenes(results),
         "tau": p.tau,
         "start rule": p.start_rule,
         "eligible starts": p.starts,
     }
+
+
+def _evaluated_scenes(results: EvaluationResults) -> DatasetIdentity | None:
+    """The dataset's identity cut to the scenes the file evaluated (None where it records none).
+
+    A dataset grows: the crops run adds a group at a time, and a file made before a group was
+    added was refused beside one made after, though both played the same scenes.
+    """
+    if results.dataset is None:
+        return None
+    played = set(results.protocol.scenes)
+    scenes = sorted((s for s in results.dataset.scenes if s.id in played), key=lambda s: s.id)
+    return DatasetIdentity(fingerprint="", scenes=scenes)
 
 
 def check_comparable(files: list[tuple[Path, EvaluationResults]]) -> None:
@@ -78,9 +94,10 @@ def check_comparable(files: list[tuple[Path, EvaluationResults]]) -> None:
         found = _identity(results)
         for key, value in wanted.items():
             if key == "dataset" and found[key] != value and results.dataset is not None:
-                raise UserError(
-                    f"{path} and {first} differ in dataset: {_scene_difference(results.dataset, base.dataset)}"
-                )
+                theirs, ours = _evaluated_scenes(results), _evaluated_scenes(base)
+                assert theirs is not None and ours is not None  # both record their dataset (above)
+                difference = _scene_difference(theirs, ours)
+                raise UserError(f"{path} and {first} differ in dataset: {difference}")
             if found[key] != value:
                 raise UserError(
                     f"{path} and {first} differ in {key} ({_shown(found[key])} against {_shown(value)}): "
