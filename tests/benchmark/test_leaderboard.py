@@ -12,6 +12,7 @@ import pytest
 from davis_ag import cli
 from davis_ag.benchmark import evaluate
 from davis_ag.benchmark.leaderboard import format_leaderboard, leaderboard
+from davis_ag.benchmark.results import load_results
 from davis_ag.errors import UserError
 from layout_factory import write_tiny_dataset
 
@@ -93,9 +94,16 @@ def test_compare_ranks_files_made_before_and_after_the_dataset_gained_a_group(
     grown = shutil.copytree(sp_root, tmp_path / "grown")
     before = evaluate([], grown, "sp", crop="strawberry", sessions=1, episodes=3).write(tmp_path / "before.json")
     write_tiny_dataset(grown, "sp", "tomato", scenes=2)
-    after = evaluate([], grown, "sp", crop="strawberry", sessions=1, episodes=3).write(tmp_path / "after.json")
-    assert cli.main(["compare", str(before), str(after)]) == 0
-    capsys.readouterr()
+    after = evaluate([_always("up")], grown, "sp", crop="strawberry", sessions=1, episodes=3)
+    after.write(tmp_path / "after.json")
+    assert cli.main(["compare", str(before), str(tmp_path / "after.json")]) == 0
+    small, large = load_results(before).dataset, after.dataset
+    assert small is not None and large is not None
+    # The page names both datasets (the baselines' rows are the first file's, always_up's the second's).
+    assert (
+        f"Datasets {small.fingerprint} ({len(small.scenes)} scenes), "
+        f"{large.fingerprint} ({len(small.scenes) + 2} scenes)"
+    ) in capsys.readouterr().out
     # A scene it played that is now another (here: drawn from another seed) is still refused.
     write_tiny_dataset(grown, "sp", "strawberry", scenes=2, seed=7)
     redrawn = evaluate([], grown, "sp", crop="strawberry", sessions=1, episodes=3).write(tmp_path / "redrawn.json")

@@ -221,16 +221,17 @@ def _gap_cell(gap: PairedGap | None) -> str:
 def format_leaderboard(rows: list[Row]) -> str:
     """The leaderboard as a Markdown page: what the numbers rest on, then the ranked table."""
     protocol = rows[0].results.protocol
-    dataset = rows[0].results.dataset
-    assert dataset is not None  # results that do not record their dataset are refused before ranking
     sampling = sorted({split_text(r.results.protocol) for r in rows})
+    # Files ranked together played the same scenes; a dataset that grew since holds more of them.
+    datasets = {r.results.dataset.fingerprint: len(r.results.dataset.scenes) for r in rows if r.results.dataset}
+    held = ", ".join(f"{fingerprint} ({count} scenes)" for fingerprint, count in datasets.items())
     baselines = [b for b in PAIRED_BASELINES if any(r.gaps.get(b) for r in rows)]
     lines = [
         f"# Leaderboard: {protocol.scenario.upper()}{' ' + protocol.crop if protocol.crop else ''}, "
         f"{protocol.environment}, {protocol.split} split",
         "",
         "What the numbers rest on: " + "; ".join(sampling) + ". "
-        f"Dataset {dataset.fingerprint} ({len(dataset.scenes)} scenes), protocol version {protocol.version}.",
+        f"Dataset{'s' if len(datasets) > 1 else ''} {held}, protocol version {protocol.version}.",
         "",
         "| Rank | Method | OER_tau | Cum. reward | Ep. length | "
         + " | ".join(f"Gap to {b} [95 %]" for b in baselines)
