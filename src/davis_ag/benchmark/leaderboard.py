@@ -222,7 +222,7 @@ def format_leaderboard(rows: list[Row]) -> str:
     """The leaderboard as a Markdown page: what the numbers rest on, then the ranked table."""
     protocol = rows[0].results.protocol
     sampling = sorted({split_text(r.results.protocol) for r in rows})
-    # Files ranked together played the same scenes; a dataset that grew since holds more of them.
+    # Files ranked together played the same scenes; a dataset that grew since holds others too.
     datasets = {r.results.dataset.fingerprint: len(r.results.dataset.scenes) for r in rows if r.results.dataset}
     held = ", ".join(f"{fingerprint} ({count} scenes)" for fingerprint, count in datasets.items())
     baselines = [b for b in PAIRED_BASELINES if any(r.gaps.get(b) for r in rows)]
