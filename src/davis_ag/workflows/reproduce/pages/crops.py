@@ -149,8 +149,7 @@ def crops_table(config: ReproduceConfig, state: RunState, root: Path | None = No
         f"group; OER_tau, mean ± std over {config.sessions} sessions of {config.episodes} test episodes. "
         f"Each learner's gap to the {BEST_FIXED} on the same episodes follows its score "
         f"({CONFIDENCE:.0%} bootstrap interval over episodes: the one model trained, seed {config.seed}, "
-        "not another training of the learner). Hardest first: the lowest "
-        f"{BEST_FIXED}."
+        f"not another training of the learner). Hardest first: the lowest {BEST_FIXED}."
     )
     columns = ["crop", "scenario", "views with a fruit boxed / fewest fruit on a plant / median box side, px"]
     columns += ["test scenes"]
