@@ -20,10 +20,10 @@ from typing import Any
 
 from davis_ag.benchmark.paired import FEW_SCENES
 from davis_ag.benchmark.results import (
-    DatasetIdentity,
     EvaluationResults,
     PairedGap,
     PolicyResult,
+    SceneIdentity,
     load_results,
     split_text,
     table_number,
@@ -62,8 +62,8 @@ def _identity(results: EvaluationResults) -> dict[str, object]:
     }
 
 
-def _evaluated_scenes(results: EvaluationResults) -> DatasetIdentity | None:
-    """The dataset's identity cut to the scenes the file evaluated (None where it records none).
+def _evaluated_scenes(results: EvaluationResults) -> list[SceneIdentity] | None:
+    """The identities of the scenes the file evaluated, by id (None where it records no dataset).
 
     A dataset grows: the crops run adds a group at a time, and a file made before a group was
     added was refused beside one made after, though both played the same scenes.
@@ -71,8 +71,7 @@ def _evaluated_scenes(results: EvaluationResults) -> DatasetIdentity | None:
     if results.dataset is None:
         return None
     played = set(results.protocol.scenes)
-    scenes = sorted((s for s in results.dataset.scenes if s.id in played), key=lambda s: s.id)
-    return DatasetIdentity(fingerprint="", scenes=scenes)
+    return sorted((s for s in results.dataset.scenes if s.id in played), key=lambda s: s.id)
 
 
 def check_comparable(files: list[tuple[Path, EvaluationResults]]) -> None:
@@ -105,9 +104,9 @@ def check_comparable(files: list[tuple[Path, EvaluationResults]]) -> None:
                 )
 
 
-def _scene_difference(found: DatasetIdentity, wanted: DatasetIdentity) -> str:
-    """Where two datasets' identities part, in words, with what to do."""
-    theirs, ours = {s.id: s for s in found.scenes}, {s.id: s for s in wanted.scenes}
+def _scene_difference(found: list[SceneIdentity], wanted: list[SceneIdentity]) -> str:
+    """Where two files' scenes part, in words, with what to do."""
+    theirs, ours = {s.id: s for s in found}, {s.id: s for s in wanted}
     if set(theirs) != set(ours):
         only = sorted(set(theirs) ^ set(ours))
         return f"{len(only)} scene(s) are in one only ({only[0]}, ...); results of different datasets cannot be ranked together"

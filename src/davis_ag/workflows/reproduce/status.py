@@ -290,7 +290,7 @@ def format_status(out: Path) -> str:
             by_step: dict[str, list[str]] = {s.stage.partition(": ")[2]: [] for s in stages}
             for stage in untimed:
                 key, _, step = stage.partition(": ")
-                by_step.setdefault(step, []).append(key)
+                by_step[step].append(key)
             named = "; ".join(f"{step} of {', '.join(keys)}" for step, keys in by_step.items() if keys)
             lines[-1] += f", and {len(untimed)} not timed yet (no rate measured for them): {named}"
         lines[-1] += "."
