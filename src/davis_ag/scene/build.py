@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from davis_ag.errors import UserError
+from davis_ag.scene.helios_threads import one_helios_thread
 from davis_ag.scene.lighting import Lighting
 from davis_ag.scene.organs import ORGAN_DATA
 from davis_ag.scene.plants import (
@@ -255,6 +256,7 @@ def build_scene(
     require_native_helios()
     from pyhelios import Context
 
+    one_helios_thread()  # growth is 15-25x slower on a busy machine with a team of threads
     context = Context()
     check_plants(plants)
     if crop.source == "library":
