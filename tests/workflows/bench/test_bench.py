@@ -27,6 +27,16 @@ def test_the_grow_and_draw_bound_is_below_the_whole_cost() -> None:
     assert "hours_one_machine_grow_and_draw_only" not in projection({c: 0.5 for c in CROPS}, {c: 30.0 for c in CROPS})
 
 
+def test_a_paper_crop_not_measured_costs_the_slowest_measured_and_no_library_crop_is_made_up() -> None:
+    from davis_ag.workflows.bench.run import fill_unmeasured_paper_crops
+
+    per_view, overhead = {"strawberry": 0.2, "vine": 0.3}, {"strawberry": 2.0, "vine": 3.0}
+    assert fill_unmeasured_paper_crops(per_view, overhead) == ["tomato"]
+    assert per_view == {"strawberry": 0.2, "vine": 0.3, "tomato": 0.3}
+    assert overhead == {"strawberry": 2.0, "vine": 3.0, "tomato": 3.0}
+    assert projection(per_view, overhead)["scenes"] > 0  # every group of the paper preset has its costs
+
+
 def test_a_measured_pool_gain_replaces_the_helios_one() -> None:
     costs = ({c: 1.0 for c in CROPS}, {c: 0.0 for c in CROPS})
     assert projection(*costs, gain=2.0)["hours_one_machine"] == pytest.approx(502_542 / 3600 / 2, abs=0.1)

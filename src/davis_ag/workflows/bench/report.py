@@ -165,6 +165,11 @@ def table(report: dict) -> str:
         f"{p[f'hours_{CLUSTER_MACHINES}_machines']} h on {CLUSTER_MACHINES} such machines with Ray. "
         f"Per-scene overhead (growing, renderer set-up), s: "
         + ", ".join(f"{k} {v}" for k, v in report["scene_overhead_s"].items())
+        + (
+            f" ({', '.join(report['assumed_as_slowest'])}, not measured: as the slowest measured)"
+            if report.get("assumed_as_slowest")
+            else ""
+        )
         + ". "
         + p["assumptions"]
         + ".",
