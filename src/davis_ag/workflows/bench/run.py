@@ -404,14 +404,7 @@ def run(out: Path, crops: list[str], repeats: int, antialiasing: str = "fxaa") -
             # On a GPU machine each learner is timed on the CPU and then on the GPU.
             report["training"] = training_speed(Path(scratch), devices=training_devices())
     report["scene_overhead_s"] = {k: round(v, 1) for k, v in overhead.items()}
-    # The paper preset grows the paper's crops only; one not measured this time is taken as the
-    # slowest one measured, and the page says so.
-    report["assumed_as_slowest"] = [
-        name for name, crop in CROPS.items() if crop.source != "library" and name not in overhead
-    ]
-    for name in report["assumed_as_slowest"]:
-        for measured in (per_view, overhead, floor, grow):
-            measured[name] = max(measured.values())
+    report["assumed_as_slowest"] = fill_unmeasured_paper_crops(per_view, overhead, floor, grow)
     report["paper_projection"] = projection(per_view, overhead, floor, grow, report.get("pool", {}).get("gain"))
     report["targets"] = {"documented_over_ours_min": TARGETS, "paper_hours_one_machine_max": PAPER_HOURS_TARGET}
     report["machine"]["load_average"] = {
