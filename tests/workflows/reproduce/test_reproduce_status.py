@@ -128,6 +128,27 @@ def test_a_learner_not_started_is_timed_at_its_rate_on_the_other_group(tmp_path:
     )
 
 
+def test_a_learner_under_way_before_its_first_checkpoint_is_timed_at_the_other_groups_rate(tmp_path: Path) -> None:
+    """MP's A2C has run 100 s on the clock and saved nothing yet: timed at SP's rate, less those 100 s."""
+    out = a_run_part_way(tmp_path)
+    record = {"timesteps": 30_000, "seconds": 600.0, "steps_per_second": 50.0}
+    (out / "models" / "a2c_sp-strawberry.training.json").write_text(json.dumps(record))
+    clock = json.loads((out / "clock.json").read_text())
+    clock["stages"]["mp-vine: train A2C"] = [{"started": "t", "seconds": 100.0, "code": "x"}]
+    (out / "clock.json").write_text(json.dumps(clock))
+    mp_a2c = {s.stage: s for s in run_status(out)[1]}["mp-vine: train A2C"]
+    assert mp_a2c.progress == "under way, no checkpoint yet; timed at sp-strawberry's 50.0 steps/s"
+    assert mp_a2c.left_s == pytest.approx(CONFIG.mp_timesteps / 50.0 - 100.0)
+    clock["stages"]["mp-vine: train A2C"][0]["seconds"] = CONFIG.mp_timesteps / 50.0 + 1  # slower than SP's
+    (out / "clock.json").write_text(json.dumps(clock))
+    mp_a2c = {s.stage: s for s in run_status(out)[1]}["mp-vine: train A2C"]
+    whole = CONFIG.mp_timesteps / 50.0 / 3600
+    assert (mp_a2c.progress, mp_a2c.left_s) == (
+        f"under way, no checkpoint yet; past the {whole:.2f} h sp-strawberry's rate gives",
+        None,
+    )
+
+
 def test_a_generate_stage_shows_its_views_before_its_first_scene_ends(tmp_path: Path) -> None:
     # A paper-scale MP vine scene takes about half an hour: the stage showed "not started" and no
     # time left for its first scenes. The journals of the scenes under way give both.

@@ -44,6 +44,10 @@ class StageStatus:
     left_s: float | None = None
 
 
+#: A learner's stage on the clock with no checkpoint yet.
+UNDER_WAY = "under way, no checkpoint yet"
+
+
 def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
     """Every stage of the run in ``out``, in the order the run takes them.
 
@@ -89,7 +93,7 @@ def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
         for algo in config.learners:
             stage = f"{key}: train {algo.upper()}"
             stages.append(_training_status(out, key, algo, timesteps, stage, seconds(stage)))
-            if stages[-1].progress == "not started":
+            if stages[-1].progress in ("not started", UNDER_WAY):
                 stages[-1] = _estimated_from_elsewhere(out, config, key, algo, timesteps, stages[-1])
         stage = f"{key}: evaluate"
         written = (out / "results" / f"{key}.json").is_file()
@@ -179,7 +183,7 @@ def _training_status(out: Path, key: str, algo: str, timesteps: int, stage: str,
     record = load_json_object(checkpoint_paths(model)[1])
     done = int(record.get("timesteps_done", 0))
     if not done:
-        return StageStatus(stage, False, "not started" if seconds is None else "under way, no checkpoint yet", seconds)
+        return StageStatus(stage, False, "not started" if seconds is None else UNDER_WAY, seconds)
     left = None
     if sittings := record.get("sittings"):
         last = sittings[-1]
@@ -193,17 +197,22 @@ def _training_status(out: Path, key: str, algo: str, timesteps: int, stage: str,
 def _estimated_from_elsewhere(
     out: Path, config: ReproduceConfig, key: str, algo: str, timesteps: int, status: StageStatus
 ) -> StageStatus:
-    """A learner not started, timed at the rate the same learner trained at on another group of
-    the run (the same network and observations; the scenes differ), where one has finished."""
+    """A learner not started, or started with no checkpoint yet to time it by, timed at the rate the
+    same learner trained at on another group of the run (the same network and observations; the
+    scenes differ), where one has finished, less the time it has run."""
 
     from davis_ag.workflows.reproduce.learners import training_record
 
     for other in (group_key(s, c) for s, c in config.pairs):
         rate = training_record(out, other, algo).get("steps_per_second") if other != key else None
-        if rate:
-            return replace(
-                status, progress=f"not started; timed at {other}'s {rate:.1f} steps/s", left_s=timesteps / rate
-            )
+        if not rate:
+            continue
+        whole, spent = timesteps / rate, status.seconds or 0.0
+        if spent >= whole:  # slower than there (a busier machine, a paused run): no guess
+            return replace(status, progress=f"{status.progress}; past the {whole / 3600:.2f} h {other}'s rate gives")
+        return replace(
+            status, progress=f"{status.progress}; timed at {other}'s {rate:.1f} steps/s", left_s=whole - spent
+        )
     return status
 
 
