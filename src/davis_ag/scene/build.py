@@ -256,7 +256,7 @@ def build_scene(
     require_native_helios()
     from pyhelios import Context
 
-    one_helios_thread()  # growth is 15-25x slower on a busy machine with a team of threads
+    one_helios_thread()  # a team of threads grows up to 29x slower on a busy machine
     context = Context()
     check_plants(plants)
     if crop.source == "library":
