@@ -8,7 +8,7 @@ import threading
 import numpy as np
 import pytest
 
-from davis_ag.scene import architecture_plants, build, library_plants
+from davis_ag.scene import build
 from davis_ag.scene.build import build_scene
 from davis_ag.scene.helios_threads import _helios_openmp, helios_threads, one_helios_thread
 from davis_ag.scene.plant_geometry import primitive_vertices
@@ -58,7 +58,6 @@ def test_a_team_of_threads_grows_the_same_scene_to_the_byte(crop: str, monkeypat
             runtime.omp_set_num_threads(2)
         return len(_helios_openmp())
 
-    for module in (build, library_plants, architecture_plants):
-        monkeypatch.setattr(module, "one_helios_thread", team_of_two)
+    monkeypatch.setattr(build, "one_helios_thread", team_of_two)
     assert _scene_digest(crop) == one
     assert helios_threads() == [2] * len(_helios_openmp())

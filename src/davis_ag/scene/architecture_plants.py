@@ -21,7 +21,6 @@ from __future__ import annotations
 import numpy as np
 
 from davis_ag.scene.goblet_vine import grow_goblet_vine, load_vine_model
-from davis_ag.scene.helios_threads import one_helios_thread
 from davis_ag.scene.plants import (
     ArchitectureModel,
     GrownPlant,
@@ -60,8 +59,6 @@ def load_architecture_model(context, crop: CropSpec, rng: np.random.Generator) -
         The loaded model, with every shoot type's parameters as loaded.
     """
     from pyhelios import PlantArchitecture
-
-    one_helios_thread()  # the module davis_ag.scene.helios_threads says why
 
     # Helios seeds a new Context from the clock, and the load keeps some of its draws for
     # good (the module docstring): seed it before anything is drawn.

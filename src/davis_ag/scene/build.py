@@ -256,6 +256,7 @@ def build_scene(
     require_native_helios()
     from pyhelios import Context
 
+    # Every growth (Canopy Generator, PlantArchitecture, plant library) runs under here.
     one_helios_thread()  # a team of threads grows up to 29x slower on a busy machine
     context = Context()
     check_plants(plants)

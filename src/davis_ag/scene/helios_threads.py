@@ -6,9 +6,11 @@ and Context operations too short to gain from one. On an idle 2-core machine two
 library apple no faster than one; with the other core busy (a second scene process, the crops run,
 the test suite) the team's threads wait on each other and growth took 16 to 29 times as long for a
 plant-library crop, 6 times for a Canopy Generator strawberry; the scene's geometry is the same byte
-for byte either way (``tests/scene/test_helios_threads.py``). ``OMP_NUM_THREADS`` would limit torch too, which reads it and would then train on one core, so
-the limit is set in Helios's runtime alone, for the calling thread: OpenMP keeps the number per
-thread, so each thread that grows plants calls :func:`one_helios_thread` first.
+for byte either way (``tests/scene/test_helios_threads.py``). ``OMP_NUM_THREADS`` would limit
+torch too, which reads it and would then train on one core, so the limit is set in Helios's runtime
+alone, for the calling thread: OpenMP keeps the number per thread, so
+:func:`davis_ag.scene.build.build_scene`, where every scene grows, calls :func:`one_helios_thread`
+first.
 """
 
 from __future__ import annotations

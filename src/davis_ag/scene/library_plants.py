@@ -24,7 +24,6 @@ from typing import Any
 import numpy as np
 
 from davis_ag.errors import UserError
-from davis_ag.scene.helios_threads import one_helios_thread
 from davis_ag.scene.library_crops import LIBRARY_RECIPES, LibraryRecipe
 from davis_ag.scene.organ_labels import label_library_plant
 from davis_ag.scene.plants import (
@@ -73,8 +72,6 @@ def load_library_model(context, crop: CropSpec, rng: np.random.Generator) -> Arc
         The loaded model, with every shoot type's parameters as the library defines them.
     """
     from pyhelios import PlantArchitecture
-
-    one_helios_thread()  # the module davis_ag.scene.helios_threads says why
 
     recipe = recipe_of(crop)
     context.seedRandomGenerator(helios_seed(rng.spawn(1)[0]))
