@@ -183,43 +183,54 @@ def replay_grid(
     """
     from davis_ag.benchmark.tvm import TVMEnv
 
-    check_replayable(results, where, "davis_ag/TVM-v0")
-    began = time.perf_counter()
-    count = sum(len(p.episodes or []) for p in results.policies.values())
+    def make_env(protocol: Any) -> TVMEnv:
+        return TVMEnv(
+            root,
+            protocol.scenario,
+            protocol.split,
+            crop=protocol.crop,
+            cache_dir=cache_dir,
+            tau=protocol.tau,
+            start_rule=protocol.start_rule or "pairs",
+        )
 
-    def report(difference: Difference | None) -> ReplayReport:
-        return ReplayReport(where, count, len(results.policies), time.perf_counter() - began, difference)
-
-    if (difference := dataset_difference(results, root)) is not None:
-        return report(difference)
-    protocol = results.protocol
-    env = TVMEnv(
-        root,
-        protocol.scenario,
-        protocol.split,
-        crop=protocol.crop,
-        cache_dir=cache_dir,
-        tau=protocol.tau,
-        start_rule=protocol.start_rule or "pairs",
-    )
     keys = ("scenario", "split", "tau", "scenes", "actions", "start_rule", "starts")
-    return report(replay_on(env, results, keys, _replay_episode, before=_replay_exact))
+    return replay_on(results, root, where, "davis_ag/TVM-v0", make_env, keys, _replay_episode, before=_replay_exact)
 
 
 def replay_on(
-    env: Any,
     results: EvaluationResults,
+    root: str | os.PathLike[str],
+    where: str,
+    environment: str,
+    make_env: Any,
     keys: tuple[str, ...],
     replay_episode: Any,
     before: Any = None,
-) -> Difference | None:
-    """The replay both environments share: the protocol's ``keys`` against ``env.describe()``,
-    ``before(results, env)`` (the grid's exact expectations), then ``replay_episode`` on every
-    episode of every policy; the environment is closed after.
+) -> ReplayReport:
+    """The replay both environments share: the file checked (:func:`check_replayable`) and its
+    dataset compared (:func:`dataset_difference`); then ``make_env(protocol)``, the protocol's
+    ``keys`` against its ``describe()``, ``before(results, env)`` (the grid's exact expectations)
+    and ``replay_episode`` on every episode of every policy; the environment is closed after.
 
     Returns:
-        The first difference, or None.
+        The report: sound, or the first difference.
+
+    Raises:
+        UserError: for a file that cannot be replayed or a dataset that is not one.
     """
+    check_replayable(results, where, environment)
+    began = time.perf_counter()
+    count = sum(len(p.episodes or []) for p in results.policies.values())
+    difference = dataset_difference(results, root)
+    if difference is None:
+        difference = _replay_episodes(make_env(results.protocol), results, keys, replay_episode, before)
+    return ReplayReport(where, count, len(results.policies), time.perf_counter() - began, difference)
+
+
+def _replay_episodes(
+    env: Any, results: EvaluationResults, keys: tuple[str, ...], replay_episode: Any, before: Any
+) -> Difference | None:
     protocol = results.protocol
     try:
         described = env.describe()

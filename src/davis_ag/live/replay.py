@@ -15,17 +15,9 @@ by a rounding: within :data:`POSE_TOLERANCE` (metres, degrees), and the target's
 from __future__ import annotations
 
 import os
-import time
 from typing import Any
 
-from davis_ag.benchmark.replay import (
-    Difference,
-    ReplayReport,
-    check_replayable,
-    dataset_difference,
-    expect,
-    replay_on,
-)
+from davis_ag.benchmark.replay import ReplayReport, expect, replay_on
 from davis_ag.benchmark.results import EvaluationResults
 from davis_ag.benchmark.tvm import episode_reward
 
@@ -43,21 +35,13 @@ def replay_continuous(results: EvaluationResults, root: str | os.PathLike[str], 
     """
     from davis_ag.live.tvm_continuous import TVMContinuousEnv
 
-    check_replayable(results, where, "davis_ag/TVMContinuous-v0")
-    began = time.perf_counter()
-    count = sum(len(p.episodes or []) for p in results.policies.values())
+    def make_env(protocol: Any) -> TVMContinuousEnv:
+        return TVMContinuousEnv(
+            root, protocol.scenario, protocol.split, crop=protocol.crop, aim=protocol.aim, tau=protocol.tau
+        )
 
-    def report(difference: Difference | None) -> ReplayReport:
-        return ReplayReport(where, count, len(results.policies), time.perf_counter() - began, difference)
-
-    if (difference := dataset_difference(results, root)) is not None:
-        return report(difference)
-    protocol = results.protocol
-    env = TVMContinuousEnv(
-        root, protocol.scenario, protocol.split, crop=protocol.crop, aim=protocol.aim, tau=protocol.tau
-    )
     keys = ("scenario", "split", "tau", "aim", "scenes", "actions")
-    return report(replay_on(env, results, keys, _replay_episode))
+    return replay_on(results, root, where, "davis_ag/TVMContinuous-v0", make_env, keys, _replay_episode)
 
 
 def _replay_episode(env: Any, name: str, stored: dict[str, Any], index: int, seed: int, per_session: int) -> None:
