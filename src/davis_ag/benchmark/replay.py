@@ -27,6 +27,7 @@ from __future__ import annotations
 import math
 import os
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -203,15 +204,25 @@ def replay_on(
     root: str | os.PathLike[str],
     where: str,
     environment: str,
-    make_env: Any,
+    make_env: Callable[[Any], Any],
     keys: tuple[str, ...],
-    replay_episode: Any,
-    before: Any = None,
+    replay_episode: Callable[..., None],
+    before: Callable[[EvaluationResults, Any], None] | None = None,
 ) -> ReplayReport:
     """The replay both environments share: the file checked (:func:`check_replayable`) and its
     dataset compared (:func:`dataset_difference`); then ``make_env(protocol)``, the protocol's
     ``keys`` against its ``describe()``, ``before(results, env)`` (the grid's exact expectations)
     and ``replay_episode`` on every episode of every policy; the environment is closed after.
+
+    Args:
+        results: The results file, read.
+        root: The dataset folder.
+        where: The file, for messages.
+        environment: The environment id the file must name (``davis_ag/TVM-v0``, ...).
+        make_env: Builds the environment from the file's protocol.
+        keys: The protocol fields the environment's ``describe()`` must repeat.
+        replay_episode: Plays one recorded episode again; raises on the first difference.
+        before: Checks run once before the episodes (the grid's exact expectations), or None.
 
     Returns:
         The report: sound, or the first difference.
@@ -229,7 +240,11 @@ def replay_on(
 
 
 def _replay_episodes(
-    env: Any, results: EvaluationResults, keys: tuple[str, ...], replay_episode: Any, before: Any
+    env: Any,
+    results: EvaluationResults,
+    keys: tuple[str, ...],
+    replay_episode: Callable[..., None],
+    before: Callable[[EvaluationResults, Any], None] | None,
 ) -> Difference | None:
     protocol = results.protocol
     try:
