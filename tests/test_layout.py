@@ -31,6 +31,7 @@ STAGES: tuple[tuple[str, ...], ...] = (
     ("labels",),
     ("generate",),
     ("data",),
+    ("robot",),  # real arms on a base: reads generated scenes, restricts the benchmark's moves
     ("benchmark",),
     ("live",),  # regrows and renders: after the benchmark, which knows nothing of Helios
     ("detection",),
@@ -40,7 +41,7 @@ STAGES: tuple[tuple[str, ...], ...] = (
 )
 RANK = {name: rank for rank, names in enumerate(STAGES) for name in names}
 #: Stages that must import without Helios or a renderer: they are pure geometry and reading.
-NO_HELIOS_AT_IMPORT = ("scene", "formats", "data", "benchmark", "detection")
+NO_HELIOS_AT_IMPORT = ("scene", "formats", "data", "robot", "benchmark", "detection")
 
 
 def module_name(path: Path) -> str:

@@ -31,6 +31,8 @@ COMMANDS = [
     "view",
     "export",
     "transfer",
+    "robots",
+    "reach",
     "bench",
     "scene-stats",
 ]

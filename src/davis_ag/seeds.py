@@ -21,6 +21,8 @@ Streams are NumPy ``SeedSequence`` keys, so two streams never share draws howeve
   seeds all of these from ``[seed, TRAIN_RESUME_STREAM, k]`` instead (:func:`resumed_training_seed`),
   so it does not replay the first sitting's episodes and draws; the snapshot scoring plays fixed episodes
   (:data:`davis_ag.benchmark.selection.SELECT_SEED`) under a forked torch state;
+- a robot's reach of a scene (:mod:`davis_ag.robot.reach`): the IK's random restarts on the
+  base line of side ``s`` (0 south, 1 north) draw from ``[scene seed, REACH_STREAM, s]``;
 - the paired bootstrap: ``default_rng(seed)`` of the evaluation (:mod:`davis_ag.benchmark.paired`);
   the transfer experiment's split ``k``: ``seed + k``, its appearance shift: ``[seed, image]``.
 
@@ -55,6 +57,8 @@ OFF_GRID_STREAM = 2**32 - 1
 TRAIN_ENV_STREAM = 2**32 - 2
 #: A training sitting resumed from a checkpoint, after the run's seed (then the step it resumes at).
 TRAIN_RESUME_STREAM = 2**32 - 3
+#: A robot's IK restarts over a scene's views, after the scene seed (then the base line's side).
+REACH_STREAM = 2**32 - 4
 
 
 def derived_seed(*keys: int) -> int:

@@ -1,4 +1,4 @@
-"""Stage 8, the benchmark: DAVIS-Ag as a Gymnasium environment, target visibility maximisation (``davis_ag/TVM-v0``).
+"""Stage 9, the benchmark: DAVIS-Ag as a Gymnasium environment, target visibility maximisation (``davis_ag/TVM-v0``).
 
 Importing this package registers the environment::
 

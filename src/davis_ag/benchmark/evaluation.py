@@ -223,7 +223,7 @@ def evaluate_policies(
         prepare(policy, env)
     described = inner.describe()
     protocol = Protocol(version=PROTOCOL_VERSION, episodes=episodes, sessions=sessions, seed=seed, **described)
-    keys = (*METRICS, "oer_0") + (("refused",) if not grid else ())
+    keys = (*METRICS, "oer_0") + (("refused",) if not grid else ()) + (("seconds",) if grid and inner.robot else ())
     rows: dict[str, dict[str, Any]] = {}
     records: dict[str, list[dict[str, Any]]] = {}
     for policy in policies:
@@ -276,6 +276,7 @@ def evaluate(
     deterministic: bool | None = None,
     cache_dir: str | os.PathLike[str] | None = None,
     keep_episodes: bool = True,
+    robot: str | None = None,
 ) -> EvaluationResults:
     """Score policies beside the baselines with section V-D's protocol (``davis_ag.benchmark.evaluate``).
 
@@ -297,6 +298,7 @@ def evaluate(
             :data:`davis_ag.benchmark.policies.DETERMINISTIC_PLAY`).
         cache_dir: The grid's observation cache folder.
         keep_episodes: Keep every episode in the results.
+        robot: A robot (name or YAML) the grid's camera rides on (:mod:`davis_ag.benchmark.robot_moves`).
 
     Returns:
         The results, exactly what ``davis-ag evaluate --out`` writes.
@@ -324,6 +326,10 @@ def evaluate(
     kwargs: dict[str, Any] = {"dataset": dataset, "scenario": scenario, "split": split, "crop": crop}
     if env == "grid":
         kwargs["cache_dir"] = cache_dir
+        if robot is not None:
+            kwargs["robot"] = robot
+    elif robot is not None:
+        raise UserError("--robot works with the grid (TVM-v0) only, not yet with --env continuous")
     made = gym.make(TVM_ID if env == "grid" else CONTINUOUS_ID, disable_env_checker=True, **kwargs)
     try:
         results = evaluate_policies(

@@ -40,7 +40,7 @@ def episode_record(
 
     Returns:
         ``{"oer_0", "oer_tau", "reward", "length", "scene", "target_fruit", "path", "actions"}``,
-        and ``"refused"`` where it is given.
+        ``"refused"`` where it is given and ``"seconds"`` where a robot moved the camera.
     """
     record = {
         "oer_0": float(info["oer_0"]),
@@ -54,6 +54,8 @@ def episode_record(
     }
     if refused is not None:
         record["refused"] = refused
+    if "robot" in info:  # TVM-v0 with a robot: the seconds its moves took
+        record["seconds"] = float(info["robot"]["seconds_total"])
     return record
 
 

@@ -166,6 +166,7 @@ def replay_grid(
     root: str | os.PathLike[str],
     where: str,
     cache_dir: str | os.PathLike[str] | None = None,
+    robot: str | None = None,
 ) -> ReplayReport:
     """Replay a TVM-v0 results file on the dataset at ``root`` (see the module docstring).
 
@@ -174,6 +175,8 @@ def replay_grid(
         root: The dataset folder.
         where: The file, for messages.
         cache_dir: The observation cache folder, as evaluate took it.
+        robot: The robot's YAML file, for a file evaluated with a robot of one (a built-in robot is
+            found by the name the file records).
 
     Returns:
         The report: sound, or the first difference.
@@ -184,6 +187,10 @@ def replay_grid(
     """
     from davis_ag.benchmark.tvm import TVMEnv
 
+    recorded = results.protocol.robot
+    if robot is not None and recorded is None:
+        raise UserError(f"{where} was evaluated without a robot; verify it without --robot")
+
     def make_env(protocol: Any) -> TVMEnv:
         return TVMEnv(
             root,
@@ -193,9 +200,10 @@ def replay_grid(
             cache_dir=cache_dir,
             tau=protocol.tau,
             start_rule=protocol.start_rule or "pairs",
+            robot=robot or (recorded["name"] if recorded else None),
         )
 
-    keys = ("scenario", "split", "tau", "scenes", "actions", "start_rule", "starts")
+    keys = ("scenario", "split", "tau", "scenes", "actions", "start_rule", "starts", "robot")
     return replay_on(results, root, where, "davis_ag/TVM-v0", make_env, keys, _replay_episode, before=_replay_exact)
 
 

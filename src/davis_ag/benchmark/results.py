@@ -92,6 +92,7 @@ class Episode(_Model):
     path: list[Any]
     actions: list[Any]
     refused: int | None = None
+    seconds: float | None = None
 
 
 class CodeDigest(_Model):
@@ -119,6 +120,7 @@ class PolicyResult(_Model):
     length: Metric
     oer_0: Metric
     refused: Metric | None = None
+    seconds: Metric | None = None
     source: str | None = Field(default=None, description="the SPEC or baseline name it was built from")
     play: str | None = Field(default=None, description="a trained model's play: sampled or deterministic")
     action: str | None = Field(default=None, description="the action of the Best fixed action row")
@@ -173,6 +175,7 @@ class Protocol(_Model):
     start_rule: str | None = None
     starts: int | None = None
     aim: str | None = None
+    robot: dict[str, str] | None = None
 
 
 class MeanScore(_Model):

@@ -24,8 +24,8 @@ from davis_ag.errors import UserError
 #: The baselines every policy is compared with episode by episode, where the evaluation has them.
 PAIRED_BASELINES: tuple[str, ...] = (BEST_FIXED, "Rand")
 #: Metrics summarised over sessions: Table 4's, then the start's OER and, on the continuous
-#: environment, the refused moves.
-METRIC_KEYS: tuple[str, ...] = ("oer_tau", "reward", "length", "oer_0", "refused")
+#: environment, the refused moves; with a robot, the seconds its moves took.
+METRIC_KEYS: tuple[str, ...] = ("oer_tau", "reward", "length", "oer_0", "refused", "seconds")
 #: How far a summary made again may differ from the stored one (JSON keeps floats exactly; this
 #: only forgives another summation order).
 TOLERANCE = 1e-9

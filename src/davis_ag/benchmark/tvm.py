@@ -30,6 +30,8 @@ An episode (section V-D):
   repeated where a move was refused; ``done`` adds none), ``target_fruit`` (instance id),
   ``scene`` (id) and ``steps``.
 - Exact planners read the dynamics through :meth:`TVMEnv.move_table`, not the image.
+- ``robot=``: moves only between views the robot reaches, each costing its seconds, with
+  ``info["robot"]`` and an optional ``budget_s`` (:mod:`davis_ag.benchmark.robot_moves`).
 """
 
 from __future__ import annotations
@@ -38,13 +40,15 @@ import copy
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, overload
+from typing import TYPE_CHECKING, Any
 
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
 from davis_ag.benchmark.cache import OBS_SIZE, SceneCache, load_scene_cache
+from davis_ag.benchmark.episode_rules import MAX_START_OER, START_RULES, can_start, episode_reward
+from davis_ag.benchmark.robot_moves import RobotOnGrid, attach_robot, no_reachable_start
 from davis_ag.benchmark.splits import scene_crop, select_scenes
 from davis_ag.errors import UserError
 from davis_ag.scene.specs import ALL_ACTIONS, crop_spec, scenario_spec
@@ -52,28 +56,8 @@ from davis_ag.scene.specs import ALL_ACTIONS, crop_spec, scenario_spec
 if TYPE_CHECKING:  # the reader loads on first use (see as_dataset)
     from davis_ag.data.reader import Dataset, Scene
 
-#: Section V-D: an episode starts on a target with OER below this.
-MAX_START_OER = 0.4
-
-
-@overload
-def can_start(oer: float, max_start_oer: float = MAX_START_OER) -> bool: ...
-@overload
-def can_start(oer: np.ndarray, max_start_oer: float = MAX_START_OER) -> np.ndarray: ...
-def can_start(oer: float | np.ndarray, max_start_oer: float = MAX_START_OER) -> bool | np.ndarray:
-    """Section V-D's start rule: a fruit may be an episode's target when its OER is below the
-    limit (a float, or an array of them); the grid and the continuous environments share it."""
-    return oer < max_start_oer
-
-
-def episode_reward(oer_0: float, oer_end: float) -> float:
-    """Section V-C's reward at an episode's end: ``max(OER_end - OER_0, 0) ** 2``."""
-    return float(max(oer_end - oer_0, 0.0) ** 2)
-
-
-#: How ``reset`` draws a start: ``pairs`` uniform over every eligible (scene, view, target),
-#: ``scene`` uniform over scenes, then views, then targets (see the module docstring).
-START_RULES = ("pairs", "scene")
+#: With ``budget_s`` and no ``tau``: the most steps an episode takes (refused moves cost no seconds).
+BUDGET_STEP_CAP = 100
 
 
 @dataclass
@@ -110,6 +94,8 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
         tau: int | None = None,
         render_mode: str | None = None,
         start_rule: str = "pairs",
+        robot: str | None = None,
+        budget_s: float | None = None,
     ) -> None:
         """Open the scenes of one scenario and split, building their caches if needed.
 
@@ -125,6 +111,11 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
             render_mode: ``None`` or ``"rgb_array"``.
             start_rule: ``pairs`` (default: every eligible start equally likely) or ``scene``
                 (scene, then view, then target; see :data:`START_RULES`).
+            robot: A robot (``davis-ag robots``, or a YAML file): moves are restricted to the views it
+                reaches and cost its seconds (:mod:`davis_ag.benchmark.robot_moves`).
+            budget_s: With a robot, end an episode when its seconds are spent (a move that would
+                overrun the budget is not made and ends the episode) instead of after ``tau``
+                steps; ``tau`` then defaults to :data:`BUDGET_STEP_CAP`, a cap on refused moves.
 
         Raises:
             UserError: when the path is not a dataset, the split has no scene, or no scene has
@@ -140,7 +131,10 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
         self.dataset = as_dataset(dataset)
         self.scenario = spec.name
         self.split = split
-        self.tau = int(tau if tau is not None else spec.tau)
+        if budget_s is not None and (robot is None or not budget_s > 0):
+            raise UserError(f"budget_s={budget_s} needs a robot and a positive number of seconds")
+        self.budget_s = budget_s
+        self.tau = int(tau if tau is not None else (BUDGET_STEP_CAP if budget_s is not None else spec.tau))
         if self.tau < 1:
             raise UserError(f"tau must be at least 1, got {self.tau}")
         #: Action names by index: the scenario's moves, then ``done``.
@@ -153,11 +147,17 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
 
         self.scenes = select_scenes(self.dataset, spec.name, split, crop)
         self.caches: list[SceneCache] = [load_scene_cache(s, self.dataset.root, cache_dir) for s in self.scenes]
+        self.robot: RobotOnGrid | None = None
+        if robot is not None:
+            self.robot, self.caches = attach_robot(robot, self.scenes, self.caches, self.dataset.root, cache_dir)
         self._starts: list[tuple[int, _Starts]] = []
         for index, (scene, cache) in enumerate(zip(self.scenes, self.caches)):
-            starts = self._eligible(cache, self._min_pixels(scene, cache), max_start_oer)
+            reachable = self.robot.reaches[index].reachable if self.robot is not None else None
+            starts = self._eligible(cache, self._min_pixels(scene, cache), max_start_oer, reachable)
             if len(starts.views):
                 self._starts.append((index, starts))
+        if not self._starts and self.robot is not None:
+            raise no_reachable_start(self.robot, self.scenes, split, self.dataset.root)
         if not self._starts:
             raise UserError(
                 f"no eligible start in the {split} split of {self.dataset.root} "
@@ -169,7 +169,7 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
             [(scene, int(box)) for scene, starts in self._starts for box in starts.boxes], dtype=np.int64
         ).reshape(-1, 2)
         self._scene = self._view = self._box = self._fruit = self._t = -1
-        self._oer_0 = 0.0
+        self._oer_0 = self._seconds = self._move_seconds = 0.0
         self._path: list[str] = []
         self._over = True
 
@@ -186,9 +186,11 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
         return float(crop_spec(crop).min_fruit_pixels_at(*cache.image_size))
 
     @staticmethod
-    def _eligible(cache: SceneCache, min_pixels: float, max_oer: float) -> _Starts:
-        """Boxes a scene's episodes may start from (OER and visible-pixel filters)."""
+    def _eligible(cache: SceneCache, min_pixels: float, max_oer: float, reachable: np.ndarray | None = None) -> _Starts:
+        """Boxes a scene's episodes may start from (OER and visible-pixel filters; a robot's reach)."""
         ok = can_start(cache.box_oer, max_oer) & (cache.box_pixels >= min_pixels)
+        if reachable is not None:
+            ok &= reachable[cache.box_view]
         boxes = np.flatnonzero(ok).astype(np.int32)
         # Rows were written view by view, so a stable sort by view keeps each view's boxes
         # together in annotation order.
@@ -229,6 +231,7 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
         self._view = int(cache.box_view[self._box])
         self._fruit = int(cache.box_fruit[self._box])
         self._t = 0
+        self._seconds = self._move_seconds = 0.0
         self._oer_0 = float(cache.box_oer[self._box])
         self._path = [cache.view_names[self._view]]
         self._over = False
@@ -285,10 +288,21 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
         if self._over:
             raise UserError("the episode is over (or never started): call reset() first")
         self._t += 1
+        over_budget = False
         if a != self.done_action:
-            self._view, self._box = self._move(self._view, a)
+            view, box = self._move(self._view, a)
+            self._move_seconds = (
+                0.0
+                if view == self._view or self.robot is None
+                else self.robot.seconds(self._scene, self._view, self._columns[a])
+            )
+            over_budget = self.budget_s is not None and self._seconds + self._move_seconds > self.budget_s
+            if over_budget:
+                self._move_seconds, view, box = 0.0, self._view, self._box
+            self._seconds += self._move_seconds
+            self._view, self._box = view, box
             self._path.append(self.caches[self._scene].view_names[self._view])
-        terminated = a == self.done_action or self._t >= self.tau
+        terminated = a == self.done_action or self._t >= self.tau or over_budget
         reward = 0.0
         if terminated:
             self._over = True
@@ -320,6 +334,7 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
             "actions": list(self.action_names),
             "start_rule": self.start_rule,
             "starts": len(self.starts),
+            "robot": self.robot.record() if self.robot is not None else None,
         }
 
     def _action_index(self, action: Any) -> int:
@@ -411,7 +426,7 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
 
     def _info(self) -> dict[str, Any]:
         """Episode facts: start and current OER, views visited, target, scene, steps."""
-        return {
+        info = {
             "oer_0": self._oer_0,
             "oer_t": self.oer,
             "path": list(self._path),
@@ -419,6 +434,9 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
             "scene": self.scenes[self._scene].id,
             "steps": self._t,
         }
+        if self.robot is not None:
+            info["robot"] = self.robot.info(self._scene, self._view, self._move_seconds, self._seconds)
+        return info
 
     def render(self) -> np.ndarray | None:
         """``rgb_array``: the 224x224 view with the target's box outlined in red."""

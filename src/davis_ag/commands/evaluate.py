@@ -87,6 +87,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--plot", type=arguments.path, default=None, metavar="PNG", help="bar chart (default: the --out path with .png)"
     )
     parser.add_argument("--force", action="store_true", help="replace an existing --out and --plot")
+    parser.add_argument(
+        "--robot",
+        default=None,
+        metavar="ROBOT",
+        help="the camera rides on this robot (davis-ag robots lists them, or a YAML file): only the views it "
+        "reaches, each move costing its seconds (docs/robot.md)",
+    )
 
 
 class _AddPolicy(argparse.Action):
@@ -165,6 +172,7 @@ def _evaluate(args: argparse.Namespace, names: list[str], specs: list[str], out:
         crop=args.crop,
         baselines=names,
         cache_dir=args.cache_dir,
+        robot=args.robot,
     )
     print(format_table(results))
     # The JSON is the result: keep it somewhere even when --out fails at the end.

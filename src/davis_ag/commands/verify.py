@@ -56,6 +56,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="DIR",
         help="with --dataset: the observation cache folder, as evaluate took it (default: in the dataset)",
     )
+    parser.add_argument(
+        "--robot",
+        default=None,
+        metavar="ROBOT.yaml",
+        help="with --dataset: the YAML of the robot a results file was evaluated with, where it is not built in",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -65,7 +71,7 @@ def run(args: argparse.Namespace) -> int:
     if args.dataset is not None:
         if args.keep is not None:
             raise UserError("--keep is for scenes made again; with --dataset nothing is made: leave it out")
-        return verify_results(args.scenes, args.dataset, args.cache_dir)
+        return verify_results(args.scenes, args.dataset, args.cache_dir, args.robot)
     if files := [p for p in args.scenes if p.suffix == ".json"]:
         raise UserError(f"{files[0]}: to verify results, give the dataset they evaluated: --dataset DATA")
     from davis_ag.generate.regenerate import verify_scene
@@ -82,7 +88,7 @@ def run(args: argparse.Namespace) -> int:
     return 0 if same == len(verdicts) else 1
 
 
-def verify_results(paths: list[Path], dataset: Path, cache_dir: Path | None = None) -> int:
+def verify_results(paths: list[Path], dataset: Path, cache_dir: Path | None = None, robot: str | None = None) -> int:
     """Replay each results file on ``dataset`` (:mod:`davis_ag.benchmark.replay`); 0 when all are sound.
 
     Raises:
@@ -100,7 +106,7 @@ def verify_results(paths: list[Path], dataset: Path, cache_dir: Path | None = No
 
             report = replay_continuous(results, dataset, str(path))
         else:
-            report = replay_grid(results, dataset, str(path), cache_dir)
+            report = replay_grid(results, dataset, str(path), cache_dir, robot)
         print(report.text(), flush=True)
         reports.append(report)
     sound = sum(r.sound for r in reports)

@@ -17,9 +17,9 @@ from __future__ import annotations
 import os
 from typing import Any
 
+from davis_ag.benchmark.episode_rules import episode_reward
 from davis_ag.benchmark.replay import ReplayReport, expect, replay_on
 from davis_ag.benchmark.results import EvaluationResults
-from davis_ag.benchmark.tvm import episode_reward
 
 #: How far a replayed pose may be from the recorded one (metres; degrees for yaw and pitch).
 POSE_TOLERANCE = 1e-3

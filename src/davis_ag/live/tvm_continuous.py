@@ -46,7 +46,7 @@ import numpy as np
 from gymnasium import spaces
 
 from davis_ag.benchmark.cache import OBS_SIZE
-from davis_ag.benchmark.tvm import MAX_START_OER, can_start, episode_reward
+from davis_ag.benchmark.episode_rules import MAX_START_OER, can_start, episode_reward
 from davis_ag.errors import UserError
 from davis_ag.generate.recorded_settings import RecordedSettings
 from davis_ag.live.continuous_moves import (

@@ -1,0 +1,81 @@
+"""``davis-ag reach DATASET --robot NAME``: which views of each scene a robot reaches.
+
+Prints, per group and camera height, the share of views the robot reaches (an IK solution within
+joint limits, clear of itself, its platform, the ground and the scene's trunks: docs/robot.md), and
+draws each scene's grid coloured by reach into ``--out``. The reach is computed once per scene and
+robot and cached beside the observation caches (``--cache-dir``), never inside the scenes."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from davis_ag.commands import arguments
+
+HELP = "which views of a dataset's scenes a robot reaches (table and a picture per scene)"
+DESCRIPTION = __doc__
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add ``reach``'s arguments to its ``parser`` (see :mod:`davis_ag.commands`)."""
+    parser.add_argument("dataset", type=arguments.path, metavar="DATASET", help="a generated dataset's root")
+    parser.add_argument(
+        "--robot", required=True, metavar="ROBOT", help="a robot (davis-ag robots lists them) or a YAML file"
+    )
+    parser.add_argument("--out", type=arguments.path, required=True, metavar="DIR", help="folder for the pictures")
+    parser.add_argument("--scenario", default=None, help="only this scenario's scenes (sp, mp or row)")
+    parser.add_argument(
+        "--cache-dir",
+        type=arguments.path,
+        default=None,
+        metavar="DIR",
+        help="the caches' folder (default: in the dataset)",
+    )
+    parser.add_argument("--force", action="store_true", help="replace pictures already in --out")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Compute (or load) every scene's reach, print the table, draw the pictures."""
+    from davis_ag.data.reader import open_dataset
+    from davis_ag.errors import UserError
+    from davis_ag.figures.reach_plots import plot_scene_reach
+    from davis_ag.formats.outputs import claim_output
+    from davis_ag.robot.base_line import base_lines
+    from davis_ag.robot.definitions import load_robot
+    from davis_ag.robot.obstacles import trunk_points
+    from davis_ag.robot.reach import load_reach, view_poses
+    from davis_ag.robot.summary import reach_table
+
+    definition = load_robot(args.robot)
+    dataset = open_dataset(args.dataset)
+    scenes = [s for s in dataset if args.scenario is None or s.scenario == args.scenario]
+    if not scenes:
+        raise UserError(f"{args.dataset} has no {args.scenario or ''} scene; generate one or choose another --scenario")
+    with claim_output(args.out, force=args.force, flag="--out", folder=True) as out:
+        reaches = []
+        for number, scene in enumerate(scenes, 1):
+
+            def progress(done: int, total: int, scene_id: str = scene.id, number: int = number) -> None:
+                if done == total or done % max(1, total // 10) == 0:
+                    print(
+                        f"\r{scene_id} ({number} of {len(scenes)}): {done} of {total} views solved",
+                        end="",
+                        file=sys.stderr,
+                    )
+                    if done == total:
+                        print(file=sys.stderr)
+
+            reach = load_reach(scene, dataset.root, definition, args.cache_dir, progress)
+            reaches.append(reach)
+            xs = view_poses(scene)[:, 0]
+            lines = base_lines(scene.scenario or "sp", scene.crop, (float(xs.min()), float(xs.max())))
+            picture = out / f"{scene.id.replace('/', '-')}-{definition.name}.png"
+            plot_scene_reach(scene, reach, tuple(line.y for line in lines.values()), picture, trunk_points(scene))
+        print(f"{definition.name} ({definition.urdf_source}) on {args.dataset}")
+        print(f"{'group':<22} {'camera m':>8} {'views':>6} {'reached':>8}")
+        for row in reach_table(scenes, reaches):
+            print(f"{row.group:<22} {row.height:>8.2f} {row.views:>6} {row.share * 100:>7.1f}%")
+        total = sum(len(r.reachable) for r in reaches)
+        reached = sum(int(r.reachable.sum()) for r in reaches)
+        print(f"all: {reached} of {total} views ({reached / total * 100:.1f} %); pictures in {out}")
+    return 0
