@@ -291,14 +291,13 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
         over_budget = False
         if a != self.done_action:
             view, box = self._move(self._view, a)
-            self._move_seconds = (
-                0.0
-                if view == self._view or self.robot is None
-                else self.robot.seconds(self._scene, self._view, self._columns[a])
-            )
-            over_budget = self.budget_s is not None and self._seconds + self._move_seconds > self.budget_s
-            if over_budget:
-                self._move_seconds, view, box = 0.0, self._view, self._box
+            if self.robot is not None and view != self._view:
+                self._move_seconds = self.robot.seconds(self._scene, self._view, self._columns[a])
+                over_budget = self.budget_s is not None and self._seconds + self._move_seconds > self.budget_s
+                if over_budget:  # the move is not made: the budget ends the episode where it is
+                    self._move_seconds, view, box = 0.0, self._view, self._box
+            else:
+                self._move_seconds = 0.0
             self._seconds += self._move_seconds
             self._view, self._box = view, box
             self._path.append(self.caches[self._scene].view_names[self._view])

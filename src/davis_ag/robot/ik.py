@@ -19,9 +19,13 @@ from davis_ag.robot.model import LIFT, RAIL, RobotModel, import_pinocchio
 #: A camera pose is reached within 1 mm and 2 mrad (0.11 degrees).
 POSITION_TOLERANCE = 1e-3
 ROTATION_TOLERANCE = 2e-3
-#: Iterations of one attempt, and the damping of the least-squares step.
-MAX_ITERATIONS = 150
+#: Iterations of one attempt at most, and the damping of the least-squares step. An attempt also
+#: stops when its error has not fallen by :data:`STALL_GAIN` (relative) in :data:`STALL_ITERATIONS`:
+#: a pose out of reach costs a few dozen iterations, one near a joint limit may take hundreds.
+MAX_ITERATIONS = 600
 DAMPING = 1e-6
+STALL_ITERATIONS = 30
+STALL_GAIN = 0.02
 
 
 @dataclass(frozen=True)
@@ -58,14 +62,22 @@ def solve_pose(robot: RobotModel, target, seed: np.ndarray) -> np.ndarray | None
     lower, upper = robot.lower, robot.upper
     q = np.clip(seed, lower, upper)
     eye = np.eye(6) * DAMPING
-    for _ in range(MAX_ITERATIONS):
+    best, best_at = np.inf, 0
+    still = upper - lower < 1e-9
+    for iteration in range(MAX_ITERATIONS):
         pin.framesForwardKinematics(model, data, q)
         current_from_target = data.oMf[frame].actInv(target)  # type: ignore[attr-defined]
         error = pin.log(current_from_target).vector
         if np.linalg.norm(error[:3]) < POSITION_TOLERANCE and np.linalg.norm(error[3:]) < ROTATION_TOLERANCE:
             return q
+        size = float(np.linalg.norm(error))
+        if size < best * (1 - STALL_GAIN):
+            best, best_at = size, iteration
+        elif iteration - best_at > STALL_ITERATIONS:
+            return None
         jacobian = pin.computeFrameJacobian(model, data, q, frame)
         jacobian = -pin.Jlog6(current_from_target.inverse()) @ jacobian
+        jacobian[:, still] = 0.0  # a joint without travel (no lift) must not take a share of the step
         step = -jacobian.T @ np.linalg.solve(jacobian @ jacobian.T + eye, error)
         q = np.clip(pin.integrate(model, q, step), lower, upper)
     return None
