@@ -36,6 +36,9 @@ def format_table(results: EvaluationResults | dict[str, Any]) -> str:
             stat = getattr(policies[name], key)
             row.append(f"{table_number(stat.mean)} ±{table_number(stat.std)}")
         cells.append(row)
+    if any(policies[name].seconds for name in names):  # a robot moved the camera: what it cost
+        cells.append(["", "Robot seconds", *(_seconds_cell(policies[n].seconds) for n in names)])
+        cells.append(["", "OER gain per s", *(_gain_per_second(policies[n]) for n in names)])
     has_exact = any(policies[name].exact for name in names)
     if has_exact:
         for key, title in METRICS.items():
@@ -74,6 +77,11 @@ def format_table(results: EvaluationResults | dict[str, Any]) -> str:
                 else ""
             )
         )
+    if protocol.robot:
+        lines.append(
+            f"robot {protocol.robot['name']} ({protocol.robot['urdf']}, definition {protocol.robot['digest']}): "
+            "moves only between views it reaches; OER gain per s = (mean OER_tau - mean OER_0) / mean seconds"
+        )
     if BEST_FIXED in policies:
         lines.append(
             f"{BEST_FIXED}: always {policies[BEST_FIXED].action}, the best single action by exact OER_tau on this split"
@@ -110,3 +118,14 @@ def _warnings(results: EvaluationResults) -> list[str]:
             "a larger test split tells methods apart"
         )
     return notes
+
+
+def _seconds_cell(stat: Any) -> str:
+    return f"{stat.mean:.2f} ±{stat.std:.2f}" if stat else "-"
+
+
+def _gain_per_second(policy: Any) -> str:
+    """The OER an episode gained per robot second, as means over episodes (``-`` without seconds)."""
+    if not policy.seconds or policy.seconds.mean <= 0:
+        return "-"
+    return f"{(policy.oer_tau.mean - policy.oer_0.mean) / policy.seconds.mean:.3f}"
