@@ -10,6 +10,8 @@ from __future__ import annotations
 import argparse
 import sys
 
+import numpy as np
+
 from davis_ag.commands import arguments
 
 HELP = "which views of a dataset's scenes a robot reaches (table and a picture per scene)"
@@ -32,6 +34,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="the caches' folder (default: in the dataset)",
     )
     parser.add_argument("--force", action="store_true", help="replace pictures already in --out")
+    parser.add_argument(
+        "--doc",
+        type=arguments.path,
+        default=None,
+        metavar="PAGE.md",
+        help="also write the table between <!-- reach-ROBOT:start/end --> markers in this page (docs/robot.md)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -73,9 +82,29 @@ def run(args: argparse.Namespace) -> int:
             plot_scene_reach(scene, reach, tuple(line.y for line in lines.values()), picture, trunk_points(scene))
         print(f"{definition.name} ({definition.urdf_source}) on {args.dataset}")
         print(f"{'group':<22} {'camera m':>8} {'views':>6} {'reached':>8}")
-        for row in reach_table(scenes, reaches):
+        rows = reach_table(scenes, reaches)
+        for row in rows:
             print(f"{row.group:<22} {row.height:>8.2f} {row.views:>6} {row.share * 100:>7.1f}%")
         total = sum(len(r.reachable) for r in reaches)
         reached = sum(int(r.reachable.sum()) for r in reaches)
         print(f"all: {reached} of {total} views ({reached / total * 100:.1f} %); pictures in {out}")
+    if args.doc is not None:
+        from davis_ag.atomic_files import write_marked_section
+        from davis_ag.robot.reach import BLOCKED
+
+        codes = np.concatenate([r.blocked for r in reaches])
+        refusals = {why: int((codes == code).sum()) for code, why in enumerate(BLOCKED) if code}
+        page = [
+            f"`davis-ag reach {args.dataset.name} --robot {definition.name}` ({definition.urdf_source}, definition "
+            f"{definition.digest}): {reached} of {total} views reached ({reached / total * 100:.1f} %), "
+            f"{sum(r.obstacle_points for r in reaches):,} trunk points as obstacles; views refused: "
+            + ", ".join(f"{why} {count}" for why, count in refusals.items())
+            + ".",
+            "",
+            "| group | camera height, m | views | reached |",
+            "|---|---|---|---|",
+            *(f"| {r.group} | {r.height:g} | {r.views} | {r.share * 100:.1f} % |" for r in rows),
+        ]
+        write_marked_section(args.doc, f"reach-{definition.name}", "\n".join(page))
+        print(f"wrote the table into {args.doc}")
     return 0

@@ -18,6 +18,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="ROBOT",
         help="robots to list: built-in names or YAML files (default: every built-in)",
     )
+    parser.add_argument(
+        "--doc",
+        default=None,
+        metavar="PAGE.md",
+        help="also write the table between <!-- robots:start/end --> markers in this page (docs/robot.md)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -27,8 +33,16 @@ def run(args: argparse.Namespace) -> int:
 
     definitions = [load_robot(name) for name in (args.robots or builtin_robots())]
     print("camera heights, m:      " + " ".join(f"{h:>4g}" for h in HEIGHTS))
+    table = ["| robot | arm | mount, m | lift, m | " + " | ".join(f"{h:g} m" for h in HEIGHTS) + " |"]
+    table.append("|---" * (4 + len(HEIGHTS)) + "|")
     for definition in definitions:
         shares = reach_by_height(definition)
+        table.append(
+            f"| {definition.name} | {definition.urdf_source} | {definition.mount_height_m:g} | "
+            f"{definition.lift_m[0]:g}-{definition.lift_m[1]:g} | "
+            + " | ".join(f"{shares[h] * 100:.0f} %" for h in HEIGHTS)
+            + " |"
+        )
         low, high = definition.lift_m
         lift = f"lift {low:g}-{high:g} m at {definition.lift_speed_m_s:g} m/s" if high > low else "no lift"
         print(
@@ -37,4 +51,9 @@ def run(args: argparse.Namespace) -> int:
             f"{definition.joint_speed_scale:g} of the URDF's speeds"
         )
         print(f"  {'reached, %':<22}" + " ".join(f"{shares[h] * 100:>4.0f}" for h in HEIGHTS))
+    if args.doc:
+        from davis_ag.atomic_files import write_marked_section
+
+        write_marked_section(args.doc, "robots", "\n".join(table))
+        print(f"wrote the table into {args.doc}")
     return 0

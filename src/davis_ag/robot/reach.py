@@ -47,7 +47,7 @@ if TYPE_CHECKING:
     from davis_ag.data.reader import Scene
 
 #: Bumped when what the cache holds changes meaning.
-REACH_VERSION = 1
+REACH_VERSION = 2
 #: Random restarts after the neighbours' and the home seeds.
 RESTARTS = 6
 #: Why a view is out of reach, by code (``SceneReach.blocked``).
