@@ -245,6 +245,7 @@ def pools_for(command: str, out: str) -> tuple[list[str], dict[str, st.SearchStr
                 "--name": ANY,
                 "--policies": ANY,
                 "--deterministic": FLAG,
+                "--robot": st.sampled_from(["ur7", "missing.yaml", "a-file"]),
                 "--env": st.sampled_from(["grid", "continuous", "x"]),
                 "--episodes": small,
                 "--sessions": small,
@@ -336,6 +337,22 @@ def pools_for(command: str, out: str) -> tuple[list[str], dict[str, st.SearchStr
             },
             ["--out"],
         )
+    if command == "robots":  # a robot that does not load: every built-in one would take seconds each
+        return [], {"--doc": st.sampled_from(["missing.md", "a-file", "/proc/x"])}, []
+    if command == "reach":  # solves every view: only robots that do not load, so it never starts
+        robots = st.sampled_from(["ur7", "missing.yaml", "a-file", "data"])
+        return (
+            ["data", "--robot", "ur7", "--out", f"{out}/reach"],
+            {
+                "--robot": robots,
+                "--out": out_or_bad,
+                "--scenario": ANY,
+                "--cache-dir": cache,
+                "--doc": st.sampled_from(["missing.md", "a-file", "/proc/x"]),
+                "--force": FLAG,
+            },
+            [],
+        )
     if command == "verify":
         return [], {"--keep": st.sampled_from([f"{out}/again", "/proc/x", "a-file", "a-file/sub", "data/again"])}, []
     raise AssertionError(command)
@@ -359,6 +376,8 @@ COVERED = (
     "transfer",
     "bench",
     "scene-stats",
+    "robots",
+    "reach",
 )
 
 
@@ -409,6 +428,8 @@ def test_no_traceback_and_nothing_outside_the_output_changes(
             ),
             label="scenes",
         )
+    elif command == "robots":
+        argv.insert(1, data.draw(st.sampled_from(["ur7", "missing.yaml", "a-file", "data"]), label="robot"))
     elif command == "plot":
         argv[1:1] = [
             data.draw(

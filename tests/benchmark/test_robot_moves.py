@@ -43,7 +43,9 @@ def _cli(*args: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run([sys.executable, "-m", "davis_ag.cli", *args], capture_output=True, text=True, check=False)
 
 
-def test_a_bigger_arm_on_a_lift_reaches_more_and_the_reach_is_cached(root: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_bigger_arm_on_a_lift_reaches_more_and_the_reach_is_cached(
+    root: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     scene = open_dataset(root).scene("Single-Vine/000")
     ur5, ur10 = (load_reach(scene, root, name) for name in ("ur5-trolley", "ur10-lift"))
     assert 0.0 < ur5.share < 1.0
@@ -129,7 +131,9 @@ def test_a_budget_of_seconds_ends_the_episode(root: Path) -> None:
 def test_a_robot_that_reaches_no_start_is_one_line_naming_what_it_reaches(root: Path, tmp_path: Path) -> None:
     text = (Path(__file__).parents[2] / "src/davis_ag/robot/robots/ur5-trolley.yaml").read_text()
     tall = tmp_path / "tall.yaml"
-    tall.write_text(text.replace("name: ur5-trolley", "name: tall").replace("mount_height_m: 0.69", "mount_height_m: 4.0"))
+    tall.write_text(
+        text.replace("name: ur5-trolley", "name: tall").replace("mount_height_m: 0.69", "mount_height_m: 4.0")
+    )
     with pytest.raises(UserError, match="reaches no eligible start .* no view at all"):
         TVMEnv(root, scenario="sp", split="all", robot=str(tall), cache_dir=tmp_path / "cache")
 
@@ -137,7 +141,21 @@ def test_a_robot_that_reaches_no_start_is_one_line_naming_what_it_reaches(root: 
 def test_evaluate_with_a_robot_records_it_and_its_seconds_and_verify_replays_it(root: Path, tmp_path: Path) -> None:
     out = tmp_path / "robot.json"
     done = _cli(
-        "evaluate", "--dataset", str(root), "--scenario", "sp", "--split", "train", "--robot", "ur10-lift", "--episodes", "20", "--sessions", "2", "--out", str(out)
+        "evaluate",
+        "--dataset",
+        str(root),
+        "--scenario",
+        "sp",
+        "--split",
+        "train",
+        "--robot",
+        "ur10-lift",
+        "--episodes",
+        "20",
+        "--sessions",
+        "2",
+        "--out",
+        str(out),
     )
     assert done.returncode == 0, done.stderr
     results = json.loads(out.read_text())
@@ -159,6 +177,18 @@ def test_evaluate_with_a_robot_records_it_and_its_seconds_and_verify_replays_it(
 
 
 def test_an_unknown_robot_is_one_line(root: Path, tmp_path: Path) -> None:
-    done = _cli("evaluate", "--dataset", str(root), "--scenario", "sp", "--split", "train", "--robot", "ur7", "--out", str(tmp_path / "r.json"))
+    done = _cli(
+        "evaluate",
+        "--dataset",
+        str(root),
+        "--scenario",
+        "sp",
+        "--split",
+        "train",
+        "--robot",
+        "ur7",
+        "--out",
+        str(tmp_path / "r.json"),
+    )
     assert done.returncode != 0 and "Traceback" not in done.stderr
     assert "ur10-lift" in done.stderr and not (tmp_path / "r.json").exists()

@@ -37,7 +37,9 @@ def test_an_unknown_robot_is_one_line_listing_the_robots() -> None:
 def test_a_yaml_robot_loads_and_its_digest_follows_its_content(tmp_path: Path) -> None:
     text = (Path(__file__).parents[2] / "src/davis_ag/robot/robots/ur5-trolley.yaml").read_text()
     mine = tmp_path / "mine.yaml"
-    mine.write_text(text.replace("name: ur5-trolley", "name: my-ur5").replace("mount_height_m: 0.69", "mount_height_m: 0.8"))
+    mine.write_text(
+        text.replace("name: ur5-trolley", "name: my-ur5").replace("mount_height_m: 0.69", "mount_height_m: 0.8")
+    )
     definition = load_robot(str(mine))
     assert definition.name == "my-ur5" and definition.mount_height_m == 0.8
     assert definition.digest != load_robot("ur5-trolley").digest

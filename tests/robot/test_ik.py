@@ -16,7 +16,10 @@ from davis_ag.robot.definitions import load_robot
 from davis_ag.robot.ik import POSITION_TOLERANCE, move_seconds, random_seeds, reach_pose, solve_pose
 from davis_ag.robot.model import build_robot, camera_rotation, view_placement
 
-ROBOTS = {name: build_robot(load_robot(name), base_lines("row", "apple-wall", (-2.0, 2.0))[1]) for name in ("ur5-trolley", "panda-trolley")}
+ROBOTS = {
+    name: build_robot(load_robot(name), base_lines("row", "apple-wall", (-2.0, 2.0))[1])
+    for name in ("ur5-trolley", "panda-trolley")
+}
 
 
 @given(yaw=st.floats(-180, 180), pitch=st.floats(-89, 89))
@@ -42,7 +45,11 @@ def test_a_pose_the_arm_takes_is_solved_again_from_another_seed(name: str, seed:
     solution = None
     # The reach's seeds: a neighbour's configuration (here q_true disturbed by 0.2 rad and 10 cm),
     # then random restarts. A redundant arm: any solution counts, not q_true.
-    nearby = np.clip(q_true + rng.normal(0.0, 0.2, q_true.shape) * np.r_[0.5, 0.5, np.ones(len(q_true) - 2)], robot.lower, robot.upper)
+    nearby = np.clip(
+        q_true + rng.normal(0.0, 0.2, q_true.shape) * np.r_[0.5, 0.5, np.ones(len(q_true) - 2)],
+        robot.lower,
+        robot.upper,
+    )
     for start in [nearby, *random_seeds(robot, 0.0, 12, rng)]:
         solution = solve_pose(robot, target, start)
         if solution is not None:
