@@ -10,9 +10,8 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pinocchio as pin
 import pytest
-
-pin = pytest.importorskip("pinocchio")
 
 from davis_ag.benchmark import TVMEnv
 from davis_ag.data.reader import open_dataset
@@ -134,7 +133,7 @@ def test_a_robot_that_reaches_no_start_is_one_line_naming_what_it_reaches(root: 
     tall.write_text(
         text.replace("name: ur5-trolley", "name: tall").replace("mount_height_m: 0.69", "mount_height_m: 4.0")
     )
-    with pytest.raises(UserError, match="reaches no eligible start .* no view at all"):
+    with pytest.raises(UserError, match=r"reaches no eligible start .* no view at all"):
         TVMEnv(root, scenario="sp", split="all", robot=str(tall), cache_dir=tmp_path / "cache")
 
 

@@ -9,8 +9,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-pytest.importorskip("pinocchio")
-
 from davis_ag.errors import UserError
 from davis_ag.robot.base_line import base_lines
 from davis_ag.robot.definitions import builtin_robots, load_robot

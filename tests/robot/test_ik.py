@@ -5,11 +5,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pinocchio as pin
 import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
-
-pin = pytest.importorskip("pinocchio")
 
 from davis_ag.robot.base_line import base_lines
 from davis_ag.robot.definitions import load_robot

@@ -5,9 +5,6 @@ from __future__ import annotations
 from types import SimpleNamespace
 
 import numpy as np
-import pytest
-
-pytest.importorskip("pinocchio")
 
 from davis_ag.robot.base_line import base_lines
 from davis_ag.robot.definitions import load_robot
