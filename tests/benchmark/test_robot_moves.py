@@ -38,6 +38,11 @@ def root(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return generate_config(tmp_path_factory, "vine", VINE)
 
 
+def _robot_yaml(name: str) -> str:
+    """A built-in robot's YAML, to write a changed copy of."""
+    return (Path(__file__).parents[2] / f"src/davis_ag/robot/robots/{name}.yaml").read_text()
+
+
 def _cli(*args: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run([sys.executable, "-m", "davis_ag.cli", *args], capture_output=True, text=True, check=False)
 
@@ -128,7 +133,7 @@ def test_a_budget_of_seconds_ends_the_episode(root: Path) -> None:
 
 
 def test_a_robot_that_reaches_no_start_is_one_line_naming_what_it_reaches(root: Path, tmp_path: Path) -> None:
-    text = (Path(__file__).parents[2] / "src/davis_ag/robot/robots/ur5-trolley.yaml").read_text()
+    text = _robot_yaml("ur5-trolley")
     tall = tmp_path / "tall.yaml"
     tall.write_text(
         text.replace("name: ur5-trolley", "name: tall").replace("mount_height_m: 0.69", "mount_height_m: 4.0")
@@ -167,7 +172,7 @@ def test_evaluate_with_a_robot_records_it_and_its_seconds_and_verify_replays_it(
     assert "sound" in verified.stdout
     # The same file replayed with another robot is not the file's: refused, nothing ranked.
     other = tmp_path / "other.yaml"
-    text = (Path(__file__).parents[2] / "src/davis_ag/robot/robots/ur10-lift.yaml").read_text()
+    text = _robot_yaml("ur10-lift")
     other.write_text(text.replace("lift_m: [0.0, 1.5]", "lift_m: [0.0, 1.0]"))
     refused = _cli("verify", str(out), "--dataset", str(root), "--robot", str(other))
     assert refused.returncode == 1

@@ -14,6 +14,9 @@ from davis_ag.robot.base_line import base_lines
 from davis_ag.robot.definitions import builtin_robots, load_robot
 from davis_ag.robot.model import build_robot
 
+#: The built-in UR5 trolley's YAML, to write changed copies of.
+UR5_YAML = (Path(__file__).parents[2] / "src/davis_ag/robot/robots/ur5-trolley.yaml").read_text()
+
 
 def test_the_three_named_robots_are_built_in_and_build() -> None:
     assert {"ur5-trolley", "ur10-lift", "panda-trolley"} <= set(builtin_robots())
@@ -33,7 +36,7 @@ def test_an_unknown_robot_is_one_line_listing_the_robots() -> None:
 
 
 def test_a_yaml_robot_loads_and_its_digest_follows_its_content(tmp_path: Path) -> None:
-    text = (Path(__file__).parents[2] / "src/davis_ag/robot/robots/ur5-trolley.yaml").read_text()
+    text = UR5_YAML
     mine = tmp_path / "mine.yaml"
     mine.write_text(
         text.replace("name: ur5-trolley", "name: my-ur5").replace("mount_height_m: 0.69", "mount_height_m: 0.8")
@@ -53,7 +56,7 @@ def test_a_yaml_robot_loads_and_its_digest_follows_its_content(tmp_path: Path) -
     ],
 )
 def test_a_broken_yaml_is_one_line(tmp_path: Path, change: tuple[str, str], message: str) -> None:
-    text = (Path(__file__).parents[2] / "src/davis_ag/robot/robots/ur5-trolley.yaml").read_text()
+    text = UR5_YAML
     broken = tmp_path / "broken.yaml"
     broken.write_text(text.replace(*change))
     with pytest.raises(UserError, match=message):
@@ -63,7 +66,7 @@ def test_a_broken_yaml_is_one_line(tmp_path: Path, change: tuple[str, str], mess
 
 def test_a_urdf_that_does_not_parse_is_one_line(tmp_path: Path) -> None:
     (tmp_path / "arm.urdf").write_text("<robot name='x'><link name='a'/><joint name='j' type='revolute'></robot>")
-    text = (Path(__file__).parents[2] / "src/davis_ag/robot/robots/ur5-trolley.yaml").read_text()
+    text = UR5_YAML
     (tmp_path / "bad.yaml").write_text(text.replace("arm: ur5", "urdf: arm.urdf"))
     with pytest.raises(UserError, match="does not load"):
         build_robot(load_robot(str(tmp_path / "bad.yaml")), base_lines("sp", None, (-1.0, 1.0))[1])

@@ -107,16 +107,13 @@ def attach_robot(
         The robot and the restricted tables.
     """
     from davis_ag.robot.definitions import load_robot
-    from davis_ag.robot.model import import_pinocchio
+    from davis_ag.robot.model import camera_in_tool
     from davis_ag.robot.reach import load_reach
 
     definition = load_robot(robot)
-    pin, _ = import_pinocchio()
-    mount = definition.camera_in_tool
-    placement = pin.SE3(pin.rpy.rpyToMatrix(*np.radians(mount.rpy_deg)), np.asarray(mount.xyz_m, dtype=float))
     reaches = [load_reach(scene, root, definition, cache_dir) for scene in scenes]
     restricted = [restrict(cache, reach) for cache, reach in zip(caches, reaches)]
-    return RobotOnGrid(definition, reaches, placement.homogeneous.tolist()), restricted
+    return RobotOnGrid(definition, reaches, camera_in_tool(definition).homogeneous.tolist()), restricted
 
 
 def no_reachable_start(robot: RobotOnGrid, scenes: list[Scene], split: str, root: Path) -> UserError:

@@ -37,7 +37,8 @@ from pathlib import Path
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
-from davis_ag.errors import UserError
+from davis_ag.errors import UserError, yaml_problem
+from davis_ag.formats.models import one_line
 
 
 class CameraMount(BaseModel):
@@ -142,15 +143,13 @@ def _parse(text: str, where: str, folder: str | None) -> RobotDefinition:
     try:
         raw = yaml.safe_load(text)
     except yaml.YAMLError as error:
-        raise UserError(f"{where} is not YAML ({str(error).splitlines()[0]}); fix the file") from error
+        raise UserError(f"{where}: {yaml_problem(error)}; fix the file") from None
     if not isinstance(raw, dict):
         raise UserError(f"{where} holds no robot (a YAML mapping of the fields in docs/robot.md)")
     try:
-        return RobotDefinition(**raw, folder=folder)
-    except (ValidationError, TypeError) as error:
-        first = error.errors()[0] if isinstance(error, ValidationError) else None
-        what = f"{'.'.join(map(str, first['loc']))}: {first['msg']}" if first else str(error)
-        raise UserError(f"{where}: {what}; see docs/robot.md for the fields") from error
+        return RobotDefinition.model_validate({**raw, "folder": folder})
+    except ValidationError as error:
+        raise UserError(f"{one_line(error, where)}; see docs/robot.md for the fields") from None
 
 
 @cache

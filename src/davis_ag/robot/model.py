@@ -66,8 +66,12 @@ def view_placement(pose: list[float] | tuple[float, ...]):
     return pin.SE3(camera_rotation(yaw, pitch), np.array([x, y, z]))
 
 
-def _rpy_placement(pin, xyz, rpy_deg):
-    return pin.SE3(pin.rpy.rpyToMatrix(*np.radians(rpy_deg)), np.asarray(xyz, dtype=float))
+def camera_in_tool(definition: RobotDefinition):
+    """The camera's placement in the tool frame (a ``pinocchio.SE3``) from the definition's
+    translation and roll-pitch-yaw."""
+    pin, _ = import_pinocchio()
+    mount = definition.camera_in_tool
+    return pin.SE3(pin.rpy.rpyToMatrix(*np.radians(mount.rpy_deg)), np.asarray(mount.xyz_m, dtype=float))
 
 
 @dataclass
@@ -214,15 +218,11 @@ def build_robot(definition: RobotDefinition, line: BaseLine, obstacles: np.ndarr
     )
     model, geometry = pin.appendModel(base, arm, base_geometry, arm_geometry, mount, pin.SE3.Identity())
     tool = model.getFrameId(definition.tool_frame)
-    camera_in_tool = _rpy_placement(pin, definition.camera_in_tool.xyz_m, definition.camera_in_tool.rpy_deg)
     tool_frame = model.frames[tool]
-    camera = model.addFrame(
-        pin.Frame("camera", tool_frame.parentJoint, tool, tool_frame.placement * camera_in_tool, pin.FrameType.OP_FRAME)
-    )
+    camera_in_joint = tool_frame.placement * camera_in_tool(definition)
+    camera = model.addFrame(pin.Frame("camera", tool_frame.parentJoint, tool, camera_in_joint, pin.FrameType.OP_FRAME))
     geometry.addGeometryObject(
-        pin.GeometryObject(
-            "camera_box", tool_frame.parentJoint, tool_frame.placement * camera_in_tool, coal.Box(*CAMERA_BOX)
-        )
+        pin.GeometryObject("camera_box", tool_frame.parentJoint, camera_in_joint, coal.Box(*CAMERA_BOX))
     )
     geometry.addGeometryObject(
         pin.GeometryObject("ground", 0, pin.SE3.Identity(), coal.Halfspace(np.array([0.0, 0.0, 1.0]), 0.0))

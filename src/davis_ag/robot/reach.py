@@ -188,15 +188,15 @@ def compute_reach(
     obstacles = trunk_points(scene)
     sides = np.array([side_of(y) for y in _nominal_y(scene, poses)])
     seed = int(meta.seed) if meta and meta.seed is not None else 0
-    robot0 = build_robot(definition, lines[1])
-    q = np.full((n, robot0.model.nq), np.nan)  # type: ignore[attr-defined]
+    robots = {side: build_robot(definition, lines[side], obstacles) for side in (-1, 1)}
+    q = np.full((n, robots[1].model.nq), np.nan)  # type: ignore[attr-defined]
     blocked = np.ones(n, dtype=np.uint8)
     done = 0
     for side_index, side in enumerate((-1, 1)):
         members = np.flatnonzero(sides == side)
         if not len(members):
             continue
-        robot = build_robot(definition, lines[side], obstacles)
+        robot = robots[side]
         rng = stream_rng(seed, REACH_STREAM, side_index)
         for i in _visit_order(members, pointers, poses[:, 0]):
             near = [int(j) for j in pointers[i] if j >= 0 and not np.isnan(q[j, 0])]
@@ -212,12 +212,11 @@ def compute_reach(
             if progress is not None:
                 progress(done, n)
     reachable = blocked == 0
-    urdf_q = np.full((n, len(robot0.locked)), np.nan)
+    urdf_q = np.full((n, len(robots[1].locked)), np.nan)
     mount = np.full((n, 4, 4), np.nan)
     seconds = np.full(pointers.shape, np.nan, dtype=np.float32)
-    movers = {side: build_robot(definition, lines[side]) for side in (-1, 1)}
     for i in np.flatnonzero(reachable).tolist():
-        mover = movers[int(sides[i])]
+        mover = robots[int(sides[i])]
         urdf_q[i] = mover.urdf_q(q[i])
         mount[i] = mover.mount(q[i])
         for j, target in enumerate(pointers[i]):
