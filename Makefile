@@ -53,6 +53,7 @@ bench: $(STAMP)
 	$(BIN)/davis-ag bench --only crops --out $(OUT)/bench-crops.json --doc docs/performance.md
 	$(BIN)/davis-ag bench --only verify --out $(OUT)/bench-verify.json --doc docs/performance.md
 	$(BIN)/davis-ag bench --only play --out $(OUT)/bench-play.json --doc docs/performance.md
+	$(BIN)/davis-ag bench --only robot --out $(OUT)/bench-robot.json --doc docs/performance.md
 
 reproduce: $(STAMP)
 	$(BIN)/davis-ag reproduce --out $(OUT)/reproduce

@@ -50,13 +50,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--only",
-        choices=("all", "continuous", "training", "crops", "verify", "play"),
+        choices=("all", "continuous", "training", "crops", "verify", "play", "robot"),
         default="all",
         help="continuous: only TVMContinuous-v0's steps/s (about a minute); training: only the "
         "learners' training steps/s (about 8 minutes); crops: only the plant-library crops' single "
         "plants and rows (grow, s/view, memory; about half an hour); verify: only how fast a results "
         "file's summaries and episodes are checked (about a minute); play: only a trained model's "
-        "episodes one at a time against in step (about a minute)",
+        "episodes one at a time against in step (about a minute); robot: the robots' reach of a row "
+        "scene and a grid step with a robot (about five minutes)",
     )
     parser.add_argument(
         "--device",
@@ -74,7 +75,7 @@ def _is_report(path: Path) -> bool:
     except (OSError, ValueError):
         return False
     return isinstance(data, dict) and bool(
-        {"machine", "continuous_env", "training", "crops", "verify", "play"} & set(data)
+        {"machine", "continuous_env", "training", "crops", "verify", "play", "robot"} & set(data)
     )
 
 
@@ -109,6 +110,7 @@ def run(args: argparse.Namespace) -> int:
         "crops": ["bench-crops"],
         "verify": ["bench-verify"],
         "play": ["bench-play"],
+        "robot": ["bench-robot"],
     }.get(args.only)
     if sections is None:  # the whole bench: the view costs, and with strawberry the rates too
         sections = ["bench", "bench-continuous", "bench-training"] if "strawberry" in args.crops else ["bench"]
@@ -120,7 +122,7 @@ def run(args: argparse.Namespace) -> int:
             f"--doc {args.doc}: not a Markdown page with <!-- {missing[0]}:start --> and <!-- {missing[0]}:end --> "
             "markers; give docs/performance.md or leave --doc out"
         )
-    if args.only in ("continuous", "training", "crops", "verify", "play"):
+    if args.only in ("continuous", "training", "crops", "verify", "play", "robot"):
         # A GPU machine's training table is always the CPU's beside the GPU's (where torch has CUDA).
         devices = ("cpu", args.device) if args.device != "cpu" else (training_devices() if gpu else ("cpu",))
         run_only(args.only, args.out, args.doc, devices, gpu, crops=args.crops)

@@ -316,12 +316,14 @@ def run_only(
     ``crops`` of them, the others' rows kept from an earlier report at ``out``; ``--only verify``:
     how fast a results file is checked, :mod:`davis_ag.workflows.bench.verify`, about a minute;
     ``--only play``: a trained model's episodes one at a time and in step,
-    :mod:`davis_ag.workflows.bench.play`, about a minute):
+    :mod:`davis_ag.workflows.bench.play`, about a minute; ``--only robot``: the robots' reach of a row
+    and the grid step with a robot, :mod:`davis_ag.workflows.bench.robot`, about five minutes):
     JSON, the doc's section (its GPU section on a ``gpu_machine``) and the line another page shows
     of it."""
     from davis_ag.scene.library_crops import LIBRARY_CROPS
     from davis_ag.workflows.bench.crops import crops_speed, crops_table, merged, write_crops
     from davis_ag.workflows.bench.play import play_speed, play_table, write_play
+    from davis_ag.workflows.bench.robot import robot_speed, robot_table, write_robot
     from davis_ag.workflows.bench.verify import verify_speed, verify_table, write_verify
 
     measurements: dict[str, tuple[str, Any, Any, Any]] = {
@@ -335,6 +337,7 @@ def run_only(
         ),
         "verify": ("verify", verify_speed, verify_table, write_verify),
         "play": ("play", play_speed, play_table, write_play),
+        "robot": ("robot", robot_speed, robot_table, write_robot),
     }
     key, measure, table_of, write = measurements[what]
     start = os.getloadavg()[0]
