@@ -215,6 +215,7 @@ def pools_for(command: str, out: str) -> tuple[list[str], dict[str, st.SearchStr
                 "--cache-dir": cache,
                 "--out": out_or_bad,
                 "--verbose": ANY,
+                "--robot": st.sampled_from(["ur7", "missing.yaml", "a-file"]),
             },
             [],
         )

@@ -196,3 +196,32 @@ def test_an_unknown_robot_is_one_line(root: Path, tmp_path: Path) -> None:
     )
     assert done.returncode != 0 and "Traceback" not in done.stderr
     assert "ur10-lift" in done.stderr and not (tmp_path / "r.json").exists()
+
+
+def test_a_learner_trains_under_a_robot_and_compare_keeps_robots_apart(root: Path, tmp_path: Path) -> None:
+    from davis_ag.benchmark.training import train_agent, training_record_path
+
+    model = train_agent(
+        root,
+        "sp",
+        total_timesteps=40,
+        n_envs=2,
+        out_path=tmp_path / "a2c.zip",
+        arch="pooled",
+        keep="last",
+        robot="ur10-lift",
+        progress=False,
+        checkpoint_every=0,
+        device="cpu",
+    )
+    record = json.loads(training_record_path(model).read_text())
+    assert record["robot"]["name"] == "ur10-lift"
+    common = ["--dataset", str(root), "--scenario", "sp", "--split", "train", "--episodes", "10", "--sessions", "1"]
+    with_robot, without = tmp_path / "robot.json", tmp_path / "free.json"
+    done = _cli("evaluate", *common, "--policy", str(model), "--robot", "ur10-lift", "--out", str(with_robot))
+    assert done.returncode == 0, done.stderr
+    rows = json.loads(with_robot.read_text())["policies"]
+    assert all(row["seconds"]["mean"] >= 0 for row in rows.values()) and len(rows) == 6  # the model and five baselines
+    assert _cli("evaluate", *common, "--policies", "Rand", "--out", str(without)).returncode == 0
+    refused = _cli("compare", str(with_robot), str(without))
+    assert refused.returncode != 0 and "robot" in refused.stderr and "Traceback" not in refused.stderr

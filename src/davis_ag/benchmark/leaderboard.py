@@ -59,6 +59,8 @@ def _identity(results: EvaluationResults) -> dict[str, object]:
         "tau": p.tau,
         "start rule": p.start_rule,
         "eligible starts": p.starts,
+        # A robot changes which moves exist: rows under different robots (or none) are not one table.
+        "robot": (p.robot["name"], p.robot["digest"]) if p.robot else None,
     }
 
 

@@ -64,6 +64,7 @@ def make_vec_tvm(
     crop: str | None = None,
     cache_dir: str | os.PathLike[str] | None = None,
     env_seeds: str = "streams",
+    robot: str | None = None,
 ) -> Any:
     """``n_envs`` TVM environments in one SB3 ``DummyVecEnv`` (each wrapped in ``Monitor``).
 
@@ -75,7 +76,7 @@ def make_vec_tvm(
         scenario: ``sp`` or ``mp``.
         n_envs: Number of environments.
         seed: The run's seed.
-        split, crop, cache_dir: As for :class:`davis_ag.benchmark.TVMEnv`.
+        split, crop, cache_dir, robot: As for :class:`davis_ag.benchmark.TVMEnv`.
         env_seeds: ``streams``: environment ``i`` is seeded with
             :func:`~davis_ag.seeds.training_env_seed` ``(seed, i)``, so runs of different seeds
             share no episode stream; ``seed+i`` (runs from before, resumed as they began):
@@ -88,6 +89,8 @@ def make_vec_tvm(
 
     opened = as_dataset(dataset)
     kwargs = {"dataset": opened, "scenario": scenario, "split": split, "crop": crop, "cache_dir": cache_dir}
+    if robot is not None:
+        kwargs["robot"] = robot
     chosen = DummyVecEnv if env_seeds == "seed+i" else StreamSeededVecEnv
     return make_vec_env(TVMEnv, n_envs=n_envs, seed=seed, env_kwargs=kwargs, vec_env_cls=chosen)
 
@@ -136,6 +139,7 @@ def train_agent(
     algo: str = "a2c",
     progress: bool = True,
     force: bool = False,
+    robot: str | None = None,
 ) -> Path:
     """Train an agent on the train split and save it; resume a killed run.
 
@@ -181,6 +185,8 @@ def train_agent(
         progress: Show progress (:class:`TrainingProgress`).
         force: Discard a checkpoint beside ``out_path`` that cannot be resumed (another run's,
             or a damaged one) instead of refusing (:func:`check_checkpoint`).
+        robot: Train with the camera on this robot (docs/robot.md): its reach and seconds, on the
+            training and the scoring environments; recorded in the settings (name and digest).
 
     Returns:
         The saved model's path.
@@ -224,6 +230,11 @@ def train_agent(
         "keep": keep,
         "env_seeds": "streams",
     }
+    if robot is not None:  # only when given: the settings of runs without one stay as they were
+        from davis_ag.robot.definitions import load_robot
+
+        definition = load_robot(robot)
+        settings["robot"] = {"name": definition.name, "digest": definition.digest}
     opened = as_dataset(dataset)
     # What it learns from: evaluation refuses to score it on any of these (a split that changed
     # since, as scenes were added), and a checkpoint of another split is not resumed.
@@ -232,7 +243,7 @@ def train_agent(
     scores: list[dict[str, Any]] = []
     if resumed is not None:  # seeded as it began (a checkpoint from before the streams: seed + i)
         settings["env_seeds"] = resumed[4]
-    env = make_vec_tvm(opened, scenario, n_envs, seed, "train", crop, cache_dir, settings["env_seeds"])
+    env = make_vec_tvm(opened, scenario, n_envs, seed, "train", crop, cache_dir, settings["env_seeds"], robot)
     if resumed is not None:
         _, earlier, points, scores, _ = resumed
         model = load_checkpoint(algorithm, model_file, env, device)
@@ -261,7 +272,7 @@ def train_agent(
     curve = LearningCurve(CURVE_EVERY, points)
     selection = None
     if keep == "best-train":
-        scoring_env = TVMEnv(opened, scenario, split="train", crop=crop, cache_dir=cache_dir)
+        scoring_env = TVMEnv(opened, scenario, split="train", crop=crop, cache_dir=cache_dir, robot=robot)
         selection = KeepBestOnTrain(
             scoring_env, final, select_every, save_model, scores, prune_at_once=not checkpoint_every
         )

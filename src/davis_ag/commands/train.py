@@ -101,6 +101,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "be resumed (another run's, or a damaged one)",
     )
     parser.add_argument("--verbose", type=int, choices=(0, 1, 2), default=1, help="SB3 verbosity (default: 1)")
+    parser.add_argument(
+        "--robot",
+        default=None,
+        metavar="ROBOT",
+        help="train with the camera on this robot (davis-ag robots lists them, or a YAML file): only the "
+        "views it reaches (docs/robot.md)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -130,6 +137,7 @@ def run(args: argparse.Namespace) -> int:
             keep=args.keep,
             algo=args.algo,
             force=args.force,
+            robot=args.robot,
         )
     print(f"saved {path}")
     return 0
