@@ -60,3 +60,15 @@ def test_the_benchmark_plays_the_row_with_mp_moves_and_tau(row_root: Path) -> No
     lengths = [row["length"]["mean"] for row in results["policies"].values()]
     assert all(0 < length <= 5 for length in lengths)
     assert results["policies"]["Oracle"]["oer_tau"]["mean"] >= results["policies"]["Rand"]["oer_tau"]["mean"]
+
+
+def test_a_row_scenes_settings_read_back_with_the_rows_camera_heights(row_root: Path) -> None:
+    """scene.json of a row holds the row's camera heights, not the crop's single-plant ones: reading it
+    back (what regrowing, views on demand and `verify SCENE` start from) must find them."""
+    from davis_ag.generate.recorded_settings import read_settings
+    from davis_ag.scene.specs import camera_altitudes
+
+    settings = read_settings(row_root / "Row-Almond/000")
+    assert settings.scenario.name == "row"
+    recorded = json.loads((row_root / "Row-Almond/000/scene.json").read_text())["grid"]["altitudes_m"]
+    assert camera_altitudes(settings.scenario, settings.crop) == recorded

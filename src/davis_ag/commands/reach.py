@@ -49,10 +49,9 @@ def run(args: argparse.Namespace) -> int:
     from davis_ag.errors import UserError
     from davis_ag.figures.reach_plots import plot_scene_reach
     from davis_ag.formats.outputs import claim_output
-    from davis_ag.robot.base_line import base_lines
     from davis_ag.robot.definitions import load_robot
     from davis_ag.robot.obstacles import trunk_points
-    from davis_ag.robot.reach import load_reach, view_poses
+    from davis_ag.robot.reach import load_reach, scene_lines, view_poses
     from davis_ag.robot.summary import reach_table
 
     definition = load_robot(args.robot)
@@ -76,8 +75,7 @@ def run(args: argparse.Namespace) -> int:
 
             reach = load_reach(scene, dataset.root, definition, args.cache_dir, progress)
             reaches.append(reach)
-            xs = view_poses(scene)[:, 0]
-            lines = base_lines(scene.scenario or "sp", scene.crop, (float(xs.min()), float(xs.max())))
+            lines, _ = scene_lines(scene, view_poses(scene))
             picture = out / f"{scene.id.replace('/', '-')}-{definition.name}.png"
             plot_scene_reach(scene, reach, tuple(line.y for line in lines.values()), picture, trunk_points(scene))
         print(f"{definition.name} ({definition.urdf_source}) on {args.dataset}")

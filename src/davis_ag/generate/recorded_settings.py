@@ -79,17 +79,19 @@ class RecordedSettings:
         )
 
 
-def _crop_with_altitudes(crop: CropSpec, altitudes: list[float]) -> tuple[CropSpec, tuple[int, ...]]:
+def _crop_with_altitudes(crop: CropSpec, altitudes: list[float], scenario: str) -> tuple[CropSpec, tuple[int, ...]]:
     """The crop whose camera altitudes hold the recorded ones (strawberry has two choices,
-    ``--strawberry-altitudes``), and the levels they are.
+    ``--strawberry-altitudes``), and the levels they are: the crop's, or in a ``row`` scene its
+    row's (:func:`davis_ag.scene.specs.camera_altitudes`).
 
     Raises:
         ValueError: when no choice holds them.
     """
     for choice in (None, *STRAWBERRY_ALTITUDES):
         candidate = crop if choice is None else with_strawberry_altitudes(crop, choice)
-        if all(a in candidate.altitudes for a in altitudes):
-            return candidate, tuple(candidate.altitudes.index(a) for a in altitudes)
+        heights = candidate.row.altitudes if scenario == "row" and candidate.row is not None else candidate.altitudes
+        if all(a in heights for a in altitudes):
+            return candidate, tuple(heights.index(a) for a in altitudes)
     raise ValueError(f"grid.altitudes_m {altitudes} are not {crop.name}'s camera altitudes {list(crop.altitudes)}")
 
 
@@ -119,7 +121,9 @@ def read_settings(scene_dir: str | Path) -> RecordedSettings:
     try:
         grid, renderer = _needed(metadata.grid, "grid"), _needed(metadata.renderer, "renderer")
         crop, levels = _crop_with_altitudes(
-            crop_spec(_needed(metadata.crop, "crop")), _needed(grid.altitudes_m, "grid.altitudes_m")
+            crop_spec(_needed(metadata.crop, "crop")),
+            _needed(grid.altitudes_m, "grid.altitudes_m"),
+            _needed(metadata.scenario, "scenario"),
         )
         scenario = scenario_spec(_needed(metadata.scenario, "scenario"), crop)
         extent_x, extent_y = _needed(grid.extent_m, "grid.extent_m")

@@ -35,7 +35,7 @@ import numpy as np
 from davis_ag.atomic_files import atomic_output
 from davis_ag.errors import UserError
 from davis_ag.formats.layout import CACHE_FOLDER
-from davis_ag.robot.base_line import base_lines, side_of
+from davis_ag.robot.base_line import BaseLine, base_lines, side_of
 from davis_ag.robot.definitions import RobotDefinition, load_robot
 from davis_ag.robot.ik import move_seconds, random_seeds, reach_pose
 from davis_ag.robot.model import LIFT, RAIL, RobotModel, build_robot, view_placement
@@ -126,6 +126,21 @@ def _nominal_y(scene: Scene, poses: np.ndarray) -> np.ndarray:
     return np.array(ys)
 
 
+def scene_lines(scene: Scene, poses: np.ndarray) -> tuple[dict[int, BaseLine], np.ndarray]:
+    """A scene's two base lines (:func:`davis_ag.robot.base_line.base_lines`) and the side
+    (``+1``/``-1``) each view is served from.
+
+    Args:
+        scene: The scene.
+        poses: Its views' poses (:func:`view_poses`).
+    """
+    meta = scene.metadata
+    scenario = (meta.scenario if meta and meta.scenario else scene.scenario) or "sp"
+    crop = (meta.crop if meta and meta.crop else scene.crop) or None
+    lines = base_lines(scenario, crop, (float(poses[:, 0].min()), float(poses[:, 0].max())))
+    return lines, np.array([side_of(y) for y in _nominal_y(scene, poses)])
+
+
 def _visit_order(members: np.ndarray, pointers: np.ndarray, xs: np.ndarray) -> list[int]:
     """Breadth-first over the move graph (both directions) from the member nearest the middle x."""
     member = np.zeros(len(pointers), dtype=bool)
@@ -182,11 +197,8 @@ def compute_reach(
     poses = view_poses(scene)
     pointers = pointer_table(scene)
     meta = scene.metadata
-    scenario = (meta.scenario if meta and meta.scenario else scene.scenario) or "sp"
-    crop = (meta.crop if meta and meta.crop else scene.crop) or None
-    lines = base_lines(scenario, crop, (float(poses[:, 0].min()), float(poses[:, 0].max())))
+    lines, sides = scene_lines(scene, poses)
     obstacles = trunk_points(scene)
-    sides = np.array([side_of(y) for y in _nominal_y(scene, poses)])
     seed = int(meta.seed) if meta and meta.seed is not None else 0
     robots = {side: build_robot(definition, lines[side], obstacles) for side in (-1, 1)}
     q = np.full((n, robots[1].model.nq), np.nan)  # type: ignore[attr-defined]
