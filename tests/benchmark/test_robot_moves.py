@@ -225,3 +225,29 @@ def test_a_learner_trains_under_a_robot_and_compare_keeps_robots_apart(root: Pat
     assert _cli("evaluate", *common, "--policies", "Rand", "--out", str(without)).returncode == 0
     refused = _cli("compare", str(with_robot), str(without))
     assert refused.returncode != 0 and "robot" in refused.stderr and "Traceback" not in refused.stderr
+
+
+def test_reach_draws_the_grid_and_the_robots_episode_and_writes_its_table(root: Path, tmp_path: Path) -> None:
+    page = tmp_path / "robot.md"
+    page.write_text("<!-- reach-ur10-lift:start -->\nold\n<!-- reach-ur10-lift:end -->\n")
+    out = tmp_path / "pictures"
+    done = _cli("reach", str(root), "--robot", "ur10-lift", "--out", str(out), "--episode", "0", "--doc", str(page))
+    assert done.returncode == 0, done.stderr
+    assert (out / "Single-Vine-000-ur10-lift.png").stat().st_size > 10_000
+    assert (out / "Single-Vine-000-ur10-lift-episode-0.png").stat().st_size > 10_000
+    assert "old" not in page.read_text() and "| Single-Vine | 0.5 |" in page.read_text()
+
+
+def test_the_robot_is_drawn_into_its_scene_and_an_unreached_view_is_refused(root: Path) -> None:
+    from davis_ag.live.robot_pictures import robot_frames
+
+    reach = load_reach(open_dataset(root).scene("Single-Vine/000"), root, "ur5-trolley")
+    reached = [n for n, ok in zip(reach.view_names, reach.reachable) if ok]
+    missed = [n for n, ok in zip(reach.view_names, reach.reachable) if not ok]
+    (frame,) = robot_frames(root / "Single-Vine/000", "ur5-trolley", reached[:1], size=(160, 90))
+    assert frame.onlooker.shape == (90, 160, 3) and frame.camera.shape == (72, 128, 3)
+    # The arm is grey-white and the platform blue: both are in the picture.
+    blue = (frame.onlooker[..., 2] > 120) & (frame.onlooker[..., 0] < 90)
+    assert blue.sum() > 20
+    with pytest.raises(UserError, match="does not reach it"):
+        robot_frames(root / "Single-Vine/000", "ur5-trolley", missed[:1], size=(160, 90))

@@ -35,11 +35,50 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--force", action="store_true", help="replace pictures already in --out")
     parser.add_argument(
+        "--episode",
+        type=arguments.whole,
+        default=None,
+        metavar="SEED",
+        help="also draw the Oracle's TVM-v0 episode of this seed under the robot as a strip: the arm at each "
+        "step, seen from the alley, above what its camera saw (reopens the scene: minutes the first time)",
+    )
+    parser.add_argument(
         "--doc",
         type=arguments.path,
         default=None,
         metavar="PAGE.md",
         help="also write the table between <!-- reach-ROBOT:start/end --> markers in this page (docs/robot.md)",
+    )
+
+
+def _episode_strip(dataset, scenario: str, robot: str, args: argparse.Namespace, out) -> object:
+    """Play the Oracle's episode ``--episode`` under the robot and draw it (figures/robot_strip.py)."""
+    from davis_ag.benchmark import TVMEnv
+    from davis_ag.benchmark.agents import build_agents
+    from davis_ag.benchmark.evaluation import run_episode
+    from davis_ag.figures.robot_strip import plot_robot_strip
+    from davis_ag.live.robot_pictures import robot_frames
+
+    env = TVMEnv(dataset, scenario, split="all", robot=robot, cache_dir=args.cache_dir)
+    played = run_episode(env, build_agents(["Oracle"])[0], args.episode)
+    _, info = env.reset(seed=args.episode)
+    steps = [(info["path"][-1], 0.0, info["oer_t"])]
+    for action in played["actions"]:
+        info = env.step(action)[4]
+        if action != env.done_action and info["path"][-1] != steps[-1][0]:
+            steps.append((info["path"][-1], info["robot"]["seconds"], info["oer_t"]))
+    scene = dataset.scene(played["scene"])
+    frames = robot_frames(scene.path, robot, [view for view, _, _ in steps], cache_dir=args.cache_dir)
+    captions = [
+        f"{'start' if k == 0 else f'step {k}, {seconds:.1f} s'}: {view}, OER {oer:.2f}"
+        for k, (view, seconds, oer) in enumerate(steps)
+    ]
+    title = (
+        f"{scene.id}: the Oracle's episode {args.episode} under {robot}, fruit {played['target_fruit']}, "
+        f"OER {played['oer_0']:.2f} -> {played['oer_tau']:.2f} in {played['seconds']:.1f} robot seconds"
+    )
+    return plot_robot_strip(
+        frames, captions, title, out / f"{scene.id.replace('/', '-')}-{robot}-episode-{args.episode}.png"
     )
 
 
@@ -86,6 +125,8 @@ def run(args: argparse.Namespace) -> int:
         total = sum(len(r.reachable) for r in reaches)
         reached = sum(int(r.reachable.sum()) for r in reaches)
         print(f"all: {reached} of {total} views ({reached / total * 100:.1f} %); pictures in {out}")
+        if args.episode is not None:
+            print(f"wrote {_episode_strip(dataset, scenes[0].scenario or 'sp', definition.name, args, out)}")
     if args.doc is not None:
         from davis_ag.atomic_files import write_marked_section
         from davis_ag.robot.reach import BLOCKED
