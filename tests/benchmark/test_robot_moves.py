@@ -43,6 +43,11 @@ def _robot_yaml(name: str) -> str:
     return (Path(__file__).parents[2] / f"src/davis_ag/robot/robots/{name}.yaml").read_text()
 
 
+def _evaluate(root: Path) -> list[str]:
+    """``evaluate`` on the vine scene's train split (its one scene)."""
+    return ["evaluate", "--dataset", str(root), "--scenario", "sp", "--split", "train"]
+
+
 def _cli(*args: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run([sys.executable, "-m", "davis_ag.cli", *args], capture_output=True, text=True, check=False)
 
@@ -144,23 +149,7 @@ def test_a_robot_that_reaches_no_start_is_one_line_naming_what_it_reaches(root: 
 
 def test_evaluate_with_a_robot_records_it_and_its_seconds_and_verify_replays_it(root: Path, tmp_path: Path) -> None:
     out = tmp_path / "robot.json"
-    done = _cli(
-        "evaluate",
-        "--dataset",
-        str(root),
-        "--scenario",
-        "sp",
-        "--split",
-        "train",
-        "--robot",
-        "ur10-lift",
-        "--episodes",
-        "20",
-        "--sessions",
-        "2",
-        "--out",
-        str(out),
-    )
+    done = _cli(*_evaluate(root), "--robot", "ur10-lift", "--episodes", "20", "--sessions", "2", "--out", str(out))
     assert done.returncode == 0, done.stderr
     results = json.loads(out.read_text())
     assert results["protocol"]["robot"]["name"] == "ur10-lift"
@@ -181,19 +170,7 @@ def test_evaluate_with_a_robot_records_it_and_its_seconds_and_verify_replays_it(
 
 
 def test_an_unknown_robot_is_one_line(root: Path, tmp_path: Path) -> None:
-    done = _cli(
-        "evaluate",
-        "--dataset",
-        str(root),
-        "--scenario",
-        "sp",
-        "--split",
-        "train",
-        "--robot",
-        "ur7",
-        "--out",
-        str(tmp_path / "r.json"),
-    )
+    done = _cli(*_evaluate(root), "--robot", "ur7", "--out", str(tmp_path / "r.json"))
     assert done.returncode != 0 and "Traceback" not in done.stderr
     assert "ur10-lift" in done.stderr and not (tmp_path / "r.json").exists()
 
@@ -216,7 +193,7 @@ def test_a_learner_trains_under_a_robot_and_compare_keeps_robots_apart(root: Pat
     )
     record = json.loads(training_record_path(model).read_text())
     assert record["robot"]["name"] == "ur10-lift"
-    common = ["--dataset", str(root), "--scenario", "sp", "--split", "train", "--episodes", "10", "--sessions", "1"]
+    common = [*_evaluate(root)[1:], "--episodes", "10", "--sessions", "1"]
     with_robot, without = tmp_path / "robot.json", tmp_path / "free.json"
     done = _cli("evaluate", *common, "--policy", str(model), "--robot", "ur10-lift", "--out", str(with_robot))
     assert done.returncode == 0, done.stderr
