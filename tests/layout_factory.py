@@ -107,7 +107,7 @@ def _grow(sc: ScenarioSpec, cr: CropSpec, rng: np.random.Generator) -> tuple[lis
     plants, fruits, leaves = [], [], []
     for p, (px, py) in enumerate(config.plant_positions(sc, cr)):
         height = cr.plant_height * rng.uniform(0.9, 1.1)
-        plants.append({"id": p, "position": [px, py, 0.0], "height": round(height, 4)})
+        plants.append({"id": p, "index": p, "position": [px, py, 0.0], "height": round(height, 4)})
         for _ in range(_FRUITS_PER_PLANT[sc.name]):
             angle, reach = rng.uniform(0, 2 * math.pi), rng.uniform(0.03, 0.12)
             centre = [px + reach * math.cos(angle), py + reach * math.sin(angle), height * rng.uniform(0.25, 0.75)]
@@ -215,7 +215,7 @@ def write_tiny_scene(
     camera = _Camera(width, height, width / 2 / math.tan(math.radians(TINY_HFOV_DEG) / 2))
     images = scene_dir / "images"
     images.mkdir(parents=True, exist_ok=True)
-    annotations, visible_fraction = {}, {}
+    annotations, visible_fraction, places = {}, {}, {}
     for view in grid.viewpoints:
         rgb, owner, visible = _render(camera, view, cr.name, fruits, leaves)
         boxes, mask = _boxes_and_mask(owner)
@@ -228,6 +228,7 @@ def write_tiny_scene(
             **published_pointers(grid, view.index),
         }
         visible_fraction[name] = {str(k): v for k, v in sorted(visible.items())}
+        places[name] = {"grid": [view.ix, view.iy, view.level, view.heading], "nominal": list(view.nominal)}
     (scene_dir / "annotations.json").write_text(json.dumps(annotations, indent=1))
     metadata = {
         "seed": seed,
@@ -241,11 +242,16 @@ def write_tiny_scene(
             "headings": sc.headings,
             "altitudes": [cr.altitudes[i] for i in sc.altitude_levels],
             "exclusion_radius": cr.exclusion_radius,
+            # Our writer's names for the same (scene.json's GridRecord).
+            "extent_m": list(sc.extent),
+            "step_m": sc.step,
+            "altitudes_m": [cr.altitudes[i] for i in sc.altitude_levels],
         },
         "min_fruit_pixels": TINY_MIN_FRUIT_PIXELS,
         "plants": plants,
         "fruits": fruits,
         "leaves": leaves,
+        "views": places,
         "visible_fraction": visible_fraction,
     }
     (scene_dir / "scene.json").write_text(json.dumps(metadata, indent=1))

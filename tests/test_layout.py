@@ -33,6 +33,7 @@ STAGES: tuple[tuple[str, ...], ...] = (
     ("data",),
     ("robot",),  # real arms on a base: reads generated scenes, restricts the benchmark's moves
     ("benchmark",),
+    ("mapping",),  # row mapping: the benchmark's tables read as a coverage task
     ("live",),  # regrows and renders: after the benchmark, which knows nothing of Helios
     ("detection",),
     ("figures",),
@@ -41,7 +42,7 @@ STAGES: tuple[tuple[str, ...], ...] = (
 )
 RANK = {name: rank for rank, names in enumerate(STAGES) for name in names}
 #: Stages that must import without Helios or a renderer: they are pure geometry and reading.
-NO_HELIOS_AT_IMPORT = ("scene", "formats", "data", "robot", "benchmark", "detection")
+NO_HELIOS_AT_IMPORT = ("scene", "formats", "data", "robot", "benchmark", "mapping", "detection")
 
 
 def module_name(path: Path) -> str:
@@ -256,4 +257,7 @@ def test_the_environments_are_made_by_name_after_importing_gymnasium_then_davis_
         check=True,
         env={"PYTHONPATH": str(PACKAGE.parent), "PATH": "/usr/bin:/bin"},
     ).stdout.strip()
-    assert out == "['davis_ag.benchmark.tvm:TVMEnv', 'davis_ag.live.tvm_continuous:TVMContinuousEnv'] False"
+    assert (
+        out
+        == "['davis_ag.benchmark.tvm:TVMEnv', 'davis_ag.live.tvm_continuous:TVMContinuousEnv', 'davis_ag.mapping.env:RowMappingEnv'] False"
+    )

@@ -22,10 +22,13 @@ from typing import Any
 TVM_ID = "davis_ag/TVM-v0"
 #: The continuous-pose environment (:class:`davis_ag.live.tvm_continuous.TVMContinuousEnv`).
 CONTINUOUS_ID = "davis_ag/TVMContinuous-v0"
+#: Row mapping (:class:`davis_ag.mapping.env.RowMappingEnv`).
+MAPPING_ID = "davis_ag/RowMapping-v0"
 #: Every environment id and its class, as Gymnasium's ``"module:Class"`` entry point.
 ENTRY_POINTS: dict[str, str] = {
     TVM_ID: "davis_ag.benchmark.tvm:TVMEnv",
     CONTINUOUS_ID: "davis_ag.live.tvm_continuous:TVMContinuousEnv",
+    MAPPING_ID: "davis_ag.mapping.env:RowMappingEnv",
 }
 
 

@@ -29,9 +29,15 @@ import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
-from davis_ag.benchmark.results import PROTOCOL_VERSION, EvaluationResults, dataset_identity, scene_identity
+from davis_ag.benchmark.results import (
+    PROTOCOL_VERSION,
+    DatasetIdentity,
+    EvaluationResults,
+    dataset_identity,
+    scene_identity,
+)
 from davis_ag.errors import UserError
 
 #: How far a replayed number may be from the stored one (the tables hold float32; JSON keeps
@@ -140,7 +146,13 @@ def check_replayable(results: EvaluationResults, where: str, environment: str) -
         raise UserError(f"{where}: {missing[0]} kept no episodes to replay: evaluate it again keeping them")
 
 
-def dataset_difference(results: EvaluationResults, root: str | os.PathLike[str]) -> Difference | None:
+class Identified(Protocol):
+    """Any results file that records the dataset it evaluated (TVM's, row mapping's)."""
+
+    dataset: DatasetIdentity | None
+
+
+def dataset_difference(results: Identified, root: str | os.PathLike[str]) -> Difference | None:
     """Whether ``root`` is the dataset the file evaluated: None, or the first scene that differs."""
     from davis_ag.benchmark.tvm import as_dataset
 

@@ -9,6 +9,7 @@ from davis_ag.commands import arguments
 
 HELP = "rank methods of several results files (a leaderboard with paired gaps)"
 DESCRIPTION = (
+    "Row-mapping results (davis-ag evaluate --task mapping) are ranked by coverage instead. "
     "Rank every method of the given results files (written by davis-ag evaluate) by OER_tau, with reward, "
     "episode length and the paired gaps to the Best fixed action and Rand (95 % bootstrap intervals "
     "where the episodes are the same), and say what the numbers rest on (scenes, eligible starts, "
@@ -46,7 +47,6 @@ def run(args: argparse.Namespace) -> int:
     from contextlib import nullcontext
 
     from davis_ag.atomic_files import write_text_atomic
-    from davis_ag.benchmark.leaderboard import format_leaderboard, leaderboard
     from davis_ag.formats.outputs import claim_output
 
     reads = [(path, "RESULTS") for path in args.results]
@@ -57,8 +57,23 @@ def run(args: argparse.Namespace) -> int:
             if verify_results(args.results, args.verify) != 0:
                 print("not ranked: a file above is not sound on the dataset", flush=True)
                 return 1
-        page = format_leaderboard(leaderboard(args.results))
+        page = _page(args.results)
         print(page, end="")
         if args.out:
             print(f"wrote {write_text_atomic(args.out, page)}")
     return 0
+
+
+def _page(paths: list) -> str:
+    """The leaderboard of the files: row mapping's when they hold mapping results, else Table 4's."""
+    from davis_ag.benchmark.leaderboard import format_leaderboard, leaderboard
+    from davis_ag.errors import UserError
+    from davis_ag.mapping.leaderboard import mapping_leaderboard
+    from davis_ag.mapping.results import is_mapping_results
+
+    kinds = {is_mapping_results(path) for path in paths}
+    if kinds == {True}:
+        return mapping_leaderboard(paths)
+    if len(kinds) > 1:
+        raise UserError("the files mix row-mapping and target-visibility results: compare each task's files apart")
+    return format_leaderboard(leaderboard(paths))

@@ -22,13 +22,18 @@ DESCRIPTION = (
     "or module:attr / path/to/file.py:attr naming a function (observation, info) -> action or a "
     "class with reset(seed) and act(observation, info). On the grid the row 'Best fixed action' "
     "(the best policy that always plays one action) is added, and the image-blind policies get their "
-    "exact expectations beside the sampled means."
+    "exact expectations beside the sampled means. "
+    "--task mapping scores row mapping instead (RowMapping-v0, docs/mapping.md): every fruit of the row "
+    "segment to see within a budget of moves, beside the Sweep, Rand and Greedy baselines and the "
+    "budget's coverage bound; the chart is then the coverage curves."
 )
 
 #: Baselines --policies accepts on the grid.
 POLICIES = ("LRD", "UDD", "Rand", "Oracle")
 #: Baselines --policies accepts with --env continuous.
 CONTINUOUS_POLICIES = ("LR", "UD", "Rand", "Greedy")
+#: Baselines --policies accepts with --task mapping.
+MAPPING_POLICIES = ("Sweep", "Rand", "Greedy")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -68,10 +73,39 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "from regrown scenes (TVMContinuous-v0; scenes made by davis-ag generate)",
     )
     parser.add_argument(
-        "--policies",
-        type=arguments.name_list(tuple(dict.fromkeys(POLICIES + CONTINUOUS_POLICIES))),
+        "--task",
+        default="tvm",
+        choices=["tvm", "mapping"],
+        help="tvm: target visibility maximisation (Table 4, default); mapping: see every fruit of a row "
+        "segment within a budget (RowMapping-v0, the grid only)",
+    )
+    parser.add_argument(
+        "--budget",
+        type=arguments.bounded(1, 10**5),
         default=None,
-        help="comma-separated baselines (grid default: LRD,UDD,Rand,Oracle; continuous: LR,UD,Rand,Greedy)",
+        metavar="MOVES",
+        help="--task mapping: moves per episode (default: the fixed sweep's, driving the row once at each height)",
+    )
+    parser.add_argument(
+        "--seen-fraction",
+        type=float,
+        default=None,
+        metavar="F",
+        help="--task mapping: the visible fraction at which a fruit counts as seen (default 0.5)",
+    )
+    parser.add_argument(
+        "--budget-s",
+        type=float,
+        default=None,
+        metavar="SECONDS",
+        help="--task mapping with --robot: also end an episode when the robot's seconds are spent",
+    )
+    parser.add_argument(
+        "--policies",
+        type=arguments.name_list(tuple(dict.fromkeys(POLICIES + CONTINUOUS_POLICIES + MAPPING_POLICIES))),
+        default=None,
+        help="comma-separated baselines (grid default: LRD,UDD,Rand,Oracle; continuous: LR,UD,Rand,Greedy; "
+        "--task mapping: Sweep,Rand,Greedy)",
     )
     parser.add_argument(
         "--deterministic",
@@ -124,13 +158,17 @@ class _NamePolicy(argparse.Action):
 
 def run(args: argparse.Namespace) -> int:
     """Evaluate, print the table, write JSON and PNG."""
-    allowed = CONTINUOUS_POLICIES if args.env == "continuous" else POLICIES
+    mapping = args.task == "mapping"
+    if mapping and args.env != "grid":
+        raise UserError("--task mapping plays the grid (RowMapping-v0): leave out --env continuous")
+    if not mapping and (args.budget, args.seen_fraction, args.budget_s) != (None, None, None):
+        raise UserError("--budget, --seen-fraction and --budget-s are for --task mapping: add it or leave them out")
+    allowed = MAPPING_POLICIES if mapping else CONTINUOUS_POLICIES if args.env == "continuous" else POLICIES
     names = list(args.policies or allowed)
     wrong = [n for n in names if n not in allowed]
     if wrong:
-        raise UserError(
-            f"--policies {wrong[0]} is not a baseline of --env {args.env}: choose from {', '.join(allowed)}"
-        )
+        where = "--task mapping" if mapping else f"--env {args.env}"
+        raise UserError(f"--policies {wrong[0]} is not a baseline of {where}: choose from {', '.join(allowed)}")
     specs = args.policy or []
     out = arguments.prove_writable_file(args.out)
     plot = arguments.prove_writable_file(args.plot or out.with_suffix(".png"), "--plot")
@@ -140,6 +178,8 @@ def run(args: argparse.Namespace) -> int:
     # A policy's file (a model, a module) is an input: never replaced by the results or the chart.
     reads = [(path, "--policy") for spec in specs for path in _spec_files(spec)]
     with claim_output(out, force=args.force, also=[(plot, "--plot")], reads=reads):  # the output rule
+        if mapping:
+            return _evaluate_mapping(args, names, specs, out, plot)
         return _evaluate(args, names, specs, out, plot)
 
 
@@ -179,6 +219,47 @@ def _evaluate(args: argparse.Namespace, names: list[str], specs: list[str], out:
     write_or_rescue(out, lambda path: write_json(results, path), "the results")
     try:
         plot_results(results, plot)
+    except OSError as error:
+        raise MachineError(
+            f"the results are in {out}, but the chart could not be written to {plot} "
+            f"({error.strerror or error}): run again with another --plot"
+        ) from None
+    print(f"wrote {out} and {plot}")
+    return 0
+
+
+def _evaluate_mapping(args: argparse.Namespace, names: list[str], specs: list[str], out: Path, plot: Path) -> int:
+    """``--task mapping``: score the baselines ``names`` and the specs on row mapping."""
+    from davis_ag.benchmark.policies import policy_from_spec
+    from davis_ag.figures.mapping_plots import plot_coverage_curves
+    from davis_ag.mapping.coverage import SEEN_FRACTION
+    from davis_ag.mapping.evaluation import evaluate_mapping
+    from davis_ag.mapping.results import mapping_table
+
+    policies = [
+        policy_from_spec(spec, name, deterministic=args.deterministic)
+        for spec, name in zip(specs, getattr(args, "policy_names", None) or [None] * len(specs), strict=True)
+    ]
+    results = evaluate_mapping(
+        policies,
+        args.dataset,
+        scenario=args.scenario,
+        split=args.split,
+        sessions=args.sessions,
+        episodes=args.episodes,
+        seed=args.seed,
+        crop=args.crop,
+        baselines=names,
+        cache_dir=args.cache_dir,
+        budget=args.budget,
+        seen_fraction=SEEN_FRACTION if args.seen_fraction is None else args.seen_fraction,
+        robot=args.robot,
+        budget_s=args.budget_s,
+    )
+    print(mapping_table(results))
+    write_or_rescue(out, results.write, "the results")
+    try:
+        plot_coverage_curves(results, plot)
     except OSError as error:
         raise MachineError(
             f"the results are in {out}, but the chart could not be written to {plot} "

@@ -97,9 +97,18 @@ def verify_results(paths: list[Path], dataset: Path, cache_dir: Path | None = No
     """
     from davis_ag.benchmark.replay import replay_grid
     from davis_ag.benchmark.results import load_results
+    from davis_ag.mapping.results import is_mapping_results
 
     reports = []
     for path in paths:
+        if is_mapping_results(path):
+            from davis_ag.mapping.evaluation import replay_mapping
+            from davis_ag.mapping.results import load_mapping_results
+
+            report = replay_mapping(load_mapping_results(path), dataset, str(path), cache_dir, robot)
+            print(report.text(), flush=True)
+            reports.append(report)
+            continue
         results = load_results(path)  # every summary made again from the episodes first
         if results.protocol.environment == "davis_ag/TVMContinuous-v0":
             from davis_ag.live.replay import replay_continuous

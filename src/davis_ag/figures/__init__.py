@@ -1,1 +1,1 @@
-"""Stage 12, pictures: contact sheets, plots and the HTML report of a dataset and its benchmark."""
+"""Stage 13, pictures: contact sheets, plots and the HTML report of a dataset and its benchmark."""

@@ -1,4 +1,4 @@
-"""Stage 10, views on demand: a generated scene reopened live, drawn from any pose, and the continuous-pose
+"""Stage 11, views on demand: a generated scene reopened live, drawn from any pose, and the continuous-pose
 visibility environment (``davis_ag/TVMContinuous-v0``) built on it.
 
 This stage comes after ``benchmark``: it regrows plants and renders (so it needs ``generate``,

@@ -1,0 +1,306 @@
+"""Score policies on row mapping, and replay a mapping results file on its dataset.
+
+The protocol is TVM-v0's (:mod:`davis_ag.benchmark.evaluation`): ``sessions`` sessions of
+``episodes`` episodes, episode ``e`` of session ``s`` reset with ``SeedSequence([seed, s])``'s
+``e``-th state and the policy's own randomness with ``SeedSequence([seed, s, 1])``'s, so every
+policy maps from the same starts. Beside the policies the results hold each scene's segment: its
+fruit, the grid's ceiling, and per part of the move graph (an alley) its ceiling and the budget's
+coverage bound (:mod:`davis_ag.mapping.bound`).
+
+The replay (``davis-ag verify``) checks the dataset's identity, builds the environment with the
+file's protocol, resets each episode with its seed (scene, start and start part must agree), steps
+the recorded actions and requires the same path and the same fruit first seen at every step;
+the segments' ceilings and bounds are computed again.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from davis_ag.benchmark.code_digest import code_digest
+from davis_ag.benchmark.evaluation import episode_seeds
+from davis_ag.benchmark.policies import Policy, as_policy, policy_from_spec, prepare
+from davis_ag.benchmark.replay import Difference, DifferenceFound, ReplayReport, dataset_difference, expect
+from davis_ag.benchmark.results import identify_dataset
+from davis_ag.errors import UserError
+from davis_ag.mapping.baselines import BASELINES, build_baselines
+from davis_ag.mapping.bound import best_views
+from davis_ag.mapping.coverage import SEEN_FRACTION
+from davis_ag.mapping.env import RowMappingEnv
+from davis_ag.mapping.results import (
+    MAPPING_PROTOCOL_VERSION,
+    MappingEpisode,
+    MappingPolicyResult,
+    MappingProtocol,
+    MappingResults,
+    PartBound,
+    SceneSegment,
+    summarise,
+)
+from davis_ag.provenance import code_version
+
+
+def scene_segments(env: RowMappingEnv) -> dict[str, SceneSegment]:
+    """Each scene's segment: fruit, the grid's ceiling, and each start part's ceiling and bound."""
+    segments = {}
+    for scene, coverage, starts in zip(env.scenes, env.coverage, env.start_views):
+        parts = []
+        for index in np.unique(coverage.part[starts]):
+            views = coverage.part_views(int(index))
+            bound = best_views(coverage.seen[views], env.budget + 1)
+            ceiling = int(coverage.seen[views].any(axis=0).sum())
+            parts.append(
+                PartBound(index=int(index), views=len(views), ceiling=ceiling, bound=bound.fruit, exact=bound.exact)
+            )
+        segments[scene.id] = SceneSegment(
+            fruit=coverage.fruit, ceiling=int(coverage.seen.any(axis=0).sum()), parts=parts
+        )
+    return segments
+
+
+def _start_record(env: RowMappingEnv, session: int, info: dict[str, Any]) -> dict[str, Any]:
+    coverage = env.coverage[env.scene_index]
+    part = int(coverage.part[env.current_view])
+    return {
+        "session": session,
+        "scene": info["scene"],
+        "fruit": coverage.fruit,
+        "part": part,
+        "part_ceiling": int(coverage.seen[coverage.part_views(part)].any(axis=0).sum()),
+        "seen_0": len(info["seen"]),
+    }
+
+
+def play_episode(env: Any, policy: Policy, reset_seed: int, policy_seed: int, session: int) -> MappingEpisode:
+    """Play one episode; the policy was prepared for ``env`` before.
+
+    Raises:
+        UserError: when the policy fails or answers with something that is not a move.
+    """
+    inner: RowMappingEnv = env.unwrapped
+    obs, info = env.reset(seed=reset_seed)
+    policy.reset(policy_seed)
+    start = _start_record(inner, session, info)
+    gains: list[int] = []
+    actions: list[int] = []
+    while True:
+        try:
+            action = policy.act(obs, info)
+            if isinstance(action, str):
+                action = inner.action_for(action)
+            obs, _, terminated, truncated, info = env.step(action)
+        except UserError as error:
+            raise UserError(f"policy {policy.name}: {error}") from None
+        except Exception as error:  # a user's policy: one line, not a traceback
+            raise UserError(f"policy {policy.name} failed: {type(error).__name__}: {error}") from None
+        actions.append(int(np.asarray(action).reshape(())))
+        gains.append(int(info["new"]))
+        if terminated or truncated:
+            break
+    seconds = float(info["robot"]["seconds_total"]) if "robot" in info else None
+    return MappingEpisode(**start, gains=gains, path=list(info["path"]), actions=actions, seconds=seconds)
+
+
+def evaluate_mapping_policies(
+    env: Any, policies: Sequence[Policy], episodes: int = 200, sessions: int = 3, seed: int = 0
+) -> MappingResults:
+    """Run every policy on the same starts and summarise (see the module docstring).
+
+    Raises:
+        UserError: for two policies of one name, or a policy that does not fit the environment.
+    """
+    inner: RowMappingEnv = env.unwrapped
+    names = [p.name for p in policies]
+    if len(set(names)) != len(names):
+        twice = next(n for n in names if names.count(n) > 1)
+        raise UserError(f"two policies are named {twice!r}: give one another name (--name)")
+    for policy in policies:
+        prepare(policy, env)
+    protocol = MappingProtocol(
+        version=MAPPING_PROTOCOL_VERSION, episodes=episodes, sessions=sessions, seed=seed, **inner.describe()
+    )
+    segments = scene_segments(inner)
+    rows = {}
+    for policy in policies:
+        played = []
+        for session in range(sessions):
+            resets, draws = episode_seeds(seed, session, episodes)
+            played += [play_episode(env, policy, r, d, session) for r, d in zip(resets, draws)]
+        row = summarise(played, inner.budget, sessions, segments)
+        row.update(source=getattr(policy, "source", None), digest=code_digest(policy), episodes=played)
+        rows[policy.name] = MappingPolicyResult.model_validate(row)
+    return MappingResults(
+        protocol=protocol,
+        dataset=identify_dataset(protocol.dataset),
+        code=code_version(),
+        segments=segments,
+        policies=rows,
+    )
+
+
+def evaluate_mapping(
+    policies: Sequence[Any],
+    dataset: Any,
+    scenario: str = "row",
+    split: str = "test",
+    sessions: int = 3,
+    episodes: int = 200,
+    seed: int = 0,
+    *,
+    crop: str | None = None,
+    baselines: bool | list[str] = True,
+    deterministic: bool | None = None,
+    cache_dir: str | os.PathLike[str] | None = None,
+    budget: int | None = None,
+    seen_fraction: float = SEEN_FRACTION,
+    robot: str | None = None,
+    budget_s: float | None = None,
+) -> MappingResults:
+    """Score policies beside the mapping baselines (``davis-ag evaluate --task mapping``).
+
+    Args:
+        policies: Policies, callables or SPEC strings (as :func:`davis_ag.benchmark.evaluate` takes them).
+        dataset: A dataset root or an opened dataset.
+        scenario: ``row`` (default) or ``mp``.
+        split, sessions, episodes, seed: The protocol.
+        crop: Keep one crop.
+        baselines: True: Sweep, Rand and Greedy; False: none; or a list of names.
+        deterministic: How SPEC models play (default: the benchmark's).
+        cache_dir: The observation cache folder.
+        budget: Moves per episode (default: the sweep's length).
+        seen_fraction: The visible fraction a sighting needs.
+        robot: A robot (name or YAML) the camera rides on.
+        budget_s: With a robot, the seconds an episode may spend.
+
+    Returns:
+        The results, exactly what ``--out`` writes.
+    """
+    import gymnasium as gym
+
+    from davis_ag.benchmark.policies import DETERMINISTIC_PLAY
+    from davis_ag.environments import MAPPING_ID
+
+    play = DETERMINISTIC_PLAY if deterministic is None else deterministic
+    chosen = [
+        policy_from_spec(p, deterministic=play) if isinstance(p, (str, os.PathLike)) else as_policy(p) for p in policies
+    ]
+    if baselines:
+        chosen += build_baselines(list(BASELINES) if baselines is True else list(baselines))
+    made = gym.make(
+        MAPPING_ID,
+        disable_env_checker=True,
+        dataset=dataset,
+        scenario=scenario,
+        split=split,
+        crop=crop,
+        cache_dir=cache_dir,
+        budget=budget,
+        seen_fraction=seen_fraction,
+        robot=robot,
+        budget_s=budget_s,
+    )
+    try:
+        results = evaluate_mapping_policies(made, chosen, episodes=episodes, sessions=sessions, seed=seed)
+    finally:
+        made.close()
+    results.protocol.crop = crop
+    return results
+
+
+def replay_mapping(
+    results: MappingResults,
+    root: str | os.PathLike[str],
+    where: str,
+    cache_dir: str | os.PathLike[str] | None = None,
+    robot: str | None = None,
+) -> ReplayReport:
+    """Replay a mapping results file on the dataset at ``root`` (see the module docstring).
+
+    Args:
+        results: The results, summaries checked already (:func:`davis_ag.mapping.results.load_mapping_results`).
+        root: The dataset folder.
+        where: The file's name, for messages.
+        cache_dir: The observation cache folder.
+        robot: The YAML of the file's robot where it is not built in.
+
+    Raises:
+        UserError: for a file of another protocol version or without its dataset's identity.
+    """
+    protocol = results.protocol
+    if protocol.version != MAPPING_PROTOCOL_VERSION:
+        raise UserError(
+            f"{where}: mapping protocol version {protocol.version}, this davis-ag plays {MAPPING_PROTOCOL_VERSION}: evaluate again"
+        )
+    if results.dataset is None:
+        raise UserError(f"{where}: records no dataset identity to check: evaluate again with this davis-ag")
+    began = time.perf_counter()
+    played = 0
+    try:
+        found = dataset_difference(results, root)
+        if found is not None:
+            raise DifferenceFound(found)
+        if protocol.robot is not None:
+            robot = robot or protocol.robot["name"]
+        env = RowMappingEnv(
+            root,
+            scenario=protocol.scenario,
+            split=protocol.split,
+            crop=protocol.crop,
+            cache_dir=cache_dir,
+            budget=protocol.budget,
+            seen_fraction=protocol.seen_fraction,
+            robot=robot,
+            budget_s=protocol.budget_s,
+        )
+        described = env.describe()
+        for field in ("scenes", "actions", "robot"):
+            expect(getattr(protocol, field), described[field], "", f"protocol {field}")
+        fresh = scene_segments(env)
+        for scene, segment in results.segments.items():
+            expect(
+                segment.model_dump(), fresh[scene].model_dump() if scene in fresh else None, "", f"segment of {scene}"
+            )
+        for name, row in results.policies.items():
+            for session in range(protocol.sessions):
+                resets, _ = episode_seeds(protocol.seed, session, protocol.episodes)
+                stored = [e for e in row.episodes if e.session == session]
+                expect(len(stored), len(resets), name, f"session {session}'s episodes")
+                for index, (episode, reset) in enumerate(zip(stored, resets)):
+                    _replay_episode(env, name, episode, reset, session, index)
+                    played += 1
+    except DifferenceFound as error:
+        return ReplayReport(where, played, len(results.policies), time.perf_counter() - began, error.difference)
+    return ReplayReport(where, played, len(results.policies), time.perf_counter() - began)
+
+
+def _replay_episode(
+    env: RowMappingEnv, name: str, stored: MappingEpisode, reset: int, session: int, index: int
+) -> None:
+    def check(field: str, value: Any) -> None:
+        expect(getattr(stored, field), value, name, field, session, index)
+
+    _, info = env.reset(seed=reset)
+    start = _start_record(env, session, info)
+    for field in ("scene", "fruit", "part", "part_ceiling", "seen_0"):
+        check(field, start[field])
+    gains = []
+    terminated = False
+    for step, action in enumerate(stored.actions):
+        if terminated:
+            raise DifferenceFound(Difference(name, "actions", len(stored.actions), step, session, index))
+        try:
+            _, _, terminated, _, info = env.step(action)
+        except UserError as error:
+            raise DifferenceFound(Difference(name, f"action {step}", action, str(error), session, index)) from None
+        gains.append(int(info["new"]))
+    check("gains", gains)
+    check("path", list(info["path"]))
+    if not terminated:
+        raise DifferenceFound(Difference(name, "length", len(stored.actions), "more moves", session, index))
+    if stored.seconds is not None or "robot" in info:
+        check("seconds", float(info["robot"]["seconds_total"]) if "robot" in info else None)
