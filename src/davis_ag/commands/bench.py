@@ -16,6 +16,8 @@ DESCRIPTION = __doc__
 CROP_NAMES = ("strawberry", "tomato", "vine")
 #: The plant-library crops ``--only crops`` measures.
 LIBRARY_NAMES = tuple(name for name, crop in CROPS.items() if crop.source == "library")
+#: The measurements ``--only`` runs alone, each written between its ``bench-NAME`` markers.
+MEASUREMENTS = ("continuous", "training", "crops", "verify", "play", "robot", "mapping")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -50,14 +52,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--only",
-        choices=("all", "continuous", "training", "crops", "verify", "play", "robot"),
+        choices=("all", *MEASUREMENTS),
         default="all",
         help="continuous: only TVMContinuous-v0's steps/s (about a minute); training: only the "
         "learners' training steps/s (about 8 minutes); crops: only the plant-library crops' single "
         "plants and rows (grow, s/view, memory; about half an hour); verify: only how fast a results "
         "file's summaries and episodes are checked (about a minute); play: only a trained model's "
         "episodes one at a time against in step (about a minute); robot: the robots' reach of a row "
-        "scene and a grid step with a robot (about five minutes)",
+        "scene and a grid step with a robot (about five minutes); mapping: a row-mapping step beside "
+        "TVM-v0's, the segment's ceiling and the budget's bound (about five minutes)",
     )
     parser.add_argument(
         "--device",
@@ -74,9 +77,7 @@ def _is_report(path: Path) -> bool:
         data = json.loads(path.read_text())
     except (OSError, ValueError):
         return False
-    return isinstance(data, dict) and bool(
-        {"machine", "continuous_env", "training", "crops", "verify", "play", "robot"} & set(data)
-    )
+    return isinstance(data, dict) and bool({"machine", "continuous_env", *MEASUREMENTS} & set(data))
 
 
 def run(args: argparse.Namespace) -> int:
@@ -104,14 +105,7 @@ def run(args: argparse.Namespace) -> int:
         raise UserError(f"--device {args.device} is for --only training: add --only training, or leave --device out")
     # A GPU machine's numbers go to the page's GPU sections, beside the 2-core machine's.
     gpu = args.doc is not None and is_gpu_machine()
-    sections = {
-        "continuous": ["bench-continuous"],
-        "training": ["bench-training"],
-        "crops": ["bench-crops"],
-        "verify": ["bench-verify"],
-        "play": ["bench-play"],
-        "robot": ["bench-robot"],
-    }.get(args.only)
+    sections = [f"bench-{args.only}"] if args.only in MEASUREMENTS else None
     if sections is None:  # the whole bench: the view costs, and with strawberry the rates too
         sections = ["bench", "bench-continuous", "bench-training"] if "strawberry" in args.crops else ["bench"]
     markers = [doc_section(name, gpu) for name in sections]
@@ -122,7 +116,7 @@ def run(args: argparse.Namespace) -> int:
             f"--doc {args.doc}: not a Markdown page with <!-- {missing[0]}:start --> and <!-- {missing[0]}:end --> "
             "markers; give docs/performance.md or leave --doc out"
         )
-    if args.only in ("continuous", "training", "crops", "verify", "play", "robot"):
+    if args.only in MEASUREMENTS:
         # A GPU machine's training table is always the CPU's beside the GPU's (where torch has CUDA).
         devices = ("cpu", args.device) if args.device != "cpu" else (training_devices() if gpu else ("cpu",))
         run_only(args.only, args.out, args.doc, devices, gpu, crops=args.crops)

@@ -20,7 +20,7 @@ from davis_ag.workflows.reproduce.run import reproduce, write_page
 from davis_ag.workflows.reproduce.state import RunState, run_config
 from davis_ag.workflows.reproduce.status import format_status
 
-HELP = "reproduce Table 4 or the crops ladder: generate, train A2C and PPO, benchmark, write the page"
+HELP = "reproduce Table 4, the crops ladder or row mapping: generate, train A2C and PPO, benchmark, write the page"
 DESCRIPTION = __doc__
 FORMATTER_CLASS = argparse.RawDescriptionHelpFormatter
 
@@ -43,8 +43,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="small (default: a smoke test of every stage, under an hour on 2 CPU cores; not comparable "
         "with Table 4), "
         "medium (the paper's grids and 300K A2C steps, hours), paper-scale (Table 3's 130 scenes "
-        "at 1280x720, over many sittings: --status says where a run stands) or crops (every "
-        "plant-library crop's SP and row scenes, its page docs/crops.md)",
+        "at 1280x720, over many sittings: --status says where a run stands), crops (every "
+        "plant-library crop's SP and row scenes, its page docs/crops.md) or mapping (row mapping on "
+        "five crops' rows with every baseline, its page docs/mapping.md)",
     )
     parser.add_argument(
         "--sp-scenes", type=arguments.bounded(1, 1000), default=None, help="override the SP scene count"

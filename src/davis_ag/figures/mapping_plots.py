@@ -111,7 +111,9 @@ def plot_mapping_episode(
     first = first_seen_steps(coverage, view_indices)
     seen = first >= 0
     steps = max(len(view_indices) - 1, 1)
-    fig, (top, side) = plt.subplots(2, 1, figsize=(8.0, 6.4), gridspec_kw={"height_ratios": [1.2, 1]})
+    fig, (top, side) = plt.subplots(
+        2, 1, figsize=(8.0, 5.2), gridspec_kw={"height_ratios": [1, 1]}, layout="constrained"
+    )
     xyz = coverage.fruit_xyz
     for ax, (a, b), label in ((top, (0, 1), "y (m)"), (side, (0, 2), "height (m)")):
         ax.scatter(xyz[~seen, a], xyz[~seen, b], s=8, color="0.75", label="never seen")

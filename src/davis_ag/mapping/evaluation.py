@@ -46,7 +46,8 @@ from davis_ag.provenance import code_version
 
 
 def scene_segments(env: RowMappingEnv) -> dict[str, SceneSegment]:
-    """Each scene's segment: fruit, the grid's ceiling, and each start part's ceiling and bound."""
+    """Each scene's segment: fruit, the ceiling of every view an episode may use (with a robot, the
+    views it reaches), and each start part's ceiling and bound."""
     segments = {}
     for scene, coverage, starts in zip(env.scenes, env.coverage, env.start_views):
         parts = []
@@ -57,8 +58,9 @@ def scene_segments(env: RowMappingEnv) -> dict[str, SceneSegment]:
             parts.append(
                 PartBound(index=int(index), views=len(views), ceiling=ceiling, bound=bound.fruit, exact=bound.exact)
             )
+        # Over every view an episode may use: the grid's, or with a robot the views it reaches.
         segments[scene.id] = SceneSegment(
-            fruit=coverage.fruit, ceiling=int(coverage.seen.any(axis=0).sum()), parts=parts
+            fruit=coverage.fruit, ceiling=int(coverage.seen[starts].any(axis=0).sum()), parts=parts
         )
     return segments
 

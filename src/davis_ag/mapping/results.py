@@ -293,5 +293,6 @@ def mapping_table(results: MappingResults) -> str:
     rows.append(f"| Ceiling: every view of the start's part | {table_number(any_row.part_ceiling)} | {blank} |")
     fruit = sum(s.fruit for s in results.segments.values())
     ceiling = sum(s.ceiling for s in results.segments.values())
-    rows.append(f"| Ceiling: every view of the grid | {table_number(ceiling / fruit)} | {blank} |")
+    reached = " the robot reaches" if robot else ""
+    rows.append(f"| Ceiling: every view of the grid{reached} | {table_number(ceiling / fruit)} | {blank} |")
     return "\n".join(rows)

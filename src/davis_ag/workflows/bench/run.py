@@ -317,11 +317,14 @@ def run_only(
     how fast a results file is checked, :mod:`davis_ag.workflows.bench.verify`, about a minute;
     ``--only play``: a trained model's episodes one at a time and in step,
     :mod:`davis_ag.workflows.bench.play`, about a minute; ``--only robot``: the robots' reach of a row
-    and the grid step with a robot, :mod:`davis_ag.workflows.bench.robot`, about five minutes):
+    and the grid step with a robot, :mod:`davis_ag.workflows.bench.robot`, about five minutes;
+    ``--only mapping``: a row-mapping step beside TVM-v0's and the segment's ceiling and bound,
+    :mod:`davis_ag.workflows.bench.mapping`, about five minutes):
     JSON, the doc's section (its GPU section on a ``gpu_machine``) and the line another page shows
     of it."""
     from davis_ag.scene.library_crops import LIBRARY_CROPS
     from davis_ag.workflows.bench.crops import crops_speed, crops_table, merged, write_crops
+    from davis_ag.workflows.bench.mapping import mapping_speed, mapping_table, write_mapping
     from davis_ag.workflows.bench.play import play_speed, play_table, write_play
     from davis_ag.workflows.bench.robot import robot_speed, robot_table, write_robot
     from davis_ag.workflows.bench.verify import verify_speed, verify_table, write_verify
@@ -338,6 +341,7 @@ def run_only(
         "verify": ("verify", verify_speed, verify_table, write_verify),
         "play": ("play", play_speed, play_table, write_play),
         "robot": ("robot", robot_speed, robot_table, write_robot),
+        "mapping": ("mapping", mapping_speed, mapping_table, write_mapping),
     }
     key, measure, table_of, write = measurements[what]
     start = os.getloadavg()[0]

@@ -11,7 +11,7 @@ from pathlib import Path
 
 from davis_ag.benchmark.cache import OBS_SIZE
 from davis_ag.scene.specs import PAPER_IMAGE_SIZE, PAPER_TABLE3, CropSpec, ScenarioSpec, crop_spec, scenario_spec
-from davis_ag.workflows.reproduce.groups import CROPS_PAIRS, SCENARIO_CROPS, group_key
+from davis_ag.workflows.reproduce.groups import CROPS_PAIRS, MAPPING_PAIRS, SCENARIO_CROPS, group_key
 
 
 @dataclass(frozen=True)
@@ -63,6 +63,8 @@ class ReproduceConfig:
         crop for the crops run."""
         if self.page == "table4":
             return f"{self.sp_scenes} SP strawberry and {self.mp_scenes} MP vine scenes"
+        if self.page == "mapping":
+            return f"{self.mp_scenes} row scene(s) of each of {len(self.pairs)} crops"
         crops = len({crop for _, crop in self.pairs})
         return f"{self.sp_scenes} SP and {self.mp_scenes} row scenes of each of {crops} crops"
 
@@ -92,6 +94,9 @@ class ReproduceConfig:
 #: ``crops``: every plant-library crop, 10 SP and 4 row scenes at 640x360, 20K steps of each
 #: learner per group: about a night of such a machine per sitting's worth of groups, resumable
 #: (docs/crops.md is its page).
+#: ``mapping``: row mapping on five of the crops run's rows (apple-wall, VSP vine, capsicum, cherry
+#: tomato, olive), one row scene each at 320x180 with dataset seed 5 (docs/robot.md's apple-wall row),
+#: every baseline at three seen fractions; no learner yet (docs/mapping.md is its page).
 #: Scene counts of Table 3 (SP strawberry, MP vine), what a configuration is measured against.
 PAPER_SCENES = (PAPER_TABLE3["sp", "strawberry"][0], PAPER_TABLE3["mp", "vine"][0])
 CONFIGS: dict[str, ReproduceConfig] = {
@@ -120,6 +125,19 @@ CONFIGS: dict[str, ReproduceConfig] = {
         mp_timesteps=20_000,
         pairs=CROPS_PAIRS,
         page="crops",
+    ),
+    "mapping": ReproduceConfig(
+        "mapping",
+        (320, 180),
+        sp_scenes=0,
+        mp_scenes=1,
+        mp_extent=None,
+        sp_timesteps=0,
+        mp_timesteps=0,
+        seed=5,
+        learners=(),
+        pairs=MAPPING_PAIRS,
+        page="mapping",
     ),
 }
 

@@ -22,3 +22,8 @@ def group_key(scenario: str, crop: str) -> str:
 
 #: The run's group of each scenario (``{"sp": "sp-strawberry", "mp": "mp-vine"}``).
 GROUPS: dict[str, str] = {scenario: group_key(scenario, crop) for scenario, crop in SCENARIO_CROPS}
+
+#: The ``mapping`` run's rows (docs/mapping.md): trellised, staked, greenhouse and orchard rows.
+MAPPING_PAIRS: tuple[tuple[str, str], ...] = tuple(
+    ("row", crop) for crop in ("apple-wall", "vsp-vine", "capsicum", "cherry-tomato", "olive")
+)

@@ -72,6 +72,10 @@ def reproduce(
     from davis_ag.workflows.stages import evaluation_split, generate_scenes, run_baselines
 
     pairs = config.pairs if pairs is None else pairs
+    if config.page == "mapping":
+        from davis_ag.workflows.reproduce.mapping_run import reproduce_mapping
+
+        return reproduce_mapping(config, out, results_md, pairs)
     check_disk(config, Path(out).expanduser().absolute(), pairs)
     out = prove_writable_folder(out)  # absolute at once: Helios moves the working directory
     results_md = prove_writable_file(results_md, "--results")
@@ -88,23 +92,7 @@ def reproduce(
     state.config = configured
     state.save(state_path)  # `--status` reads the run from its first stage on, not after it
     clock = StageClock(out / CLOCK_FILE, code_version(), machine=machine_summary())
-
-    def record(
-        stage: str,
-        seconds: float,
-        note: str = "",
-        code: str | None = None,
-        check_seconds: float | None = None,
-        stamp: str | None = None,
-    ) -> None:
-        state.stages[stage] = StageRecord(
-            seconds=round(seconds, 1),
-            note=note,
-            code=code or code_version(),
-            check_seconds=check_seconds,
-            stamp=stamp,
-        )
-        state.save(state_path)
+    record = stage_recorder(state, state_path)
 
     camera = Camera(*config.size)
     for scenario_name, crop_name in pairs:
@@ -171,6 +159,30 @@ def reproduce(
     return 0
 
 
+def stage_recorder(state: RunState, state_path: Path) -> Record:
+    """The run's :class:`Record`: a stage's record written into ``state`` and saved at once."""
+    from davis_ag.provenance import code_version
+
+    def record(
+        stage: str,
+        seconds: float,
+        note: str = "",
+        code: str | None = None,
+        check_seconds: float | None = None,
+        stamp: str | None = None,
+    ) -> None:
+        state.stages[stage] = StageRecord(
+            seconds=round(seconds, 1),
+            note=note,
+            code=code or code_version(),
+            check_seconds=check_seconds,
+            stamp=stamp,
+        )
+        state.save(state_path)
+
+    return record
+
+
 def write_page(path: Path, config: ReproduceConfig, state: RunState, out: Path | None) -> None:
     """Write the run's page from its records: Table 4's results page, or the crops run's.
 
@@ -180,7 +192,12 @@ def write_page(path: Path, config: ReproduceConfig, state: RunState, out: Path |
         state: The run's records.
         out: The run's folder, for the records beside its state (None: not read).
     """
-    if config.page == "crops":
+    if config.page == "mapping":
+        from davis_ag.workflows.reproduce.mapping_run import write_run_page
+
+        if out is not None:
+            write_run_page(path, config, out, config.pairs)
+    elif config.page == "crops":
         from davis_ag.workflows.reproduce.pages.crops import write_crops_md
 
         write_crops_md(path, config, state, out)
