@@ -6,12 +6,12 @@ import shutil
 from pathlib import Path
 
 import pytest
-from layout_factory import write_tiny_dataset
 
 from davis_ag.mapping.evaluation import evaluate_mapping
 from davis_ag.workflows.reproduce.configs import CONFIGS
 from davis_ag.workflows.reproduce.mapping_run import SEEN_FRACTIONS, write_run_page
 from davis_ag.workflows.reproduce.pages.mapping import results_name
+from layout_factory import write_tiny_dataset
 
 
 @pytest.fixture(scope="module")
