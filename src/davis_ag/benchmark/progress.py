@@ -58,7 +58,11 @@ class TrainingProgress(BaseCallback):
 
     def _score(self) -> str:
         best = self.selection.scores[-1] if self.selection and self.selection.scores else None
-        return f"train OER_tau {best['oer_tau']:.3f} at {best['step']}" if best else "no train score yet"
+        return (
+            f"train {self.selection.score_text(best)} at {best['step']}"
+            if self.selection and best
+            else "no train score yet"
+        )
 
     def _on_step(self) -> bool:
         from tqdm import tqdm

@@ -52,15 +52,26 @@ def snapshot_path(final: Path, step: int) -> Path:
 
 
 def train_split_score(
-    model: Any, env: Any, episodes: int = SELECT_EPISODES, seed: int = SELECT_SEED
+    model: Any,
+    env: Any,
+    episodes: int = SELECT_EPISODES,
+    seed: int = SELECT_SEED,
+    play: Any = None,
+    keys: tuple[str, ...] = ("oer_tau", "reward", "length"),
 ) -> dict[str, float]:
     """Mean OER_tau and reward of ``model`` over ``episodes`` episodes of ``env`` (the train split).
 
     Play is sampled or deterministic as in the benchmark (``DETERMINISTIC_PLAY``). Torch's random
     state is restored afterwards, so scoring does not change the training run's own draws.
 
+    Args:
+        model, env, episodes, seed: What plays where, how many episodes, their base seed.
+        play: ``(env, policy, resets, draws) -> records`` of another task (default TVM-v0's
+            :func:`davis_ag.benchmark.evaluation.play_episodes`).
+        keys: The records' fields to average.
+
     Returns:
-        ``{"oer_tau", "reward", "length"}``, means over the episodes.
+        ``{"oer_tau", "reward", "length"}`` (the ``keys``), means over the episodes.
     """
     from davis_ag.benchmark.evaluation import episode_seeds, play_episodes
     from davis_ag.benchmark.policies import DETERMINISTIC_PLAY, ModelPolicy, prepare
@@ -72,16 +83,17 @@ def train_split_score(
     # that device's generator, so it is saved and restored too, not only the CPU's.
     device = getattr(model, "device", torch.device("cpu"))
     with torch.random.fork_rng(devices=[device] if device.type == "cuda" else []):
-        records = play_episodes(env, agent, resets, draws)
-    return {key: round(float(np.mean([r[key] for r in records])), 6) for key in ("oer_tau", "reward", "length")}
+        records = (play or play_episodes)(env, agent, resets, draws)
+    return {key: round(float(np.mean([r[key] for r in records])), 6) for key in keys}
 
 
 class KeepBestOnTrain(BaseCallback):
     """Scores the policy on the train split every ``every`` steps and at the end; saves each new
     best as a snapshot file (see the module docstring).
 
-    ``scores`` is a list of ``{"step", "oer_tau", "reward", "length"}``; ``best`` the entry of the
-    kept snapshot. Earlier scores of a resumed run are passed in.
+    ``scores`` is a list of ``{"step", "oer_tau", "reward", "length"}`` (another task's score in
+    place of ``oer_tau``: ``key``); ``best`` the entry of the kept snapshot. Earlier scores of a
+    resumed run are passed in.
     """
 
     def __init__(
@@ -93,8 +105,24 @@ class KeepBestOnTrain(BaseCallback):
         scores: list[dict[str, Any]] | None = None,
         episodes: int = SELECT_EPISODES,
         prune_at_once: bool = False,
+        score: Any = None,
+        key: str = "oer_tau",
+        label: str = "OER_tau",
     ) -> None:
+        """Args:
+        env: The train split's environment the snapshots play.
+        final: The run's model path.
+        every: Environment steps between scores (0: only at the end).
+        save: Saves a model to a path.
+        scores: Earlier scores of a resumed run.
+        episodes: Episodes per score.
+        prune_at_once: Remove a superseded snapshot at once (no checkpoint names it).
+        score: ``(model, env, episodes) -> dict`` of a task other than TVM-v0 (default
+            :func:`train_split_score`, looked up when it scores); its ``key`` is the score kept.
+        key, label: The score's name in the records and in messages.
+        """
         super().__init__()
+        self.score, self.key, self.label = score, key, label
         self.env, self.final, self.every, self.save = env, final, every, save
         self.episodes, self.prune_at_once = episodes, prune_at_once
         self.scores: list[dict[str, Any]] = list(scores or [])
@@ -112,7 +140,11 @@ class KeepBestOnTrain(BaseCallback):
     @property
     def best(self) -> dict[str, Any] | None:
         """The highest-scoring entry (the earliest of ties), or ``None`` before any score."""
-        return max(self.scores, key=lambda s: (s["oer_tau"], -s["step"])) if self.scores else None
+        return max(self.scores, key=lambda s: (s[self.key], -s["step"])) if self.scores else None
+
+    def score_text(self, entry: dict[str, Any]) -> str:
+        """An entry's score as messages show it (``OER_tau 0.412``)."""
+        return f"{self.label} {entry[self.key]:.3f}"
 
     def _on_training_start(self) -> None:
         # On the run's multiples of ``every``, whatever step a sitting resumes at.
@@ -134,7 +166,8 @@ class KeepBestOnTrain(BaseCallback):
         if any(s["step"] == step for s in self.scores):
             return
         before = self.best
-        entry = {"step": step, **train_split_score(self.model, self.env, self.episodes)}
+        score = self.score or train_split_score  # by name at each score: a test may replace it
+        entry = {"step": step, **score(self.model, self.env, self.episodes)}
         self.scores.append(entry)
         if self.best is entry:
             try:
@@ -148,8 +181,8 @@ class KeepBestOnTrain(BaseCallback):
         if self.best is entry or before is None:  # (before is None only where this entry is the best)
             note = " (best so far)"
         else:
-            note = f" (best {before['oer_tau']:.3f} at {before['step']})"
-        print(f"train-split score at {step} steps: OER_tau {entry['oer_tau']:.3f}" + note, flush=True)
+            note = f" (best {before[self.key]:.3f} at {before['step']})"
+        print(f"train-split score at {step} steps: {self.score_text(entry)}" + note, flush=True)
 
     def prune(self, keep_none: bool = False) -> None:
         """Remove every snapshot file but the best's (all of them with ``keep_none``)."""

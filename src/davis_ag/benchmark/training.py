@@ -16,6 +16,7 @@ steps its sittings begin at, not bit-identical to an uninterrupted one.
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -55,6 +56,31 @@ CURVE_EVERY = 1_000
 SELECT_EVERY = 10_000
 
 
+@dataclass(frozen=True)
+class TrainingTask:
+    """What a run learns and how its snapshots are scored: TVM-v0 (:data:`TVM_TASK`) unless a later
+    stage gives another (row mapping's, :func:`davis_ag.mapping.training.mapping_task`).
+
+    Attributes:
+        name: ``tvm``, or the task recorded in the run's settings.
+        env_class: The environment (made with the dataset, scenario, split, crop, cache_dir, robot).
+        env_kwargs: Its further settings (recorded in the run's settings).
+        score: ``(model, env, episodes) -> dict`` of a snapshot on the train split; None: TVM-v0's.
+        key, label: The score kept, by its record name and as messages show it.
+    """
+
+    name: str
+    env_class: Any
+    env_kwargs: dict[str, Any] = field(default_factory=dict)
+    score: Any = None
+    key: str = "oer_tau"
+    label: str = "OER_tau"
+
+
+#: The paper's task.
+TVM_TASK = TrainingTask("tvm", TVMEnv)
+
+
 def make_vec_tvm(
     dataset: Dataset | str | os.PathLike[str],
     scenario: str,
@@ -65,6 +91,7 @@ def make_vec_tvm(
     cache_dir: str | os.PathLike[str] | None = None,
     env_seeds: str = "streams",
     robot: str | None = None,
+    task: TrainingTask = TVM_TASK,
 ) -> Any:
     """``n_envs`` TVM environments in one SB3 ``DummyVecEnv`` (each wrapped in ``Monitor``).
 
@@ -77,6 +104,7 @@ def make_vec_tvm(
         n_envs: Number of environments.
         seed: The run's seed.
         split, crop, cache_dir, robot: As for :class:`davis_ag.benchmark.TVMEnv`.
+        task: The environment's task (TVM-v0 by default).
         env_seeds: ``streams``: environment ``i`` is seeded with
             :func:`~davis_ag.seeds.training_env_seed` ``(seed, i)``, so runs of different seeds
             share no episode stream; ``seed+i`` (runs from before, resumed as they began):
@@ -92,7 +120,9 @@ def make_vec_tvm(
     if robot is not None:
         kwargs["robot"] = robot
     chosen = DummyVecEnv if env_seeds == "seed+i" else StreamSeededVecEnv
-    return make_vec_env(TVMEnv, n_envs=n_envs, seed=seed, env_kwargs=kwargs, vec_env_cls=chosen)
+    return make_vec_env(
+        task.env_class, n_envs=n_envs, seed=seed, env_kwargs={**kwargs, **task.env_kwargs}, vec_env_cls=chosen
+    )
 
 
 class StreamSeededVecEnv(DummyVecEnv):
@@ -140,6 +170,7 @@ def train_agent(
     progress: bool = True,
     force: bool = False,
     robot: str | None = None,
+    task: TrainingTask = TVM_TASK,
 ) -> Path:
     """Train an agent on the train split and save it; resume a killed run.
 
@@ -187,6 +218,8 @@ def train_agent(
             or a damaged one) instead of refusing (:func:`check_checkpoint`).
         robot: Train with the camera on this robot (docs/robot.md): its reach and seconds, on the
             training and the scoring environments; recorded in the settings (name and digest).
+        task: What to learn (TVM-v0 by default; row mapping's from :mod:`davis_ag.mapping.training`),
+            recorded in the settings with its environment's settings when it is another.
 
     Returns:
         The saved model's path.
@@ -235,6 +268,8 @@ def train_agent(
 
         definition = load_robot(robot)
         settings["robot"] = {"name": definition.name, "digest": definition.digest}
+    if task.name != TVM_TASK.name:  # only then: the settings of TVM-v0 runs stay as they were
+        settings["task"] = {"name": task.name, **task.env_kwargs}
     opened = as_dataset(dataset)
     # What it learns from: evaluation refuses to score it on any of these (a split that changed
     # since, as scenes were added), and a checkpoint of another split is not resumed.
@@ -243,7 +278,7 @@ def train_agent(
     scores: list[dict[str, Any]] = []
     if resumed is not None:  # seeded as it began (a checkpoint from before the streams: seed + i)
         settings["env_seeds"] = resumed[4]
-    env = make_vec_tvm(opened, scenario, n_envs, seed, "train", crop, cache_dir, settings["env_seeds"], robot)
+    env = make_vec_tvm(opened, scenario, n_envs, seed, "train", crop, cache_dir, settings["env_seeds"], robot, task)
     if resumed is not None:
         _, earlier, points, scores, _ = resumed
         model = load_checkpoint(algorithm, model_file, env, device)
@@ -272,9 +307,19 @@ def train_agent(
     curve = LearningCurve(CURVE_EVERY, points)
     selection = None
     if keep == "best-train":
-        scoring_env = TVMEnv(opened, scenario, split="train", crop=crop, cache_dir=cache_dir, robot=robot)
+        scoring_env = task.env_class(
+            opened, scenario, split="train", crop=crop, cache_dir=cache_dir, robot=robot, **task.env_kwargs
+        )
         selection = KeepBestOnTrain(
-            scoring_env, final, select_every, save_model, scores, prune_at_once=not checkpoint_every
+            scoring_env,
+            final,
+            select_every,
+            save_model,
+            scores,
+            prune_at_once=not checkpoint_every,
+            score=task.score,
+            key=task.key,
+            label=task.label,
         )
     shown = TrainingProgress(total_timesteps, f"{algo.upper()} {scenario}", selection) if progress else None
     callbacks = [c for c in (callback, curve, selection, shown) if c is not None]
@@ -306,8 +351,8 @@ def train_agent(
             publish_snapshot(snapshot_path(final, best["step"]), final)
             extra["selection"] = selection.record()
             print(
-                f"kept the snapshot at {best['step']} steps (train-split OER_tau "
-                f"{best['oer_tau']:.3f}, the best of {len(selection.scores)})",
+                f"kept the snapshot at {best['step']} steps (train-split {selection.score_text(best)}, "
+                f"the best of {len(selection.scores)})",
                 flush=True,
             )
         written = True

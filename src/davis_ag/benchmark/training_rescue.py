@@ -54,12 +54,22 @@ def keep_what_it_trained(
     )
     if steps == 0 or (not finished and unsaved is None and model_file.is_file()):
         return what_survives(error, final, selection, model_file)
-    if finished and best is not None and unsaved is None and snapshot_path(final, best["step"]).is_file():
+    if (
+        selection is not None
+        and finished
+        and best is not None
+        and unsaved is None
+        and snapshot_path(final, best["step"]).is_file()
+    ):
         return (
-            f"{failed}; the best snapshot ({best['step']} steps, train-split OER_tau {best['oer_tau']:.3f}) "
+            f"{failed}; the best snapshot ({best['step']} steps, train-split {selection.score_text(best)}) "
             f"is kept in {snapshot_path(final, best['step'])}: move it to {final} to use it"
         )
-    score = f", train-split OER_tau {unsaved['oer_tau']:.3f}, the best" if unsaved is not None else ""
+    score = (
+        f", train-split {selection.score_text(unsaved)}, the best"
+        if selection is not None and unsaved is not None
+        else ""
+    )
     what = f"the trained model ({steps} steps{score})" if finished else f"the model so far ({steps} steps{score})"
     beside = _kept_beside(final, selection, model_file)
     try:
@@ -100,9 +110,9 @@ def _kept_beside(final: Path, selection: KeepBestOnTrain | None, model_file: Pat
     """Which finished model of the run a file beside ``final`` holds (the best snapshot so far, or
     the last checkpoint), and where, as a phrase; None when none does."""
     best = selection.best if selection is not None else None
-    if best is not None and snapshot_path(final, best["step"]).is_file():
+    if selection is not None and best is not None and snapshot_path(final, best["step"]).is_file():
         return (
-            f"the best snapshot so far ({best['step']} steps, train-split OER_tau {best['oer_tau']:.3f}) "
+            f"the best snapshot so far ({best['step']} steps, train-split {selection.score_text(best)}) "
             f"is kept in {snapshot_path(final, best['step'])}"
         )
     if model_file.is_file():

@@ -111,11 +111,21 @@ def run(args: argparse.Namespace) -> int:
         state = RunState.load(args.out / "state.json")
         if not state.config:
             raise UserError(f"{args.out / 'state.json'}: no finished run to write results from")
-        write_page(args.results, run_config(state, args.out / "state.json"), state, args.out)
+        recorded = run_config(state, args.out / "state.json")
+        if recorded.page == "mapping":
+            from davis_ag.workflows.reproduce.mapping_run import write_run_page
+
+            write_run_page(args.results, recorded, args.out, recorded.pairs)
+        else:
+            write_page(args.results, recorded, state, args.out)
         print(f"wrote {args.results}")
         return 0
     arguments.prove_writable_folder(args.out)
     pairs = [p for p in config.pairs if args.only in (None, p[0])]
     if not pairs:
         raise UserError(f"--only {args.only}: the {config.name} run has no {args.only} groups")
+    if config.page == "mapping":
+        from davis_ag.workflows.reproduce.mapping_run import reproduce_mapping
+
+        return reproduce_mapping(config, args.out, args.results, pairs)
     return reproduce(config, args.out, args.results, pairs)

@@ -108,13 +108,44 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="train with the camera on this robot (davis-ag robots lists them, or a YAML file): only the "
         "views it reaches (docs/robot.md)",
     )
+    parser.add_argument(
+        "--task",
+        default="tvm",
+        choices=["tvm", "mapping"],
+        help="tvm: target visibility maximisation (default); mapping: row mapping (RowMapping-v0, "
+        "docs/mapping.md), snapshots kept by their train-split coverage",
+    )
+    parser.add_argument(
+        "--budget",
+        type=arguments.bounded(1, 10**5),
+        default=None,
+        metavar="MOVES",
+        help="--task mapping: moves per episode (default: the fixed sweep's)",
+    )
+    parser.add_argument(
+        "--seen-fraction",
+        type=float,
+        default=None,
+        metavar="F",
+        help="--task mapping: the visible fraction at which a fruit counts as seen (default 0.5)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
     """Train and save; prints the model's path."""
-    from davis_ag.benchmark.training import check_device, model_path, train_agent
+    from davis_ag.benchmark.training import TVM_TASK, check_device, model_path, train_agent
+    from davis_ag.errors import UserError
     from davis_ag.formats.outputs import claim_output
 
+    task = TVM_TASK
+    if args.task == "mapping":
+        from davis_ag.mapping.coverage import SEEN_FRACTION
+        from davis_ag.mapping.training import mapping_task
+
+        fraction = SEEN_FRACTION if args.seen_fraction is None else args.seen_fraction
+        task = mapping_task(args.budget, fraction)
+    elif (args.budget, args.seen_fraction) != (None, None):
+        raise UserError("--budget and --seen-fraction are for --task mapping: add it or leave them out")
     check_device(args.device)
     arguments.prove_writable_file(args.out)
     if args.cache_dir is not None:
@@ -138,6 +169,7 @@ def run(args: argparse.Namespace) -> int:
             algo=args.algo,
             force=args.force,
             robot=args.robot,
+            task=task,
         )
     print(f"saved {path}")
     return 0

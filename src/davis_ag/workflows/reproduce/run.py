@@ -72,10 +72,6 @@ def reproduce(
     from davis_ag.workflows.stages import evaluation_split, generate_scenes, run_baselines
 
     pairs = config.pairs if pairs is None else pairs
-    if config.page == "mapping":
-        from davis_ag.workflows.reproduce.mapping_run import reproduce_mapping
-
-        return reproduce_mapping(config, out, results_md, pairs)
     check_disk(config, Path(out).expanduser().absolute(), pairs)
     out = prove_writable_folder(out)  # absolute at once: Helios moves the working directory
     results_md = prove_writable_file(results_md, "--results")
@@ -192,12 +188,7 @@ def write_page(path: Path, config: ReproduceConfig, state: RunState, out: Path |
         state: The run's records.
         out: The run's folder, for the records beside its state (None: not read).
     """
-    if config.page == "mapping":
-        from davis_ag.workflows.reproduce.mapping_run import write_run_page
-
-        if out is not None:
-            write_run_page(path, config, out, config.pairs)
-    elif config.page == "crops":
+    if config.page == "crops":
         from davis_ag.workflows.reproduce.pages.crops import write_crops_md
 
         write_crops_md(path, config, state, out)
