@@ -174,6 +174,25 @@ class Greedy(_TablePolicy):
         return self.first_free_move(scene, view)
 
 
+class FixedMove:
+    """The same move every step: a trivial policy, what a learner that collapsed to one move plays."""
+
+    def __init__(self, move: str, name: str | None = None) -> None:
+        """Args:
+        move: The move's name (``forward`` ...).
+        name: The row's name (default ``always <move>``).
+        """
+        self.move, self.name = move, name or f"always {move}"
+        self.source = f"always {move}"
+
+    def reset(self, seed: int | None = None) -> None:
+        """Nothing random."""
+
+    def act(self, observation: np.ndarray, info: dict[str, Any]) -> str:
+        """The move, by name."""
+        return self.move
+
+
 class RandMapping(SeededPolicy):
     """A uniformly random move each step."""
 

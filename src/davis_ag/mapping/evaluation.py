@@ -28,7 +28,7 @@ from davis_ag.benchmark.policies import Policy, as_policy, policy_from_spec, pre
 from davis_ag.benchmark.replay import Difference, DifferenceFound, ReplayReport, dataset_difference, expect
 from davis_ag.benchmark.results import identify_dataset
 from davis_ag.errors import UserError
-from davis_ag.mapping.baselines import BASELINES, build_baselines
+from davis_ag.mapping.baselines import BASELINES, FixedMove, build_baselines
 from davis_ag.mapping.bound import best_views
 from davis_ag.mapping.coverage import SEEN_FRACTION
 from davis_ag.mapping.env import RowMappingEnv
@@ -108,15 +108,52 @@ def play_episode(env: Any, policy: Policy, reset_seed: int, policy_seed: int, se
     return MappingEpisode(**start, gains=gains, path=list(info["path"]), actions=actions, seconds=seconds)
 
 
+#: The row of the best policy that always makes one move.
+BEST_FIXED_MOVE = "Best fixed move"
+
+
+def best_fixed_move(env: Any, episodes: int, sessions: int, seed: int) -> FixedMove:
+    """Of the policies that always make the same move, the one with the highest mean coverage on
+    these episodes, named :data:`BEST_FIXED_MOVE` (the move it makes is in its ``source``)."""
+    inner: RowMappingEnv = env.unwrapped
+    best, best_coverage = inner.action_names[0], -1.0
+    for move in inner.action_names:
+        policy = FixedMove(move)
+        coverages = []
+        for session in range(sessions):
+            resets, draws = episode_seeds(seed, session, episodes)
+            for r, d in zip(resets, draws):
+                episode = play_episode(env, policy, r, d, session)
+                coverages.append((episode.seen_0 + sum(episode.gains)) / episode.fruit)
+        if float(np.mean(coverages)) > best_coverage:
+            best, best_coverage = move, float(np.mean(coverages))
+    return FixedMove(best, name=BEST_FIXED_MOVE)
+
+
 def evaluate_mapping_policies(
-    env: Any, policies: Sequence[Policy], episodes: int = 200, sessions: int = 3, seed: int = 0
+    env: Any,
+    policies: Sequence[Policy],
+    episodes: int = 200,
+    sessions: int = 3,
+    seed: int = 0,
+    best_fixed: bool = False,
 ) -> MappingResults:
     """Run every policy on the same starts and summarise (see the module docstring).
+
+    Args:
+        env: RowMappingEnv (wrapped or not).
+        policies: The policies, names distinct.
+        episodes, sessions, seed: The protocol.
+        best_fixed: Add the :data:`BEST_FIXED_MOVE` row, so that a learner that collapsed to one
+            move is seen beside the best such policy.
 
     Raises:
         UserError: for two policies of one name, or a policy that does not fit the environment.
     """
     inner: RowMappingEnv = env.unwrapped
+    policies = list(policies)
+    if best_fixed:
+        policies.append(best_fixed_move(env, episodes, sessions, seed))
     names = [p.name for p in policies]
     if len(set(names)) != len(names):
         twice = next(n for n in names if names.count(n) > 1)
@@ -171,7 +208,8 @@ def evaluate_mapping(
         scenario: ``row`` (default) or ``mp``.
         split, sessions, episodes, seed: The protocol.
         crop: Keep one crop.
-        baselines: True: Sweep, Rand and Greedy; False: none; or a list of names.
+        baselines: True: Sweep, Rand and Greedy; False: none; or a list of names. With any, the
+            best fixed move's row too.
         deterministic: How SPEC models play (default: the benchmark's).
         cache_dir: The observation cache folder.
         budget: Moves per episode (default: the sweep's length).
@@ -207,7 +245,9 @@ def evaluate_mapping(
         budget_s=budget_s,
     )
     try:
-        results = evaluate_mapping_policies(made, chosen, episodes=episodes, sessions=sessions, seed=seed)
+        results = evaluate_mapping_policies(
+            made, chosen, episodes=episodes, sessions=sessions, seed=seed, best_fixed=bool(baselines)
+        )
     finally:
         made.close()
     results.protocol.crop = crop
