@@ -88,7 +88,7 @@ def test_gymnasium_makes_the_environment_by_its_module_and_id_with_nothing_impor
         "observation, info = env.reset(seed=0); "
         "print(observation.shape, sorted(i for i in gym.registry if i.startswith('davis_ag/')))"
     )
-    assert out == "(224, 224, 4) ['davis_ag/TVM-v0', 'davis_ag/TVMContinuous-v0']"
+    assert out == "(224, 224, 4) ['davis_ag/RowMapping-v0', 'davis_ag/TVM-v0', 'davis_ag/TVMContinuous-v0']"
 
 
 def test_the_readme_imports_make_the_environment(sp_root: Path) -> None:
@@ -113,7 +113,7 @@ def test_the_readme_imports_make_the_environment(sp_root: Path) -> None:
 def test_the_ids_are_registered_whichever_is_imported_first(imports: str) -> None:
     """No import order to remember: davis_ag registers at once, or the moment Gymnasium loads."""
     out = run_python(f"{imports}; print(sorted(i for i in gym.registry if i.startswith('davis_ag/')))")
-    assert out == "['davis_ag/TVM-v0', 'davis_ag/TVMContinuous-v0']"
+    assert out == "['davis_ag/RowMapping-v0', 'davis_ag/TVM-v0', 'davis_ag/TVMContinuous-v0']"
 
 
 def test_importing_davis_ag_alone_loads_no_gymnasium() -> None:

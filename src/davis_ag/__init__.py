@@ -30,6 +30,8 @@ _PUBLIC: dict[str, str] = {
     "Policy": "davis_ag.benchmark.policies:Policy",
     "TVMEnv": "davis_ag.benchmark.tvm:TVMEnv",
     "TVMContinuousEnv": "davis_ag.live.tvm_continuous:TVMContinuousEnv",
+    "RowMappingEnv": "davis_ag.mapping.env:RowMappingEnv",
+    "evaluate_mapping": "davis_ag.mapping.evaluation:evaluate_mapping",
 }
 
 if TYPE_CHECKING:  # for type checkers and editors; at run time __getattr__ loads them
@@ -38,16 +40,20 @@ if TYPE_CHECKING:  # for type checkers and editors; at run time __getattr__ load
     from davis_ag.benchmark.tvm import TVMEnv
     from davis_ag.data.reader import Dataset, Scene, View, exposure_rate, open_dataset
     from davis_ag.live.tvm_continuous import TVMContinuousEnv
+    from davis_ag.mapping.env import RowMappingEnv
+    from davis_ag.mapping.evaluation import evaluate_mapping
 
 __all__ = [
     "Dataset",
     "Policy",
+    "RowMappingEnv",
     "Scene",
     "TVMContinuousEnv",
     "TVMEnv",
     "View",
     "__version__",
     "evaluate",
+    "evaluate_mapping",
     "exposure_rate",
     "open_dataset",
 ]
