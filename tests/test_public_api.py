@@ -24,6 +24,8 @@ PUBLIC = {
     "Policy": "davis_ag.benchmark.policies",
     "TVMEnv": "davis_ag.benchmark.tvm",
     "TVMContinuousEnv": "davis_ag.live.tvm_continuous",
+    "RowMappingEnv": "davis_ag.mapping.env",
+    "evaluate_mapping": "davis_ag.mapping.evaluation",
 }
 
 #: What ``import davis_ag`` must not load: no stage, nor the heavy libraries the stages use.
