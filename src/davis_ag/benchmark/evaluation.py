@@ -223,7 +223,7 @@ def evaluate_policies(
         prepare(policy, env)
     described = inner.describe()
     protocol = Protocol(version=PROTOCOL_VERSION, episodes=episodes, sessions=sessions, seed=seed, **described)
-    keys = (*METRICS, "oer_0") + (("refused",) if not grid else ()) + (("seconds",) if grid and inner.robot else ())
+    keys = (*METRICS, "oer_0") + (("refused",) if not grid else ()) + (("seconds",) if inner.robot else ())
     rows: dict[str, dict[str, Any]] = {}
     records: dict[str, list[dict[str, Any]]] = {}
     for policy in policies:
@@ -298,7 +298,8 @@ def evaluate(
             :data:`davis_ag.benchmark.policies.DETERMINISTIC_PLAY`).
         cache_dir: The grid's observation cache folder.
         keep_episodes: Keep every episode in the results.
-        robot: A robot (name or YAML) the grid's camera rides on (:mod:`davis_ag.benchmark.robot_moves`).
+        robot: A robot (name or YAML) the camera rides on (:mod:`davis_ag.benchmark.robot_moves` on the
+            grid, :mod:`davis_ag.live.continuous_robot` on the continuous environment).
 
     Returns:
         The results, exactly what ``davis-ag evaluate --out`` writes.
@@ -326,10 +327,8 @@ def evaluate(
     kwargs: dict[str, Any] = {"dataset": dataset, "scenario": scenario, "split": split, "crop": crop}
     if env == "grid":
         kwargs["cache_dir"] = cache_dir
-        if robot is not None:
-            kwargs["robot"] = robot
-    elif robot is not None:
-        raise UserError("--robot works with the grid (TVM-v0) only, not yet with --env continuous")
+    if robot is not None:
+        kwargs["robot"] = robot
     made = gym.make(TVM_ID if env == "grid" else CONTINUOUS_ID, disable_env_checker=True, **kwargs)
     try:
         results = evaluate_policies(

@@ -78,9 +78,10 @@ def format_table(results: EvaluationResults | dict[str, Any]) -> str:
             )
         )
     if protocol.robot:
+        where = "views" if protocol.environment == "davis_ag/TVM-v0" else "poses"
         lines.append(
             f"robot {protocol.robot['name']} ({protocol.robot['urdf']}, definition {protocol.robot['digest']}): "
-            "moves only between views it reaches; OER gain per s = (mean OER_tau - mean OER_0) / mean seconds"
+            f"moves only between {where} it reaches; OER gain per s = (mean OER_tau - mean OER_0) / mean seconds"
         )
     if BEST_FIXED in policies:
         lines.append(

@@ -65,7 +65,7 @@ class RobotOnGrid:
 
     def record(self) -> dict[str, str]:
         """What a results file records of the robot: name, definition digest and URDF."""
-        return {"name": self.definition.name, "digest": self.definition.digest, "urdf": self.definition.urdf_source}
+        return self.definition.results_record()
 
     def seconds(self, scene: int, view: int, column: int) -> float:
         """Seconds of the move from ``view`` along pointer column ``column`` (the robot reaches both)."""
@@ -74,17 +74,7 @@ class RobotOnGrid:
     def info(self, scene: int, view: int, seconds: float, total: float) -> dict[str, Any]:
         """``info["robot"]`` at ``view`` of ``scene`` (see the module docstring)."""
         reach = self.reaches[scene]
-        return {
-            "name": self.definition.name,
-            "urdf": self.definition.urdf_source,
-            "digest": self.definition.digest,
-            "mount": reach.mount[view].tolist(),
-            "q": reach.urdf_q[view].tolist(),
-            "tool_frame": self.definition.tool_frame,
-            "camera_in_tool": self.camera_in_tool,
-            "seconds": seconds,
-            "seconds_total": total,
-        }
+        return self.definition.step_info(self.camera_in_tool, reach.mount[view], reach.urdf_q[view], seconds, total)
 
 
 def attach_robot(

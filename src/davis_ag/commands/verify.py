@@ -113,7 +113,7 @@ def verify_results(paths: list[Path], dataset: Path, cache_dir: Path | None = No
         if results.protocol.environment == "davis_ag/TVMContinuous-v0":
             from davis_ag.live.replay import replay_continuous
 
-            report = replay_continuous(results, dataset, str(path))
+            report = replay_continuous(results, dataset, str(path), robot)
         else:
             report = replay_grid(results, dataset, str(path), cache_dir, robot)
         print(report.text(), flush=True)

@@ -79,3 +79,25 @@ def grid_turn(settings: RecordedSettings) -> float:
     headings (30 for a grid of one heading)."""
     headings = settings.scenario.headings
     return 360.0 / headings if headings > 1 else 30.0
+
+
+def named_action(name: str, size: int) -> np.ndarray:
+    """A grid move's name as a full unit move along its axis (:data:`NAMED_MOVES`; ``done`` stands
+    still) in an action of ``size`` components.
+
+    Raises:
+        UserError: for a name with no such move here.
+    """
+    from davis_ag.errors import UserError
+
+    action = np.zeros(size, dtype=np.float32)
+    if name == "done":
+        return action
+    axis, sign = NAMED_MOVES.get(name, (size, 0.0))
+    if axis >= size:
+        names = [n for n, (a, _) in NAMED_MOVES.items() if a < size] + ["done"]
+        raise UserError(
+            f"invalid action {name!r}: this environment takes {', '.join(names)} or {size} numbers in [-1, 1]"
+        )
+    action[axis] = sign
+    return action

@@ -27,8 +27,11 @@ POSE_TOLERANCE = 1e-3
 OER_TOLERANCE = 0.01
 
 
-def replay_continuous(results: EvaluationResults, root: str | os.PathLike[str], where: str) -> ReplayReport:
-    """Replay a TVMContinuous-v0 results file on the dataset at ``root`` (see the module docstring).
+def replay_continuous(
+    results: EvaluationResults, root: str | os.PathLike[str], where: str, robot: str | None = None
+) -> ReplayReport:
+    """Replay a TVMContinuous-v0 results file on the dataset at ``root`` (see the module docstring);
+    with the file's robot (``robot``: its YAML where it is not built in).
 
     Raises:
         UserError: for a file that cannot be replayed or a dataset that is not one.
@@ -36,11 +39,12 @@ def replay_continuous(results: EvaluationResults, root: str | os.PathLike[str], 
     from davis_ag.live.tvm_continuous import TVMContinuousEnv
 
     def make_env(protocol: Any) -> TVMContinuousEnv:
+        rides = (robot or protocol.robot["name"]) if protocol.robot else None
         return TVMContinuousEnv(
-            root, protocol.scenario, protocol.split, crop=protocol.crop, aim=protocol.aim, tau=protocol.tau
+            root, protocol.scenario, protocol.split, crop=protocol.crop, aim=protocol.aim, tau=protocol.tau, robot=rides
         )
 
-    keys = ("scenario", "split", "tau", "aim", "scenes", "actions")
+    keys = ("scenario", "split", "tau", "aim", "scenes", "actions", "robot")
     return replay_on(results, root, where, "davis_ag/TVMContinuous-v0", make_env, keys, _replay_episode)
 
 

@@ -50,14 +50,15 @@ from davis_ag.benchmark.episode_rules import MAX_START_OER, can_start, episode_r
 from davis_ag.errors import UserError
 from davis_ag.generate.recorded_settings import RecordedSettings
 from davis_ag.live.continuous_moves import (
-    NAMED_MOVES,
     PITCH_RANGE,
     blocked_move,
     grid_bounds,
     grid_climb,
     grid_turn,
+    named_action,
     scene_folders,
 )
+from davis_ag.live.continuous_robot import RobotOnPoses
 from davis_ag.live.scene import LiveScene, LiveView, open_live_scene
 from davis_ag.scene.specs import SLIP_SIGMA, scenario_spec
 from davis_ag.scene.view_grid import Viewpoint, excluded
@@ -87,6 +88,8 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         size: int = OBS_SIZE,
         antialiasing: str = "none",
         render_mode: str | None = None,
+        robot: str | None = None,
+        budget_s: float | None = None,
     ) -> None:
         """Open (regrow or load) the scenes.
 
@@ -106,6 +109,8 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
             antialiasing: The renderer's: ``none`` (default: the fastest), ``fxaa`` or ``msaa``; ids are
                 exact in every mode.
             render_mode: None or ``"rgb_array"``.
+            robot, budget_s: The camera rides on this robot, its seconds spent at most ``budget_s``
+                (:mod:`davis_ag.live.continuous_robot`).
 
         Raises:
             UserError: for bad settings, or when no scene of ours matches.
@@ -139,6 +144,7 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
                         f"pass scenario={scene.settings.scenario.name!r}"
                     )
                 self.scenes.append(scene)
+            self.robot = RobotOnPoses.made(robot, folders, budget_s)
         except BaseException:
             self.close()
             raise
@@ -225,6 +231,8 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
             self._target = int(options.get("target", -1))
             if self._labels.box(self._target) is None:
                 raise UserError(f"fruit {self._target} has no box from pose {options['pose']}")
+            if self.robot is not None and not self.robot.start(self._scene, self._view.pose, rng):
+                raise UserError(f"the robot does not reach pose {options['pose']}")
         else:
             self._scene = int(options["scene"]) if "scene" in options else int(rng.integers(len(self.scenes)))
             self._start(rng)
@@ -250,7 +258,7 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
             view = self._pose(position, yaw, pitch)
             labels = self._draw(view)
             eligible = [f for f, oer in labels.oer.items() if can_start(oer, self.max_start_oer)]
-            if eligible:
+            if eligible and (self.robot is None or self.robot.start(self._scene, view.pose, rng)):
                 self._view, self._labels = view, labels
                 self._target = int(eligible[int(rng.integers(len(eligible)))])
                 return
@@ -267,18 +275,7 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         Raises:
             UserError: for a name with no such move here.
         """
-        size = self.action_space.shape[0]
-        action = np.zeros(size, dtype=np.float32)
-        if name == "done":
-            return action
-        axis, sign = NAMED_MOVES.get(name, (size, 0.0))
-        if axis >= size:
-            names = [n for n, (a, _) in NAMED_MOVES.items() if a < size] + ["done"]
-            raise UserError(
-                f"invalid action {name!r}: this environment takes {', '.join(names)} or {size} numbers in [-1, 1]"
-            )
-        action[axis] = sign
-        return action
+        return named_action(name, self.action_space.shape[0])
 
     def describe(self) -> dict[str, Any]:
         """What an evaluation's protocol records of this environment (its starts are drawn poses,
@@ -292,6 +289,7 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
             "scenes": [s.settings.metadata.scene for s in self.scenes],
             "dataset": self.dataset_root,
             "actions": ["dx", "dy", "dz", "dyaw", "dpitch"][: self.action_space.shape[0]],
+            "robot": self.robot.record() if self.robot is not None else None,
         }
 
     @property
@@ -363,11 +361,13 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
             raise UserError("the episode is over (or never started): call reset() first")
         view = self.proposed(action)
         self._refused, labels = self.try_pose(view)
+        if self.robot is not None:
+            self._refused = self.robot.check(self._scene, view.pose, self._refused)
         if not self._refused:
             self._view, self._labels = view, labels
         self._t += 1
         self._path.append(self._rounded_pose())
-        terminated = self._t >= self.tau
+        terminated = self._t >= self.tau or (self.robot is not None and self.robot.over_budget)
         reward = 0.0
         if terminated:
             self._over = True
@@ -419,7 +419,7 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         return obs
 
     def _info(self) -> dict[str, Any]:
-        return {
+        info = {
             "oer_0": self._oer_0,
             "oer_t": self.oer,
             "path": [list(p) for p in self._path],
@@ -428,6 +428,9 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
             "scene": self.scene.settings.metadata.scene,
             "steps": self._t,
         }
+        if self.robot is not None:
+            info["robot"] = self.robot.info(self._scene)
+        return info
 
     def render(self) -> np.ndarray | None:
         """``rgb_array``: the current view with the target's box outlined in red."""

@@ -33,7 +33,9 @@ import json
 from functools import cache
 from importlib import resources
 from pathlib import Path
+from typing import Any
 
+import numpy as np
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
@@ -83,6 +85,27 @@ class RobotDefinition(BaseModel):
         """SHA-256 (first 16 hex digits) of the definition as written: what a results file records."""
         text = json.dumps(self.model_dump(mode="json"), sort_keys=True)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+    def results_record(self) -> dict[str, str]:
+        """What a results file records of the robot: name, definition digest and URDF."""
+        return {"name": self.name, "digest": self.digest, "urdf": self.urdf_source}
+
+    def step_info(
+        self, camera_in_tool: list[list[float]], mount: np.ndarray, urdf_q: np.ndarray, seconds: float, total: float
+    ) -> dict[str, Any]:
+        """A step's ``info["robot"]``: what anyone can check with pinocchio on the URDF alone
+        (:mod:`davis_ag.benchmark.robot_moves` lists the fields)."""
+        return {
+            "name": self.name,
+            "urdf": self.urdf_source,
+            "digest": self.digest,
+            "mount": np.asarray(mount).tolist(),
+            "q": np.asarray(urdf_q).tolist(),
+            "tool_frame": self.tool_frame,
+            "camera_in_tool": camera_in_tool,
+            "seconds": seconds,
+            "seconds_total": total,
+        }
 
     @property
     def urdf_source(self) -> str:

@@ -169,7 +169,7 @@ def _visit_order(members: np.ndarray, pointers: np.ndarray, xs: np.ndarray) -> l
     return order
 
 
-def _home(robot: RobotModel, x: float, z: float) -> np.ndarray:
+def home_configuration(robot: RobotModel, x: float, z: float) -> np.ndarray:
     """The robot's home pose beside a camera at ``(x, z)``: the lift as near ``z`` as it goes."""
     q = np.zeros(robot.model.nq)  # type: ignore[attr-defined]
     q[RAIL] = x
@@ -213,7 +213,7 @@ def compute_reach(
         for i in _visit_order(members, pointers, poses[:, 0]):
             near = [int(j) for j in pointers[i] if j >= 0 and not np.isnan(q[j, 0])]
             near.sort(key=lambda j: float(np.linalg.norm(poses[j, :3] - poses[i, :3])))
-            seeds = [q[j] for j in near] + [_home(robot, poses[i, 0], poses[i, 2])]
+            seeds = [q[j] for j in near] + [home_configuration(robot, poses[i, 0], poses[i, 2])]
             seeds += random_seeds(robot, poses[i, 0], RESTARTS, rng)
             solution = reach_pose(robot, view_placement(poses[i]), seeds)
             if solution.ok:
