@@ -95,9 +95,8 @@ class ReproduceConfig:
 #: learner per group: about a night of such a machine per sitting's worth of groups, resumable
 #: (docs/crops.md is its page).
 #: ``mapping``: row mapping on five of the crops run's rows (apple-wall, VSP vine, capsicum, cherry
-#: tomato, olive), two row scenes each (one trains, one tests) at 320x180 with dataset seed 5 (scene 0
-#: of apple-wall is docs/robot.md's row), every baseline at three seen fractions, A2C and PPO trained
-#: 10K steps each on mapping: a smoke-scale learner beside the baselines (docs/mapping.md is its page).
+#: tomato, olive), one row scene each at 320x180 with dataset seed 5 (apple-wall's is docs/robot.md's
+#: row), every baseline at three seen fractions; no learner (docs/mapping.md is its page).
 #: Scene counts of Table 3 (SP strawberry, MP vine), what a configuration is measured against.
 PAPER_SCENES = (PAPER_TABLE3["sp", "strawberry"][0], PAPER_TABLE3["mp", "vine"][0])
 CONFIGS: dict[str, ReproduceConfig] = {
@@ -131,11 +130,12 @@ CONFIGS: dict[str, ReproduceConfig] = {
         "mapping",
         (320, 180),
         sp_scenes=0,
-        mp_scenes=2,
+        mp_scenes=1,
         mp_extent=None,
         sp_timesteps=0,
-        mp_timesteps=10_000,
+        mp_timesteps=0,
         seed=5,
+        learners=(),
         pairs=MAPPING_PAIRS,
         page="mapping",
     ),

@@ -60,7 +60,6 @@ def train_learner(
     timesteps: int,
     config: Any,
     settings: dict[str, Any] | None = None,
-    task: Any = None,
     **train_kwargs: Any,
 ) -> float | None:
     """Train one learner of a run on the train split, unless its finished model is reusable.
@@ -77,7 +76,6 @@ def train_learner(
         timesteps: Environment steps.
         config: The run's :class:`~davis_ag.workflows.reproduce.configs.ReproduceConfig` (seed, environments).
         settings: The algorithm's settings over ours (tests: a short PPO rollout); None: ours.
-        task: Another task than TVM-v0 (:class:`davis_ag.benchmark.training.TrainingTask`), in the stamp.
         **train_kwargs: Passed on to ``train_agent`` (tests: a small network, a callback).
 
     Returns:
@@ -88,9 +86,6 @@ def train_learner(
     stamp = model.with_suffix(".json")
     made = {"keep": "last", **load_json_object(stamp)}
     wanted = learner_stamp(algo, timesteps, settings)
-    if task is not None:  # only then: the stamps of TVM-v0's models stay as they were
-        wanted["task"] = {"name": task.name, **task.env_kwargs}
-        train_kwargs["task"] = task
     if (
         model.is_file()
         and all(made.get(k) == v for k, v in wanted.items())

@@ -5,10 +5,9 @@ For each row of the configuration in turn, each stage resumable: its scenes (fin
 skipped), their validation, then the mapping evaluation (Sweep, Rand, Greedy, the budget's bound)
 at each seen fraction of :data:`SEEN_FRACTIONS`, a results file each (reused when it is one of the
 same protocol and scenes), the coverage curves and, for the first row, one episode of the greedy
-planner and of the sweep drawn on its segment. Where the group has test scenes, the configuration's
-learners (A2C, PPO) are first trained on its train split (:mod:`davis_ag.mapping.training`) and
-scored beside the baselines at the default seen fraction; a group of one scene is scored on all its
-scenes without learners (``evaluation_split``). The page says which split.
+planner and of the sweep drawn on its segment. No learner is trained here yet (``train --task
+mapping`` trains one), so a group of one scene is scored on all its scenes (``evaluation_split``);
+the page says which split.
 """
 
 from __future__ import annotations
@@ -30,9 +29,8 @@ from davis_ag.workflows.reproduce.state import RunState
 SEEN_FRACTIONS = (0.3, SEEN_FRACTION, 0.7)
 
 
-def _reusable(path: Path, config: ReproduceConfig, scenes: list[str], rows: set[str]) -> MappingResults | None:
-    """An earlier evaluation of the same protocol and scenes with every row of ``rows``, or None to
-    evaluate anew (a learner trained since is scored with every row again: the episodes are seeded)."""
+def _reusable(path: Path, config: ReproduceConfig, scenes: list[str]) -> MappingResults | None:
+    """An earlier evaluation of the same protocol and scenes, or None to evaluate anew."""
     from davis_ag.mapping.results import load_mapping_results
 
     if not path.is_file():
@@ -43,7 +41,7 @@ def _reusable(path: Path, config: ReproduceConfig, scenes: list[str], rows: set[
         return None
     p = results.protocol
     same = (p.episodes, p.sessions, p.seed, p.scenes) == (config.episodes, config.sessions, config.seed, scenes)
-    return results if same and rows <= set(results.policies) else None
+    return results if same else None
 
 
 def _draw_episodes(results: MappingResults, root: Path, images: Path, key: str) -> None:
@@ -81,11 +79,9 @@ def reproduce_mapping(
     from davis_ag.generate.one_scene import SceneRequest
     from davis_ag.mapping.evaluation import evaluate_mapping
     from davis_ag.mapping.results import mapping_table
-    from davis_ag.mapping.training import mapping_task
     from davis_ag.provenance import code_version, machine_summary
     from davis_ag.scene.camera import Camera
     from davis_ag.workflows.reproduce.clock import CLOCK_FILE, StageClock
-    from davis_ag.workflows.reproduce.learners import model_path, train_learner
     from davis_ag.workflows.reproduce.run import split_scene_ids, stage_recorder, validate_once
     from davis_ag.workflows.stages import evaluation_split, generate_scenes
 
@@ -112,27 +108,13 @@ def reproduce_mapping(
             return 1
         split = evaluation_split(root, scenario_name, crop_name)
         scenes = split_scene_ids(root, scenario_name, split, crop_name)
-        models = []
-        if config.learners and split == "test":  # learners need scenes they did not learn from
-            for algo in config.learners:
-                model = model_path(out, key, algo)
-                began = time.perf_counter()
-                stage = f"{key}: train {algo.upper()}"
-                timesteps = config.timesteps(scenario_name)
-                if train_learner(algo, root, scenario_name, crop_name, model, timesteps, config, task=mapping_task()):
-                    record(stage, time.perf_counter() - began, f"{timesteps} steps on the train split")
-                models.append(model)
         for fraction in SEEN_FRACTIONS:
             path = out / "results" / results_name(key, fraction)
-            # The learners trained at the default fraction are scored there; the others map the
-            # baselines alone (how the measure moves, not the policies).
-            playing = models if fraction == SEEN_FRACTION else []
-            rows = {"Sweep", "Rand", "Greedy"} | {m.name.split("_")[0].upper() for m in playing}
-            if _reusable(path, config, scenes, rows) is None:
+            if _reusable(path, config, scenes) is None:
                 began = time.perf_counter()
                 results = evaluate_mapping(
-                    [str(m) for m in playing], root, scenario_name, split, config.sessions, config.episodes,
-                    config.seed, crop=crop_name, seen_fraction=fraction,
+                    [], root, scenario_name, split, config.sessions, config.episodes, config.seed,
+                    crop=crop_name, seen_fraction=fraction,
                 )  # fmt: skip
                 path.parent.mkdir(parents=True, exist_ok=True)
                 write_or_rescue(path, results.write, "the results")
