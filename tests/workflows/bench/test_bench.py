@@ -186,3 +186,26 @@ def test_a_gpu_machine_asks_for_the_pages_gpu_sections(
     err = capsys.readouterr().err.strip()
     assert f"<!-- {missing}:start -->" in err and "\n" not in err
     assert page.read_text() == text
+
+
+def test_the_continuous_rate_with_a_robot_is_written_under_its_table() -> None:
+    from davis_ag.workflows.bench.report import continuous_table
+
+    result = {
+        "steps_per_second": 40.0,
+        "cpu_ms_per_step": 20.0,
+        "steps": 600,
+        "resets": 200,
+        "refused_share": 0.5,
+        "render_and_label_ms": 10.0,
+        "draws_per_step": 1.5,
+        "draws_per_reset": 3.0,
+        "open_and_first_reset_s": 1.0,
+        "target_min": 50.0,
+        "triangles": 1000,
+        "triangles_drawn": 900,
+    }
+    assert "camera on" not in continuous_table(result, (1.0, 1.0))  # a report from before the robot
+    robot = {"name": "ur10-lift", "steps_per_second": 31.5, "cpu_ms_per_step": 25.0, "refused_share": 0.6}
+    text = continuous_table({**result, "robot": robot}, (1.0, 1.0))
+    assert "With the camera on ur10-lift" in text and "**31.5 steps/s**" in text and "60% of moves refused" in text

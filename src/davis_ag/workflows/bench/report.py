@@ -106,7 +106,18 @@ def continuous_table(result: dict, load: tuple[float, float]) -> str:
         f"| {result['steps']} | {result['resets']} | {result['refused_share']:.0%} | "
         f"{result['draws_per_step']} ({result['draws_per_reset']}) | "
         f"{result['render_and_label_ms']} | {result['open_and_first_reset_s']} | {result['cpu_ms_per_step']} | "
-        f"**{result['steps_per_second']}** | >= {result['target_min']:.0f} ({met}) |"
+        f"**{result['steps_per_second']}** | >= {result['target_min']:.0f} ({met}) |" + _with_robot(result.get("robot"))
+    )
+
+
+def _with_robot(robot: dict | None) -> str:
+    """The rate with the camera on a robot, as a sentence under the table (none in older reports)."""
+    if not robot:
+        return ""
+    return (
+        f"\n\nWith the camera on {robot['name']} (docs/robot.md: the arm solved from its configuration "
+        f"at every move): **{robot['steps_per_second']} steps/s**, {robot['cpu_ms_per_step']} ms of CPU per "
+        f"step, {robot['refused_share']:.0%} of moves refused (the robot issue's target: at least 50)."
     )
 
 
