@@ -62,6 +62,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="ROBOT.yaml",
         help="with --dataset: the YAML of the robot a results file was evaluated with, where it is not built in",
     )
+    parser.add_argument(
+        "--policy",
+        action="append",
+        default=[],
+        metavar="NAME=SPEC",
+        help="with --dataset: also play row NAME's episodes again with its code (SPEC as evaluate --policy "
+        "takes it: file.py:function, file.py:Class, module:attr, MODEL.zip), which must have the digest the "
+        "file records and give every recorded action (repeatable)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -71,7 +80,13 @@ def run(args: argparse.Namespace) -> int:
     if args.dataset is not None:
         if args.keep is not None:
             raise UserError("--keep is for scenes made again; with --dataset nothing is made: leave it out")
-        return verify_results(args.scenes, args.dataset, args.cache_dir, args.robot)
+        from davis_ag.workflows.rerun import parse_policy_arguments
+
+        return verify_results(
+            args.scenes, args.dataset, args.cache_dir, args.robot, parse_policy_arguments(args.policy)
+        )
+    if args.policy:
+        raise UserError("--policy re-runs a results file's row: give the results files and --dataset DATA")
     if files := [p for p in args.scenes if p.suffix == ".json"]:
         raise UserError(f"{files[0]}: to verify results, give the dataset they evaluated: --dataset DATA")
     from davis_ag.generate.regenerate import verify_scene
@@ -88,8 +103,15 @@ def run(args: argparse.Namespace) -> int:
     return 0 if same == len(verdicts) else 1
 
 
-def verify_results(paths: list[Path], dataset: Path, cache_dir: Path | None = None, robot: str | None = None) -> int:
-    """Replay each results file on ``dataset`` (:mod:`davis_ag.benchmark.replay`); 0 when all are sound.
+def verify_results(
+    paths: list[Path],
+    dataset: Path,
+    cache_dir: Path | None = None,
+    robot: str | None = None,
+    policies: dict[str, str] | None = None,
+) -> int:
+    """Replay each results file on ``dataset`` (:mod:`davis_ag.benchmark.replay`), and play each row
+    named in ``policies`` again with its code (:mod:`davis_ag.workflows.rerun`); 0 when all are sound.
 
     Raises:
         UserError: for a file that is not results, holds a summary its episodes do not give, or
@@ -97,30 +119,41 @@ def verify_results(paths: list[Path], dataset: Path, cache_dir: Path | None = No
     """
     from davis_ag.benchmark.replay import replay_grid
     from davis_ag.benchmark.results import load_results
+    from davis_ag.errors import UserError
     from davis_ag.mapping.results import is_mapping_results
+    from davis_ag.workflows.rerun import rerun_row
 
-    reports = []
+    policies = policies or {}
+    reports: list[Any] = []
     for path in paths:
+        results: Any
         if is_mapping_results(path):
             from davis_ag.mapping.evaluation import replay_mapping
             from davis_ag.mapping.results import load_mapping_results
 
-            report = replay_mapping(load_mapping_results(path), dataset, str(path), cache_dir, robot)
-            print(report.text(), flush=True)
-            reports.append(report)
-            continue
-        results = load_results(path)  # every summary made again from the episodes first
-        if results.protocol.environment == "davis_ag/TVMContinuous-v0":
-            from davis_ag.live.replay import replay_continuous
-
-            report = replay_continuous(results, dataset, str(path), robot)
+            results = load_mapping_results(path)
+            report: Any = replay_mapping(results, dataset, str(path), cache_dir, robot)
         else:
-            report = replay_grid(results, dataset, str(path), cache_dir, robot)
+            results = load_results(path)  # every summary made again from the episodes first
+            if results.protocol.environment == "davis_ag/TVMContinuous-v0":
+                from davis_ag.live.replay import replay_continuous
+
+                report = replay_continuous(results, dataset, str(path), robot)
+            else:
+                report = replay_grid(results, dataset, str(path), cache_dir, robot)
         print(report.text(), flush=True)
         reports.append(report)
+        missing = [name for name in policies if name not in results.policies]
+        if len(paths) == 1 and missing:
+            raise UserError(f"{path}: has no row {missing[0]!r} (its rows: {', '.join(results.policies)})")
+        for name, spec in policies.items():
+            if report.sound and name in results.policies:
+                rerun = rerun_row(path, results, dataset, name, spec, cache_dir, robot)
+                print(rerun.text(), flush=True)
+                reports.append(rerun)
     sound = sum(r.sound for r in reports)
     if len(reports) > 1:
-        print(f"{sound} of {len(reports)} results files sound")
+        print(f"{sound} of {len(reports)} {'checks' if policies else 'results files'} sound")
     return 0 if sound == len(reports) else 1
 
 
