@@ -36,6 +36,7 @@ def test_the_page_runs_as_written(
         ("bash", None),
         ("python", None),
         ("bash", None),
+        ("bash", None),
     ]
     for language, name, body in page:
         if name:
@@ -61,4 +62,13 @@ def test_the_page_runs_as_written(
     # A leaderboard maintainer's check: both files replay sound on the dataset, and rank as before.
     assert "heuristic.json: sound: 900 episodes of 6 policies replayed on the dataset" in printed
     assert "ppo.json: sound: 900 episodes of 6 policies" in printed
-    assert Path("verified.md").read_text() == board
+    verified = Path("verified.md").read_text()  # the same rows, each marked how it was checked
+    assert "| Checked |" in verified and "| ours |" in verified and "| replayed |" in verified
+    assert [line.split("|")[2] for line in verified.splitlines() if line.startswith("| ")] == [
+        line.split("|")[2] for line in board.splitlines() if line.startswith("| ")
+    ]
+    # Its re-run: the rows' code plays every episode again with the same actions.
+    assert "toward_target re-run sound with my_policy.py:toward_target: 150 episodes played again" in printed
+    assert "PPO re-run sound with ppo.zip: 150 episodes played again" in printed
+    checked = Path("rerun.md").read_text()
+    assert "| re-run |" in checked and "| ours |" in checked

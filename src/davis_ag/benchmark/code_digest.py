@@ -85,3 +85,12 @@ def code_digest(policy: Policy) -> CodeDigest:
         thing = getattr(policy, "function", None) or type(policy)
         sha, of, name = hashlib.sha256(getattr(thing, "__qualname__", repr(thing)).encode()).hexdigest(), "name", None
     return CodeDigest(sha256=sha, of=of, file=name, package=__version__, commit=source_revision())
+
+
+def is_davis_ag_code(digest: CodeDigest | None) -> bool:
+    """Whether a row's digest is of a file of this davis-ag as installed (a baseline of ours), byte
+    for byte: a leaderboard needs no one's code to re-run such a row (the replay checks it)."""
+    if digest is None or digest.of != "source" or not digest.file:
+        return False
+    package = Path(__file__).resolve().parents[1]
+    return any(file_sha256(path) == digest.sha256 for path in package.rglob(digest.file))

@@ -42,6 +42,8 @@ class Row:
     results: EvaluationResults
     policy: PolicyResult
     gaps: dict[str, PairedGap | None]
+    #: How a maintainer checked the row (``compare --verify``): ``re-run``, ``ours``, ``replayed``; "" unchecked.
+    check: str = ""
 
 
 def _identity(results: EvaluationResults) -> dict[str, object]:
@@ -227,6 +229,7 @@ def format_leaderboard(rows: list[Row]) -> str:
     datasets = {r.results.dataset.fingerprint: len(r.results.dataset.scenes) for r in rows if r.results.dataset}
     held = ", ".join(f"{fingerprint} ({count} scenes)" for fingerprint, count in datasets.items())
     baselines = [b for b in PAIRED_BASELINES if any(r.gaps.get(b) for r in rows)]
+    checked = any(r.check for r in rows)
     lines = [
         f"# Leaderboard: {protocol.scenario.upper()}{' ' + protocol.crop if protocol.crop else ''}, "
         f"{protocol.environment}, {protocol.split} split",
@@ -237,8 +240,9 @@ def format_leaderboard(rows: list[Row]) -> str:
         "| Rank | Method | OER_tau | Cum. reward | Ep. length | "
         + " | ".join(f"Gap to {b} [95 %]" for b in baselines)
         + (" | " if baselines else "")
-        + "Code | File |",
-        "|---:|---|---:|---:|---:|" + "---:|" * len(baselines) + "---|---|",
+        + "Code | File |"
+        + (" Checked |" if checked else ""),
+        "|---:|---|---:|---:|---:|" + "---:|" * len(baselines) + "---|---|" + ("---|" if checked else ""),
     ]
     for rank, row in enumerate(rows, 1):
         p = row.policy
@@ -247,6 +251,7 @@ def format_leaderboard(rows: list[Row]) -> str:
         ]
         code = f"`{p.digest.short()}`" if p.digest is not None else "-"
         cells += [_gap_cell(row.gaps.get(b)) for b in baselines] + [code, row.file.name]
+        cells += [row.check or "-"] if checked else []
         lines.append("| " + " | ".join(cells) + " |")
     lines += [
         "",
@@ -255,6 +260,13 @@ def format_leaderboard(rows: list[Row]) -> str:
         f"`scenes`, over the test scenes resampled (would it hold on other scenes like these? coarse below "
         f"{FEW_SCENES} scenes); `-`: the baseline itself, or a method that did not play the same episodes. "
         "Code: the first digits of the SHA-256 of what played (the model's zip, the policy's source file; "
-        "`-`: results from before digests), recorded with davis-ag's version and commit.",
+        "`-`: results from before digests), recorded with davis-ag's version and commit."
+        + (
+            " Checked (`compare --verify`): `re-run`, its code played every episode again with the same "
+            "actions; `ours`, a davis-ag baseline, its episodes replayed; `replayed`, its episodes replayed "
+            "on the dataset but its code not run."
+            if checked
+            else ""
+        ),
     ]
     return "\n".join(lines) + "\n"

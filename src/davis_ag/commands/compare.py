@@ -4,8 +4,10 @@ protocol, with each method's paired gaps to the baselines."""
 from __future__ import annotations
 
 import argparse
+from typing import Any
 
 from davis_ag.commands import arguments
+from davis_ag.errors import UserError
 
 HELP = "rank methods of several results files (a leaderboard with paired gaps)"
 DESCRIPTION = (
@@ -40,6 +42,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="DATA",
         help="replay every file's episodes on this dataset first (davis-ag verify) and rank only sound files",
     )
+    parser.add_argument(
+        "--policy",
+        action="append",
+        default=[],
+        metavar="NAME=SPEC",
+        help="with --verify: play row NAME's episodes again with its code (as verify --policy) and rank only "
+        "rows re-run so and davis-ag's own baselines (repeatable)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -51,29 +61,59 @@ def run(args: argparse.Namespace) -> int:
 
     reads = [(path, "RESULTS") for path in args.results]
     with claim_output(args.out, force=args.force, reads=reads) if args.out else nullcontext():  # the output rule
+        from davis_ag.workflows.stages.rerun import parse_policy_arguments
+
+        policies = parse_policy_arguments(args.policy)
+        if policies and args.verify is None:
+            raise UserError("--policy re-runs rows on the dataset: give --verify DATA too")
         if args.verify is not None:
             from davis_ag.commands.verify import verify_results
 
-            if verify_results(args.results, args.verify) != 0:
-                print("not ranked: a file above is not sound on the dataset", flush=True)
+            if verify_results(args.results, args.verify, policies=policies) != 0:
+                print("not ranked: a check above is not sound", flush=True)
                 return 1
-        page = _page(args.results)
+        page = _page(args.results, policies if args.verify is not None else None)
         print(page, end="")
         if args.out:
             print(f"wrote {write_text_atomic(args.out, page)}")
     return 0
 
 
-def _page(paths: list) -> str:
-    """The leaderboard of the files: row mapping's when they hold mapping results, else Table 4's."""
+def _check(name: str, digest: Any, policies: dict[str, str]) -> str:
+    """How ``compare --verify`` checked a row: ``re-run`` with its code, ``ours`` (a davis-ag
+    baseline), else ``replayed``; "" (left out) for such a row when rows' code was given."""
+    from davis_ag.benchmark.code_digest import is_davis_ag_code
+
+    if name in policies:
+        return "re-run"
+    if is_davis_ag_code(digest):
+        return "ours"
+    return "" if policies else "replayed"
+
+
+def _page(paths: list, policies: dict[str, str] | None = None) -> str:
+    """The leaderboard of the files: row mapping's when they hold mapping results, else Table 4's;
+    with ``policies`` (``--verify``) each row says how it was checked."""
     from davis_ag.benchmark.leaderboard import format_leaderboard, leaderboard
-    from davis_ag.errors import UserError
     from davis_ag.mapping.leaderboard import mapping_leaderboard
     from davis_ag.mapping.results import is_mapping_results
 
     kinds = {is_mapping_results(path) for path in paths}
-    if kinds == {True}:
-        return mapping_leaderboard(paths)
     if len(kinds) > 1:
         raise UserError("the files mix row-mapping and target-visibility results: compare each task's files apart")
-    return format_leaderboard(leaderboard(paths))
+    if kinds == {True}:
+        checks = (lambda name, row: _check(name, row.digest, policies)) if policies is not None else None
+        return mapping_leaderboard(paths, checks)
+    rows = leaderboard(paths)
+    if policies is None:
+        return format_leaderboard(rows)
+    for row in rows:
+        row.check = _check(row.base, row.policy.digest, policies)
+    ranked = [row for row in rows if row.check]
+    if not ranked:
+        raise UserError("no row is left to rank: give each method's code with --policy NAME=SPEC")
+    page = format_leaderboard(ranked)
+    left = [f"{row.name} ({row.file.name})" for row in rows if not row.check]
+    if left:
+        page += f"\nNot ranked (their code was not re-run: give --policy NAME=SPEC): {', '.join(left)}.\n"
+    return page

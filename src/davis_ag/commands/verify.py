@@ -80,7 +80,7 @@ def run(args: argparse.Namespace) -> int:
     if args.dataset is not None:
         if args.keep is not None:
             raise UserError("--keep is for scenes made again; with --dataset nothing is made: leave it out")
-        from davis_ag.workflows.rerun import parse_policy_arguments
+        from davis_ag.workflows.stages.rerun import parse_policy_arguments
 
         return verify_results(
             args.scenes, args.dataset, args.cache_dir, args.robot, parse_policy_arguments(args.policy)
@@ -111,7 +111,7 @@ def verify_results(
     policies: dict[str, str] | None = None,
 ) -> int:
     """Replay each results file on ``dataset`` (:mod:`davis_ag.benchmark.replay`), and play each row
-    named in ``policies`` again with its code (:mod:`davis_ag.workflows.rerun`); 0 when all are sound.
+    named in ``policies`` again with its code (:mod:`davis_ag.workflows.stages.rerun`); 0 when all are sound.
 
     Raises:
         UserError: for a file that is not results, holds a summary its episodes do not give, or
@@ -121,7 +121,7 @@ def verify_results(
     from davis_ag.benchmark.results import load_results
     from davis_ag.errors import UserError
     from davis_ag.mapping.results import is_mapping_results
-    from davis_ag.workflows.rerun import rerun_row
+    from davis_ag.workflows.stages.rerun import rerun_row
 
     policies = policies or {}
     reports: list[Any] = []

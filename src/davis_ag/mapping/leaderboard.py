@@ -9,7 +9,9 @@ seen fraction and robot. Anything else is refused in one line, naming what diffe
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 from davis_ag.benchmark.results import table_number
 from davis_ag.errors import UserError
@@ -36,9 +38,14 @@ def _identity(results: MappingResults) -> dict[str, object]:
     }
 
 
-def mapping_leaderboard(paths: list[str | os.PathLike[str]]) -> str:
+def mapping_leaderboard(paths: list[str | os.PathLike[str]], checks: Callable[[str, Any], str] | None = None) -> str:
     """Read the files (every summary made again from its episodes), check they measure the same
     thing and rank every method by coverage.
+
+    Args:
+        paths: The results files.
+        checks: How a maintainer checked each row (``compare --verify``): ``(name, row) -> check``;
+            a row whose check is "" is left out of the ranking and named under it.
 
     Returns:
         A Markdown page: what the numbers rest on, then the table.
@@ -57,11 +64,17 @@ def mapping_leaderboard(paths: list[str | os.PathLike[str]]) -> str:
                 f"{path} and {first_path} measure different things ({differs}: {other[differs]} vs "
                 f"{reference[differs]}): rank only results of one dataset, split and protocol"
             )
-    rows = []
+    rows, left_out = [], []
     for path, results in files:
         for name, row in results.policies.items():
             digest = row.digest.short() if row.digest is not None else "-"
-            rows.append((row.coverage.mean, name, path.name, row, digest))
+            check = checks(name, row) if checks is not None else "-"
+            if not check:
+                left_out.append(f"{name} ({path.name})")
+                continue
+            rows.append((row.coverage.mean, name, path.name, row, digest, check))
+    if not rows:
+        raise UserError("no row is left to rank: give each method's code with --policy NAME=SPEC")
     rows.sort(key=lambda r: -r[0])
     p = first.protocol
     lines = [
@@ -69,14 +82,18 @@ def mapping_leaderboard(paths: list[str | os.PathLike[str]]) -> str:
         f"budget {p.budget} moves, seen at a visible fraction of {p.seen_fraction:g}"
         f"{', robot ' + p.robot['name'] if p.robot else ''}; {p.sessions} x {p.episodes} episodes per file",
         "",
-        "| rank | policy | file | coverage | curve area | 50 % of reachable | 80 % of reachable | code |",
-        "|---|---|---|---|---|---|---|---|",
+        "| rank | policy | file | coverage | curve area | 50 % of reachable | 80 % of reachable | code | checked |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
-    for rank, (_, name, file, row, digest) in enumerate(rows, 1):
+    for rank, (_, name, file, row, digest, check) in enumerate(rows, 1):
         lines.append(
             f"| {rank} | {name} | {file} | {table_number(row.coverage.mean)} ± {table_number(row.coverage.std)} "
-            f"| {table_number(row.area.mean)} | {row.reach_50.mean:.0%} | {row.reach_80.mean:.0%} | {digest} |"
+            f"| {table_number(row.area.mean)} | {row.reach_50.mean:.0%} | {row.reach_80.mean:.0%} | {digest} | {check} |"
         )
     any_row = rows[0][3]
-    lines.append(f"| - | Bound: the best {p.budget + 1} views | - | {table_number(any_row.bound)} | - | - | - | - |")
+    lines.append(
+        f"| - | Bound: the best {p.budget + 1} views | - | {table_number(any_row.bound)} | - | - | - | - | - |"
+    )
+    if left_out:
+        lines += ["", f"Not ranked (their code was not re-run: give --policy NAME=SPEC): {', '.join(left_out)}."]
     return "\n".join(lines) + "\n"

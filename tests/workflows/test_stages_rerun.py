@@ -11,7 +11,7 @@ from davis_ag.benchmark.evaluation import evaluate
 from davis_ag.cli import main
 from davis_ag.errors import UserError
 from davis_ag.mapping.evaluation import evaluate_mapping
-from davis_ag.workflows.rerun import parse_policy_arguments
+from davis_ag.workflows.stages.rerun import parse_policy_arguments
 from layout_factory import write_tiny_dataset
 
 POLICY = '''
@@ -115,3 +115,21 @@ def test_an_unknown_row_and_a_missing_file_are_one_line(
     assert main(["verify", str(path), "--dataset", str(data), "--policy", "toward=missing.py:toward"]) == 2
     err = capsys.readouterr().err
     assert "missing.py" in err and len(err.strip().splitlines()) == 1
+
+
+def test_compare_ranks_only_rows_re_run_and_ours(setup: tuple[Path, Path], capsys: pytest.CaptureFixture[str]) -> None:
+    data, folder = setup
+    mine, drawn = f"{folder}/mine.py:toward", f"{folder}/mine.py:Drawn"
+    path = _evaluated(data, folder, mine, drawn)
+    assert main(["compare", str(path), "--verify", str(data), "--policy", f"toward={mine}"]) == 0
+    out = capsys.readouterr().out
+    rows = {
+        line.split("|")[2].strip(): line.split("|")[-2].strip()
+        for line in out.splitlines()
+        if line.startswith("| ") and line[2].isdigit()
+    }
+    assert rows["toward"] == "re-run" and rows["Oracle"] == "ours" and rows["Rand"] == "ours"
+    assert "Drawn" not in rows and "Not ranked (their code was not re-run" in out and "Drawn (" in out
+    assert main(["compare", str(path), "--policy", f"toward={mine}"]) == 2  # a re-run needs the dataset
+    assert main(["compare", str(path), "--verify", str(data)]) == 0
+    assert "| replayed |" in capsys.readouterr().out  # without code given: every row, marked replayed
