@@ -57,8 +57,8 @@ def verify_speed(scratch: Path) -> dict[str, Any]:
     from davis_ag.generate.one_scene import SceneRequest
     from davis_ag.scene.camera import Camera
     from davis_ag.scene.specs import CROPS, scenario_spec
-    from davis_ag.workflows.stages.rerun import rerun_row
     from davis_ag.workflows.stages import generate_scenes
+    from davis_ag.workflows.stages.rerun import rerun_row
 
     crop = CROPS["strawberry"]
     root = scratch / "verify"
