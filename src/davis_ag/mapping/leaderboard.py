@@ -88,7 +88,7 @@ def mapping_leaderboard(paths: list[str | os.PathLike[str]], checks: Callable[[s
     for rank, (_, name, file, row, digest, check) in enumerate(rows, 1):
         lines.append(
             f"| {rank} | {name} | {file} | {table_number(row.coverage.mean)} ± {table_number(row.coverage.std)} "
-            f"| {table_number(row.area.mean)} | {row.reach_50.mean:.0%} | {row.reach_80.mean:.0%} | {digest} | {check} |"
+            f"| {table_number(row.area.mean)} | {row.reach_50.mean:.1%} | {row.reach_80.mean:.1%} | {digest} | {check} |"
         )
     any_row = rows[0][3]
     lines.append(

@@ -272,14 +272,17 @@ def mapping_table(results: MappingResults) -> str:
     def moves(value: float | None) -> str:
         return f"{value:.1f}" if value is not None else "never"
 
+    def share(value: float) -> str:  # one decimal: 1 episode in 600 is not 0 %
+        return f"{value:.1%}"
+
     for name, row in ordered:
         cells = [
             name,
             f"{table_number(row.coverage.mean)} ± {table_number(row.coverage.std)}",
             table_number(row.area.mean),
-            f"{row.reach_50.mean:.0%}",
+            share(row.reach_50.mean),
             moves(row.moves_50),
-            f"{row.reach_80.mean:.0%}",
+            share(row.reach_80.mean),
             moves(row.moves_80),
         ]
         if robot:
@@ -290,7 +293,7 @@ def mapping_table(results: MappingResults) -> str:
     bound_name = f"Bound: the best {protocol.budget + 1} views{'' if exact else ' (proven upper bound)'}"
     blank = " | ".join(["-"] * (len(rows[0].split("|")) - 4))
     rows.append(f"| {bound_name} | {table_number(any_row.bound)} | {blank} |")
-    rows.append(f"| Ceiling: every view of the start's part | {table_number(any_row.part_ceiling)} | {blank} |")
+    rows.append(f"| Ceiling: every view of the start's alley | {table_number(any_row.part_ceiling)} | {blank} |")
     fruit = sum(s.fruit for s in results.segments.values())
     ceiling = sum(s.ceiling for s in results.segments.values())
     reached = " the robot reaches" if robot else ""

@@ -29,8 +29,9 @@ def _ladder(runs: dict[str, dict[float, MappingResults]]) -> list[str]:
     """The crops from hardest to easiest to map: by the greedy planner's coverage (perfect
     perception: what is left is the row's own difficulty), with the bound and the ceilings."""
     rows = [
-        "| rank | row | fruit on the segment | Greedy | Sweep | Rand | bound | ceiling of the start's alley | grid ceiling |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "| rank | row | fruit on the segment | budget, moves | Greedy | Sweep | Rand | bound | ceiling of the start's alley "
+        "| grid ceiling |",
+        "|---|---|---|---|---|---|---|---|---|---|",
     ]
     main = {key: by_fraction[SEEN_FRACTION] for key, by_fraction in runs.items() if SEEN_FRACTION in by_fraction}
     ordered = sorted(main.items(), key=lambda item: item[1].policies["Greedy"].coverage.mean)
@@ -41,7 +42,7 @@ def _ladder(runs: dict[str, dict[float, MappingResults]]) -> list[str]:
         ceiling = sum(s.ceiling for s in results.segments.values()) / fruit
         cells = [table_number(policies[n].coverage.mean) if n in policies else "-" for n in ("Greedy", "Sweep", "Rand")]
         rows.append(
-            f"| {rank} | {key} | {fruit} | {' | '.join(cells)} | {table_number(first.bound)} | "
+            f"| {rank} | {key} | {fruit} | {results.protocol.budget} | {' | '.join(cells)} | {table_number(first.bound)} | "
             f"{table_number(first.part_ceiling)} | {table_number(ceiling)} |"
         )
     return rows
@@ -81,7 +82,7 @@ def mapping_section(runs: dict[str, dict[float, MappingResults]], images: Path, 
     link = Path(os.path.relpath(images, page.parent)).as_posix()
     lines = [
         f"{len(runs)} rows, {p.sessions} sessions x {p.episodes} episodes each, seed {p.seed}, split {p.split}, "
-        f"a budget of {p.budget} moves (the sweep's) on the {p.scenario} grid; a fruit counts as seen at a visible "
+        f"each row's budget the sweep's length on its {p.scenario} grid; a fruit counts as seen at a visible "
         f"fraction of {SEEN_FRACTION:g}. Written by `davis-ag reproduce --config mapping`.",
         "",
         "### The ladder: which row is hardest to map",
