@@ -12,12 +12,14 @@ from PIL import Image
 
 import davis_ag  # noqa: F401 - registers the environments
 from davis_ag.benchmark import CONTINUOUS_ID, TVMEnv
+from davis_ag.environments import MAPPING_ID
 from davis_ag.errors import UserError
 from layout_factory import write_original_style_dataset
 
 #: Every grid environment registered; TVMContinuous-v0 renders scenes of ours, so it is checked
 #: on a generated scene in tests/live/test_tvm_continuous.py, not on these tiny layout datasets.
-ENV_IDS = sorted(i for i in gymnasium.registry if i.startswith("davis_ag/") and i != CONTINUOUS_ID)
+# TVM-v0's ids: the continuous environment and row mapping have tests of their own (tests/live, tests/mapping).
+ENV_IDS = sorted(i for i in gymnasium.registry if i.startswith("davis_ag/") and i not in (CONTINUOUS_ID, MAPPING_ID))
 
 
 def _episode(env: gymnasium.Env, seed: int, actions: list[int]) -> list:
