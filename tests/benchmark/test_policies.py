@@ -11,7 +11,8 @@ import pytest
 from davis_ag.benchmark import TVMEnv, evaluate
 from davis_ag.benchmark.evaluation import evaluate_policies
 from davis_ag.benchmark.exact import start_expectations
-from davis_ag.benchmark.policies import ModelPolicy, Policy, model_algorithm, policy_from_spec
+from davis_ag.benchmark.policies import ModelPolicy, Policy, policy_from_spec
+from davis_ag.benchmark.sb3_models import model_algorithm
 from davis_ag.errors import UserError
 
 POLICY_FILE = """

@@ -207,7 +207,7 @@ def test_a_seed_makes_the_same_model_bit_for_bit_and_another_seed_another(
     """Every random choice of a training run flows from its seed: two uninterrupted runs of the
     same seed on the same machine keep the same snapshot with the same weights (what lets a
     reproduce run's learner rows be made again), and another seed trains another model."""
-    from davis_ag.benchmark.policies import load_model
+    from davis_ag.benchmark.sb3_models import load_model
     from davis_ag.benchmark.training import train_agent
 
     root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=3)
@@ -444,7 +444,7 @@ def test_ppo_and_dqn_train_resume_and_keep_the_best(
     import stable_baselines3
 
     from davis_ag.benchmark import algorithms, progress, training
-    from davis_ag.benchmark.policies import model_algorithm
+    from davis_ag.benchmark.sb3_models import model_algorithm
 
     out = tmp_path / algo
     short = {"ppo": {"n_steps": 20, "batch_size": 20}, "dqn": {"learning_starts": 40}}[

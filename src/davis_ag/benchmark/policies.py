@@ -12,8 +12,10 @@ does not fit raises :class:`davis_ag.errors.UserError` there.
 
 A SPEC (``davis-ag evaluate --policy``, :func:`policy_from_spec`) is one of:
 
-- ``MODEL.zip``: a saved Stable-Baselines3 model of any algorithm; the algorithm is read from
-  the file (:func:`model_algorithm`) and names the row (``PPO``, ``A2C``, ``DQN``...);
+- ``MODEL.zip``: a saved Stable-Baselines3 or sb3-contrib model; the algorithm is read from
+  the file (:func:`davis_ag.benchmark.sb3_models.model_algorithm`) and names the row (``PPO``,
+  ``A2C``, ``DQN``, ``RecurrentPPO``...). A recurrent policy keeps its LSTM state through an
+  episode and starts each afresh; MaskablePPO is given the environment's ``action_masks()``;
 - ``module:attr`` or ``path/to/file.py:attr``: a callable ``(observation, info) -> action``, a
   class with ``reset``/``act`` (made with no arguments) or such an object.
 """
@@ -23,10 +25,8 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import inspect
-import json
 import os
 import sys
-import zipfile
 from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
 from pathlib import Path
@@ -34,6 +34,12 @@ from typing import Any, Protocol, TypeVar, runtime_checkable
 
 import numpy as np
 
+from davis_ag.benchmark.sb3_models import (
+    CONTRIB_ALGORITHMS,
+    SB3_ALGORITHMS,
+    load_model,
+    recurrent_batch,
+)
 from davis_ag.errors import UserError
 
 #: How a trained model plays by default (one owner for every SB3 model: ``davis-ag evaluate``,
@@ -48,8 +54,8 @@ from davis_ag.errors import UserError
 #: and ``reproduce`` reports it as the row ``A2C (deterministic)``.
 DETERMINISTIC_PLAY = False
 
-#: Stable-Baselines3 algorithms a saved model may be, by the name :func:`model_algorithm` reads.
-ALGORITHMS: tuple[str, ...] = ("A2C", "PPO", "DQN", "SAC", "TD3", "DDPG")
+#: Algorithms a saved model may be, by the name :func:`~davis_ag.benchmark.sb3_models.model_algorithm` reads (sb3-contrib's with the extra).
+ALGORITHMS: tuple[str, ...] = (*SB3_ALGORITHMS, *CONTRIB_ALGORITHMS)
 
 
 @runtime_checkable
@@ -180,53 +186,6 @@ def as_policy(thing: Any, name: str | None = None) -> Policy:
     )
 
 
-def model_algorithm(path: Path) -> str:
-    """The Stable-Baselines3 algorithm a saved model was trained with, read from its file.
-
-    SB3 keeps the model's constructor settings in the zip's ``data`` entry: the policy class's
-    module names the off-policy algorithms (``stable_baselines3.dqn.policies``...); A2C and PPO
-    share their policy classes, and only PPO has a clip range.
-
-    Raises:
-        UserError: when the file is missing or not a Stable-Baselines3 model.
-    """
-    if path.is_dir():
-        raise UserError(f"{path}: a folder, not a model file; give the .zip `davis-ag train` saved")
-    if not path.is_file():
-        raise UserError(f"{path}: no such model file; train one with `davis-ag train`")
-    try:
-        with zipfile.ZipFile(path) as archive:
-            data = json.loads(archive.read("data"))
-        module = str(data["policy_class"].get("__module__", ""))
-    except (zipfile.BadZipFile, KeyError, ValueError, AttributeError, OSError) as error:
-        raise UserError(
-            f"{path}: not a Stable-Baselines3 model ({error}); give the .zip "
-            "`davis-ag train` (or SB3's model.save) wrote"
-        ) from None
-    for name in ("DQN", "SAC", "TD3", "DDPG"):
-        if f".{name.lower()}." in module:
-            return name
-    return "PPO" if "clip_range" in data else "A2C"
-
-
-def load_model(path: str | os.PathLike[str], device: str = "cpu") -> Any:
-    """A saved Stable-Baselines3 model of any algorithm (:func:`model_algorithm`).
-
-    Raises:
-        UserError: when the file is missing or cannot be loaded.
-    """
-    import stable_baselines3
-
-    path = Path(path)
-    algorithm = model_algorithm(path)
-    try:
-        return getattr(stable_baselines3, algorithm).load(path, device=device)
-    except Exception as error:
-        raise UserError(
-            f"{path}: a {algorithm} model that does not load ({error}); give the .zip `davis-ag train` wrote"
-        ) from None
-
-
 def _space_text(space: Any) -> str:
     return f"{space.n} actions" if hasattr(space, "n") else f"actions of shape {getattr(space, 'shape', None)}"
 
@@ -261,11 +220,18 @@ class ModelPolicy:
 
             self.trained_on = recorded_train_scenes(model)
             model = load_model(model, device)
-        # A Q-learner's policy is its greedy action: SB3's "sampled" DQN is epsilon-greedy with
-        # training's exploration rate, which is no distribution of the learnt policy.
-        greedy = hasattr(model, "q_net")
+        # A Q-learner's policy is its greedy action: SB3's "sampled" DQN (and QR-DQN) is
+        # epsilon-greedy with training's exploration rate, which is no distribution of the learnt policy.
+        greedy = hasattr(model, "q_net") or hasattr(model, "quantile_net")
         self.model, self.deterministic = model, bool(deterministic) or greedy
         self.name = name or type(model).__name__
+        #: A recurrent policy (RecurrentPPO): its LSTM state, kept through an episode.
+        self.recurrent = hasattr(getattr(model, "policy", None), "lstm_actor")
+        #: MaskablePPO: it is given the environment's action mask at every step.
+        self.masked = type(model).__name__ == "MaskablePPO"
+        self._memory: Any = None
+        self._starting = True
+        self._env: Any = None
 
     @property
     def play(self) -> str:
@@ -273,7 +239,8 @@ class ModelPolicy:
         return "deterministic" if self.deterministic else "sampled"
 
     def reset(self, seed: int | None = None) -> None:
-        """Seed torch's sampling when acting stochastically (a no-op when deterministic)."""
+        """Seed torch's sampling when acting stochastically; a recurrent policy's memory starts afresh."""
+        self._memory, self._starting = None, True
         if seed is not None and not self.deterministic:
             import torch
 
@@ -304,6 +271,10 @@ class ModelPolicy:
                 f"{env.observation_space.shape}: use a model trained by davis-ag train"
             )
         inner = getattr(env, "unwrapped", env)
+        if self.masked:
+            if not callable(getattr(inner, "action_masks", None)):
+                raise UserError(f"{self.name}: a MaskablePPO model needs an environment with action_masks()")
+            self._env = inner
         described = inner.describe() if hasattr(inner, "describe") else {}
         if self.trained_on and described.get("split") == "test":
             seen = sorted(set(self.trained_on) & set(described.get("scenes", [])))
@@ -315,23 +286,39 @@ class ModelPolicy:
                 )
 
     def act(self, observation: np.ndarray, info: dict[str, Any]) -> Any:
-        """The model's action for ``observation``."""
+        """The model's action for ``observation`` (a recurrent policy's memory carried on)."""
+        if self.recurrent:
+            starting = np.array([self._starting])
+            action, self._memory = self.model.predict(
+                observation, state=self._memory, episode_start=starting, deterministic=self.deterministic
+            )
+            self._starting = False
+            return action
+        if self.masked:
+            masks = self._env.action_masks() if self._env is not None else None
+            action, _ = self.model.predict(observation, deterministic=self.deterministic, action_masks=masks)
+            return action
         action, _ = self.model.predict(observation, deterministic=self.deterministic)
         return action
 
     @property
     def batches(self) -> bool:
         """Whether :meth:`act_batch` can play this model: deterministic play of any model, sampled
-        play of a model whose policy gives a distribution over discrete actions (A2C, PPO)."""
-        return hasattr(self.model.action_space, "n") and (
-            self.deterministic or hasattr(self.model.policy, "get_distribution")
+        play of a model whose policy gives a distribution over discrete actions (A2C, PPO,
+        RecurrentPPO); not MaskablePPO, whose mask is each episode's environment's."""
+        return (
+            hasattr(self.model.action_space, "n")
+            and not self.masked
+            and (self.deterministic or hasattr(self.model.policy, "get_distribution"))
         )
 
     def streams(self, seeds: list[int]) -> list[Any]:
         """One torch generator per episode, on the model's device, seeded as :meth:`reset` seeds
-        torch's own: episode ``i`` of a batch draws what it would draw played alone."""
+        torch's own: episode ``i`` of a batch draws what it would draw played alone. A recurrent
+        policy's memories are kept per stream, so a new batch starts them afresh."""
         import torch
 
+        self._memories: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         device = getattr(self.model, "device", torch.device("cpu"))
         return [torch.Generator(device=device).manual_seed(int(seed)) for seed in seeds]
 
@@ -351,6 +338,8 @@ class ModelPolicy:
         """
         import torch
 
+        if self.recurrent:
+            return recurrent_batch(self, observations, streams)
         if self.deterministic:
             actions, _ = self.model.predict(np.stack(observations), deterministic=True)
             return [int(a) for a in np.asarray(actions).reshape(-1)]

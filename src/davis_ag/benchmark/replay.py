@@ -154,7 +154,7 @@ class Identified(Protocol):
 
 def dataset_difference(results: Identified, root: str | os.PathLike[str]) -> Difference | None:
     """Whether ``root`` is the dataset the file evaluated: None, or the first scene that differs."""
-    from davis_ag.benchmark.tvm import as_dataset
+    from davis_ag.benchmark.splits import as_dataset
 
     dataset = as_dataset(root)
     found = dataset_identity([scene_identity(s.id, s.metadata) for s in dataset.scenes])

@@ -292,7 +292,7 @@ def dataset_identity(scenes: list[SceneIdentity]) -> DatasetIdentity:
 def identify_dataset(root: str | os.PathLike[str]) -> DatasetIdentity | None:
     """The identity of the dataset at ``root`` (every scene), or None when it is not one
     (e.g. a single scene folder given to the continuous environment)."""
-    from davis_ag.benchmark.tvm import as_dataset
+    from davis_ag.benchmark.splits import as_dataset
 
     try:
         dataset = as_dataset(root)

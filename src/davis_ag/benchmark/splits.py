@@ -120,3 +120,12 @@ def select_scenes(dataset: Dataset, scenario: str, split: str, crop: str | None 
             "dataset with more scenes, or evaluate on all of them (evaluate --split all, split='all')"
         )
     return chosen
+
+
+def as_dataset(dataset: Dataset | str | os.PathLike[str]) -> Dataset:
+    """Accept an opened dataset or a path to one."""
+    if not isinstance(dataset, (str, os.PathLike)):
+        return dataset
+    from davis_ag.data.reader import open_dataset
+
+    return open_dataset(Path(os.fspath(dataset)))

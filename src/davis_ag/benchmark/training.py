@@ -36,10 +36,9 @@ from davis_ag.benchmark.checkpoints import CheckpointEvery, Sittings, check_chec
 from davis_ag.benchmark.networks import ARCHITECTURES
 from davis_ag.benchmark.progress import LearningCurve, TrainingProgress
 from davis_ag.benchmark.selection import KeepBestOnTrain, check_keep, publish_snapshot, snapshot_path
-from davis_ag.benchmark.splits import select_scenes
+from davis_ag.benchmark.splits import as_dataset, select_scenes
 from davis_ag.benchmark.training_record import model_path, training_record_path
 from davis_ag.benchmark.training_rescue import keep_what_it_trained, rescued_selection, what_survives
-from davis_ag.benchmark.tvm import as_dataset
 from davis_ag.errors import MachineError, UserError
 from davis_ag.formats.models import check_seed
 from davis_ag.seeds import resumed_training_seed, training_env_seed

@@ -29,9 +29,10 @@ An episode (section V-D):
 - ``info``: ``oer_0``, ``oer_t`` (current), ``path`` (view names: the start, then one per move,
   repeated where a move was refused; ``done`` adds none), ``target_fruit`` (instance id),
   ``scene`` (id) and ``steps``.
-- Exact planners read the dynamics through :meth:`TVMEnv.move_table`, not the image.
-- ``robot=``: moves only between views the robot reaches, each costing its seconds, with
-  ``info["robot"]`` and an optional ``budget_s`` (:mod:`davis_ag.benchmark.robot_moves`).
+- Exact planners read the dynamics through :meth:`TVMEnv.move_table`, not the image;
+  :meth:`TVMEnv.action_masks` gives the actions not refused now (sb3-contrib's MaskablePPO).
+- ``robot=``: moves only between reachable views, each costing its seconds, with ``info["robot"]``
+  and an optional ``budget_s`` (:mod:`davis_ag.benchmark.robot_moves`).
 """
 
 from __future__ import annotations
@@ -39,7 +40,6 @@ from __future__ import annotations
 import copy
 import os
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import gymnasium as gym
@@ -49,7 +49,7 @@ from gymnasium import spaces
 from davis_ag.benchmark.cache import OBS_SIZE, SceneCache, load_scene_cache
 from davis_ag.benchmark.episode_rules import MAX_START_OER, START_RULES, can_start, episode_reward
 from davis_ag.benchmark.robot_moves import RobotOnGrid, attach_robot, no_reachable_start
-from davis_ag.benchmark.splits import scene_crop, select_scenes
+from davis_ag.benchmark.splits import as_dataset, scene_crop, select_scenes
 from davis_ag.errors import UserError
 from davis_ag.scene.specs import ALL_ACTIONS, crop_spec, scenario_spec
 
@@ -67,15 +67,6 @@ class _Starts:
     views: np.ndarray  # (n,) view indices with at least one eligible target
     offsets: np.ndarray  # (n + 1,) into boxes
     boxes: np.ndarray  # rows of the scene's box tables
-
-
-def as_dataset(dataset: Dataset | str | os.PathLike[str]) -> Dataset:
-    """Accept an opened dataset or a path to one."""
-    if not isinstance(dataset, (str, os.PathLike)):
-        return dataset
-    from davis_ag.data.reader import open_dataset
-
-    return open_dataset(Path(os.fspath(dataset)))
 
 
 class TVMEnv(gym.Env[np.ndarray, np.int64]):
@@ -307,6 +298,10 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
             self._over = True
             reward = self.reward(self._oer_0, self.oer)
         return self._observation(), reward, terminated, False, self._info()
+
+    def action_masks(self) -> np.ndarray:
+        """Which actions are not refused from here: ``done``, and each move to a view where the target has a box."""
+        return np.array([self._move(self._view, a)[0] != self._view for a in range(self.done_action)] + [True])
 
     def action_for(self, name: str) -> int:
         """The index of the action called ``name`` (a policy may answer with names).

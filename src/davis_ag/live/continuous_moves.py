@@ -34,8 +34,7 @@ def scene_folders(source: str | os.PathLike[str], scenario: str, split: str, cro
     path = Path(os.fspath(source))
     if (path / SCENE_METADATA).is_file() and (path / ANNOTATIONS).is_file():
         return [path]
-    from davis_ag.benchmark.splits import select_scenes
-    from davis_ag.benchmark.tvm import as_dataset
+    from davis_ag.benchmark.splits import as_dataset, select_scenes
 
     return [scene.path for scene in select_scenes(as_dataset(path), scenario, split, crop)]
 

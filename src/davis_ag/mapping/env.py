@@ -37,8 +37,7 @@ from gymnasium import spaces
 
 from davis_ag.benchmark.cache import OBS_SIZE, SceneCache, load_scene_cache
 from davis_ag.benchmark.robot_moves import RobotOnGrid, attach_robot, no_reachable_start
-from davis_ag.benchmark.splits import select_scenes
-from davis_ag.benchmark.tvm import as_dataset
+from davis_ag.benchmark.splits import as_dataset, select_scenes
 from davis_ag.environments import MAPPING_ID
 from davis_ag.errors import UserError
 from davis_ag.mapping.coverage import SEEN_FRACTION, SegmentCoverage, segment_coverage
@@ -307,6 +306,10 @@ class RowMappingEnv(gym.Env[np.ndarray, np.int64]):
             f"invalid action {action!r}: expected an integer in 0..{len(self.action_names) - 1} "
             f"({', '.join(self.action_names)})"
         )
+
+    def action_masks(self) -> np.ndarray:
+        """Which moves are not refused from here (sb3-contrib's MaskablePPO convention)."""
+        return self.next_views[self._scene][self._view] != self._view
 
     def action_for(self, name: str) -> int:
         """The index of the move called ``name``.

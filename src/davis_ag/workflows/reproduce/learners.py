@@ -129,9 +129,8 @@ def _made_as_configured(model: Path, config: Any, arch: str) -> bool:
 def _split_unchanged(model: Path, root: Path, scenario: str, crop: str) -> bool:
     """Whether a finished model was trained on today's train split (a group that grew moves
     scenes between the splits); a model from before the scenes were recorded is taken as it is."""
-    from davis_ag.benchmark.splits import select_scenes
+    from davis_ag.benchmark.splits import as_dataset, select_scenes
     from davis_ag.benchmark.training_record import recorded_train_scenes
-    from davis_ag.benchmark.tvm import as_dataset
 
     trained_on = recorded_train_scenes(model)
     if trained_on is None:

@@ -237,8 +237,7 @@ def validate_once(group: Path, state: RunState, stage: str, clock: StageClock, r
 
 def split_scene_ids(root: Path, scenario: str, split: str, crop: str) -> list[str]:
     """The ids of a split's scenes of one group, as the environment takes them."""
-    from davis_ag.benchmark.splits import select_scenes
-    from davis_ag.benchmark.tvm import as_dataset
+    from davis_ag.benchmark.splits import as_dataset, select_scenes
 
     return [s.id for s in select_scenes(as_dataset(root), scenario, split, crop)]
 
