@@ -35,6 +35,7 @@ def test_the_page_runs_as_written(
         ("python", "my_policy.py"),
         ("bash", None),
         ("python", None),
+        ("python", None),
         ("bash", None),
         ("bash", None),
     ]
@@ -62,6 +63,7 @@ def test_the_page_runs_as_written(
     # A leaderboard maintainer's check: both files replay sound on the dataset, and rank as before.
     assert "heuristic.json: sound: 900 episodes of 6 policies replayed on the dataset" in printed
     assert "ppo.json: sound: 900 episodes of 6 policies" in printed
+    assert Path("rppo.zip").is_file()  # the recurrent example trained and scored its model
     verified = Path("verified.md").read_text()  # the same rows, each marked how it was checked
     assert "| Checked |" in verified and "| ours |" in verified and "| replayed |" in verified
     assert [line.split("|")[2] for line in verified.splitlines() if line.startswith("| ")] == [
