@@ -141,3 +141,25 @@ def test_a_contrib_model_without_sb3_contrib_names_the_extra(
     monkeypatch.setitem(sys.modules, "sb3_contrib", None)  # import sb3_contrib now fails
     with pytest.raises(UserError, match=r"needs sb3-contrib.*davis-ag\[contrib\]"):
         ModelPolicy(models["QRDQN"])
+
+
+@pytest.mark.parametrize(
+    ("algo", "settings"),
+    [
+        ("recurrentppo", {"n_steps": 16, "batch_size": 32}),
+        ("qrdqn", {"learning_starts": 16, "buffer_size": 200}),
+        ("trpo", {"n_steps": 16, "batch_size": 32}),
+        ("maskableppo", {"n_steps": 16, "batch_size": 32}),
+    ],
+)
+def test_train_trains_each_contrib_algorithm(root: Path, tmp_path: Path, algo: str, settings: dict) -> None:
+    from davis_ag.benchmark.training import train_agent, training_record_path
+
+    out = train_agent(
+        root, "sp", total_timesteps=64, n_envs=2, arch="pooled", out_path=tmp_path / f"{algo}.zip",
+        checkpoint_every=0, select_every=32, progress=False, algo=algo, settings=settings,
+    )  # fmt: skip
+    record = json.loads(training_record_path(out).read_text())
+    assert model_algorithm(out) == record["algorithm"] and record["selection"]["scores"]
+    results = evaluate([str(out)], root, "sp", "test", sessions=1, episodes=3, baselines=False)
+    assert replay_grid(results, root, f"{algo}.json").sound

@@ -1,5 +1,7 @@
 """The algorithms ``davis-ag train --algo`` trains and their settings: the paper's A2C (its settings
-chosen on the train split) and PPO and DQN (Stable-Baselines3's defaults)."""
+chosen on the train split), PPO and DQN (Stable-Baselines3's defaults), and sb3-contrib's
+algorithms for a discrete action space (RecurrentPPO, QR-DQN, TRPO, MaskablePPO; the ``contrib``
+extra)."""
 
 from __future__ import annotations
 
@@ -7,8 +9,29 @@ from typing import Any
 
 from davis_ag.errors import UserError
 
-#: The algorithms :func:`davis_ag.benchmark.training.train_agent` trains (``davis-ag train --algo``).
-ALGORITHMS: tuple[str, ...] = ("a2c", "ppo", "dqn")
+#: The algorithms :func:`davis_ag.benchmark.training.train_agent` trains (``davis-ag train --algo``),
+#: and the class each names (:func:`davis_ag.benchmark.sb3_models.algorithm_class`).
+CLASS_NAMES: dict[str, str] = {
+    "a2c": "A2C",
+    "ppo": "PPO",
+    "dqn": "DQN",
+    "recurrentppo": "RecurrentPPO",
+    "qrdqn": "QRDQN",
+    "trpo": "TRPO",
+    "maskableppo": "MaskablePPO",
+}
+ALGORITHMS: tuple[str, ...] = tuple(CLASS_NAMES)
+#: The policy an algorithm trains on images, where it is not SB3's ``CnnPolicy``.
+POLICY_NAMES: dict[str, str] = {"recurrentppo": "CnnLstmPolicy"}
+
+
+def algorithm_of(algo: str) -> Any:
+    """The class ``davis-ag train --algo`` names (sb3-contrib's: one line naming the extra when missing)."""
+    from davis_ag.benchmark.sb3_models import algorithm_class
+
+    return algorithm_class(CLASS_NAMES[algo])
+
+
 #: PPO's and DQN's settings on top of Stable-Baselines3's defaults. PPO: RL Baselines3 Zoo's
 #: settings for Atari (``hyperparams/ppo.yml``, the zoo's set for a ``CnnPolicy`` on images with
 #: our 8 environments), not SB3's defaults, which are made for small vector observations: with
@@ -36,6 +59,9 @@ SB3_SETTINGS: dict[str, dict[str, Any]] = {
         "replay_buffer_kwargs": {"handle_timeout_termination": False},
     },
 }
+#: QR-DQN's replay buffer as DQN's (the same 224x224x4 observations); the other contrib algorithms
+#: train with sb3-contrib's defaults and ``--set``.
+SB3_SETTINGS["qrdqn"] = dict(SB3_SETTINGS["dqn"])
 #: The settings a ``lin_X`` value may be given to: those SB3 takes as a schedule.
 SCHEDULES = ("learning_rate", "clip_range", "clip_range_vf")
 
@@ -103,7 +129,7 @@ def check_setting_values(algo: str, settings: dict[str, Any]) -> None:
     count below 1, a negative rate or coefficient, or a number that is not finite.
 
     Args:
-        algo: ``a2c``, ``ppo`` or ``dqn``.
+        algo: A name of :data:`ALGORITHMS`.
         settings: The settings given (``--set`` or a dict), before SB3's defaults fill the rest.
 
     Raises:
@@ -112,9 +138,7 @@ def check_setting_values(algo: str, settings: dict[str, Any]) -> None:
     import inspect
     import math
 
-    import stable_baselines3
-
-    defaults = {k: v.default for k, v in inspect.signature(getattr(stable_baselines3, algo.upper())).parameters.items()}
+    defaults = {k: v.default for k, v in inspect.signature(algorithm_of(algo)).parameters.items()}
     for key, value in settings.items():
         default = defaults.get(key)
         if (isinstance(value, str) and value.startswith("lin_")) or default is None or isinstance(value, dict):
@@ -158,20 +182,18 @@ def resolve_sb3_settings(algo: str, settings: str | dict[str, Any]) -> dict[str,
     """
     import inspect
 
-    import stable_baselines3
-
     if isinstance(settings, str):
         if settings != "ours":
             raise UserError(
                 f"--a2c-settings {settings} is for --algo a2c; {algo} trains with its own settings and --set"
             )
-        return dict(SB3_SETTINGS[algo])
-    known = inspect.signature(getattr(stable_baselines3, algo.upper())).parameters
+        return dict(SB3_SETTINGS.get(algo, {}))
+    known = inspect.signature(algorithm_of(algo)).parameters
     wrong = [k for k in settings if k not in known or k in ("policy", "env", "seed", "device", "verbose")]
     if wrong:
         raise UserError(f"{algo.upper()} setting {wrong[0]!r} cannot be changed here")
     check_setting_values(algo, settings)
-    return {**SB3_SETTINGS[algo], **settings}
+    return {**SB3_SETTINGS.get(algo, {}), **settings}
 
 
 def console_logger(verbose: int) -> Any:

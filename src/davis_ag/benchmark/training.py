@@ -27,6 +27,9 @@ from davis_ag.atomic_files import prove_writable_file, write_json_atomic
 from davis_ag.benchmark import TVMEnv
 from davis_ag.benchmark.algorithms import (
     ALGORITHMS,
+    CLASS_NAMES,
+    POLICY_NAMES,
+    algorithm_of,
     console_logger,
     resolve_sb3_settings,
     resolve_settings,
@@ -211,7 +214,7 @@ def train_agent(
         keep: ``best-train`` (default): save the snapshot with the best train-split OER_tau,
             scored every ``select_every`` steps and at the end; ``last``: the last one.
         select_every: Environment steps between train-split scores (``best-train`` only).
-        algo: ``a2c`` (default), ``ppo`` or ``dqn`` (:data:`ALGORITHMS`).
+        algo: ``a2c`` (default), ``ppo``, ``dqn``, or sb3-contrib's ``recurrentppo``, ``qrdqn``, ``trpo``, ``maskableppo`` (:data:`ALGORITHMS`).
         progress: Show progress (:class:`TrainingProgress`).
         force: Discard a checkpoint beside ``out_path`` that cannot be resumed (another run's,
             or a damaged one) instead of refusing (:func:`check_checkpoint`).
@@ -230,11 +233,10 @@ def train_agent(
             a model in memory that no file beside ``out_path`` holds is kept in a rescue folder
             first, whatever ``keep`` says (:func:`keep_what_it_trained`).
     """
-    import stable_baselines3
 
     if algo not in ALGORITHMS:
         raise UserError(f"unknown algorithm {algo!r}: choose one of {', '.join(ALGORITHMS)}")
-    algorithm = getattr(stable_baselines3, algo.upper())
+    algorithm = algorithm_of(algo)
     if arch not in ARCHITECTURES:
         raise UserError(f"unknown network {arch!r}: choose one of {', '.join(ARCHITECTURES)}")
     if total_timesteps < 1 or n_envs < 1 or checkpoint_every < 0 or select_every < 0:
@@ -256,7 +258,7 @@ def train_agent(
         "seed": seed,
         "n_envs": n_envs,
         "arch": arch,
-        "algorithm": algo.upper(),
+        "algorithm": CLASS_NAMES[algo],
         "a2c_settings" if algo == "a2c" else "sb3_settings": chosen,
         "start_rule": "pairs",
         "keep": keep,
@@ -292,7 +294,7 @@ def train_agent(
         print(f"resuming {final.name} from its checkpoint at {done} of {total_timesteps} steps", flush=True)
     else:
         model = algorithm(
-            "CnnPolicy",
+            POLICY_NAMES.get(algo, "CnnPolicy"),
             env,
             seed=seed,
             device=device,
@@ -320,7 +322,7 @@ def train_agent(
             key=task.key,
             label=task.label,
         )
-    shown = TrainingProgress(total_timesteps, f"{algo.upper()} {scenario}", selection) if progress else None
+    shown = TrainingProgress(total_timesteps, f"{CLASS_NAMES[algo]} {scenario}", selection) if progress else None
     callbacks = [c for c in (callback, curve, selection, shown) if c is not None]
     if checkpoint_every:
         callbacks.append(

@@ -36,9 +36,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     arguments.add_dataset_flags(parser, "train")
     parser.add_argument(
         "--algo",
-        choices=["a2c", "ppo", "dqn"],
+        choices=["a2c", "ppo", "dqn", "recurrentppo", "qrdqn", "trpo", "maskableppo"],
         default="a2c",
-        help="a2c (the paper's, default), ppo or dqn (on the discrete moves)",
+        help="a2c (the paper's, default), ppo or dqn (on the discrete moves); with the contrib extra, "
+        "sb3-contrib's recurrentppo, qrdqn, trpo or maskableppo",
     )
     parser.add_argument(
         "--timesteps",

@@ -38,6 +38,8 @@ class RobotOnPoses:
         self.followers = [ArmFollower.for_scene(open_dataset(folder).scenes[0], definition) for folder in folders]
         self.budget_s = budget_s
         self.arm: Any = None
+        self._planned: tuple[Any, float] | None = None
+        self._budget_hit = False
         self.seconds = self.total = 0.0
         self.over_budget = False
 
@@ -62,28 +64,31 @@ class RobotOnPoses:
         self.arm, self.seconds, self.total, self.over_budget = arm, 0.0, 0.0, False
         return True
 
-    def move(self, scene: int, pose: list[float]) -> str:
-        """Move the arm to ``pose``: "" when it did, else why not (``robot: ...`` or ``budget``)."""
+    def plan(self, scene: int, pose: list[float]) -> str:
+        """Solve the arm for ``pose`` from where it is, without moving it: "" when it can go (the
+        move is kept for :meth:`settle`), else why not (``robot: ...`` or ``budget``)."""
         follower = self.followers[scene]
+        self._planned, self._budget_hit = None, False
         arm, why = follower.follow(self.arm, pose)
         if arm is None:
-            self.seconds = 0.0
             return f"robot: {why}"
         seconds = follower.seconds(self.arm, arm)
-        if self.budget_s is not None and self.total + seconds > self.budget_s:
-            self.seconds, self.over_budget = 0.0, True
+        self._budget_hit = self.budget_s is not None and self.total + seconds > self.budget_s
+        if self._budget_hit:
             return "budget"
-        self.arm, self.seconds = arm, seconds
-        self.total += seconds
+        self._planned = (arm, seconds)
         return ""
 
-    def check(self, scene: int, pose: list[float], refused: str) -> str:
-        """A step's refusal with the robot: a move the environment refused already (``refused``)
-        costs no seconds and the arm stays; else :meth:`move`."""
-        if refused:
+    def settle(self, moved: bool) -> None:
+        """End a step: the planned move is made when the camera moved, else the arm stays and the
+        step costs no seconds (a move refused for the budget ends the episode: :attr:`over_budget`)."""
+        self.over_budget = self.over_budget or (not moved and self._budget_hit)
+        if moved and self._planned is not None:
+            self.arm, self.seconds = self._planned
+            self.total += self.seconds
+        else:
             self.seconds = 0.0
-            return refused
-        return self.move(scene, pose)
+        self._planned = None
 
     def info(self, scene: int) -> dict[str, Any]:
         """``info["robot"]`` now."""

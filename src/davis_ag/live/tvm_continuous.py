@@ -342,10 +342,11 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         """Whether the camera may go from the current pose to ``view``, and the labels there.
 
         Returns:
-            The pair ``("", labels)`` when allowed, else ``(reason, labels or None)``, the reason
-                ``bounds``, ``collision`` or ``target lost``.
+            ``("", labels)`` when allowed, else ``(reason, labels or None)``: ``bounds``, ``collision``, ``target lost``, or the robot's.
         """
         reason = self.blocked(np.asarray(self._here.position), np.asarray(view.position))
+        if not reason and self.robot is not None:  # the arm's IK before the draw, which costs more
+            reason = self.robot.plan(self._scene, view.pose)
         if reason:
             return reason, None
         labels = self._draw(view)
@@ -362,7 +363,7 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
         view = self.proposed(action)
         self._refused, labels = self.try_pose(view)
         if self.robot is not None:
-            self._refused = self.robot.check(self._scene, view.pose, self._refused)
+            self.robot.settle(moved=not self._refused)
         if not self._refused:
             self._view, self._labels = view, labels
         self._t += 1

@@ -190,6 +190,7 @@ class RowMappingEnv(gym.Env[np.ndarray, np.int64]):
         self._playable = np.array(playable, dtype=np.int64)
         self._scene = self._view = self._t = -1
         self._seen = np.zeros(0, dtype=bool)
+        self._seen_ids: list[int] = []
         self._map = np.zeros((OBS_SIZE, OBS_SIZE, 4), dtype=np.uint8)
         self._path: list[str] = []
         self._new, self._refused, self._over = 0, False, True
@@ -219,6 +220,7 @@ class RowMappingEnv(gym.Env[np.ndarray, np.int64]):
         self._t, self._over, self._refused = 0, False, False
         self._seconds = self._move_seconds = 0.0
         self._seen = self.coverage[self._scene].seen[self._view].copy()
+        self._seen_ids = self.coverage[self._scene].fruit_ids[self._seen].tolist()
         self._new = 0
         self._path = [self.caches[self._scene].view_names[self._view]]
         self._map[...] = 0
@@ -282,6 +284,7 @@ class RowMappingEnv(gym.Env[np.ndarray, np.int64]):
         self._new = int(fresh.sum())
         if self._new:
             self._seen |= fresh
+            self._seen_ids = sorted(self._seen_ids + coverage.fruit_ids[fresh].tolist())
             for r, c in self._plans[self._scene].dots[fresh]:
                 self._map[r : r + 2, c : c + 2, 3] = FRUIT_SEEN
         terminated = self._t >= self.budget or over_budget
@@ -343,7 +346,7 @@ class RowMappingEnv(gym.Env[np.ndarray, np.int64]):
     @property
     def coverage_now(self) -> float:
         """The episode's coverage so far."""
-        return float(self._seen.sum() / self.coverage[self._scene].fruit)
+        return len(self._seen_ids) / self.coverage[self._scene].fruit
 
     def describe(self) -> dict[str, Any]:
         """What a results file's protocol records of this environment."""
@@ -367,8 +370,8 @@ class RowMappingEnv(gym.Env[np.ndarray, np.int64]):
     def _info(self) -> dict[str, Any]:
         coverage = self.coverage[self._scene]
         info: dict[str, Any] = {
-            "seen": coverage.fruit_ids[self._seen].tolist(),
-            "coverage": float(self._seen.sum() / coverage.fruit),
+            "seen": list(self._seen_ids),
+            "coverage": len(self._seen_ids) / coverage.fruit,
             "new": self._new,
             "refused": self._refused,
             "fruit": coverage.fruit,
