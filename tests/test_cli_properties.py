@@ -355,6 +355,7 @@ def pools_for(command: str, out: str) -> tuple[list[str], dict[str, st.SearchStr
                 "--robot": robots,
                 "--out": out_or_bad,
                 "--scenario": ANY,
+                "--crop": ANY,
                 "--cache-dir": cache,
                 "--doc": st.sampled_from(["missing.md", "a-file", "/proc/x"]),
                 "--force": FLAG,

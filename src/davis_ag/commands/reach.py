@@ -26,6 +26,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--out", type=arguments.path, required=True, metavar="DIR", help="folder for the pictures")
     parser.add_argument("--scenario", default=None, help="only this scenario's scenes (sp, mp or row)")
+    parser.add_argument("--crop", default=None, help="only this crop's scenes (e.g. vsp-vine)")
     parser.add_argument(
         "--cache-dir",
         type=arguments.path,
@@ -59,7 +60,7 @@ def _episode_strip(dataset, scenario: str, robot: str, args: argparse.Namespace,
     from davis_ag.figures.robot_strip import plot_robot_strip
     from davis_ag.live.robot_pictures import robot_frames
 
-    env = TVMEnv(dataset, scenario, split="all", robot=robot, cache_dir=args.cache_dir)
+    env = TVMEnv(dataset, scenario, split="all", crop=args.crop, robot=robot, cache_dir=args.cache_dir)
     played = run_episode(env, build_agents(["Oracle"])[0], args.episode)
     _, info = env.reset(seed=args.episode)
     steps = [(info["path"][-1], 0.0, info["oer_t"])]
@@ -84,6 +85,7 @@ def _episode_strip(dataset, scenario: str, robot: str, args: argparse.Namespace,
 
 def run(args: argparse.Namespace) -> int:
     """Compute (or load) every scene's reach, print the table, draw the pictures."""
+    from davis_ag.benchmark.splits import scene_crop
     from davis_ag.data.reader import open_dataset
     from davis_ag.errors import UserError
     from davis_ag.figures.reach_plots import plot_scene_reach
@@ -95,9 +97,16 @@ def run(args: argparse.Namespace) -> int:
 
     definition = load_robot(args.robot)
     dataset = open_dataset(args.dataset)
-    scenes = [s for s in dataset if args.scenario is None or s.scenario == args.scenario]
+    scenes = [
+        s
+        for s in dataset
+        if (args.scenario is None or s.scenario == args.scenario) and (args.crop is None or scene_crop(s) == args.crop)
+    ]
     if not scenes:
-        raise UserError(f"{args.dataset} has no {args.scenario or ''} scene; generate one or choose another --scenario")
+        which = " ".join(w for w in (args.scenario, args.crop) if w)
+        raise UserError(
+            f"{args.dataset} has no {which + ' ' if which else ''}scene; generate one or choose another --scenario or --crop"
+        )
     with claim_output(args.out, force=args.force, flag="--out", folder=True) as out:
         reaches = []
         for number, scene in enumerate(scenes, 1):
