@@ -14,6 +14,16 @@ from filelock import FileLock
 
 from davis_ag.errors import UserError
 
+#: A goblet vine (trunk and cordons: a robot's obstacles) on a 75 cm grid at three heights: 54 views,
+#: with depth; the robot tests' scene (tests/benchmark/test_robot_moves.py, tests/live/test_continuous_robot.py).
+ROBOT_VINE = """\
+seed: 5
+image_size: 128x72
+grid: {extent: [3.0, 3.0], step: 0.75}
+groups:
+  - {scenario: sp, crop: vine, scenes: 1}
+"""
+
 
 def session_folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A folder every worker of this test session shares: the session's temporary root (with

@@ -19,23 +19,14 @@ from davis_ag.errors import UserError
 from davis_ag.robot import reach as reach_module
 from davis_ag.robot.model import camera_rotation
 from davis_ag.robot.reach import load_reach
-from real_scenes import generate_config
+from real_scenes import ROBOT_VINE, generate_config
 
 pytestmark = pytest.mark.slow
-
-#: A goblet vine (trunk and cordons: obstacles) on a 75 cm grid at three heights: 54 views, with depth.
-VINE = """\
-seed: 5
-image_size: 128x72
-grid: {extent: [3.0, 3.0], step: 0.75}
-groups:
-  - {scenario: sp, crop: vine, scenes: 1}
-"""
 
 
 @pytest.fixture(scope="module")
 def root(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return generate_config(tmp_path_factory, "vine", VINE)
+    return generate_config(tmp_path_factory, "vine", ROBOT_VINE)
 
 
 def _robot_yaml(name: str) -> str:

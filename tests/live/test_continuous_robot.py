@@ -13,23 +13,14 @@ import pytest
 from davis_ag.errors import UserError
 from davis_ag.live.tvm_continuous import TVMContinuousEnv
 from davis_ag.robot.model import camera_rotation
-from real_scenes import generate_config
+from real_scenes import ROBOT_VINE, generate_config
 
 pytestmark = pytest.mark.slow
-
-#: The grid robot test's goblet vine (trunk and cordons: obstacles).
-VINE = """\
-seed: 5
-image_size: 128x72
-grid: {extent: [3.0, 3.0], step: 0.75}
-groups:
-  - {scenario: sp, crop: vine, scenes: 1}
-"""
 
 
 @pytest.fixture(scope="module")
 def root(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return generate_config(tmp_path_factory, "vine", VINE)
+    return generate_config(tmp_path_factory, "vine", ROBOT_VINE)
 
 
 def test_the_arm_follows_the_camera_by_forward_kinematics(root: Path) -> None:

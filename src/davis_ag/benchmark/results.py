@@ -16,7 +16,7 @@ import hashlib
 import json
 import os
 from pathlib import Path
-from typing import Any, Final, Literal
+from typing import Any, Final, Literal, TypeVar
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
@@ -242,26 +242,43 @@ def load_results(path: str | os.PathLike[str], check: bool = True) -> Evaluation
             summary its episodes do not give.
     """
     path = Path(path)
-    try:
-        data = json.loads(path.read_text())
-    except OSError as error:
-        raise UserError(f"{path}: cannot read it ({error.strerror or error})") from None
-    except ValueError as error:
-        raise UserError(f"{path}: not JSON ({error}); give a RESULTS.json davis-ag evaluate wrote") from None
-    try:
-        results = EvaluationResults.model_validate(data)
-    except ValidationError as error:
-        first = error.errors()[0]
-        where = ".".join(str(p) for p in first["loc"])
-        raise UserError(
-            f"{path}: not davis-ag evaluation results ({where}: {first['msg']}); give a RESULTS.json "
-            "davis-ag evaluate wrote"
-        ) from None
+    results = read_results_file(path, EvaluationResults, "evaluation results", "davis-ag evaluate")
     if check:
         from davis_ag.benchmark.summaries import check_summaries
 
         check_summaries(results, str(path))
     return results
+
+
+ModelT = TypeVar("ModelT", bound=BaseModel)
+
+
+def read_results_file(path: Path, model: type[ModelT], what: str, writer: str) -> ModelT:
+    """A results file read and checked against its schema (summaries not yet checked).
+
+    Args:
+        path: The file.
+        model: Its pydantic schema.
+        what: What it must hold, for the message ("evaluation results").
+        writer: The command that writes such a file, for the advice.
+
+    Raises:
+        UserError: one line when it cannot be read, is not JSON or does not fit the schema.
+    """
+    try:
+        data = json.loads(path.read_text())
+    except OSError as error:
+        raise UserError(f"{path}: cannot read it ({error.strerror or error})") from None
+    except ValueError as error:
+        raise UserError(f"{path}: not JSON ({error}); give a RESULTS.json {writer} wrote") from None
+    try:
+        return model.model_validate(data)
+    except ValidationError as error:
+        first = error.errors()[0]
+        where = ".".join(str(p) for p in first["loc"])
+        raise UserError(
+            f"{path}: not davis-ag {what} ({where}: {first['msg']}); give a RESULTS.json {writer} wrote"
+        ) from None
 
 
 def scene_identity(scene_id: str, metadata: SceneFile | None) -> SceneIdentity:

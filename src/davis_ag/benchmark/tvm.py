@@ -47,7 +47,14 @@ import numpy as np
 from gymnasium import spaces
 
 from davis_ag.benchmark.cache import OBS_SIZE, SceneCache, load_scene_cache
-from davis_ag.benchmark.episode_rules import MAX_START_OER, START_RULES, can_start, episode_reward
+from davis_ag.benchmark.episode_rules import (
+    MAX_START_OER,
+    START_RULES,
+    can_start,
+    discrete_action,
+    episode_reward,
+    named_action,
+)
 from davis_ag.benchmark.robot_moves import RobotOnGrid, attach_robot, no_reachable_start
 from davis_ag.benchmark.splits import as_dataset, scene_crop, select_scenes
 from davis_ag.errors import UserError
@@ -309,11 +316,7 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
         Raises:
             UserError: for a name that is not an action of this scenario.
         """
-        if name not in self.action_names:
-            raise UserError(
-                f"invalid action {name!r}: this {self.scenario} environment has {', '.join(self.action_names)}"
-            )
-        return self.action_names.index(name)
+        return named_action(name, self.action_names, f"this {self.scenario} environment")
 
     def describe(self) -> dict[str, Any]:
         """What an evaluation's protocol records of this environment: its id, scenario, split,
@@ -333,15 +336,7 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
 
     def _action_index(self, action: Any) -> int:
         """Validate an action (Python or NumPy integer, or a one-element integer array)."""
-        if isinstance(action, np.ndarray) and action.size == 1:
-            action = action.reshape(()).item() if action.dtype.kind in "iu" else action
-        if isinstance(action, (int, np.integer)) and not isinstance(action, bool):
-            if 0 <= int(action) < len(self.action_names):
-                return int(action)
-        raise UserError(
-            f"invalid action {action!r}: expected an integer in "
-            f"0..{len(self.action_names) - 1} ({', '.join(self.action_names)})"
-        )
+        return discrete_action(action, self.action_names)
 
     def _move(self, view: int, action: int) -> tuple[int, int]:
         """Where a move leads for the current target: ``(view, box row)``; refused: stays."""

@@ -240,3 +240,33 @@ def add_dataset_flags(parser: argparse.ArgumentParser, verb: str) -> None:
         metavar="DIR",
         help="observation cache folder (default: DIR/.davis_ag_cache)",
     )
+
+
+def add_task_flags(parser: argparse.ArgumentParser, verb: str) -> None:
+    """Add ``--task``, ``--budget`` and ``--seen-fraction``, shared by train and evaluate.
+
+    Args:
+        parser: the sub-command's parser.
+        verb: what the command does with the task (``train``: "train on"; evaluate: "score").
+    """
+    parser.add_argument(
+        "--task",
+        default="tvm",
+        choices=["tvm", "mapping"],
+        help=f"tvm: {verb} target visibility maximisation (default); mapping: {verb} row mapping "
+        "(RowMapping-v0, docs/mapping.md; the grid only)",
+    )
+    parser.add_argument(
+        "--budget",
+        type=bounded(1, 10**5),
+        default=None,
+        metavar="MOVES",
+        help="--task mapping: moves per episode (default: the fixed sweep's, driving the row once at each height)",
+    )
+    parser.add_argument(
+        "--seen-fraction",
+        type=float,
+        default=None,
+        metavar="F",
+        help="--task mapping: the visible fraction at which a fruit counts as seen (default 0.5)",
+    )

@@ -72,27 +72,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="grid: the dataset's views (TVM-v0, default); continuous: any pose, drawn live "
         "from regrown scenes (TVMContinuous-v0; scenes made by davis-ag generate)",
     )
-    parser.add_argument(
-        "--task",
-        default="tvm",
-        choices=["tvm", "mapping"],
-        help="tvm: target visibility maximisation (Table 4, default); mapping: see every fruit of a row "
-        "segment within a budget (RowMapping-v0, the grid only)",
-    )
-    parser.add_argument(
-        "--budget",
-        type=arguments.bounded(1, 10**5),
-        default=None,
-        metavar="MOVES",
-        help="--task mapping: moves per episode (default: the fixed sweep's, driving the row once at each height)",
-    )
-    parser.add_argument(
-        "--seen-fraction",
-        type=float,
-        default=None,
-        metavar="F",
-        help="--task mapping: the visible fraction at which a fruit counts as seen (default 0.5)",
-    )
+    arguments.add_task_flags(parser, "score")
     parser.add_argument(
         "--budget-s",
         type=float,
@@ -189,19 +169,40 @@ def _spec_files(spec: str) -> list[Path]:
     return [Path(c) for c in candidates if Path(c).expanduser().is_file()][:1]
 
 
-def _evaluate(args: argparse.Namespace, names: list[str], specs: list[str], out: Path, plot: Path) -> int:
-    """Evaluate the baselines ``names`` and the ``--policy`` specs on the claimed ``out`` and ``plot``."""
-    from davis_ag.benchmark.evaluation import evaluate, write_json
+def _policies(args: argparse.Namespace, specs: list[str]) -> list[Any]:
+    """The ``--policy`` specs as policies, each with the ``--name`` given after it."""
     from davis_ag.benchmark.policies import policy_from_spec
-    from davis_ag.benchmark.results_table import format_table
-    from davis_ag.figures.result_charts import plot_results
 
-    policies = [
+    return [
         policy_from_spec(spec, name, deterministic=args.deterministic)
         for spec, name in zip(specs, getattr(args, "policy_names", None) or [None] * len(specs), strict=True)
     ]
+
+
+def _finish(table: str, out: Path, plot: Path, write: Any, draw: Any) -> int:
+    """Print the table, write the results (kept somewhere even when ``out`` fails at the end: the
+    JSON is the result) and draw the chart."""
+    print(table)
+    write_or_rescue(out, write, "the results")
+    try:
+        draw(plot)
+    except OSError as error:
+        raise MachineError(
+            f"the results are in {out}, but the chart could not be written to {plot} "
+            f"({error.strerror or error}): run again with another --plot"
+        ) from None
+    print(f"wrote {out} and {plot}")
+    return 0
+
+
+def _evaluate(args: argparse.Namespace, names: list[str], specs: list[str], out: Path, plot: Path) -> int:
+    """Evaluate the baselines ``names`` and the ``--policy`` specs on the claimed ``out`` and ``plot``."""
+    from davis_ag.benchmark.evaluation import evaluate, write_json
+    from davis_ag.benchmark.results_table import format_table
+    from davis_ag.figures.result_charts import plot_results
+
     results = evaluate(
-        policies,
+        _policies(args, specs),
         args.dataset,
         scenario=args.scenario,
         split=args.split,
@@ -214,34 +215,24 @@ def _evaluate(args: argparse.Namespace, names: list[str], specs: list[str], out:
         cache_dir=args.cache_dir,
         robot=args.robot,
     )
-    print(format_table(results))
-    # The JSON is the result: keep it somewhere even when --out fails at the end.
-    write_or_rescue(out, lambda path: write_json(results, path), "the results")
-    try:
-        plot_results(results, plot)
-    except OSError as error:
-        raise MachineError(
-            f"the results are in {out}, but the chart could not be written to {plot} "
-            f"({error.strerror or error}): run again with another --plot"
-        ) from None
-    print(f"wrote {out} and {plot}")
-    return 0
+    return _finish(
+        format_table(results),
+        out,
+        plot,
+        lambda path: write_json(results, path),
+        lambda path: plot_results(results, path),
+    )
 
 
 def _evaluate_mapping(args: argparse.Namespace, names: list[str], specs: list[str], out: Path, plot: Path) -> int:
     """``--task mapping``: score the baselines ``names`` and the specs on row mapping."""
-    from davis_ag.benchmark.policies import policy_from_spec
     from davis_ag.figures.mapping_plots import plot_coverage_curves
     from davis_ag.mapping.coverage import SEEN_FRACTION
     from davis_ag.mapping.evaluation import evaluate_mapping
     from davis_ag.mapping.results import mapping_table
 
-    policies = [
-        policy_from_spec(spec, name, deterministic=args.deterministic)
-        for spec, name in zip(specs, getattr(args, "policy_names", None) or [None] * len(specs), strict=True)
-    ]
     results = evaluate_mapping(
-        policies,
+        _policies(args, specs),
         args.dataset,
         scenario=args.scenario,
         split=args.split,
@@ -256,14 +247,4 @@ def _evaluate_mapping(args: argparse.Namespace, names: list[str], specs: list[st
         robot=args.robot,
         budget_s=args.budget_s,
     )
-    print(mapping_table(results))
-    write_or_rescue(out, results.write, "the results")
-    try:
-        plot_coverage_curves(results, plot)
-    except OSError as error:
-        raise MachineError(
-            f"the results are in {out}, but the chart could not be written to {plot} "
-            f"({error.strerror or error}): run again with another --plot"
-        ) from None
-    print(f"wrote {out} and {plot}")
-    return 0
+    return _finish(mapping_table(results), out, plot, results.write, lambda path: plot_coverage_curves(results, path))

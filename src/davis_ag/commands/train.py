@@ -109,27 +109,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="train with the camera on this robot (davis-ag robots lists them, or a YAML file): only the "
         "views it reaches (docs/robot.md)",
     )
-    parser.add_argument(
-        "--task",
-        default="tvm",
-        choices=["tvm", "mapping"],
-        help="tvm: target visibility maximisation (default); mapping: row mapping (RowMapping-v0, "
-        "docs/mapping.md), snapshots kept by their train-split coverage",
-    )
-    parser.add_argument(
-        "--budget",
-        type=arguments.bounded(1, 10**5),
-        default=None,
-        metavar="MOVES",
-        help="--task mapping: moves per episode (default: the fixed sweep's)",
-    )
-    parser.add_argument(
-        "--seen-fraction",
-        type=float,
-        default=None,
-        metavar="F",
-        help="--task mapping: the visible fraction at which a fruit counts as seen (default 0.5)",
-    )
+    arguments.add_task_flags(parser, "train on")
 
 
 def run(args: argparse.Namespace) -> int:

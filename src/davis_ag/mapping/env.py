@@ -36,6 +36,7 @@ import numpy as np
 from gymnasium import spaces
 
 from davis_ag.benchmark.cache import OBS_SIZE, SceneCache, load_scene_cache
+from davis_ag.benchmark.episode_rules import discrete_action, named_action
 from davis_ag.benchmark.robot_moves import RobotOnGrid, attach_robot, no_reachable_start
 from davis_ag.benchmark.splits import as_dataset, select_scenes
 from davis_ag.environments import MAPPING_ID
@@ -300,15 +301,7 @@ class RowMappingEnv(gym.Env[np.ndarray, np.int64]):
             cell[cell == CURRENT] = value
 
     def _action_index(self, action: Any) -> int:
-        if isinstance(action, np.ndarray) and action.size == 1:
-            action = action.reshape(()).item() if action.dtype.kind in "iu" else action
-        if isinstance(action, (int, np.integer)) and not isinstance(action, bool):
-            if 0 <= int(action) < len(self.action_names):
-                return int(action)
-        raise UserError(
-            f"invalid action {action!r}: expected an integer in 0..{len(self.action_names) - 1} "
-            f"({', '.join(self.action_names)})"
-        )
+        return discrete_action(action, self.action_names)
 
     def action_masks(self) -> np.ndarray:
         """Which moves are not refused from here (sb3-contrib's MaskablePPO convention)."""
@@ -320,9 +313,7 @@ class RowMappingEnv(gym.Env[np.ndarray, np.int64]):
         Raises:
             UserError: for a name that is not a move of this scenario.
         """
-        if name not in self.action_names:
-            raise UserError(f"invalid action {name!r}: this environment has {', '.join(self.action_names)}")
-        return self.action_names.index(name)
+        return named_action(name, self.action_names, "this environment")
 
     # ----------------------------------------------------------------------------- state
 

@@ -14,15 +14,14 @@ over the budget, 1 for a policy that sees everything at once), ``reach_50`` and 
 
 from __future__ import annotations
 
-import json
 import os
 from pathlib import Path
 from typing import Any, Final, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, ConfigDict, Field
 
-from davis_ag.benchmark.results import CodeDigest, DatasetIdentity, Metric, table_number
+from davis_ag.benchmark.results import CodeDigest, DatasetIdentity, Metric, read_results_file, table_number
 from davis_ag.benchmark.summaries import session_metrics
 from davis_ag.errors import UserError
 
@@ -241,21 +240,7 @@ def load_mapping_results(path: str | os.PathLike[str]) -> MappingResults:
         UserError: when the file is missing, not JSON, not mapping results, or edited.
     """
     path = Path(path)
-    try:
-        data = json.loads(path.read_text())
-    except OSError as error:
-        raise UserError(f"{path}: cannot read it ({error.strerror or error})") from None
-    except ValueError as error:
-        raise UserError(f"{path}: not JSON ({error}); give a RESULTS.json davis-ag evaluate wrote") from None
-    try:
-        results = MappingResults.model_validate(data)
-    except ValidationError as error:
-        first = error.errors()[0]
-        where = ".".join(str(p) for p in first["loc"])
-        raise UserError(
-            f"{path}: not davis-ag mapping results ({where}: {first['msg']}); give a RESULTS.json "
-            "davis-ag evaluate --task mapping wrote"
-        ) from None
+    results = read_results_file(path, MappingResults, "mapping results", "davis-ag evaluate --task mapping")
     check_mapping_summaries(results, str(path))
     return results
 

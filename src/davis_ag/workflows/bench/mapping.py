@@ -21,6 +21,7 @@ import numpy as np
 
 from davis_ag.atomic_files import write_marked_section
 from davis_ag.workflows.bench.report import doc_section
+from davis_ag.workflows.bench.robot import steps_per_second
 
 #: The scene: docs/robot.md's apple-wall row.
 CROP, SCENARIO = "apple-wall", "row"
@@ -28,15 +29,6 @@ SEED = 5
 SIZE = (320, 180)
 #: Steps timed each way.
 STEPS = 20_000
-
-
-def _rate(env: Any, actions: np.ndarray) -> float:
-    env.reset(seed=0)
-    began = time.perf_counter()
-    for action in actions:
-        if env.step(int(action))[2]:
-            env.reset()
-    return len(actions) / (time.perf_counter() - began)
 
 
 def _update_us(env: Any, views: np.ndarray) -> float:
@@ -90,7 +82,7 @@ def mapping_speed(scratch: Path) -> dict[str, Any]:
     mapping = RowMappingEnv(root, SCENARIO, split="all")
     tvm = TVMEnv(root, SCENARIO, split="all")
     moves = np.random.default_rng(0).integers(len(mapping.action_names), size=STEPS)
-    tvm_rate, mapping_rate = _rate(tvm, moves), _rate(mapping, moves)
+    tvm_rate, mapping_rate = steps_per_second(tvm, moves), steps_per_second(mapping, moves)
     update = _update_us(mapping, np.random.default_rng(1).integers(cache.n_views, size=STEPS))
     bounds = []
     for part in np.unique(coverage.part):

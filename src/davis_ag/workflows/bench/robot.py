@@ -32,7 +32,8 @@ REACH_TARGET_S = 30.0
 STEP_TARGET_US = 100.0
 
 
-def _steps_per_second(env: Any, actions: np.ndarray) -> float:
+def steps_per_second(env: Any, actions: np.ndarray) -> float:
+    """Steps a second of a discrete environment playing ``actions``, resetting at each episode's end."""
     env.reset(seed=0)
     began = time.perf_counter()
     for action in actions:
@@ -75,8 +76,8 @@ def robot_speed(scratch: Path) -> dict[str, Any]:
     free = TVMEnv(root, SCENARIO, split="all")
     robot = TVMEnv(root, SCENARIO, split="all", robot=STEP_ROBOT)
     actions = np.random.default_rng(0).integers(len(free.action_names), size=STEPS)
-    without = _steps_per_second(free, actions)
-    with_robot = _steps_per_second(robot, actions)
+    without = steps_per_second(free, actions)
+    with_robot = steps_per_second(robot, actions)
     return {
         "scene": scene.id,
         "views": len(scene),
