@@ -109,8 +109,8 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
             antialiasing: The renderer's: ``none`` (default: the fastest), ``fxaa`` or ``msaa``; ids are
                 exact in every mode.
             render_mode: None or ``"rgb_array"``.
-            robot, budget_s: The camera rides on this robot, its seconds spent at most ``budget_s``
-                (:mod:`davis_ag.live.continuous_robot`).
+            robot: The camera rides on this robot (:mod:`davis_ag.live.continuous_robot`).
+            budget_s: With a robot, the most seconds an episode may spend.
 
         Raises:
             UserError: for bad settings, or when no scene of ours matches.

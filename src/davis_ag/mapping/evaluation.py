@@ -206,7 +206,10 @@ def evaluate_mapping(
         policies: Policies, callables or SPEC strings (as :func:`davis_ag.benchmark.evaluate` takes them).
         dataset: A dataset root or an opened dataset.
         scenario: ``row`` (default) or ``mp``.
-        split, sessions, episodes, seed: The protocol.
+        split: ``test`` (default), ``train`` or ``all``.
+        sessions: Sessions of the protocol.
+        episodes: Episodes per session.
+        seed: The protocol's seed.
         crop: Keep one crop.
         baselines: True: Sweep, Rand and Greedy; False: none; or a list of names. With any, the
             best fixed move's row too.
