@@ -90,6 +90,7 @@ def play_episode(env: Any, policy: Policy, reset_seed: int, policy_seed: int, se
     start = _start_record(inner, session, info)
     gains: list[int] = []
     actions: list[int] = []
+    step_seconds: list[float] = []
     while True:
         try:
             action = policy.act(obs, info)
@@ -102,10 +103,19 @@ def play_episode(env: Any, policy: Policy, reset_seed: int, policy_seed: int, se
             raise UserError(f"policy {policy.name} failed: {type(error).__name__}: {error}") from None
         actions.append(int(np.asarray(action).reshape(())))
         gains.append(int(info["new"]))
+        if "robot" in info:
+            step_seconds.append(float(info["robot"]["seconds"]))
         if terminated or truncated:
             break
-    seconds = float(info["robot"]["seconds_total"]) if "robot" in info else None
-    return MappingEpisode(**start, gains=gains, path=list(info["path"]), actions=actions, seconds=seconds)
+    robot = "robot" in info
+    return MappingEpisode(
+        **start,
+        gains=gains,
+        path=list(info["path"]),
+        actions=actions,
+        seconds=float(info["robot"]["seconds_total"]) if robot else None,
+        step_seconds=step_seconds if robot else None,
+    )
 
 
 #: The row of the best policy that always makes one move.
@@ -333,7 +343,7 @@ def _replay_episode(
     start = _start_record(env, session, info)
     for field in ("scene", "fruit", "part", "part_ceiling", "seen_0"):
         check(field, start[field])
-    gains = []
+    gains, step_seconds = [], []
     terminated = False
     for step, action in enumerate(stored.actions):
         if terminated:
@@ -343,9 +353,12 @@ def _replay_episode(
         except UserError as error:
             raise DifferenceFound(Difference(name, f"action {step}", action, str(error), session, index)) from None
         gains.append(int(info["new"]))
+        if "robot" in info:
+            step_seconds.append(float(info["robot"]["seconds"]))
     check("gains", gains)
     check("path", list(info["path"]))
     if not terminated:
         raise DifferenceFound(Difference(name, "length", len(stored.actions), "more moves", session, index))
     if stored.seconds is not None or "robot" in info:
         check("seconds", float(info["robot"]["seconds_total"]) if "robot" in info else None)
+        check("step_seconds", step_seconds if "robot" in info else None)

@@ -52,6 +52,7 @@ class MappingEpisode(_Model):
     path: list[str]
     actions: list[int]
     seconds: float | None = None
+    step_seconds: list[float] | None = Field(default=None, description="with a robot: each step's seconds")
 
 
 class PartBound(_Model):
@@ -104,6 +105,8 @@ class MappingPolicyResult(_Model):
     refused: Metric
     moves_50: float | None = Field(default=None, description="mean moves to 50 % of the part's ceiling, where reached")
     moves_80: float | None = None
+    seconds_50: float | None = Field(default=None, description="with a robot: mean seconds to 50 %, where reached")
+    seconds_80: float | None = None
     seconds: Metric | None = None
     bound: float = Field(description="mean over its episodes of the start part's budget bound, as a share")
     part_ceiling: float = Field(description="mean over its episodes of the start part's ceiling, as a share")
@@ -157,6 +160,9 @@ def episode_metrics(episode: MappingEpisode, budget: int) -> dict[str, Any]:
         reached = np.flatnonzero(curve >= goal) if episode.part_ceiling else np.zeros(0, dtype=np.int64)
         metrics[f"reach_{key}"] = float(len(reached) > 0)
         metrics[f"moves_{key}"] = int(reached[0]) if len(reached) else None
+        if episode.step_seconds is not None:  # the seconds of the moves made until then
+            spent = float(np.sum(episode.step_seconds[: int(reached[0])])) if len(reached) else None
+            metrics[f"seconds_{key}"] = spent
     if episode.seconds is not None:
         metrics["seconds"] = float(episode.seconds)
     return metrics
@@ -170,9 +176,10 @@ def summarise(
     keys = METRIC_KEYS + (("seconds",) if all("seconds" in r for r in records) else ())
     row: dict[str, Any] = session_metrics(records, keys, sessions)
     for share in MILESTONES:
-        key = f"moves_{round(share * 100)}"
-        moves = [r[key] for r in records if r[key] is not None]
-        row[key] = float(np.mean(moves)) if moves else None
+        for unit in ("moves", "seconds"):
+            key = f"{unit}_{round(share * 100)}"
+            values = [r[key] for r in records if r.get(key) is not None]
+            row[key] = float(np.mean(values)) if values else None
     row["bound"] = float(np.mean([_start_part(e, segments).bound / e.fruit for e in episodes]))
     row["part_ceiling"] = float(np.mean([e.part_ceiling / e.fruit for e in episodes]))
     return row
@@ -250,7 +257,7 @@ def mapping_table(results: MappingResults) -> str:
     protocol = results.protocol
     robot = protocol.robot is not None
     head = "| policy | coverage | curve area | 50 % of reachable | moves to 50 % | 80 % of reachable | moves to 80 % |"
-    head += " robot seconds |" if robot else ""
+    head += " robot seconds | seconds to 50 % | seconds to 80 % |" if robot else ""
     rows = [head, "|" + "---|" * (head.count("|") - 1)]
     ordered = sorted(results.policies.items(), key=lambda item: -item[1].coverage.mean)
 
@@ -272,6 +279,7 @@ def mapping_table(results: MappingResults) -> str:
         ]
         if robot:
             cells.append(f"{row.seconds.mean:.1f}" if row.seconds is not None else "-")
+            cells += [f"{v:.1f}" if v is not None else "never" for v in (row.seconds_50, row.seconds_80)]
         rows.append("| " + " | ".join(cells) + " |")
     any_row = next(iter(results.policies.values()))
     exact = all(part.exact for s in results.segments.values() for part in s.parts)
