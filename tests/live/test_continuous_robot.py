@@ -32,6 +32,7 @@ def test_the_arm_follows_the_camera_by_forward_kinematics(root: Path) -> None:
     data = model.createData()
     refused: dict[str, int] = {}
     moved = 0
+    rng = np.random.default_rng(0)  # small seeded moves: most stay in the arm's reach
     for episode in range(6):
         _, info = env.reset(seed=episode)
         while True:
@@ -43,7 +44,7 @@ def test_the_arm_follows_the_camera_by_forward_kinematics(root: Path) -> None:
             assert np.linalg.norm(camera[:3, 3] - pose[:3]) < 0.01
             cosine = (np.trace(camera_rotation(pose[3], pose[4]).T @ camera[:3, :3]) - 1) / 2
             assert math.degrees(math.acos(min(1.0, cosine))) < 1.0
-            _, _, over, _, info = env.step(env.action_space.sample())
+            _, _, over, _, info = env.step(rng.uniform(-0.3, 0.3, env.action_space.shape))
             refused[info["refused"]] = refused.get(info["refused"], 0) + 1
             if info["refused"]:
                 assert info["robot"]["seconds"] == 0 and info["path"][-1] == info["path"][-2]
@@ -60,6 +61,7 @@ def test_the_arm_follows_the_camera_by_forward_kinematics(root: Path) -> None:
 def test_a_budget_of_seconds_ends_the_episode_and_needs_a_robot(root: Path) -> None:
     env = TVMContinuousEnv(root, scenario="sp", split="all", robot="ur10-lift", budget_s=1e-6, tau=50, size=64)
     env.reset(seed=0)
+    env.action_space.seed(0)
     steps, over = 0, False
     while not over:
         _, _, over, _, info = env.step(env.action_space.sample())
