@@ -309,15 +309,13 @@ def evaluate(
     """
     import gymnasium as gym
 
-    from davis_ag.benchmark.policies import DETERMINISTIC_PLAY, as_policy, policy_from_spec
+    from davis_ag.benchmark.policies import DETERMINISTIC_PLAY, as_policies
     from davis_ag.environments import CONTINUOUS_ID, TVM_ID
 
     if env not in ENVIRONMENTS:
         raise UserError(f"unknown env {env!r}: choose one of {', '.join(ENVIRONMENTS)}")
     play = DETERMINISTIC_PLAY if deterministic is None else deterministic
-    chosen = [
-        policy_from_spec(p, deterministic=play) if isinstance(p, (str, os.PathLike)) else as_policy(p) for p in policies
-    ]
+    chosen = as_policies(policies, play)
     names, builder = ENVIRONMENTS[env]
     if baselines:
         # By name, as Gymnasium loads an entry point: the continuous baselines are a later stage's.

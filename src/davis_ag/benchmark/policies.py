@@ -27,7 +27,7 @@ import importlib.util
 import inspect
 import os
 import sys
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Protocol, TypeVar, runtime_checkable
@@ -349,6 +349,15 @@ class ModelPolicy:
         with torch.no_grad():
             probs = policy.get_distribution(tensor).distribution.probs
             return [int(torch.multinomial(probs[i : i + 1], 1, True, generator=g)) for i, g in enumerate(streams)]
+
+
+def as_policies(items: Iterable[Any], deterministic: bool = DETERMINISTIC_PLAY) -> list[Policy]:
+    """Policies from what an evaluation is handed: SPEC strings (:func:`policy_from_spec`, models
+    playing as ``deterministic`` says) and policy objects or callables (:func:`as_policy`)."""
+    return [
+        policy_from_spec(p, deterministic=deterministic) if isinstance(p, (str, os.PathLike)) else as_policy(p)
+        for p in items
+    ]
 
 
 def _import_target(target: str, spec: str) -> Any:

@@ -124,18 +124,19 @@ def expect(
         raise DifferenceFound(Difference(policy, field, stored, replayed, session, episode))
 
 
-def check_replayable(results: EvaluationResults, where: str, environment: str) -> None:
-    """Refuse, in one line, a file that cannot be replayed: of an older protocol, without its
-    dataset's identity or its episodes, or of another environment than ``environment``.
+def check_replayable(results: Any, where: str, environment: str, version: int = PROTOCOL_VERSION) -> None:
+    """Refuse, in one line, a file that cannot be replayed: of another protocol version than
+    ``version`` (the environment's), without its dataset's identity or its episodes, or of another
+    environment than ``environment``.
 
     Raises:
         UserError: naming the file and what to do.
     """
     protocol = results.protocol
-    if protocol.version != PROTOCOL_VERSION:
+    if protocol.version != version:
         raise UserError(
             f"{where}: written with protocol version {protocol.version}, this davis-ag plays version "
-            f"{PROTOCOL_VERSION}: evaluate again to verify it"
+            f"{version}: evaluate again to verify it"
         )
     if results.dataset is None:
         raise UserError(f"{where}: records no dataset identity to check: evaluate again with this davis-ag")
@@ -220,22 +221,23 @@ def replay_grid(
 
 
 def replay_on(
-    results: EvaluationResults,
+    results: Any,
     root: str | os.PathLike[str],
     where: str,
     environment: str,
     make_env: Callable[[Any], Any],
     keys: tuple[str, ...],
     replay_episode: Callable[..., None],
-    before: Callable[[EvaluationResults, Any], None] | None = None,
+    before: Callable[[Any, Any], None] | None = None,
+    version: int = PROTOCOL_VERSION,
 ) -> ReplayReport:
-    """The replay both environments share: the file checked (:func:`check_replayable`) and its
+    """The replay every environment shares: the file checked (:func:`check_replayable`) and its
     dataset compared (:func:`dataset_difference`); then ``make_env(protocol)``, the protocol's
     ``keys`` against its ``describe()``, ``before(results, env)`` (the grid's exact expectations)
     and ``replay_episode`` on every episode of every policy; the environment is closed after.
 
     Args:
-        results: The results file, read.
+        results: The results file, read (TVM-v0's, TVMContinuous-v0's or RowMapping-v0's).
         root: The dataset folder.
         where: The file, for messages.
         environment: The environment id the file must name (``davis_ag/TVM-v0``, ...).
@@ -243,6 +245,7 @@ def replay_on(
         keys: The protocol fields the environment's ``describe()`` must repeat.
         replay_episode: Plays one recorded episode again; raises on the first difference.
         before: Checks run once before the episodes (the grid's exact expectations), or None.
+        version: The protocol version this davis-ag plays for the environment.
 
     Returns:
         The report: sound, or the first difference.
@@ -250,7 +253,7 @@ def replay_on(
     Raises:
         UserError: for a file that cannot be replayed or a dataset that is not one.
     """
-    check_replayable(results, where, environment)
+    check_replayable(results, where, environment, version)
     began = time.perf_counter()
     count = sum(len(p.episodes or []) for p in results.policies.values())
     difference = dataset_difference(results, root)
@@ -261,10 +264,10 @@ def replay_on(
 
 def _replay_episodes(
     env: Any,
-    results: EvaluationResults,
+    results: Any,
     keys: tuple[str, ...],
     replay_episode: Callable[..., None],
-    before: Callable[[EvaluationResults, Any], None] | None,
+    before: Callable[[Any, Any], None] | None,
 ) -> Difference | None:
     protocol = results.protocol
     try:

@@ -16,7 +16,6 @@ the segments' ceilings and bounds are computed again.
 from __future__ import annotations
 
 import os
-import time
 from collections.abc import Sequence
 from typing import Any
 
@@ -24,9 +23,10 @@ import numpy as np
 
 from davis_ag.benchmark.code_digest import code_digest
 from davis_ag.benchmark.evaluation import episode_seeds
-from davis_ag.benchmark.policies import Policy, as_policy, policy_from_spec, prepare
-from davis_ag.benchmark.replay import Difference, DifferenceFound, ReplayReport, dataset_difference, expect
+from davis_ag.benchmark.policies import Policy, as_policies, prepare
+from davis_ag.benchmark.replay import Difference, DifferenceFound, ReplayReport, expect, replay_on
 from davis_ag.benchmark.results import identify_dataset
+from davis_ag.environments import MAPPING_ID
 from davis_ag.errors import UserError
 from davis_ag.mapping.baselines import BASELINES, FixedMove, build_baselines
 from davis_ag.mapping.bound import best_views
@@ -239,9 +239,7 @@ def evaluate_mapping(
     from davis_ag.environments import MAPPING_ID
 
     play = DETERMINISTIC_PLAY if deterministic is None else deterministic
-    chosen = [
-        policy_from_spec(p, deterministic=play) if isinstance(p, (str, os.PathLike)) else as_policy(p) for p in policies
-    ]
+    chosen = as_policies(policies, play)
     if baselines:
         chosen += build_baselines(list(BASELINES) if baselines is True else list(baselines))
     made = gym.make(
@@ -274,7 +272,8 @@ def replay_mapping(
     cache_dir: str | os.PathLike[str] | None = None,
     robot: str | None = None,
 ) -> ReplayReport:
-    """Replay a mapping results file on the dataset at ``root`` (see the module docstring).
+    """Replay a mapping results file on the dataset at ``root`` (see the module docstring), through
+    the replay every environment shares (:func:`davis_ag.benchmark.replay.replay_on`).
 
     Args:
         results: The results, summaries checked already (:func:`davis_ag.mapping.results.load_mapping_results`).
@@ -286,79 +285,57 @@ def replay_mapping(
     Raises:
         UserError: for a file of another protocol version or without its dataset's identity.
     """
-    protocol = results.protocol
-    if protocol.version != MAPPING_PROTOCOL_VERSION:
-        raise UserError(
-            f"{where}: mapping protocol version {protocol.version}, this davis-ag plays {MAPPING_PROTOCOL_VERSION}: evaluate again"
-        )
-    if results.dataset is None:
-        raise UserError(f"{where}: records no dataset identity to check: evaluate again with this davis-ag")
-    began = time.perf_counter()
-    played = 0
-    try:
-        found = dataset_difference(results, root)
-        if found is not None:
-            raise DifferenceFound(found)
-        if protocol.robot is not None:
-            robot = robot or protocol.robot["name"]
-        env = RowMappingEnv(
-            root,
-            scenario=protocol.scenario,
-            split=protocol.split,
-            crop=protocol.crop,
-            cache_dir=cache_dir,
-            budget=protocol.budget,
-            seen_fraction=protocol.seen_fraction,
-            robot=robot,
+
+    def make_env(protocol: MappingProtocol) -> RowMappingEnv:
+        return RowMappingEnv(
+            root, protocol.scenario, protocol.split, crop=protocol.crop, cache_dir=cache_dir, budget=protocol.budget,
+            seen_fraction=protocol.seen_fraction, robot=(robot or protocol.robot["name"]) if protocol.robot else None,
             budget_s=protocol.budget_s,
-        )
-        described = env.describe()
-        for field in ("scenes", "actions", "robot"):
-            expect(getattr(protocol, field), described[field], "", f"protocol {field}")
+        )  # fmt: skip
+
+    def segments(stored: MappingResults, env: RowMappingEnv) -> None:
         fresh = scene_segments(env)
-        for scene, segment in results.segments.items():
+        for scene, segment in stored.segments.items():
             expect(
                 segment.model_dump(), fresh[scene].model_dump() if scene in fresh else None, "", f"segment of {scene}"
             )
-        for name, row in results.policies.items():
-            for session in range(protocol.sessions):
-                resets, _ = episode_seeds(protocol.seed, session, protocol.episodes)
-                stored = [e for e in row.episodes if e.session == session]
-                expect(len(stored), len(resets), name, f"session {session}'s episodes")
-                for index, (episode, reset) in enumerate(zip(stored, resets)):
-                    _replay_episode(env, name, episode, reset, session, index)
-                    played += 1
-    except DifferenceFound as error:
-        return ReplayReport(where, played, len(results.policies), time.perf_counter() - began, error.difference)
-    return ReplayReport(where, played, len(results.policies), time.perf_counter() - began)
+
+    keys = ("scenario", "split", "budget", "budget_s", "seen_fraction", "scenes", "actions", "robot")
+    return replay_on(
+        results, root, where, MAPPING_ID, make_env, keys, _replay_episode, segments, MAPPING_PROTOCOL_VERSION
+    )
 
 
 def _replay_episode(
-    env: RowMappingEnv, name: str, stored: MappingEpisode, reset: int, session: int, index: int
+    env: RowMappingEnv, name: str, stored: dict[str, Any], index: int, seed: int, per_session: int
 ) -> None:
-    def check(field: str, value: Any) -> None:
-        expect(getattr(stored, field), value, name, field, session, index)
+    """Play one recorded episode again: its seeded start (scene, fruit, part, what it sees), then its
+    moves, which must see the recorded fruit first at every step, along the recorded path."""
+    session, episode = divmod(index, per_session)
 
-    _, info = env.reset(seed=reset)
+    def check(field: str, value: Any) -> None:
+        expect(stored[field], value, name, field, session, episode)
+
+    _, info = env.reset(seed=episode_seeds(seed, session, per_session)[0][episode])
     start = _start_record(env, session, info)
     for field in ("scene", "fruit", "part", "part_ceiling", "seen_0"):
         check(field, start[field])
     gains, step_seconds = [], []
     terminated = False
-    for step, action in enumerate(stored.actions):
+    for step, action in enumerate(stored["actions"]):
         if terminated:
-            raise DifferenceFound(Difference(name, "actions", len(stored.actions), step, session, index))
+            raise DifferenceFound(Difference(name, "actions", len(stored["actions"]), step, session, episode))
         try:
             _, _, terminated, _, info = env.step(action)
         except UserError as error:
-            raise DifferenceFound(Difference(name, f"action {step}", action, str(error), session, index)) from None
+            raise DifferenceFound(Difference(name, f"action {step}", action, str(error), session, episode)) from None
         gains.append(int(info["new"]))
         if "robot" in info:
             step_seconds.append(float(info["robot"]["seconds"]))
     check("gains", gains)
     check("path", list(info["path"]))
     if not terminated:
-        raise DifferenceFound(Difference(name, "length", len(stored.actions), "more moves", session, index))
-    if stored.seconds is not None or "robot" in info:
+        raise DifferenceFound(Difference(name, "length", len(stored["actions"]), "more moves", session, episode))
+    if stored["seconds"] is not None or "robot" in info:
         check("seconds", float(info["robot"]["seconds_total"]) if "robot" in info else None)
         check("step_seconds", step_seconds if "robot" in info else None)
