@@ -20,7 +20,10 @@ from davis_ag.workflows.reproduce.run import reproduce, write_page
 from davis_ag.workflows.reproduce.state import RunState, run_config
 from davis_ag.workflows.reproduce.status import format_status
 
-HELP = "reproduce Table 4, the crops ladder or row mapping: generate, train A2C and PPO, benchmark, write the page"
+HELP = (
+    "reproduce Table 4, the crops ladder, row mapping or the robot run: generate, train A2C and PPO, "
+    "benchmark, write the page"
+)
 DESCRIPTION = __doc__
 FORMATTER_CLASS = argparse.RawDescriptionHelpFormatter
 
@@ -44,8 +47,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "with Table 4), "
         "medium (the paper's grids and 300K A2C steps, hours), paper-scale (Table 3's 130 scenes "
         "at 1280x720, over many sittings: --status says where a run stands), crops (every "
-        "plant-library crop's SP and row scenes, its page docs/crops.md) or mapping (row mapping on "
-        "five crops' rows with every baseline, its page docs/mapping.md)",
+        "plant-library crop's SP and row scenes, its page docs/crops.md), mapping (row mapping on "
+        "five crops' rows with every baseline, its page docs/mapping.md) or robot (three rows without "
+        "a robot and with each robot, A2C and PPO trained under each, its page docs/robot.md)",
     )
     parser.add_argument(
         "--sp-scenes", type=arguments.bounded(1, 1000), default=None, help="override the SP scene count"
@@ -116,6 +120,10 @@ def run(args: argparse.Namespace) -> int:
             from davis_ag.workflows.reproduce.mapping_run import write_run_page
 
             write_run_page(args.results, recorded, args.out, recorded.pairs)
+        elif recorded.page == "robot":
+            from davis_ag.workflows.reproduce.pages.robot import write_robot_page
+
+            write_robot_page(args.results, recorded, state, args.out, recorded.pairs)
         else:
             write_page(args.results, recorded, state, args.out)
         print(f"wrote {args.results}")
@@ -128,4 +136,8 @@ def run(args: argparse.Namespace) -> int:
         from davis_ag.workflows.reproduce.mapping_run import reproduce_mapping
 
         return reproduce_mapping(config, args.out, args.results, pairs)
+    if config.page == "robot":
+        from davis_ag.workflows.reproduce.robot_run import reproduce_robot
+
+        return reproduce_robot(config, args.out, args.results, pairs)
     return reproduce(config, args.out, args.results, pairs)

@@ -11,7 +11,7 @@ from pathlib import Path
 
 from davis_ag.benchmark.cache import OBS_SIZE
 from davis_ag.scene.specs import PAPER_IMAGE_SIZE, PAPER_TABLE3, CropSpec, ScenarioSpec, crop_spec, scenario_spec
-from davis_ag.workflows.reproduce.groups import CROPS_PAIRS, MAPPING_PAIRS, SCENARIO_CROPS, group_key
+from davis_ag.workflows.reproduce.groups import CROPS_PAIRS, MAPPING_PAIRS, ROBOT_PAIRS, SCENARIO_CROPS, group_key
 
 
 @dataclass(frozen=True)
@@ -32,7 +32,9 @@ class ReproduceConfig:
             with the same steps, seed, network, train split and keep rule: the paper's ``a2c``
             and, beside it, ``ppo`` with RL Baselines3 Zoo's Atari settings.
         pairs: The run's ``(scenario, crop)`` groups, in the order it takes them.
-        page: The page the run writes: ``table4`` (docs/results.md) or ``crops`` (docs/crops.md).
+        page: The page the run writes: ``table4`` (docs/results.md), ``crops`` (docs/crops.md),
+            ``mapping`` (docs/mapping.md) or ``robot`` (docs/robot.md).
+        robots: The robots each row is played with beside none (the ``robot`` run).
     """
 
     name: str
@@ -49,6 +51,7 @@ class ReproduceConfig:
     learners: tuple[str, ...] = ("a2c", "ppo")
     pairs: tuple[tuple[str, str], ...] = SCENARIO_CROPS
     page: str = "table4"
+    robots: tuple[str, ...] = ()
 
     def scenes(self, scenario_name: str) -> int:
         """How many scenes the run makes of a scenario (``sp``; ``mp`` or ``row``)."""
@@ -63,7 +66,7 @@ class ReproduceConfig:
         crop for the crops run."""
         if self.page == "table4":
             return f"{self.sp_scenes} SP strawberry and {self.mp_scenes} MP vine scenes"
-        if self.page == "mapping":
+        if self.page in ("mapping", "robot"):
             return f"{self.mp_scenes} row scene(s) of each of {len(self.pairs)} crops"
         crops = len({crop for _, crop in self.pairs})
         return f"{self.sp_scenes} SP and {self.mp_scenes} row scenes of each of {crops} crops"
@@ -97,6 +100,10 @@ class ReproduceConfig:
 #: ``mapping``: row mapping on five of the crops run's rows (apple-wall, VSP vine, capsicum, cherry
 #: tomato, olive), one row scene each at 320x180 with dataset seed 5 (apple-wall's is docs/robot.md's
 #: row), every baseline at three seen fractions; no learner (docs/mapping.md is its page).
+#: ``robot``: the apple-wall, VSP vine and capsicum rows (docs/robot.md's reach rows: 320x180,
+#: dataset seed 5), two scenes each (one trains, one tests), played without a robot and with each
+#: named robot; every baseline, and A2C and PPO trained under each robot for 10K steps (half the
+#: crops run's; the table sets them beside Rand and the Best fixed action).
 #: Scene counts of Table 3 (SP strawberry, MP vine), what a configuration is measured against.
 PAPER_SCENES = (PAPER_TABLE3["sp", "strawberry"][0], PAPER_TABLE3["mp", "vine"][0])
 CONFIGS: dict[str, ReproduceConfig] = {
@@ -138,6 +145,19 @@ CONFIGS: dict[str, ReproduceConfig] = {
         learners=(),
         pairs=MAPPING_PAIRS,
         page="mapping",
+    ),
+    "robot": ReproduceConfig(
+        "robot",
+        (320, 180),
+        sp_scenes=0,
+        mp_scenes=2,
+        mp_extent=None,
+        sp_timesteps=0,
+        mp_timesteps=10_000,
+        seed=5,
+        pairs=ROBOT_PAIRS,
+        page="robot",
+        robots=("ur10-lift", "ur5-trolley", "panda-trolley"),
     ),
 }
 

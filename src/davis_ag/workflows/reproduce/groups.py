@@ -27,3 +27,6 @@ GROUPS: dict[str, str] = {scenario: group_key(scenario, crop) for scenario, crop
 MAPPING_PAIRS: tuple[tuple[str, str], ...] = tuple(
     ("row", crop) for crop in ("apple-wall", "vsp-vine", "capsicum", "cherry-tomato", "olive")
 )
+
+#: The ``robot`` run's rows (docs/robot.md): a trellised wall, a vineyard and a greenhouse crop.
+ROBOT_PAIRS: tuple[tuple[str, str], ...] = tuple(("row", crop) for crop in ("apple-wall", "vsp-vine", "capsicum"))

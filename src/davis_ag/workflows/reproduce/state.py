@@ -152,6 +152,7 @@ def run_config(state: RunState, path: Path) -> ReproduceConfig:
             mp_extent=tuple(saved["mp_extent"]) if saved.get("mp_extent") else None,
             learners=tuple(saved.get("learners", ("a2c",))),  # a run from before PPO trained A2C alone
             pairs=tuple(tuple(pair) for pair in saved.get("pairs", SCENARIO_CROPS)),
+            robots=tuple(saved.get("robots", ())),
         )
         return ReproduceConfig(**saved)
     except (TypeError, KeyError, ValueError) as error:

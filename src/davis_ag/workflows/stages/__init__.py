@@ -83,6 +83,7 @@ def run_baselines(
     seed: int = 0,
     model: Path | None = None,
     learners: tuple[Path, ...] = (),
+    robot: str | None = None,
 ) -> EvaluationResults:
     """Evaluate LRD, UDD, Rand, Oracle, the Best fixed action (and A2C when ``model`` is given,
     and other learners' models beside it) as in Table 4.
@@ -102,6 +103,7 @@ def run_baselines(
         learners: Other trained models (e.g. PPO's ``.zip``), each a row named by its algorithm,
             played as A2C is. Every policy plays the same seeded episodes with its own seeded
             randomness, so adding one leaves the other rows' numbers as they were.
+        robot: The robot the camera rides on (docs/robot.md): its reach, its seconds; None: none.
 
     Returns:
         What :func:`davis_ag.benchmark.evaluation.evaluate` returns (``as_json()`` is its JSON).
@@ -126,4 +128,5 @@ def run_baselines(
         seed=seed,
         crop=crop,
         baselines=list(BASELINES),
+        robot=robot,
     )
