@@ -33,9 +33,16 @@ from davis_ag.workflows.reproduce.state import RunState
 NO_ROBOT = "none"
 
 
+def robot_label(robot: str | None) -> str:
+    """What a robot goes by in file names and the table: its name, a YAML file's stem, or ``none``."""
+    if robot is None:
+        return NO_ROBOT
+    return Path(robot).stem if robot.endswith((".yaml", ".yml")) else robot
+
+
 def cell_key(scenario: str, crop: str, robot: str | None) -> str:
     """The name of one row and robot: its results file and models (``row-apple-wall-ur10-lift``)."""
-    return f"{group_key(scenario, crop)}-{robot or NO_ROBOT}"
+    return f"{group_key(scenario, crop)}-{robot_label(robot)}"
 
 
 def cell_results_path(out: Path, scenario: str, crop: str, robot: str | None) -> Path:

@@ -63,7 +63,7 @@ def robot_section(config: ReproduceConfig, state: RunState, out: Path, pairs) ->
     Returns:
         Markdown.
     """
-    from davis_ag.workflows.reproduce.robot_run import cell_key, cell_results_path, skipped_stage
+    from davis_ag.workflows.reproduce.robot_run import cell_key, cell_results_path, robot_label, skipped_stage
 
     robots: tuple[str | None, ...] = (None, *config.robots)
     steps = ", ".join(f"{a.upper()} {config.timesteps('row') // 1000}K steps" for a in config.learners)
@@ -86,7 +86,7 @@ def robot_section(config: ReproduceConfig, state: RunState, out: Path, pairs) ->
         lines += [
             f"**{group_key(scenario, crop)}** (test: {', '.join(scenes) or 'not yet evaluated'})",
             "",
-            "| method | " + " | ".join(r or "no robot" for r in robots) + " |",
+            "| method | " + " | ".join(robot_label(r) if r else "no robot" for r in robots) + " |",
             "|---|" + "---|" * len(robots),
         ]
         for name in METHODS:
@@ -106,15 +106,15 @@ def robot_section(config: ReproduceConfig, state: RunState, out: Path, pairs) ->
         for robot in robots:
             skipped = state.stages.get(skipped_stage(scenario, crop, robot)) if robot else None
             if skipped is not None:
-                missing.append(f"{robot}: {skipped.note}")
+                missing.append(f"{robot_label(robot)}: {skipped.note}")
             elif (evaluated := cells[robot]) is None:
-                missing.append(f"{robot or 'no robot'}: not yet evaluated")
+                missing.append(f"{robot_label(robot) if robot else 'no robot'}: not yet evaluated")
             else:
                 untrained = [a.upper() for a in config.learners if a.upper() not in evaluated.policies]
                 if untrained:
-                    missing.append(f"{robot or 'no robot'}: {', '.join(untrained)} not yet trained")
+                    missing.append(f"{robot_label(robot) if robot else 'no robot'}: {', '.join(untrained)} not yet trained")
         trained = [
-            f"{cell_key(scenario, crop, robot).removeprefix(group_key(scenario, crop) + '-')} "
+            f"{robot_label(robot) if robot else 'no robot'} "
             f"{algo.upper()} {record.seconds / 60:.0f} min"
             for robot in robots
             for algo in config.learners
