@@ -24,7 +24,9 @@ def _tall_robot(folder: Path) -> str:
     """The UR5 trolley mounted 4 m up: it reaches no view of the vine."""
     text = (Path(__file__).parents[3] / "src/davis_ag/robot/robots/ur5-trolley.yaml").read_text()
     path = folder / "tall.yaml"
-    path.write_text(text.replace("name: ur5-trolley", "name: tall").replace("mount_height_m: 0.69", "mount_height_m: 4.0"))
+    path.write_text(
+        text.replace("name: ur5-trolley", "name: tall").replace("mount_height_m: 0.69", "mount_height_m: 4.0")
+    )
     return str(path)
 
 
@@ -92,3 +94,19 @@ def test_a_learner_trained_under_the_robot_joins_its_cell(run) -> None:
     train_learner("a2c", out / "dataset", "sp", "vine", model, 32, short, robot="ur10-lift", arch="pooled")
     results = evaluate_cell(short, out, "sp", "vine", "ur10-lift", state, record)
     assert results is not None and "A2C" in results.policies and results.policies["A2C"].seconds.mean >= 0
+
+
+def test_the_status_lists_every_cell_and_an_unreached_robot(run) -> None:
+    import json
+    from dataclasses import asdict
+
+    from davis_ag.workflows.reproduce.status import run_status
+
+    out, config, state, _, _ = run
+    state.config = json.loads(json.dumps(asdict(replace(config, pairs=tuple(PAIRS)))))
+    state.save(out / "state.json")
+    _, stages = run_status(out)
+    by_name = {s.stage: s for s in stages}
+    assert by_name["sp-vine-none: baselines"].done and by_name["sp-vine-ur10-lift: baselines"].done
+    assert by_name["sp-vine-tall: baselines"].done and "reaches no" in by_name["sp-vine-tall: baselines"].progress
+    assert "sp-vine-tall: train A2C" not in by_name and not by_name["sp-vine-ur10-lift: evaluate"].done

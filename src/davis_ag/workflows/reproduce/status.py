@@ -89,6 +89,8 @@ def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
             stages[-1] = replace(stages[-1], progress="started, not finished")
         elif not note:
             stages[-1] = _validation_from_elsewhere(config, clock, recorded, scenario, crop, stages[-1])
+        if config.page == "robot":
+            continue  # its learners and evaluations are per robot: after every row's data
         timesteps = config.timesteps(scenario)
         for algo in config.learners:
             stage = f"{key}: train {algo.upper()}"
@@ -101,7 +103,46 @@ def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
         stages.append(StageStatus(stage, written, progress, seconds(stage)))
         if not written and seconds(stage) is None:
             stages[-1] = _evaluation_from_elsewhere(config, clock, out, scenario, crop, stages[-1])
+    if config.page == "robot":
+        stages += _robot_cells(out, config, state, seconds)
     return config, stages
+
+
+def _robot_cells(out: Path, config: ReproduceConfig, state: RunState, seconds: Any) -> list[StageStatus]:
+    """The ``robot`` run's cells (a row without a robot and with each robot), in its order: every
+    cell's baselines, then cell by cell its learners and its evaluation with them."""
+    from davis_ag.benchmark.results import load_results
+    from davis_ag.errors import UserError
+    from davis_ag.workflows.reproduce.robot_run import cell_key, cell_results_path, skipped_stage
+
+    cells = [(pair, robot) for robot in (None, *config.robots) for pair in config.pairs]
+    rows: dict[str, set[str] | None] = {}  # each evaluated cell's learner rows
+    baselines = []
+    for (scenario, crop), robot in cells:
+        key = cell_key(scenario, crop, robot)
+        unreached = state.stages.get(skipped_stage(scenario, crop, robot)) if robot else None
+        try:
+            rows[key] = set(load_results(cell_results_path(out, scenario, crop, robot), check=False).policies)
+        except UserError:
+            rows[key] = None
+        if unreached is not None:
+            baselines.append(StageStatus(f"{key}: baselines", True, unreached.note))
+        else:
+            done = rows[key] is not None
+            baselines.append(StageStatus(f"{key}: baselines", done, "written" if done else "not started"))
+    learners = []
+    for (scenario, crop), robot in cells:
+        key = cell_key(scenario, crop, robot)
+        if robot and skipped_stage(scenario, crop, robot) in state.stages:
+            continue
+        for algo in config.learners:
+            stage = f"{key}: train {algo.upper()}"
+            learners.append(_training_status(out, key, algo, config.timesteps(scenario), stage, seconds(stage)))
+        wanted = {a.upper() for a in config.learners}
+        done = rows[key] is not None and wanted <= (rows[key] or set())
+        progress = "written with " + ", ".join(sorted(wanted)) if done else "not started"
+        learners.append(StageStatus(f"{key}: evaluate", done, progress, seconds(f"{key}: evaluate")))
+    return baselines + learners
 
 
 def _generation_status(

@@ -112,10 +112,11 @@ def robot_section(config: ReproduceConfig, state: RunState, out: Path, pairs) ->
             else:
                 untrained = [a.upper() for a in config.learners if a.upper() not in evaluated.policies]
                 if untrained:
-                    missing.append(f"{robot_label(robot) if robot else 'no robot'}: {', '.join(untrained)} not yet trained")
+                    missing.append(
+                        f"{robot_label(robot) if robot else 'no robot'}: {', '.join(untrained)} not yet trained"
+                    )
         trained = [
-            f"{robot_label(robot) if robot else 'no robot'} "
-            f"{algo.upper()} {record.seconds / 60:.0f} min"
+            f"{robot_label(robot) if robot else 'no robot'} {algo.upper()} {record.seconds / 60:.0f} min"
             for robot in robots
             for algo in config.learners
             if (record := state.stages.get(f"{cell_key(scenario, crop, robot)}: train {algo.upper()}"))
