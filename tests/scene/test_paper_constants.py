@@ -76,7 +76,5 @@ def test_environment_threshold_without_scene_json_scales_the_same_way() -> None:
     class Cache:
         image_size = (640, 360)
 
-    assert (
-        min_pixels(Scene(), Cache()) == pytest.approx(240 / 4) == CROPS["tomato"].min_fruit_pixels_at(640, 360)
-    )
+    assert min_pixels(Scene(), Cache()) == pytest.approx(240 / 4) == CROPS["tomato"].min_fruit_pixels_at(640, 360)
     assert np.isclose(min_pixels(Scene(), type("C", (), {"image_size": (1280, 720)})()), 240)

@@ -60,6 +60,8 @@ def _identity(results: EvaluationResults) -> dict[str, object]:
         "dataset": _evaluated_scenes(results),
         "tau": p.tau,
         "start rule": p.start_rule,
+        # Another split rule's test side holds other starts: a file from before the rules split by scenes.
+        "split rule": p.split_rule or "scenes",
         "eligible starts": p.starts,
         # A robot changes which moves exist: rows under different robots (or none) are not one table.
         "robot": (p.robot["name"], p.robot["digest"]) if p.robot else None,

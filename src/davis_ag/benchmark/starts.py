@@ -17,7 +17,6 @@ import numpy as np
 
 from davis_ag.benchmark.episode_rules import can_start
 from davis_ag.benchmark.splits import scene_crop
-from davis_ag.errors import UserError
 from davis_ag.formats.splits import Start, check_split_rule, recorded_seed, split_starts
 from davis_ag.scene.specs import crop_spec
 
@@ -65,7 +64,9 @@ def compress(cache: SceneCache, ok: np.ndarray) -> SceneStarts:
 def start_names(scene_id: str, cache: SceneCache, boxes: np.ndarray) -> list[Start]:
     """The identities (scene id, view name, target fruit id) of a scene's box rows."""
     names, fruits = cache.view_names, cache.fruit_ids
-    return [(scene_id, names[int(v)], int(fruits[int(f)])) for v, f in zip(cache.box_view[boxes], cache.box_fruit[boxes])]
+    return [
+        (scene_id, names[int(v)], int(fruits[int(f)])) for v, f in zip(cache.box_view[boxes], cache.box_fruit[boxes])
+    ]
 
 
 def split_seed(dataset: Dataset) -> int:
@@ -103,33 +104,3 @@ def keep_side(
         narrowed[np.flatnonzero(mask)] = [n in side for n in each]
         kept.append(narrowed)
     return kept
-
-
-def check_trained_split(name: str, trained_on: list[str] | None, trained_rule: str | None, described: dict) -> None:
-    """Refuse to score a model on a test split it has seen: one trained under another split rule
-    (whose train side may hold these very starts), or under ``scenes`` on a test scene.
-
-    Args:
-        name: The policy's row name, for the message.
-        trained_on: The scenes its training record lists (None: no record).
-        trained_rule: The split rule its record names (None: a record from before the rules, or none).
-        described: The environment's ``describe()``.
-
-    Raises:
-        UserError: one line saying what to do.
-    """
-    if described.get("split") != "test" or trained_on is None:
-        return
-    rule, ours = trained_rule or "scenes", described.get("split_rule") or "scenes"
-    if rule != ours:
-        raise UserError(
-            f"{name}: trained under --split-rule {rule}, whose train side overlaps this {ours} rule's test "
-            f"split: evaluate it with --split-rule {rule}, or train it again with --split-rule {ours}"
-        )
-    seen = sorted(set(trained_on) & set(described.get("scenes", []))) if rule == "scenes" else []
-    if seen:
-        raise UserError(
-            f"{name}: trained on {len(seen)} of the {len(described['scenes'])} test scenes "
-            f"({seen[0]}{', ...' if len(seen) > 1 else ''}): the split changed after it was trained "
-            "(scenes added or removed, or splits.json edited); train it again on this dataset"
-        )

@@ -33,6 +33,8 @@ class ReproduceConfig:
             and, beside it, ``ppo`` with RL Baselines3 Zoo's Atari settings.
         pairs: The run's ``(scenario, crop)`` groups, in the order it takes them.
         page: The page the run writes: ``table4`` (docs/results.md) or ``crops`` (docs/crops.md).
+        split_rule: How train and test split (:mod:`davis_ag.formats.splits`): ``scenes``
+            (default) or ``starts``; the learners train and everything is scored under it.
     """
 
     name: str
@@ -49,6 +51,7 @@ class ReproduceConfig:
     learners: tuple[str, ...] = ("a2c", "ppo")
     pairs: tuple[tuple[str, str], ...] = SCENARIO_CROPS
     page: str = "table4"
+    split_rule: str = "scenes"
 
     def scenes(self, scenario_name: str) -> int:
         """How many scenes the run makes of a scenario (``sp``; ``mp`` or ``row``)."""
