@@ -197,7 +197,7 @@ def test_a_model_is_never_scored_on_another_split_rules_test_split(tmp_path: Pat
     assert record["train_scenes"] == ["Single-Strawberry/000", "Single-Strawberry/001"]  # both sides' scenes
     scored = evaluate([ModelPolicy(out)], root, "sp", sessions=1, episodes=2, split_rule="starts")
     assert scored.protocol.split_rule == "starts"
-    with pytest.raises(UserError, match="trained under --split-rule starts.*evaluate it with --split-rule starts"):
+    with pytest.raises(UserError, match=r"trained under --split-rule starts.*evaluate it with --split-rule starts"):
         evaluate([ModelPolicy(out)], root, "sp", sessions=1, episodes=2)
     # The same model as a scenes run records it (no rule: runs from before the rules resume).
     record_file.write_text(json.dumps({k: v for k, v in record.items() if k != "split_rule"}))

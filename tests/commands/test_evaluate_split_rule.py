@@ -13,10 +13,8 @@ from davis_ag import cli
 
 
 def evaluate(dataset: Path, out: Path, *extra: str) -> int:
-    return cli.main(
-        ["evaluate", "--dataset", str(dataset), "--scenario", "sp", "--episodes", "4", "--sessions", "1"]
-        + ["--policies", "Rand,Oracle", "--out", str(out), *extra]
-    )
+    flags = ["--dataset", str(dataset), "--scenario", "sp", "--episodes", "4", "--sessions", "1"]
+    return cli.main(["evaluate", *flags, "--policies", "Rand,Oracle", "--out", str(out), *extra])
 
 
 def test_evaluate_under_the_starts_rule_then_verify_and_compare(
@@ -26,7 +24,10 @@ def test_evaluate_under_the_starts_rule_then_verify_and_compare(
     assert evaluate(sp_root, starts, "--split-rule", "starts") == 0
     assert "split test (split rule starts): 2 SP scene(s)" in capsys.readouterr().out
     protocol = json.loads(starts.read_text())["protocol"]
-    assert protocol["split_rule"] == "starts" and protocol["scenes"] == ["Single-Strawberry/000", "Single-Strawberry/001"]
+    assert protocol["split_rule"] == "starts" and protocol["scenes"] == [
+        "Single-Strawberry/000",
+        "Single-Strawberry/001",
+    ]
     assert evaluate(sp_root, scenes) == 0
     assert json.loads(scenes.read_text())["protocol"]["split_rule"] == "scenes"
     capsys.readouterr()
@@ -54,10 +55,8 @@ def test_evaluate_under_the_starts_rule_then_verify_and_compare(
 def test_the_rule_is_refused_where_it_does_not_apply(
     sp_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], extra: list[str], message: str
 ) -> None:
-    code = cli.main(
-        ["evaluate", "--dataset", str(sp_root), "--scenario", "sp", "--out", str(tmp_path / "r.json")]
-        + ["--split-rule", "starts", *extra]
-    )
+    flags = ["--dataset", str(sp_root), "--scenario", "sp", "--out", str(tmp_path / "r.json")]
+    code = cli.main(["evaluate", *flags, "--split-rule", "starts", *extra])
     assert code == 2
     assert message in capsys.readouterr().err
     assert not (tmp_path / "r.json").exists()
