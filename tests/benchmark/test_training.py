@@ -204,6 +204,19 @@ def test_a_model_is_never_scored_on_another_split_rules_test_split(tmp_path: Pat
     with pytest.raises(UserError, match=r"^A2C: trained under --split-rule scenes, whose train side overlaps"):
         evaluate([ModelPolicy(out)], root, "sp", sessions=1, episodes=2, split_rule="starts")
     assert evaluate([ModelPolicy(out)], root, "sp", split="train", sessions=1, episodes=2, split_rule="starts")
+    # A checkpoint of one rule is not resumed under another, and says so.
+    with pytest.raises(KeyboardInterrupt):
+        train_a2c(
+            root,
+            "sp",
+            total_timesteps=80,
+            out_path=tmp_path / "b",
+            split_rule="starts",
+            callback=KillAfter(30),
+            **TINY_RUN,
+        )
+    with pytest.raises(UserError, match=r"checkpoint of another run \(split rule 'starts', not 'scenes'\)"):
+        train_a2c(root, "sp", total_timesteps=80, out_path=tmp_path / "b", **TINY_RUN)
     with pytest.raises(UserError, match="--split-rule starts splits TVM-v0's starts; mapping splits by scenes"):
         from davis_ag.mapping.training import mapping_task
 
