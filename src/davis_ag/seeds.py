@@ -9,6 +9,9 @@ Streams are NumPy ``SeedSequence`` keys, so two streams never share draws howeve
   which leaves those draws as they were;
 - a scene's random appearance: ``[scene seed, APPEARANCE_STREAM]``;
 - a group's train/test split: ``[split seed, scenario's index, crop's index, SPLIT_STREAM]``;
+- a group's split of its episode starts (``--split-rule starts``) and of its target fruits
+  (``--split-rule fruits``): ``[split seed, scenario's index, crop's index, START_SPLIT_STREAM]``
+  and ``[..., FRUIT_SPLIT_STREAM]`` (:mod:`davis_ag.formats.splits`);
 - our renderer's per-view noise: ``[lighting's noise seed, view index]`` for a grid view, and
   ``[lighting's noise seed, OFF_GRID_STREAM, digest of the pose]`` for a pose off the grid (a live
   scene's free camera): the same pose always gets the same noise (:func:`view_noise_seed`);
@@ -59,6 +62,11 @@ TRAIN_ENV_STREAM = 2**32 - 2
 TRAIN_RESUME_STREAM = 2**32 - 3
 #: A robot's IK restarts over a scene's views, after the scene seed (then the base line's side).
 REACH_STREAM = 2**32 - 4
+#: A group's split of its episode starts, after the group's keys; beyond any scene index, whose
+#: keys ``[dataset seed, scenario, crop, scene]`` share the first places.
+START_SPLIT_STREAM = 2**32 - 5
+#: A group's split of its target fruits, after the group's keys (as :data:`START_SPLIT_STREAM`).
+FRUIT_SPLIT_STREAM = 2**32 - 6
 
 
 def derived_seed(*keys: int) -> int:

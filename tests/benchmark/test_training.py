@@ -181,6 +181,48 @@ def test_a_model_is_never_scored_on_the_scenes_it_learnt_from(
         train_a2c(root, "sp", total_timesteps=100, seed=1, out_path=tmp_path / "b.zip", **TINY_RUN)
 
 
+def test_a_model_is_never_scored_on_another_split_rules_test_split(tmp_path: Path, one_thread: None) -> None:
+    """Issue 59: under --split-rule starts a model trains on 70 % of every scene's starts, so the
+    scenes rule's test scenes hold starts it learnt from, and the scenes rule's train scenes hold
+    the starts rule's test starts: each is refused, in one line, on the other's test split."""
+    from davis_ag.benchmark import evaluate
+    from davis_ag.benchmark.policies import ModelPolicy
+
+    root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2)
+    out = tmp_path / "a2c.zip"
+    train_a2c(root, "sp", total_timesteps=40, seed=1, out_path=out, split_rule="starts", **TINY_RUN)
+    record_file = training_record_path(out)
+    record = json.loads(record_file.read_text())
+    assert record["split_rule"] == "starts"
+    assert record["train_scenes"] == ["Single-Strawberry/000", "Single-Strawberry/001"]  # both sides' scenes
+    scored = evaluate([ModelPolicy(out)], root, "sp", sessions=1, episodes=2, split_rule="starts")
+    assert scored.protocol.split_rule == "starts"
+    with pytest.raises(UserError, match=r"trained under --split-rule starts.*evaluate it with --split-rule starts"):
+        evaluate([ModelPolicy(out)], root, "sp", sessions=1, episodes=2)
+    # The same model as a scenes run records it (no rule: runs from before the rules resume).
+    record_file.write_text(json.dumps({k: v for k, v in record.items() if k != "split_rule"}))
+    with pytest.raises(UserError, match=r"^A2C: trained under --split-rule scenes, whose train side overlaps"):
+        evaluate([ModelPolicy(out)], root, "sp", sessions=1, episodes=2, split_rule="starts")
+    assert evaluate([ModelPolicy(out)], root, "sp", split="train", sessions=1, episodes=2, split_rule="starts")
+    # A checkpoint of one rule is not resumed under another, and says so.
+    with pytest.raises(KeyboardInterrupt):
+        train_a2c(
+            root,
+            "sp",
+            total_timesteps=80,
+            out_path=tmp_path / "b",
+            split_rule="starts",
+            callback=KillAfter(30),
+            **TINY_RUN,
+        )
+    with pytest.raises(UserError, match=r"checkpoint of another run \(split rule 'starts', not 'scenes'\)"):
+        train_a2c(root, "sp", total_timesteps=80, out_path=tmp_path / "b", **TINY_RUN)
+    with pytest.raises(UserError, match="--split-rule starts splits TVM-v0's starts; mapping splits by scenes"):
+        from davis_ag.mapping.training import mapping_task
+
+        train_a2c(root, "sp", total_timesteps=40, out_path=out, split_rule="starts", task=mapping_task(None, 0.5))
+
+
 def test_runs_of_different_seeds_share_no_episode_stream(tmp_path: Path) -> None:
     """SB3 seeds environment i with seed + i, so environment 1 of a seed-0 run replayed the starts
     of environment 0 of a seed-1 run: runs meant as independent seeds shared 7 of 8 streams."""

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from davis_ag.benchmark.tvm import TVMEnv
+from davis_ag.benchmark.starts import min_pixels
 from davis_ag.generate.one_scene import SceneRequest
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import CROPS, PAPER_PIXELS, SCENARIOS, SLIP_SIGMA
@@ -76,7 +76,5 @@ def test_environment_threshold_without_scene_json_scales_the_same_way() -> None:
     class Cache:
         image_size = (640, 360)
 
-    assert (
-        TVMEnv._min_pixels(Scene(), Cache()) == pytest.approx(240 / 4) == CROPS["tomato"].min_fruit_pixels_at(640, 360)
-    )
-    assert np.isclose(TVMEnv._min_pixels(Scene(), type("C", (), {"image_size": (1280, 720)})()), 240)
+    assert min_pixels(Scene(), Cache()) == pytest.approx(240 / 4) == CROPS["tomato"].min_fruit_pixels_at(640, 360)
+    assert np.isclose(min_pixels(Scene(), type("C", (), {"image_size": (1280, 720)})()), 240)

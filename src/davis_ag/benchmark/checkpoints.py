@@ -102,12 +102,16 @@ def _checkpoint_problem(settings_file: Path, model_file: Path, settings: dict[st
         return f"the checkpoint is damaged ({settings_file.name} is unreadable), so it cannot be resumed"
     if not isinstance(saved, dict):
         return f"the checkpoint is damaged ({settings_file.name} is not a record), so it cannot be resumed"
-    differ = [
+    rules = (saved.get("split_rule") or "scenes", settings.get("split_rule") or "scenes")  # scenes records none
+    # Another split rule trains on other scenes too: named as such, not as scenes added.
+    differ = [f"split rule {rules[0]!r}, not {rules[1]!r}"] if rules[0] != rules[1] else []
+    skip = ("dataset", "env_seeds", "split_rule") + (("train_scenes",) if differ else ())
+    differ += [
         "another train split (scenes added or removed)"
         if key == "train_scenes"
         else f"{key} {saved.get(key)!r}, not {settings[key]!r}"
         for key in settings
-        if key in saved and saved[key] != settings[key] and key not in ("dataset", "env_seeds")  # never blocks
+        if key in saved and saved[key] != settings[key] and key not in skip
     ]
     differ += ["another dataset"] if saved.get("dataset") not in (settings["dataset"], "/", None) else []
     return f"it is the checkpoint of another run ({'; '.join(differ[:3]) or 'older settings'}), which this one cannot resume"

@@ -54,6 +54,7 @@ from davis_ag.benchmark.summaries import (
     session_metrics,
 )
 from davis_ag.errors import UserError
+from davis_ag.formats.splits import check_split_rule
 from davis_ag.provenance import code_version
 
 if TYPE_CHECKING:
@@ -277,6 +278,7 @@ def evaluate(
     cache_dir: str | os.PathLike[str] | None = None,
     keep_episodes: bool = True,
     robot: str | None = None,
+    split_rule: str = "scenes",
 ) -> EvaluationResults:
     """Score policies beside the baselines with section V-D's protocol (``davis_ag.benchmark.evaluate``).
 
@@ -300,6 +302,8 @@ def evaluate(
         keep_episodes: Keep every episode in the results.
         robot: A robot (name or YAML) the camera rides on (:mod:`davis_ag.benchmark.robot_moves` on the
             grid, :mod:`davis_ag.live.continuous_robot` on the continuous environment).
+        split_rule: ``scenes`` (default), ``starts`` or ``fruits``: which starts ``split`` holds
+            (:mod:`davis_ag.formats.splits`); the grid only.
 
     Returns:
         The results, exactly what ``davis-ag evaluate --out`` writes.
@@ -314,6 +318,8 @@ def evaluate(
 
     if env not in ENVIRONMENTS:
         raise UserError(f"unknown env {env!r}: choose one of {', '.join(ENVIRONMENTS)}")
+    if check_split_rule(split_rule) != "scenes" and env != "grid":
+        raise UserError(f"--split-rule {split_rule} splits TVM-v0's starts; --env {env} splits by scenes: leave it out")
     play = DETERMINISTIC_PLAY if deterministic is None else deterministic
     chosen = as_policies(policies, play)
     names, builder = ENVIRONMENTS[env]
@@ -325,6 +331,7 @@ def evaluate(
     kwargs: dict[str, Any] = {"dataset": dataset, "scenario": scenario, "split": split, "crop": crop}
     if env == "grid":
         kwargs["cache_dir"] = cache_dir
+        kwargs["split_rule"] = split_rule
     if robot is not None:
         kwargs["robot"] = robot
     made = gym.make(TVM_ID if env == "grid" else CONTINUOUS_ID, disable_env_checker=True, **kwargs)

@@ -122,7 +122,7 @@ def fixed_action_expectations(env: TVMEnv) -> dict[str, dict[str, float]]:
 
 
 def split_fixed_actions(
-    dataset: Dataset | str | os.PathLike[str], scenario: str, split: str, crop: str | None
+    dataset: Dataset | str | os.PathLike[str], scenario: str, split: str, crop: str | None, split_rule: str = "scenes"
 ) -> dict[str, Any]:
     """Every fixed action's exact expectations on one split of a dataset, and its start count.
 
@@ -134,11 +134,12 @@ def split_fixed_actions(
         scenario: ``sp`` or ``mp``.
         split: ``train``, ``test`` or ``all``.
         crop: The crop (``None``: every crop of the scenario).
+        split_rule: The split rule (:mod:`davis_ag.formats.splits`).
 
     Returns:
         ``{"split", "starts", "fixed_actions"}``; ``fixed_actions`` as :func:`fixed_action_expectations`.
     """
-    env = TVMEnv(dataset, scenario=scenario, split=split, crop=crop)
+    env = TVMEnv(dataset, scenario=scenario, split=split, crop=crop, split_rule=split_rule)
     try:
         return {"split": split, "starts": len(env.starts), "fixed_actions": fixed_action_expectations(env)}
     finally:

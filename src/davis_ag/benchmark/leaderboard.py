@@ -3,7 +3,7 @@
 Results are ranked together only when they measure the same thing: the same protocol version,
 the same evaluated scenes (each one's identity in :class:`davis_ag.benchmark.results.DatasetIdentity`:
 seed, code, how it was drawn; scenes the dataset gained since, another crop's group, change nothing
-a file measured), environment, scenario, crop, split (hence scenes and eligible starts). Anything
+a file measured), environment, scenario, crop, split and split rule (hence scenes and eligible starts). Anything
 else is refused in one line.
 Files may differ in sessions, episodes or seed; then their means are still comparable (each an
 estimate of the same expectation), but their episodes are not the same, and a paired gap is
@@ -55,6 +55,9 @@ def _identity(results: EvaluationResults) -> dict[str, object]:
         "scenario": p.scenario,
         "crop": p.crop,
         "split": p.split,
+        # Another rule's test side holds other starts (and scenes): named before the scenes it moves.
+        # A file from before the rules split by scenes.
+        "split rule": p.split_rule or "scenes",
         "test scenes": tuple(p.scenes),
         # After the split and its scenes: another split plays other scenes, and is named as such.
         "dataset": _evaluated_scenes(results),
@@ -104,7 +107,7 @@ def check_comparable(files: list[tuple[Path, EvaluationResults]]) -> None:
             if found[key] != value:
                 raise UserError(
                     f"{path} and {first} differ in {key} ({_shown(found[key])} against {_shown(value)}): "
-                    "results of different datasets, splits or protocol versions cannot be ranked together"
+                    "results of different datasets, splits, split rules or protocol versions cannot be ranked together"
                 )
 
 

@@ -15,7 +15,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from davis_ag.benchmark.cache import SceneCache
-from davis_ag.benchmark.tvm import MAX_START_OER, TVMEnv
+from davis_ag.benchmark.starts import min_pixels as start_pixels
+from davis_ag.benchmark.tvm import MAX_START_OER
 from davis_ag.scene.specs import ALL_ACTIONS, scenario_spec
 
 if TYPE_CHECKING:
@@ -71,7 +72,7 @@ def refused_moves(
 def refused_moves_of_scenes(scenes: Sequence[Scene], caches: list[SceneCache], scenario: str) -> RefusedMoves:
     """:func:`refused_moves` summed over scenes of one scenario (the environment's own threshold)."""
     actions = tuple(scenario_spec(scenario).actions)
-    parts = [refused_moves(cache, actions, TVMEnv._min_pixels(scene, cache)) for scene, cache in zip(scenes, caches)]
+    parts = [refused_moves(cache, actions, start_pixels(scene, cache)) for scene, cache in zip(scenes, caches)]
     return RefusedMoves(
         *(sum(getattr(p, name) for p in parts) for name in ("starts", "moves", "no_view", "target_lost"))
     )

@@ -40,6 +40,7 @@ from davis_ag.benchmark.sb3_models import (
     load_model,
     recurrent_batch,
 )
+from davis_ag.benchmark.training_record import check_trained_split
 from davis_ag.errors import UserError
 
 #: How a trained model plays by default (one owner for every SB3 model: ``davis-ag evaluate``,
@@ -212,13 +213,16 @@ class ModelPolicy:
         """
         #: The scenes it was trained on, where its training record says (``davis-ag train``'s).
         self.trained_on: list[str] | None = None
+        #: The split rule its training record names (None: none recorded, i.e. ``scenes``).
+        self.split_rule: str | None = None
         #: The zip it was loaded from (None: a model given in memory); its digest names the code.
         self.path: Path | None = None
         if isinstance(model, (str, os.PathLike)):
             self.path = Path(os.fspath(model)).expanduser()
-            from davis_ag.benchmark.training_record import recorded_train_scenes
+            from davis_ag.benchmark.training_record import recorded_split_rule, recorded_train_scenes
 
             self.trained_on = recorded_train_scenes(model)
+            self.split_rule = recorded_split_rule(model)
             model = load_model(model, device)
         # A Q-learner's policy is its greedy action: SB3's "sampled" DQN (and QR-DQN) is
         # epsilon-greedy with training's exploration rate, which is no distribution of the learnt policy.
@@ -276,14 +280,7 @@ class ModelPolicy:
                 raise UserError(f"{self.name}: a MaskablePPO model needs an environment with action_masks()")
             self._env = inner
         described = inner.describe() if hasattr(inner, "describe") else {}
-        if self.trained_on and described.get("split") == "test":
-            seen = sorted(set(self.trained_on) & set(described.get("scenes", [])))
-            if seen:
-                raise UserError(
-                    f"{self.name}: trained on {len(seen)} of the {len(described['scenes'])} test scenes "
-                    f"({seen[0]}{', ...' if len(seen) > 1 else ''}): the split changed after it was trained "
-                    "(scenes added or removed, or splits.json edited); train it again on this dataset"
-                )
+        check_trained_split(self.name, self.trained_on, self.split_rule, described)
 
     def act(self, observation: np.ndarray, info: dict[str, Any]) -> Any:
         """The model's action for ``observation`` (a recurrent policy's memory carried on)."""

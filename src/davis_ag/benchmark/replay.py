@@ -6,7 +6,8 @@ leaderboard maintainer therefore replays what was claimed, as EvalAI re-scores s
 
 1. the dataset is the one evaluated (its fingerprint, scene by scene:
    :class:`davis_ag.benchmark.results.DatasetIdentity`), and the environment built on it with the
-   file's protocol describes itself as the file says (scenes, eligible starts, actions, tau, start rule);
+   file's protocol (its split rule included: none recorded reads as ``scenes``) describes itself as
+   the file says (scenes, eligible starts, actions, tau, start rule);
 2. episode ``e`` of session ``s`` of every policy resets with the protocol's seed for it
    (:func:`davis_ag.benchmark.evaluation.episode_seeds`), so its scene, start view, target and
    OER_0 must be the recorded ones; then its recorded actions are stepped through the scene's
@@ -213,6 +214,7 @@ def replay_grid(
             cache_dir=cache_dir,
             tau=protocol.tau,
             start_rule=protocol.start_rule or "pairs",
+            split_rule=protocol.split_rule or "scenes",  # a file from before the rules: scenes
             robot=robot or (recorded["name"] if recorded else None),
         )
 

@@ -173,6 +173,10 @@ class Protocol(_Model):
     dataset: str
     actions: list[str]
     start_rule: str | None = None
+    split_rule: str | None = Field(
+        default=None,
+        description="scenes, starts or fruits (davis_ag.formats.splits); None: scenes, as before the rules",
+    )
     starts: int | None = None
     aim: str | None = None
     robot: dict[str, str] | None = None
@@ -323,8 +327,9 @@ def split_text(protocol: Protocol) -> str:
     scenes = protocol.scenes
     shown = ", ".join(scenes[:4]) + (f", ... ({len(scenes) - 4} more)" if len(scenes) > 4 else "")
     starts = f"; {protocol.starts} eligible starts" if protocol.starts is not None else "; starts drawn live"
+    rule = f" (split rule {protocol.split_rule})" if protocol.split_rule not in (None, "scenes") else ""
     return (
-        f"split {protocol.split}: {len(scenes)} {protocol.scenario.upper()} scene(s) ({shown}){starts}; "
+        f"split {protocol.split}{rule}: {len(scenes)} {protocol.scenario.upper()} scene(s) ({shown}){starts}; "
         f"{protocol.sessions} sessions x {protocol.episodes} episodes, seed {protocol.seed}, tau={protocol.tau}"
     )
 

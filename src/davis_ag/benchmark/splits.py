@@ -6,6 +6,10 @@ only used by ``split="all"``); otherwise (e.g. the original download, which ship
 generator's own rule, :mod:`davis_ag.formats.splits`, with the seed of the dataset's
 ``dataset.json`` (0 without one). The same dataset therefore always splits the same way, and as
 the generator would have split it.
+
+Under the split rules ``starts`` and ``fruits`` (:mod:`davis_ag.formats.splits`) train and test
+play the same scenes, every scene of either list; which starts each side plays is
+:mod:`davis_ag.benchmark.starts`'s.
 """
 
 from __future__ import annotations
@@ -16,7 +20,7 @@ from typing import TYPE_CHECKING
 
 from davis_ag.errors import UserError
 from davis_ag.formats.layout import ANNOTATIONS
-from davis_ag.formats.splits import recorded_seed, split_scenes
+from davis_ag.formats.splits import check_split_rule, recorded_seed, split_scenes
 from davis_ag.scene.specs import crop_spec, parse_group_name, scenario_spec
 
 if TYPE_CHECKING:
@@ -86,7 +90,9 @@ def _refuse_unlabelled(dataset: Dataset, lists: dict[str, list[str]]) -> None:
                 )
 
 
-def select_scenes(dataset: Dataset, scenario: str, split: str, crop: str | None = None) -> list[Scene]:
+def select_scenes(
+    dataset: Dataset, scenario: str, split: str, crop: str | None = None, rule: str = "scenes"
+) -> list[Scene]:
     """The scenes of one scenario (and crop) in one split, sorted by id.
 
     Args:
@@ -94,25 +100,29 @@ def select_scenes(dataset: Dataset, scenario: str, split: str, crop: str | None 
         scenario: ``sp`` or ``mp``.
         split: ``train``, ``test`` or ``all``.
         crop: Keep only this crop; ``None`` keeps every crop.
+        rule: The split rule: ``scenes`` (default) keeps the split's scenes; ``starts`` and
+            ``fruits`` keep the scenes of both lists for ``train`` and ``test`` alike.
 
     Returns:
         The selected scenes.
 
     Raises:
-        UserError: for an unknown split, when nothing is left, or when the split lost a scene
-            (:func:`dataset_splits`).
+        UserError: for an unknown split or rule, when nothing is left, or when the split lost a
+            scene (:func:`dataset_splits`).
     """
     scenario = scenario_spec(scenario).name
     crop = crop_spec(crop).name if crop else None
     if split not in SPLITS:
         raise UserError(f"unknown split {split!r}: choose one of {', '.join(SPLITS)}")
+    check_split_rule(rule)
     scenes = [s for s in dataset.scenes if scene_scenario(s) == scenario and (crop is None or scene_crop(s) == crop)]
     where = f"{scenario}{'/' + crop if crop else ''} scenes of {dataset.root}"
     if not scenes:
         raise UserError(f"no {where}: pick a scenario/crop the dataset has")
     if split == "all":
         return sorted(scenes, key=lambda s: s.id)
-    keep = set(dataset_splits(dataset)[split])
+    lists = dataset_splits(dataset)
+    keep = set(lists[split]) if rule == "scenes" else set(lists["train"]) | set(lists["test"])
     chosen = sorted((s for s in scenes if s.id in keep), key=lambda s: s.id)
     if not chosen:
         raise UserError(

@@ -44,6 +44,7 @@ from davis_ag.benchmark.training_record import model_path, training_record_path
 from davis_ag.benchmark.training_rescue import keep_what_it_trained, rescued_selection, what_survives
 from davis_ag.errors import MachineError, UserError
 from davis_ag.formats.models import check_seed
+from davis_ag.formats.splits import check_split_rule
 from davis_ag.seeds import resumed_training_seed, training_env_seed
 
 if TYPE_CHECKING:
@@ -94,6 +95,7 @@ def make_vec_tvm(
     env_seeds: str = "streams",
     robot: str | None = None,
     task: TrainingTask = TVM_TASK,
+    split_rule: str = "scenes",
 ) -> Any:
     """``n_envs`` TVM environments in one SB3 ``DummyVecEnv`` (each wrapped in ``Monitor``).
 
@@ -107,6 +109,7 @@ def make_vec_tvm(
         seed: The run's seed.
         split, crop, cache_dir, robot: As for :class:`davis_ag.benchmark.TVMEnv`.
         task: The environment's task (TVM-v0 by default).
+        split_rule: The split rule (:mod:`davis_ag.formats.splits`); TVM-v0 only.
         env_seeds: ``streams``: environment ``i`` is seeded with
             :func:`~davis_ag.seeds.training_env_seed` ``(seed, i)``, so runs of different seeds
             share no episode stream; ``seed+i`` (runs from before, resumed as they began):
@@ -121,6 +124,8 @@ def make_vec_tvm(
     kwargs = {"dataset": opened, "scenario": scenario, "split": split, "crop": crop, "cache_dir": cache_dir}
     if robot is not None:
         kwargs["robot"] = robot
+    if split_rule != "scenes":  # only then: other tasks' environments take no rule
+        kwargs["split_rule"] = split_rule
     chosen = DummyVecEnv if env_seeds == "seed+i" else StreamSeededVecEnv
     return make_vec_env(
         task.env_class, n_envs=n_envs, seed=seed, env_kwargs={**kwargs, **task.env_kwargs}, vec_env_cls=chosen
@@ -173,6 +178,7 @@ def train_agent(
     force: bool = False,
     robot: str | None = None,
     task: TrainingTask = TVM_TASK,
+    split_rule: str = "scenes",
 ) -> Path:
     """Train an agent on the train split and save it; resume a killed run.
 
@@ -222,6 +228,9 @@ def train_agent(
             training and the scoring environments; recorded in the settings (name and digest).
         task: What to learn (TVM-v0 by default; row mapping's from :mod:`davis_ag.mapping.training`),
             recorded in the settings with its environment's settings when it is another.
+        split_rule: ``scenes`` (default), ``starts`` or ``fruits`` (:mod:`davis_ag.formats.splits`):
+            which starts train; recorded in the settings when not ``scenes``, and evaluation refuses
+            the model on another rule's test split. TVM-v0 only.
 
     Returns:
         The saved model's path.
@@ -244,6 +253,9 @@ def train_agent(
     check_keep(keep)
     check_seed(seed, "--seed")
     check_device(device)
+    check_split_rule(split_rule)
+    if split_rule != "scenes" and task.name != TVM_TASK.name:
+        raise UserError(f"--split-rule {split_rule} splits TVM-v0's starts; {task.name} splits by scenes: leave it out")
     chosen = resolve_settings(settings) if algo == "a2c" else resolve_sb3_settings(algo, settings)
     arguments = sb3_arguments(chosen)  # a bad lin_X refused here, before the data is opened
     final = model_path(Path(out_path).expanduser().absolute())
@@ -269,17 +281,21 @@ def train_agent(
 
         definition = load_robot(robot)
         settings["robot"] = {"name": definition.name, "digest": definition.digest}
+    if split_rule != "scenes":  # only then: the settings (and checkpoints) of runs before the rules stay as they were
+        settings["split_rule"] = split_rule
     if task.name != TVM_TASK.name:  # only then: the settings of TVM-v0 runs stay as they were
         settings["task"] = {"name": task.name, **task.env_kwargs}
     opened = as_dataset(dataset)
     # What it learns from: evaluation refuses to score it on any of these (a split that changed
     # since, as scenes were added), and a checkpoint of another split is not resumed.
-    settings["train_scenes"] = sorted(s.id for s in select_scenes(opened, scenario, "train", crop))
+    settings["train_scenes"] = sorted(s.id for s in select_scenes(opened, scenario, "train", crop, split_rule))
     resumed = check_checkpoint(settings_file, model_file, settings, force)
     scores: list[dict[str, Any]] = []
     if resumed is not None:  # seeded as it began (a checkpoint from before the streams: seed + i)
         settings["env_seeds"] = resumed[4]
-    env = make_vec_tvm(opened, scenario, n_envs, seed, "train", crop, cache_dir, settings["env_seeds"], robot, task)
+    env = make_vec_tvm(
+        opened, scenario, n_envs, seed, "train", crop, cache_dir, settings["env_seeds"], robot, task, split_rule
+    )
     if resumed is not None:
         _, earlier, points, scores, _ = resumed
         model = load_checkpoint(algorithm, model_file, env, device)
@@ -308,8 +324,9 @@ def train_agent(
     curve = LearningCurve(CURVE_EVERY, points)
     selection = None
     if keep == "best-train":
+        rule = {"split_rule": split_rule} if split_rule != "scenes" else {}
         scoring_env = task.env_class(
-            opened, scenario, split="train", crop=crop, cache_dir=cache_dir, robot=robot, **task.env_kwargs
+            opened, scenario, split="train", crop=crop, cache_dir=cache_dir, robot=robot, **task.env_kwargs, **rule
         )
         selection = KeepBestOnTrain(
             scoring_env,

@@ -39,7 +39,6 @@ from __future__ import annotations
 
 import copy
 import os
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import gymnasium as gym
@@ -50,30 +49,22 @@ from davis_ag.benchmark.cache import OBS_SIZE, SceneCache, load_scene_cache
 from davis_ag.benchmark.episode_rules import (
     MAX_START_OER,
     START_RULES,
-    can_start,
     discrete_action,
     episode_reward,
     named_action,
 )
 from davis_ag.benchmark.robot_moves import RobotOnGrid, attach_robot, no_reachable_start
-from davis_ag.benchmark.splits import as_dataset, scene_crop, select_scenes
+from davis_ag.benchmark.splits import as_dataset, select_scenes
+from davis_ag.benchmark.starts import SceneStarts, compress, eligible, keep_side, min_pixels
 from davis_ag.errors import UserError
-from davis_ag.scene.specs import ALL_ACTIONS, crop_spec, scenario_spec
+from davis_ag.formats.splits import check_split_rule
+from davis_ag.scene.specs import ALL_ACTIONS, scenario_spec
 
 if TYPE_CHECKING:  # the reader loads on first use (see as_dataset)
-    from davis_ag.data.reader import Dataset, Scene
+    from davis_ag.data.reader import Dataset
 
 #: With ``budget_s`` and no ``tau``: the most steps an episode takes (refused moves cost no seconds).
 BUDGET_STEP_CAP = 100
-
-
-@dataclass
-class _Starts:
-    """One scene's eligible starts, as compressed rows: views, then boxes per view."""
-
-    views: np.ndarray  # (n,) view indices with at least one eligible target
-    offsets: np.ndarray  # (n + 1,) into boxes
-    boxes: np.ndarray  # rows of the scene's box tables
 
 
 class TVMEnv(gym.Env[np.ndarray, np.int64]):
@@ -94,6 +85,7 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
         start_rule: str = "pairs",
         robot: str | None = None,
         budget_s: float | None = None,
+        split_rule: str = "scenes",
     ) -> None:
         """Open the scenes of one scenario and split, building their caches if needed.
 
@@ -114,6 +106,9 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
             budget_s: With a robot, end an episode when its seconds are spent (a move that would
                 overrun the budget is not made and ends the episode) instead of after ``tau``
                 steps; ``tau`` then defaults to :data:`BUDGET_STEP_CAP`, a cap on refused moves.
+            split_rule: ``scenes`` (default: the split's scenes, every start of them), ``starts`` or
+                ``fruits`` (every scene of the split, the starts of ``split``'s side;
+                :mod:`davis_ag.benchmark.starts`).
 
         Raises:
             UserError: when the path is not a dataset, the split has no scene, or no scene has
@@ -125,6 +120,7 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
         if start_rule not in START_RULES:
             raise UserError(f"unknown start_rule {start_rule!r}: use one of {', '.join(START_RULES)}")
         self.start_rule = start_rule
+        self.split_rule = check_split_rule(split_rule)
         self.render_mode = render_mode
         self.dataset = as_dataset(dataset)
         self.scenario = spec.name
@@ -143,15 +139,18 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
         self.action_space = spaces.Discrete(len(self.action_names))
         self.observation_space = spaces.Box(0, 255, (OBS_SIZE, OBS_SIZE, 4), dtype=np.uint8)
 
-        self.scenes = select_scenes(self.dataset, spec.name, split, crop)
+        self.scenes = select_scenes(self.dataset, spec.name, split, crop, split_rule)
         self.caches: list[SceneCache] = [load_scene_cache(s, self.dataset.root, cache_dir) for s in self.scenes]
         self.robot: RobotOnGrid | None = None
         if robot is not None:
             self.robot, self.caches = attach_robot(robot, self.scenes, self.caches, self.dataset.root, cache_dir)
-        self._starts: list[tuple[int, _Starts]] = []
-        for index, (scene, cache) in enumerate(zip(self.scenes, self.caches)):
-            reachable = self.robot.reaches[index].reachable if self.robot is not None else None
-            starts = self._eligible(cache, self._min_pixels(scene, cache), max_start_oer, reachable)
+        masks = [eligible(c, min_pixels(s, c), max_start_oer) for s, c in zip(self.scenes, self.caches)]
+        masks = keep_side(self.dataset, self.scenes, self.caches, masks, split_rule, split)
+        self._starts: list[tuple[int, SceneStarts]] = []
+        for index, (mask, cache) in enumerate(zip(masks, self.caches)):
+            if self.robot is not None:  # after the split's side: a robot narrows a split, never moves it
+                mask = mask & self.robot.reaches[index].reachable[cache.box_view]
+            starts = compress(cache, mask)
             if len(starts.views):
                 self._starts.append((index, starts))
         if not self._starts and self.robot is not None:
@@ -170,32 +169,6 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
         self._oer_0 = self._seconds = self._move_seconds = 0.0
         self._path: list[str] = []
         self._over = True
-
-    @staticmethod
-    def _min_pixels(scene: Scene, cache: SceneCache) -> float:
-        """Visible pixels a start target needs: scene.json's threshold if the scene has one
-        (what its boxes were made with), else the crop's at the image size (the generator's rule)."""
-        metadata = scene.metadata
-        if metadata is not None and metadata.min_fruit_pixels is not None:
-            return float(metadata.min_fruit_pixels)
-        crop = scene_crop(scene)
-        if crop is None:
-            return 0.0
-        return float(crop_spec(crop).min_fruit_pixels_at(*cache.image_size))
-
-    @staticmethod
-    def _eligible(cache: SceneCache, min_pixels: float, max_oer: float, reachable: np.ndarray | None = None) -> _Starts:
-        """Boxes a scene's episodes may start from (OER and visible-pixel filters; a robot's reach)."""
-        ok = can_start(cache.box_oer, max_oer) & (cache.box_pixels >= min_pixels)
-        if reachable is not None:
-            ok &= reachable[cache.box_view]
-        boxes = np.flatnonzero(ok).astype(np.int32)
-        # Rows were written view by view, so a stable sort by view keeps each view's boxes
-        # together in annotation order.
-        boxes = boxes[np.argsort(cache.box_view[boxes], kind="stable")]
-        views, counts = np.unique(cache.box_view[boxes], return_counts=True)
-        offsets = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
-        return _Starts(views=views.astype(np.int32), offsets=offsets, boxes=boxes)
 
     # ----------------------------------------------------------------------------- episode
 
@@ -320,7 +293,7 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
 
     def describe(self) -> dict[str, Any]:
         """What an evaluation's protocol records of this environment: its id, scenario, split,
-        tau, scenes, dataset root, action names, start rule and eligible start count."""
+        split rule, tau, scenes, dataset root, action names, start rule and eligible start count."""
         return {
             "environment": "davis_ag/TVM-v0",
             "scenario": self.scenario,
@@ -330,6 +303,7 @@ class TVMEnv(gym.Env[np.ndarray, np.int64]):
             "dataset": str(self.dataset.root),
             "actions": list(self.action_names),
             "start_rule": self.start_rule,
+            "split_rule": self.split_rule,
             "starts": len(self.starts),
             "robot": self.robot.record() if self.robot is not None else None,
         }

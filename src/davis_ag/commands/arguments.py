@@ -242,8 +242,36 @@ def add_dataset_flags(parser: argparse.ArgumentParser, verb: str) -> None:
     )
 
 
+def add_split_rule_flag(parser: argparse.ArgumentParser, recorded: bool = False) -> None:
+    """Add ``--split-rule`` (:data:`davis_ag.formats.splits.SPLIT_RULES`): train's and evaluate's
+    rule (default ``scenes``), or, with ``recorded``, verify's and compare's check of the rule the
+    results files record (default: none, each file replayed under its own).
+
+    Args:
+        parser: the sub-command's parser.
+        recorded: Whether the rule is read from results files rather than chosen.
+    """
+    from davis_ag.formats.splits import SPLIT_RULES
+
+    rules = (
+        "scenes: 70 %% of each group's scenes train, 30 %% test (splits.json); starts: train and test play "
+        "the same scenes, 70 %% of each group's (view, target) starts train, 30 %% test; fruits: 70 %% of "
+        "each group's target fruits train, their starts with them (TVM-v0 only; docs/benchmark.md)"
+    )
+    if recorded:
+        parser.add_argument(
+            "--split-rule",
+            choices=SPLIT_RULES,
+            default=None,
+            help="refuse results files evaluated under another split rule (default: each under the rule it "
+            "records; a file from before the rules records scenes). " + rules,
+        )
+        return
+    parser.add_argument("--split-rule", choices=SPLIT_RULES, default="scenes", help="(default: scenes) " + rules)
+
+
 def add_task_flags(parser: argparse.ArgumentParser, verb: str) -> None:
-    """Add ``--task``, ``--budget`` and ``--seen-fraction``, shared by train and evaluate.
+    """Add ``--task``, ``--budget``, ``--seen-fraction`` and ``--split-rule``, shared by train and evaluate.
 
     Args:
         parser: the sub-command's parser.
@@ -270,3 +298,23 @@ def add_task_flags(parser: argparse.ArgumentParser, verb: str) -> None:
         metavar="F",
         help="--task mapping: the visible fraction at which a fruit counts as seen (default 0.5)",
     )
+    add_split_rule_flag(parser)
+
+
+def check_task_split_rule(args: argparse.Namespace) -> None:
+    """Refuse ``--split-rule`` other than scenes where it does not apply: ``--task mapping`` and
+    ``--env continuous`` split by scenes only.
+
+    Raises:
+        UserError: one line.
+    """
+    rule = getattr(args, "split_rule", "scenes")
+    other = (
+        "--task mapping"
+        if args.task == "mapping"
+        else "--env continuous"
+        if getattr(args, "env", "") == "continuous"
+        else None
+    )
+    if rule != "scenes" and other is not None:
+        raise UserError(f"--split-rule {rule} splits TVM-v0's starts; {other} splits by scenes: leave it out")

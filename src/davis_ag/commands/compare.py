@@ -17,7 +17,7 @@ DESCRIPTION = (
     "where the episodes are the same), and say what the numbers rest on (scenes, eligible starts, "
     "sessions x episodes). Every summary is made again from the file's episodes first, and a file "
     "whose stored summary differs is refused; with --verify DATA every episode is also played again on "
-    "the dataset (davis-ag verify). Refuses results of different datasets, splits or protocol versions. "
+    "the dataset (davis-ag verify). Refuses results of different datasets, splits, split rules or protocol versions. "
     "Each row shows the first digits of the SHA-256 of the code that played."
 )
 
@@ -50,6 +50,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="with --verify: play row NAME's episodes again with its code (as verify --policy) and rank only "
         "rows re-run so and davis-ag's own baselines (repeatable)",
     )
+    arguments.add_split_rule_flag(parser, recorded=True)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -69,9 +70,17 @@ def run(args: argparse.Namespace) -> int:
         if args.verify is not None:
             from davis_ag.commands.verify import verify_results
 
-            if verify_results(args.results, args.verify, policies=policies) != 0:
+            if verify_results(args.results, args.verify, policies=policies, split_rule=args.split_rule) != 0:
                 print("not ranked: a check above is not sound", flush=True)
                 return 1
+        if args.split_rule is not None and args.verify is None:
+            from davis_ag.benchmark.results import load_results
+            from davis_ag.commands.verify import check_recorded_rule
+            from davis_ag.mapping.results import is_mapping_results
+
+            for path in args.results:
+                rule = None if is_mapping_results(path) else load_results(path, check=False).protocol.split_rule
+                check_recorded_rule(path, rule, args.split_rule)
         page = _page(args.results, policies if args.verify is not None else None)
         print(page, end="")
         if args.out:

@@ -40,7 +40,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add ``evaluate``'s arguments to its ``parser`` (see :mod:`davis_ag.commands`)."""
     arguments.add_dataset_flags(parser, "evaluate")
     parser.add_argument(
-        "--split", default="test", choices=["train", "test", "all"], help="scenes to evaluate on (default: test)"
+        "--split",
+        default="test",
+        choices=["train", "test", "all"],
+        help="the split's side to evaluate on (default: test; --split-rule says how it splits)",
     )
     parser.add_argument(
         "--policy",
@@ -143,6 +146,7 @@ def run(args: argparse.Namespace) -> int:
         raise UserError("--task mapping plays the grid (RowMapping-v0): leave out --env continuous")
     if not mapping and (args.budget, args.seen_fraction, args.budget_s) != (None, None, None):
         raise UserError("--budget, --seen-fraction and --budget-s are for --task mapping: add it or leave them out")
+    arguments.check_task_split_rule(args)
     allowed = MAPPING_POLICIES if mapping else CONTINUOUS_POLICIES if args.env == "continuous" else POLICIES
     names = list(args.policies or allowed)
     wrong = [n for n in names if n not in allowed]
@@ -214,6 +218,7 @@ def _evaluate(args: argparse.Namespace, names: list[str], specs: list[str], out:
         baselines=names,
         cache_dir=args.cache_dir,
         robot=args.robot,
+        split_rule=args.split_rule,
     )
     return _finish(
         format_table(results),

@@ -127,6 +127,7 @@ def run(args: argparse.Namespace) -> int:
         task = mapping_task(args.budget, fraction)
     elif (args.budget, args.seen_fraction) != (None, None):
         raise UserError("--budget and --seen-fraction are for --task mapping: add it or leave them out")
+    arguments.check_task_split_rule(args)
     check_device(args.device)
     arguments.prove_writable_file(args.out)
     if args.cache_dir is not None:
@@ -151,6 +152,7 @@ def run(args: argparse.Namespace) -> int:
             force=args.force,
             robot=args.robot,
             task=task,
+            split_rule=args.split_rule,
         )
     print(f"saved {path}")
     return 0

@@ -71,6 +71,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "takes it: file.py:function, file.py:Class, module:attr, MODEL.zip), which must have the digest the "
         "file records and give every recorded action (repeatable)",
     )
+    arguments.add_split_rule_flag(parser, recorded=True)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -83,8 +84,10 @@ def run(args: argparse.Namespace) -> int:
         from davis_ag.workflows.stages.rerun import parse_policy_arguments
 
         return verify_results(
-            args.scenes, args.dataset, args.cache_dir, args.robot, parse_policy_arguments(args.policy)
+            args.scenes, args.dataset, args.cache_dir, args.robot, parse_policy_arguments(args.policy), args.split_rule
         )
+    if args.split_rule is not None:
+        raise UserError("--split-rule checks results files: give them with --dataset DATA, or leave it out")
     if args.policy:
         raise UserError("--policy re-runs a results file's row: give the results files and --dataset DATA")
     if files := [p for p in args.scenes if p.suffix == ".json"]:
@@ -109,13 +112,16 @@ def verify_results(
     cache_dir: Path | None = None,
     robot: str | None = None,
     policies: dict[str, str] | None = None,
+    split_rule: str | None = None,
 ) -> int:
-    """Replay each results file on ``dataset`` (:mod:`davis_ag.benchmark.replay`), and play each row
-    named in ``policies`` again with its code (:mod:`davis_ag.workflows.stages.rerun`); 0 when all are sound.
+    """Replay each results file on ``dataset`` (:mod:`davis_ag.benchmark.replay`) under the split
+    rule it records, and play each row named in ``policies`` again with its code
+    (:mod:`davis_ag.workflows.stages.rerun`); 0 when all are sound.
 
     Raises:
         UserError: for a file that is not results, holds a summary its episodes do not give, or
-            cannot be replayed, or a dataset that is not one.
+            cannot be replayed, a dataset that is not one, or a file of another rule than
+            ``split_rule`` (None: any).
     """
     from davis_ag.benchmark.replay import replay_grid
     from davis_ag.benchmark.results import load_results
@@ -132,9 +138,11 @@ def verify_results(
             from davis_ag.mapping.results import load_mapping_results
 
             results = load_mapping_results(path)
+            check_recorded_rule(path, None, split_rule)
             report: Any = replay_mapping(results, dataset, str(path), cache_dir, robot)
         else:
             results = load_results(path)  # every summary made again from the episodes first
+            check_recorded_rule(path, results.protocol.split_rule, split_rule)
             if results.protocol.environment == "davis_ag/TVMContinuous-v0":
                 from davis_ag.live.replay import replay_continuous
 
@@ -155,6 +163,27 @@ def verify_results(
     if len(reports) > 1:
         print(f"{sound} of {len(reports)} {'checks' if policies else 'results files'} sound")
     return 0 if sound == len(reports) else 1
+
+
+def check_recorded_rule(path: Path, recorded: str | None, wanted: str | None) -> None:
+    """Refuse a results file evaluated under another split rule than ``--split-rule`` asks for.
+
+    Args:
+        path: The file, for the message.
+        recorded: The rule its protocol records (None: a file from before the rules, or of an
+            environment without them: ``scenes``).
+        wanted: ``--split-rule`` (None: any rule).
+
+    Raises:
+        UserError: one line.
+    """
+    from davis_ag.errors import UserError
+
+    if wanted is not None and (recorded or "scenes") != wanted:
+        raise UserError(
+            f"{path}: evaluated under --split-rule {recorded or 'scenes'}, not {wanted}: give files of one rule, "
+            "or leave --split-rule out to replay each under its own"
+        )
 
 
 def check_before_making(scenes: list[Path], keep: Path | None) -> None:

@@ -35,6 +35,8 @@ class ReproduceConfig:
         page: The page the run writes: ``table4`` (docs/results.md), ``crops`` (docs/crops.md),
             ``mapping`` (docs/mapping.md) or ``robot`` (docs/robot.md).
         robots: The robots each row is played with beside none (the ``robot`` run).
+        split_rule: How train and test split (:mod:`davis_ag.formats.splits`): ``scenes``
+            (default) or ``starts``; the learners train and everything is scored under it.
     """
 
     name: str
@@ -52,6 +54,7 @@ class ReproduceConfig:
     pairs: tuple[tuple[str, str], ...] = SCENARIO_CROPS
     page: str = "table4"
     robots: tuple[str, ...] = ()
+    split_rule: str = "scenes"
 
     def scenes(self, scenario_name: str) -> int:
         """How many scenes the run makes of a scenario (``sp``; ``mp`` or ``row``)."""

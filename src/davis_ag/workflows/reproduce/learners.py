@@ -89,7 +89,7 @@ def train_learner(
     if (
         model.is_file()
         and all(made.get(k) == v for k, v in wanted.items())
-        and _split_unchanged(model, root, scenario, crop)
+        and _split_unchanged(model, root, scenario, crop, config.split_rule)
         and _made_as_configured(model, config, train_kwargs.get("arch", "paper"))
     ):
         return None
@@ -109,6 +109,7 @@ def train_learner(
         algo=algo,
         settings="ours" if settings is None else settings,
         force=True,
+        split_rule=config.split_rule,
         **train_kwargs,
     )  # its own work folder: a checkpoint of other settings is redone, as said above
     seconds = time.perf_counter() - start
@@ -126,13 +127,15 @@ def _made_as_configured(model: Path, config: Any, arch: str) -> bool:
     return all(record.get(key, value) == value for key, value in wanted.items())
 
 
-def _split_unchanged(model: Path, root: Path, scenario: str, crop: str) -> bool:
-    """Whether a finished model was trained on today's train split (a group that grew moves
-    scenes between the splits); a model from before the scenes were recorded is taken as it is."""
+def _split_unchanged(model: Path, root: Path, scenario: str, crop: str, rule: str = "scenes") -> bool:
+    """Whether a finished model was trained on today's train split under the run's split rule (a
+    group that grew moves scenes between the splits); a model from before the scenes were
+    recorded is taken as it is."""
     from davis_ag.benchmark.splits import as_dataset, select_scenes
-    from davis_ag.benchmark.training_record import recorded_train_scenes
+    from davis_ag.benchmark.training_record import recorded_split_rule, recorded_train_scenes
 
     trained_on = recorded_train_scenes(model)
     if trained_on is None:
         return True
-    return trained_on == sorted(s.id for s in select_scenes(as_dataset(root), scenario, "train", crop))
+    chosen = select_scenes(as_dataset(root), scenario, "train", crop, rule)
+    return (recorded_split_rule(model) or "scenes") == rule and trained_on == sorted(s.id for s in chosen)

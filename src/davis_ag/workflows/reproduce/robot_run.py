@@ -87,6 +87,7 @@ def _reusable(
     same = (
         (p.split, sorted(p.scenes), p.episodes, p.sessions, p.seed) == (split, sorted(scenes), config.episodes, config.sessions, config.seed)
         and recorded == _robot_digest(robot)
+        and (p.split_rule or "scenes") == config.split_rule
         and BEST_FIXED in results.policies
         and learners == {name for name in results.policies if name in {"A2C", "PPO"}}
     )  # fmt: skip
@@ -117,8 +118,8 @@ def evaluate_cell(
 
     root = out / "dataset"
     key = cell_key(scenario, crop, robot)
-    split = evaluation_split(root, scenario, crop)
-    scenes = split_scene_ids(root, scenario, split, crop)
+    split = evaluation_split(root, scenario, crop, config.split_rule)
+    scenes = split_scene_ids(root, scenario, split, crop, config.split_rule)
     models = {algo: model_path(out, key, algo) for algo in config.learners}
     finished = {algo: path for algo, path in models.items() if path.is_file()}
     path = cell_results_path(out, scenario, crop, robot)
@@ -130,6 +131,7 @@ def evaluate_cell(
         results = run_baselines(
             root, scenario, crop, split, config.episodes, config.sessions, config.seed,
             model=finished.get("a2c"), learners=tuple(p for a, p in finished.items() if a != "a2c"), robot=robot,
+            split_rule=config.split_rule,
         )  # fmt: skip
     except UserError as error:
         if robot is None or "reaches" not in str(error):

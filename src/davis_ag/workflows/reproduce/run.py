@@ -79,7 +79,8 @@ def reproduce(
     state_path = out / "state.json"
     state = RunState.load(state_path)
     configured = json.loads(json.dumps(asdict(config)))
-    if state.config and state.config != configured:
+    # A state from before the split rules ran under scenes, as the field's default says.
+    if state.config and {"split_rule": "scenes", **state.config} != configured:
         print(
             f"note: {out} was started with another configuration; finished stages are reused "
             "only where their files match",
@@ -106,7 +107,7 @@ def reproduce(
         group = root / requests[0].folder.split("/")[0]
         if not validate_once(group, state, f"{key}: validate", clock, record):
             return 1
-        split = evaluation_split(root, scenario_name, crop_name)
+        split = evaluation_split(root, scenario_name, crop_name, config.split_rule)
         timesteps = config.timesteps(scenario_name)
         models = {}
         for algo in config.learners:
@@ -122,7 +123,11 @@ def reproduce(
         print(f"benchmark on split {split!r}: {config.sessions} x {config.episodes} episodes", flush=True)
         results_json = out / "results" / f"{key}.json"
         results = _reusable_results(
-            results_json, list(models.values()), split, split_scene_ids(root, scenario_name, split, crop_name), config
+            results_json,
+            list(models.values()),
+            split,
+            split_scene_ids(root, scenario_name, split, crop_name, config.split_rule),
+            config,
         )
         if results is None:
             with clock.timing(f"{key}: evaluate"):
@@ -136,13 +141,14 @@ def reproduce(
                     config.seed,
                     model=models.get("a2c"),
                     learners=tuple(path for algo, path in models.items() if algo != "a2c"),
+                    split_rule=config.split_rule,
                 )
                 write_or_rescue(results_json, partial(write_json, results), "the results")
                 plot_results(results, results_json.with_suffix(".png"))
             record(f"{key}: evaluate", clock.seconds(f"{key}: evaluate"), f"split {split}")
         else:
             print(f"reusing {results_json}", flush=True)
-        added = add_train_split(results, root, scenario_name, crop_name)
+        added = add_train_split(results, root, scenario_name, crop_name, config.split_rule)
         if add_train_scores(results, root, scenario_name, crop_name, models, config) or added:
             write_or_rescue(results_json, partial(write_json, results), "the results")
         print(format_table(results), flush=True)
@@ -235,11 +241,11 @@ def validate_once(group: Path, state: RunState, stage: str, clock: StageClock, r
     return report.ok
 
 
-def split_scene_ids(root: Path, scenario: str, split: str, crop: str) -> list[str]:
-    """The ids of a split's scenes of one group, as the environment takes them."""
+def split_scene_ids(root: Path, scenario: str, split: str, crop: str, rule: str = "scenes") -> list[str]:
+    """The ids of a split's scenes of one group under a split rule, as the environment takes them."""
     from davis_ag.benchmark.splits import as_dataset, select_scenes
 
-    return [s.id for s in select_scenes(as_dataset(root), scenario, split, crop)]
+    return [s.id for s in select_scenes(as_dataset(root), scenario, split, crop, rule)]
 
 
 def _reusable_results(
@@ -281,6 +287,7 @@ def _reusable_results(
         and protocol.episodes == config.episodes
         and protocol.sessions == config.sessions
         and protocol.seed == config.seed
+        and (protocol.split_rule or "scenes") == config.split_rule
     )
     # Evaluations from before the Best fixed action row and the uniform start rule are run anew.
     current = protocol.start_rule == "pairs" and BEST_FIXED in results.policies
@@ -293,7 +300,7 @@ def _row_name(model: Path) -> str:
     return model.name.split("_", 1)[0].upper()
 
 
-def add_train_split(results: EvaluationResults, root: Path, scenario: str, crop: str) -> bool:
+def add_train_split(results: EvaluationResults, root: Path, scenario: str, crop: str, rule: str = "scenes") -> bool:
     """Add the yardstick of the split A2C's snapshot was chosen on: every fixed action's exact
     expectations on train (``results.train_split``); an evaluation that has it is left alone.
 
@@ -302,6 +309,7 @@ def add_train_split(results: EvaluationResults, root: Path, scenario: str, crop:
         root: The dataset root.
         scenario: ``sp``, ``mp`` or ``row``.
         crop: The group's crop.
+        rule: The run's split rule.
 
     Returns:
         Whether it was added (the results file needs writing).
@@ -310,7 +318,7 @@ def add_train_split(results: EvaluationResults, root: Path, scenario: str, crop:
 
     if results.train_split is not None:
         return False
-    results.train_split = TrainSplit.model_validate(split_fixed_actions(root, scenario, "train", crop))
+    results.train_split = TrainSplit.model_validate(split_fixed_actions(root, scenario, "train", crop, rule))
     return True
 
 
@@ -358,6 +366,7 @@ def add_train_scores(
         crop=crop,
         baselines=False,
         keep_episodes=False,
+        split_rule=config.split_rule,
     )
     for name, row in fresh.policies.items():
         scored[name] = TrainScore(

@@ -52,13 +52,15 @@ def generate_scenes(
     ]
 
 
-def evaluation_split(root: Path, scenario: str, crop: str) -> str:
+def evaluation_split(root: Path, scenario: str, crop: str, split_rule: str = "scenes") -> str:
     """``test`` when the dataset's split has test scenes of this scenario and crop, else ``all``.
 
     Args:
         root: The dataset root.
         scenario: ``sp`` or ``mp``.
         crop: Crop name.
+        split_rule: The split rule (:mod:`davis_ag.formats.splits`): under ``starts`` and
+            ``fruits`` the test side plays every scene, so one scene has a test split.
 
     Returns:
         The split to evaluate on.
@@ -67,7 +69,7 @@ def evaluation_split(root: Path, scenario: str, crop: str) -> str:
     from davis_ag.data.reader import open_dataset
 
     try:
-        select_scenes(open_dataset(root), scenario, "test", crop)
+        select_scenes(open_dataset(root), scenario, "test", crop, split_rule)
     except UserError:
         return "all"
     return "test"
@@ -84,6 +86,7 @@ def run_baselines(
     model: Path | None = None,
     learners: tuple[Path, ...] = (),
     robot: str | None = None,
+    split_rule: str = "scenes",
 ) -> EvaluationResults:
     """Evaluate LRD, UDD, Rand, Oracle, the Best fixed action (and A2C when ``model`` is given,
     and other learners' models beside it) as in Table 4.
@@ -104,6 +107,7 @@ def run_baselines(
             played as A2C is. Every policy plays the same seeded episodes with its own seeded
             randomness, so adding one leaves the other rows' numbers as they were.
         robot: The robot the camera rides on (docs/robot.md): its reach, its seconds; None: none.
+        split_rule: The split rule (:mod:`davis_ag.formats.splits`).
 
     Returns:
         What :func:`davis_ag.benchmark.evaluation.evaluate` returns (``as_json()`` is its JSON).
@@ -129,4 +133,5 @@ def run_baselines(
         crop=crop,
         baselines=list(BASELINES),
         robot=robot,
+        split_rule=split_rule,
     )
