@@ -31,7 +31,11 @@ def test_the_readme_block_beside_docs_is_rewritten_from_the_run(tmp_path: Path) 
     text = readme.read_text()
     assert "stale" not in text and text.startswith("# p\n\nbefore\n") and text.endswith("after\n")
     assert "PPO" not in text and "PPO" not in page  # a run without PPO (medium's), whatever CONFIGS now lists
-    assert "| SP strawberry, ours (2 test scenes) | .600 ± .010 | .440 ± .010 | .300 ± .010 | .450 ± .010 | – |" in text
+    assert (
+        "| SP strawberry, ours (2 test scenes, split rule `scenes`) | .600 ± .010 | .440 ± .010 | .300 ± .010 "
+        "| .450 ± .010 | – |"
+    ) in text
+    assert "(70/30 split by scene, seeded)" in page
     assert "| SP strawberry, paper (Table 4) | .520 ± .004 | .433 ± .007 | .371 ± .008 | .438 ± .101 | - |" in text
     assert "| MP vine, ours | not run yet |" in text and "| MP vine, paper (Table 4) | .369 ± .009 |" in text
     assert "SP strawberry: A2C > Rand ~ LRD > UDD **holds**." in text
@@ -41,6 +45,23 @@ def test_the_readme_block_beside_docs_is_rewritten_from_the_run(tmp_path: Path) 
     other.mkdir()
     write_results_md(other / "results.md", CONFIGS["medium"], RunState(), other)
     assert readme.read_text() == text
+
+
+def test_the_readme_block_names_each_rows_split_rule(tmp_path: Path) -> None:
+    # Issue 59: a row scored under the starts rule says so, beside the rows of the scenes rule.
+    (tmp_path / "docs").mkdir()
+    readme = tmp_path / "README.md"
+    readme.write_text("<!-- results-table4:start -->\n<!-- results-table4:end -->\n")
+    scored = results({"A2C": 0.6, "Rand": 0.45, "LRD": 0.44, "UDD": 0.3}, {}, SP_SCENES)
+    scored.protocol.split_rule = "starts"
+    page = write_results_md(
+        tmp_path / "docs" / "results.md", CONFIGS["medium"], RunState(results={"sp": scored}), tmp_path
+    )
+    assert "| SP strawberry, ours (2 test scenes, split rule `starts`) |" in readme.read_text()
+    assert (
+        "split rule `starts`: 70/30 of each group's starts, seeded, train and test on the same scenes"
+        in page.read_text()
+    )
 
 
 def test_the_blocks_beside_docs_give_the_train_gap_and_the_measured_hours(tmp_path: Path) -> None:

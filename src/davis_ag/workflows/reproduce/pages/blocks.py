@@ -74,14 +74,14 @@ def readme_block(config: ReproduceConfig, state: RunState, out: Path | None = No
         if result is not None:
             policies = result.policies
             scenes, split = len(result.protocol.scenes), result.protocol.split
+            rule = result.protocol.split_rule or "scenes"
             cells = [
                 f"{cell(policies[n].oer_tau.mean)} ± {cell(policies[n].oer_tau.std)}" if n in policies else "–"
                 for n in columns
             ]
             lines.append(
-                f"| {TITLES[scenario]}, ours ({scenes} {split} scene{'s' if scenes != 1 else ''}) | "
-                + " | ".join(cells)
-                + " |"
+                f"| {TITLES[scenario]}, ours ({scenes} {split} scene{'s' if scenes != 1 else ''}, "
+                f"split rule `{rule}`) | " + " | ".join(cells) + " |"
             )
             failures = ordering_failures(PAPER_ORDERINGS[scenario], {n: p.oer_tau for n, p in policies.items()})
             verdict = (

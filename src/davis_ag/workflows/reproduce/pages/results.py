@@ -78,9 +78,14 @@ def _notes(config: ReproduceConfig, state: RunState, out: Path | None) -> list[s
                     "(in-sample for A2C; the heuristics and the Oracle do not learn)."
                 )
             else:
+                rule = protocol.split_rule or "scenes"
+                how = (
+                    "70/30 split by scene, seeded"
+                    if rule == "scenes"
+                    else f"split rule `{rule}`: 70/30 of each group's {rule}, seeded, train and test on the same scenes"
+                )
                 notes.append(
-                    f"{key}: evaluated on the test split, {len(scenes)} scene(s): "
-                    f"{', '.join(scenes)} (70/30 split by scene, seeded)."
+                    f"{key}: evaluated on the test split, {len(scenes)} scene(s): {', '.join(scenes)} ({how})."
                 )
     for scenario, result in state.results.items():
         lengths = {n: p.length.mean for n, p in result.policies.items()}
