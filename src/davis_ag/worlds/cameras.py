@@ -29,4 +29,4 @@ def camera_to_world(pose: Sequence[float]) -> np.ndarray:
     matrix = np.eye(4)
     matrix[:3, 0], matrix[:3, 1], matrix[:3, 2] = right, up, -forward
     matrix[:3, 3] = [float(v) for v in pose[:3]]
-    return matrix
+    return matrix + 0.0  # no -0.0 in the files
