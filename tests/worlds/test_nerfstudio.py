@@ -21,14 +21,20 @@ def project(frame: dict, meta: dict, point: list[float]) -> tuple[float, float, 
     return meta["cx"] + meta["fl_x"] * camera[0] / ahead, meta["cy"] - meta["fl_y"] * camera[1] / ahead, ahead
 
 
-def test_each_visible_fruits_centre_projects_into_its_mask(world_root: Path, world_scene_dir: Path, tmp_path: Path) -> None:
+def test_each_visible_fruits_centre_projects_into_its_mask(
+    world_root: Path, world_scene_dir: Path, tmp_path: Path
+) -> None:
     out = tmp_path / "ns"
     assert cli.main(["export", "nerfstudio", str(world_root), str(out)]) == 0
     folder = out / world_scene_dir.relative_to(world_root)
     meta = json.loads((folder / "transforms.json").read_text())
     scene = json.loads((world_scene_dir / "scene.json").read_text())
     annotations = json.loads((world_scene_dir / "annotations.json").read_text())
-    assert (meta["camera_model"], meta["w"], meta["h"]) == ("OPENCV", scene["camera"]["width"], scene["camera"]["height"])
+    assert (meta["camera_model"], meta["w"], meta["h"]) == (
+        "OPENCV",
+        scene["camera"]["width"],
+        scene["camera"]["height"],
+    )
     assert len(meta["frames"]) == len(annotations)
     centres = {f["id"]: f["center"] for f in scene["fruits"]}
     landed = checked = 0
