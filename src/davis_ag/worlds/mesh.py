@@ -68,8 +68,8 @@ def glb_bytes(world: WorldTriangles) -> bytes:
     """The scene as a GLB, a node per plant and organ class and per fruit."""
     import trimesh
 
-    scene = trimesh.Scene(base_frame=ROOT_NODE)
-    scene.graph.update(frame_to=ROOT_NODE, matrix=Z_UP_TO_Y_UP)
+    scene = trimesh.Scene()
+    scene.graph.update(frame_from=scene.graph.base_frame, frame_to=ROOT_NODE, matrix=Z_UP_TO_Y_UP)
     for part in parts(world):
         mesh = _soup(world, part.faces)
         mesh.metadata.update(
