@@ -17,7 +17,7 @@ pxr = pytest.importorskip("pxr", reason="usd-core is the worlds extra")
 def test_the_stage_holds_every_fruit_and_every_camera_as_recorded(
     world_root: Path, world_scene_dir: Path, tmp_path: Path
 ) -> None:
-    from pxr import Usd, UsdGeom, UsdSemantics, UsdShade
+    from pxr import Usd, UsdGeom, UsdSemantics, UsdShade, UsdValidation
 
     out = tmp_path / "usd"
     assert cli.main(["export", "usd", str(world_root), str(out)]) == 0
@@ -25,6 +25,9 @@ def test_the_stage_holds_every_fruit_and_every_camera_as_recorded(
     stage = Usd.Stage.Open(str(path))
     assert UsdGeom.GetStageUpAxis(stage) == UsdGeom.Tokens.z and UsdGeom.GetStageMetersPerUnit(stage) == 1.0
     assert stage.GetDefaultPrim().GetPath() == "/World"
+    # USD's own validators (schema types, material bindings, shader inputs) find nothing.
+    validators = UsdValidation.ValidationRegistry().GetOrLoadAllValidators()
+    assert [e.GetMessage() for e in UsdValidation.ValidationContext(validators).Validate(stage)] == []
     scene = json.loads((world_scene_dir / "scene.json").read_text())
     annotations = json.loads((world_scene_dir / "annotations.json").read_text())
 

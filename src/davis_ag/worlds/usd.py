@@ -98,7 +98,7 @@ def _define_materials(stage, world: WorldTriangles, materials: list, texture_nam
         if texture >= 0:
             reader = UsdShade.Shader.Define(stage, material.GetPath().AppendChild("st"))
             reader.CreateIdAttr("UsdPrimvarReader_float2")
-            reader.CreateInput("varname", Sdf.ValueTypeNames.Token).Set("st")
+            reader.CreateInput("varname", Sdf.ValueTypeNames.String).Set("st")
             image = UsdShade.Shader.Define(stage, material.GetPath().AppendChild("Texture"))
             image.CreateIdAttr("UsdUVTexture")
             image.CreateInput("file", Sdf.ValueTypeNames.Asset).Set(f"./textures/{texture_names[texture]}")
