@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import pytest
@@ -44,3 +45,12 @@ def test_an_export_that_exists_is_kept_without_force(
     (foreign / "notes.txt").write_text("keep")
     assert "not a usd export" in refused(capsys, "export", "usd", str(world_root), str(foreign), "--force")
     assert (foreign / "notes.txt").read_text() == "keep"
+
+
+def test_usd_without_usd_core_is_refused_before_anything_is_written(
+    capsys: pytest.CaptureFixture[str], world_root: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setitem(sys.modules, "pxr", None)  # as where the worlds extra is not installed
+    out = tmp_path / "usd"
+    assert "usd-core" in refused(capsys, "export", "usd", str(world_root), str(out))
+    assert not out.exists()

@@ -64,6 +64,10 @@ def check_scenes(args: argparse.Namespace) -> list:
     """The scenes to export, each checked to have scene.json, before anything is written."""
     from davis_ag.worlds.triangles import geometry_scenes
 
+    if args.format == "usd":
+        from davis_ag.worlds.usd import require_usd
+
+        require_usd()
     return geometry_scenes(args.dir, args.format)
 
 

@@ -60,6 +60,15 @@ def _pxr():
     return Gf, Sdf, Usd, UsdGeom, UsdSemantics, UsdShade, Vt
 
 
+def require_usd() -> None:
+    """Refuse, before any work, when usd-core is not installed.
+
+    Raises:
+        UserError: naming the package and the extra.
+    """
+    _pxr()
+
+
 def _material_keys(world: WorldTriangles) -> tuple[np.ndarray, list[tuple[int, int, tuple[int, int, int]]]]:
     """Each triangle's material index and the materials: (mode, texture, 8-bit Helios colour)."""
     geometry = world.geometry
