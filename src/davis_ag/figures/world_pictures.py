@@ -43,6 +43,7 @@ def draw_mesh(path: Path, out_path: Path, margin: float = 0.3, elevation: float 
         azimuth: Viewing azimuth, degrees.
     """
     from matplotlib.patches import Patch
+    from mpl_toolkits.mplot3d import Axes3D
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     mesh = read_mesh(path)
@@ -66,6 +67,7 @@ def draw_mesh(path: Path, out_path: Path, margin: float = 0.3, elevation: float 
     figure = new_figure(12.0, 4.6)
     for k, (title, colours) in enumerate(panels):
         ax = figure.add_axes((k / 3, 0.1, 1 / 3, 0.84), projection="3d")
+        assert isinstance(ax, Axes3D)  # matplotlib's stubs know only 2-D axes
         ax.add_collection3d(Poly3DCollection(corners[keep], facecolors=colours / 255.0, linewidths=0))
         ax.set_xlim(lo[0], hi[0])
         ax.set_ylim(lo[1], hi[1])
