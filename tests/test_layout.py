@@ -36,6 +36,7 @@ STAGES: tuple[tuple[str, ...], ...] = (
     ("mapping",),  # row mapping: the benchmark's tables read as a coverage task
     ("live",),  # regrows and renders: after the benchmark, which knows nothing of Helios
     ("detection",),
+    ("worlds",),  # 3-D exports (USD, meshes, nerfstudio): reads the live scene's geometry
     ("figures",),
     ("workflows",),
     ("commands", "cli"),

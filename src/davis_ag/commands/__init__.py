@@ -1,4 +1,4 @@
-"""Stage 15, commands: one module per ``davis-ag`` sub-command. :func:`davis_ag.cli.add_command` makes each command's
+"""Stage 16, commands: one module per ``davis-ag`` sub-command. :func:`davis_ag.cli.add_command` makes each command's
 parser from its module, which defines:
 
 - ``HELP``: the command's line in ``davis-ag --help``;

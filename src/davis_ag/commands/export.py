@@ -1,5 +1,5 @@
-"""``davis-ag export coco|yolo|pointcloud DIR OUT``: a DAVIS-Ag dataset in a detection format, by split,
-or as point clouds (PLY) from its depth images."""
+"""``davis-ag export coco|yolo|pointcloud|usd|mesh|nerfstudio DIR OUT``: a DAVIS-Ag dataset in a detection
+format, by split, as point clouds (PLY) from its depth images, or in 3-D (:mod:`davis_ag.commands.world_export`)."""
 
 from __future__ import annotations
 
@@ -9,20 +9,24 @@ from pathlib import Path
 
 from davis_ag.atomic_files import write_json_atomic
 from davis_ag.commands import arguments
+from davis_ag.commands.world_export import WORLD_FORMATS, add_formats, check_scenes, run_world
 from davis_ag.errors import UserError
 from davis_ag.formats.outputs import LOCK_FILE, claim_output
 
-HELP = "write a dataset as COCO (RLE masks) or YOLO (ultralytics) detection data, or point clouds"
+HELP = "write a dataset as COCO or YOLO detection data, point clouds, USD stages, labelled meshes or nerfstudio sets"
 DESCRIPTION = (
     "Export a DAVIS-Ag dataset for detectors, one set per split (splits.json, else the benchmark's "
     "seeded 70/30 split by scene). coco: OUT/annotations/instances_<split>.json with RLE masks, "
     "boxes, fruit ids and visible fractions, images referenced in place. yolo: the ultralytics "
     "layout (images/, labels/, data.yaml). pointcloud: PLY point clouds in the world frame from "
-    "the depth images, with colour, organ class and fruit id."
+    "the depth images, with colour, organ class and fruit id. usd, mesh, nerfstudio: each scene in 3-D "
+    "(docs/worlds.md): a USD stage with plants, fruit and cameras; its triangles labelled per face "
+    "(PLY or GLB); nerfstudio's transforms.json with the views' poses."
 )
 
 #: What an export folder may already hold (a previous export: carried on when unfinished, replaced with --force).
 _OURS = {"coco": {"annotations"}, "yolo": {"images", "labels", "data.yaml"}, "pointcloud": set()}
+_OURS.update({name: set() for name in WORLD_FORMATS})  # group folders only, as pointcloud
 #: Marks an export that has not finished: the same command carries on without --force.
 UNFINISHED = ".davis_ag-export-unfinished"
 #: What a killed export leaves (hidden working folders, temporary files), removed by the next run.
@@ -31,7 +35,7 @@ LEFT_BY_A_KILL = ("annotations/.coco-*", "**/.*.tmp")
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add ``export``'s formats, each a sub-parser with its own arguments (see :mod:`davis_ag.commands`)."""
-    formats = parser.add_subparsers(dest="format", required=True, metavar="{coco,yolo,pointcloud}")
+    formats = parser.add_subparsers(dest="format", required=True, metavar="{coco,yolo,pointcloud,usd,mesh,nerfstudio}")
     for name, help_text in (
         ("coco", "COCO instances JSON, masks as pycocotools RLE"),
         ("yolo", "ultralytics layout: images/, labels/, data.yaml"),
@@ -91,6 +95,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="M",
         help="keep one point per cube of this side, m (default 0.005 with --fuse, else 0: all)",
     )
+    add_formats(formats)
 
 
 def check_out(out: Path, fmt: str) -> None:
@@ -104,7 +109,7 @@ def check_out(out: Path, fmt: str) -> None:
             p.name
             for p in out.iterdir()
             if p.name not in _OURS[fmt] | {UNFINISHED, LOCK_FILE}
-            and not (fmt == "pointcloud" and p.is_dir() and parse_group_name(p.name))
+            and not (fmt in ("pointcloud", *WORLD_FORMATS) and p.is_dir() and parse_group_name(p.name))
         )
         if foreign:
             raise UserError(
@@ -119,7 +124,8 @@ def run(args: argparse.Namespace) -> int:
     from davis_ag.detection.instances import check_export_splits
 
     dataset = open_dataset(args.dir)  # a bad DIR, or a split that lost a scene, before anything is created
-    if args.format != "pointcloud":
+    scenes = check_scenes(args) if args.format in WORLD_FORMATS else []  # scene.json, before OUT is made
+    if args.format not in ("pointcloud", *WORLD_FORMATS):
         check_export_splits(dataset)
     if args.format == "yolo" and args.task == "segment":  # polygons need masks: refused before anything is made
         lacking = next((v for s in dataset.scenes for v in s if not v.mask_path.is_file()), None)
@@ -137,7 +143,10 @@ def run(args: argparse.Namespace) -> int:
         if args.force:  # replaced, not refreshed: nothing of the old export stays beside the new one
             clear_export(args.out)
         write_json_atomic(marker, wanted)
-        code = run_point_clouds(args) if args.format == "pointcloud" else _export(args)
+        if args.format in WORLD_FORMATS:
+            code = run_world(args, scenes)
+        else:
+            code = run_point_clouds(args) if args.format == "pointcloud" else _export(args)
         marker.unlink()
     return code
 

@@ -1,1 +1,1 @@
-"""Stage 13, pictures: contact sheets, plots and the HTML report of a dataset and its benchmark."""
+"""Stage 14, pictures: contact sheets, plots and the HTML report of a dataset and its benchmark."""

@@ -10,6 +10,10 @@ primitives, the exact grid poses) is cached in ``live_geometry.npz`` inside the 
 written atomically and keyed by everything that shapes it (scene.json's seed and settings,
 generator and pyhelios versions). A cache with another key is ignored and rewritten; a scene
 folder that cannot be written is reopened uncached, with one line on stderr.
+
+The cache also holds each primitive's organ class and plant (the 3-D exports' labels,
+:mod:`davis_ag.worlds`); a cache written before they were kept still serves drawing, and is
+regrown once by a caller that asks for them (``reopen_assets(..., labelled=True)``).
 """
 
 from __future__ import annotations
@@ -70,6 +74,10 @@ class SceneAssets:
         aim_height: Height single-plant cameras aim at, m.
         grid_views: The grid's exact viewpoints (unrounded slip), in image order.
         from_cache: Whether this came from the cache (False: regrown just now).
+        organ_of_uuid: Organ class (:mod:`davis_ag.scene.organs`) of every primitive, indexed by
+            UUID (uint8; None from a cache written before it was kept).
+        plant_of_uuid: Plant index of every primitive, indexed by UUID, -1 for none (int32; None
+            as ``organ_of_uuid``).
     """
 
     geometry: SceneGeometry
@@ -79,6 +87,8 @@ class SceneAssets:
     aim_height: float
     grid_views: list[Viewpoint]
     from_cache: bool
+    organ_of_uuid: np.ndarray | None = None
+    plant_of_uuid: np.ndarray | None = None
 
 
 def _pyhelios_root() -> Path | None:
@@ -151,6 +161,9 @@ def assets_from_model(model, grid) -> SceneAssets:
     """A grown scene's drawable content (:func:`davis_ag.generate.one_scene.grow_scene`'s output)."""
     from davis_ag.render.scene_geometry import read_scene_geometry
 
+    plant_of_uuid = np.full(model.uuid_count, -1, dtype=np.int32)
+    for plant in model.plants:
+        plant_of_uuid[np.asarray(plant.uuids, dtype=np.int64)] = plant.index
     return SceneAssets(
         read_scene_geometry(model.context),
         {f.id: np.asarray(f.uuids, dtype=np.int64) for f in model.fruits},
@@ -159,6 +172,8 @@ def assets_from_model(model, grid) -> SceneAssets:
         float(model.aim_height),
         list(grid.viewpoints),
         False,
+        model.organ_of_uuid(),
+        plant_of_uuid,
     )
 
 
@@ -200,6 +215,8 @@ def save_cache(path: Path, key: str, assets: SceneAssets) -> None:
         view_position=np.array([v.position for v in views], dtype=np.float64).reshape(-1, 3),
         view_angles=np.array([(v.yaw, v.pitch) for v in views], dtype=np.float64).reshape(-1, 2),
     )
+    if assets.organ_of_uuid is not None and assets.plant_of_uuid is not None:
+        arrays.update(organ_of_uuid=assets.organ_of_uuid, plant_of_uuid=assets.plant_of_uuid)
     with atomic_output(path) as handle:
         np.savez(handle, **arrays)
 
@@ -246,23 +263,27 @@ def load_cache(path: Path, key: str) -> SceneAssets | None:
                 float(data["aim_height"]),
                 views,
                 True,
+                data["organ_of_uuid"] if "organ_of_uuid" in data.files else None,
+                data["plant_of_uuid"] if "plant_of_uuid" in data.files else None,
             )
     except (OSError, ValueError, KeyError, IndexError, TypeError):
         return None
 
 
-def reopen_assets(settings: RecordedSettings, use_cache: bool = True) -> SceneAssets:
+def reopen_assets(settings: RecordedSettings, use_cache: bool = True, labelled: bool = False) -> SceneAssets:
     """The scene's assets from its cache if current, else regrown (and cached where possible).
 
     Args:
         settings: From :func:`~davis_ag.generate.recorded_settings.read_settings`.
         use_cache: False regrows even when a current cache exists (and rewrites it).
+        labelled: The organ class and plant of every primitive are needed: a cache written
+            before they were kept is regrown (and rewritten with them).
     """
     path = settings.folder / LIVE_GEOMETRY
     key = cache_key(settings)
     if use_cache:
         cached = load_cache(path, key)
-        if cached is not None:
+        if cached is not None and (not labelled or cached.organ_of_uuid is not None):
             return cached
     assets = regrow(settings)
     try:

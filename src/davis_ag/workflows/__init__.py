@@ -1,4 +1,4 @@
-"""Stage 14, workflows: the jobs composed from the stages before, one role each.
+"""Stage 15, workflows: the jobs composed from the stages before, one role each.
 
 ``stages`` holds the helpers the jobs share (generate scenes, choose the split, run the
 baselines); ``demo``, ``reproduce/`` (with the pages it writes), ``bench/``, ``scene_stats/`` and
