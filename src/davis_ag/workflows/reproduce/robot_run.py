@@ -27,32 +27,8 @@ from davis_ag.benchmark.results import EvaluationResults
 from davis_ag.errors import UserError
 from davis_ag.workflows.reproduce.configs import ReproduceConfig, check_disk
 from davis_ag.workflows.reproduce.groups import group_key
+from davis_ag.workflows.reproduce.robot_cells import cell_key, cell_results_path, skipped_stage
 from davis_ag.workflows.reproduce.state import RunState
-
-#: The column of the rows played without a robot (the camera floats, as in the paper).
-NO_ROBOT = "none"
-
-
-def robot_label(robot: str | None) -> str:
-    """What a robot goes by in file names and the table: its name, a YAML file's stem, or ``none``."""
-    if robot is None:
-        return NO_ROBOT
-    return Path(robot).stem if robot.endswith((".yaml", ".yml")) else robot
-
-
-def cell_key(scenario: str, crop: str, robot: str | None) -> str:
-    """The name of one row and robot: its results file and models (``row-apple-wall-ur10-lift``)."""
-    return f"{group_key(scenario, crop)}-{robot_label(robot)}"
-
-
-def cell_results_path(out: Path, scenario: str, crop: str, robot: str | None) -> Path:
-    """Where a run keeps one cell's evaluation."""
-    return out / "results" / f"{cell_key(scenario, crop, robot)}.json"
-
-
-def skipped_stage(scenario: str, crop: str, robot: str) -> str:
-    """The state record of a robot that reaches none of a row's test starts."""
-    return f"{cell_key(scenario, crop, robot)}: unreached"
 
 
 def _robot_digest(robot: str | None) -> str | None:

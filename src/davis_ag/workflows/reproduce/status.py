@@ -113,7 +113,7 @@ def _robot_cells(out: Path, config: ReproduceConfig, state: RunState, seconds: A
     cell's baselines, then cell by cell its learners and its evaluation with them."""
     from davis_ag.benchmark.results import load_results
     from davis_ag.errors import UserError
-    from davis_ag.workflows.reproduce.robot_run import cell_key, cell_results_path, skipped_stage
+    from davis_ag.workflows.reproduce.robot_cells import cell_key, cell_results_path, skipped_stage
 
     cells = [(pair, robot) for robot in (None, *config.robots) for pair in config.pairs]
     rows: dict[str, set[str] | None] = {}  # each evaluated cell's learner rows

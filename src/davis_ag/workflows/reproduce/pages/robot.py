@@ -63,7 +63,7 @@ def robot_section(config: ReproduceConfig, state: RunState, out: Path, pairs) ->
     Returns:
         Markdown.
     """
-    from davis_ag.workflows.reproduce.robot_run import cell_key, cell_results_path, robot_label, skipped_stage
+    from davis_ag.workflows.reproduce.robot_cells import cell_key, cell_results_path, robot_label, skipped_stage
 
     robots: tuple[str | None, ...] = (None, *config.robots)
     steps = ", ".join(f"{a.upper()} {config.timesteps('row') // 1000}K steps" for a in config.learners)
