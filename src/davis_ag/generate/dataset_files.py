@@ -42,12 +42,12 @@ def dataset_settings(requests: Sequence[SceneRequest]) -> dict[str, Any]:
         if (
             request.dataset_seed != first.dataset_seed
             or request.camera != first.camera
-            or (request.renderer, request.look, request.plants, request.appearance)
-            != (first.renderer, first.look, first.plants, first.appearance)
+            or (request.renderer, request.look, request.plants, request.appearance, request.structures)
+            != (first.renderer, first.look, first.plants, first.appearance, first.structures)
         ):
             raise UserError(
                 "the scenes of one run must share the dataset seed, the image size, the renderer, "
-                "the look, the plant generator and the appearance"
+                "the look, the plant generator, the appearance and the structures"
             )
     groups: dict[str, Any] = {}
     for request in requests:
@@ -62,6 +62,7 @@ def dataset_settings(requests: Sequence[SceneRequest]) -> dict[str, Any]:
             "look": resolve_look(first.renderer, first.look),
             "plants": first.plants,
             "appearance": first.appearance,
+            "structures": first.structures,
             "classes": organ_table() if first.classes else None,
             "groups": groups,
         }
@@ -116,6 +117,7 @@ def reconcile_settings(root: Path, wanted: dict[str, Any]) -> dict[str, Any]:
         ("look", "--look"),
         ("plants", "--plants"),
         ("appearance", "--appearance"),
+        ("structures", "--structures"),
     ):
         if old.get(key) != wanted[key]:
             shown = [_shown(old.get(key)), _shown(wanted[key])]
