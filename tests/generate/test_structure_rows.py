@@ -49,7 +49,7 @@ def test_the_structure_is_drawn_labelled_and_recorded(rows: dict[str, Path]) -> 
     scene = json.loads((root / SCENE / "scene.json").read_text())
     assert scene["structures"] == "default"
     assert scene["classes"]["table"] == list(ORGAN_NAMES)
-    assert json.loads((root / "dataset.json").read_text())["structures"] == "default"
+    assert json.loads((root / "dataset.json").read_text())["groups"]["Row-Capsicum"]["structures"] == "default"
     assert np.count_nonzero(_classes(root) == STRUCTURE) > 0
 
 
@@ -57,6 +57,7 @@ def test_without_structures_the_scene_is_the_bare_row_of_before(rows: dict[str, 
     bare = json.loads((rows["none"] / SCENE / "scene.json").read_text())
     built = json.loads((rows["default"] / SCENE / "scene.json").read_text())
     assert "structures" not in bare
+    assert "structures" not in json.loads((rows["none"] / "dataset.json").read_text())["groups"]["Row-Capsicum"]
     assert bare["classes"]["table"] == list(BARE_ORGAN_NAMES)
     assert "9 structure" not in bare["conventions"]["classes"]
     assert not np.any(_classes(rows["none"]) == STRUCTURE)

@@ -120,7 +120,9 @@ def test_support_positions_hold_the_ends_and_a_support_near_the_middle(plants: i
     row = RowSpec("test", spacing, 3.0, plants, 1.0, (0.5, 1.0, 1.5), "test")
     xs = support_positions(row, every)
     half = (plants + 2) * spacing / 2
-    assert xs == sorted(set(xs)) and math.isclose(xs[0], -half) and math.isclose(xs[-1], half)
+    assert (
+        xs == sorted(set(xs)) and math.isclose(xs[0], -half, abs_tol=1e-8) and math.isclose(xs[-1], half, abs_tol=1e-8)
+    )
     assert min(abs(x) for x in xs) <= spacing / 2 + 1e-9  # the cameras' stretch sees one
     interior = xs[1:-1]
     for a, b in itertools.pairwise(interior):

@@ -334,8 +334,6 @@ class DatasetFile(_Model):
     plants: PlantGenerator = "architecture"
     # ... and before randomised appearance, the paper's.
     appearance: AppearanceMode = "paper"
-    # ... and before structures, bare rows.
-    structures: StructureSetting = "none"
     #: The organ class table of NNNN_class.png, where the scenes have them.
     classes: list[OrganClass] | None = None
     groups: dict[str, DatasetGroup]

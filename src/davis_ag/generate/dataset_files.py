@@ -42,16 +42,19 @@ def dataset_settings(requests: Sequence[SceneRequest]) -> dict[str, Any]:
         if (
             request.dataset_seed != first.dataset_seed
             or request.camera != first.camera
-            or (request.renderer, request.look, request.plants, request.appearance, request.structures)
-            != (first.renderer, first.look, first.plants, first.appearance, first.structures)
+            or (request.renderer, request.look, request.plants, request.appearance)
+            != (first.renderer, first.look, first.plants, first.appearance)
         ):
             raise UserError(
                 "the scenes of one run must share the dataset seed, the image size, the renderer, "
-                "the look, the plant generator, the appearance and the structures"
+                "the look, the plant generator and the appearance"
             )
     groups: dict[str, Any] = {}
     for request in requests:
-        groups[request.folder.split("/")[0]] = {"grid": grid_settings(request.scenario, request.crop)}
+        group: dict[str, Any] = {"grid": grid_settings(request.scenario, request.crop)}
+        if request.structures != "none":  # a group without a structure records what it always did
+            group["structures"] = request.structures
+        groups[request.folder.split("/")[0]] = group
     return DatasetFile.model_validate(
         {
             "format": DATASET_FORMAT,
@@ -62,7 +65,6 @@ def dataset_settings(requests: Sequence[SceneRequest]) -> dict[str, Any]:
             "look": resolve_look(first.renderer, first.look),
             "plants": first.plants,
             "appearance": first.appearance,
-            "structures": first.structures,
             "classes": organ_table() if first.classes else None,
             "groups": groups,
         }
@@ -117,7 +119,6 @@ def reconcile_settings(root: Path, wanted: dict[str, Any]) -> dict[str, Any]:
         ("look", "--look"),
         ("plants", "--plants"),
         ("appearance", "--appearance"),
-        ("structures", "--structures"),
     ):
         if old.get(key) != wanted[key]:
             shown = [_shown(old.get(key)), _shown(wanted[key])]
@@ -127,6 +128,12 @@ def reconcile_settings(root: Path, wanted: dict[str, Any]) -> dict[str, Any]:
     groups = dict(old["groups"])
     for name, settings in wanted["groups"].items():
         if name in groups and groups[name] != settings and any(s.startswith(name + "/") for s in present):
+            made, asked = groups[name].get("structures", "none"), settings.get("structures", "none")
+            if made != asked:
+                raise UserError(
+                    f"{root}: {name} scenes were made with structures {made}, not {asked}: use "
+                    f"--structures {made} (or structures: {made} in the config) or another --out"
+                )
             raise UserError(
                 f"{root}: {name} scenes were made with grid {groups[name]['grid']}, not "
                 f"{settings['grid']}: use the same grid or another --out"

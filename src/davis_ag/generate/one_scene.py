@@ -49,7 +49,7 @@ from davis_ag.scene.specs import (
     plant_centres,
     scene_folder,
 )
-from davis_ag.scene.structures import DEFAULT_STRUCTURES, check_structures
+from davis_ag.scene.structures import DEFAULT_STRUCTURES, check_structures, structure_parts
 from davis_ag.scene.view_grid import build_view_grid
 from davis_ag.seeds import derived_seed
 
@@ -138,6 +138,10 @@ class SceneRequest(SceneSettings):
     def __post_init__(self) -> None:
         resolve_appearance(self.appearance)
         check_structures(self.structures)
+        if not structure_parts(self.scenario.name, self.crop, self.structures):
+            # What the scene gets, not what was asked: a scene with nothing to build is a bare
+            # one, and reads back from its scene.json as such.
+            object.__setattr__(self, "structures", "none")
         if self.appearance != "paper" and self.renderer != "opengl":
             raise UserError(
                 f"appearance {self.appearance} needs our renderer: drop --renderer {self.renderer} "
