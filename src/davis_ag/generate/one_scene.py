@@ -342,7 +342,7 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict, timing: di
 
     lighting = model.lighting
     organ_names = scene_organ_names(model.structures is not None)
-    return SceneFile(
+    record = SceneFile(
         format=SCENE_FORMAT,
         generator=GeneratorRecord(
             name="davis-ag",
@@ -359,8 +359,6 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict, timing: di
         crop=request.crop.name,
         scene=request.folder,
         plant_generator=model.plant_generator,
-        # Written only where a structure was built: a scene without one records what it always did.
-        **({"structures": model.structures} if model.structures is not None else {}),
         conventions={**conventions(organ_names), "segmentation": segmentation_convention(len(model.fruits))},
         camera=CameraRecord.model_validate(request.camera.intrinsics()),
         renderer=RendererRecord(
@@ -410,5 +408,10 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict, timing: di
             for v in grid.viewpoints
         },
         visible_fraction=visible,
-        **({"timing_s": timing} if timing is not None else {}),
     )
+    # Set only when known, so that a record without them dumps without the keys (``as_written``).
+    if timing is not None:
+        record.timing_s = timing
+    if model.structures is not None:  # only where one was built: a scene without records what it always did
+        record.structures = model.structures
+    return record

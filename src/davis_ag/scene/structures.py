@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Literal, get_args
+from typing import Final, Literal, get_args
 
 from davis_ag.errors import UserError
 from davis_ag.scene.crop_spec import CropSpec, RowSpec
@@ -29,7 +29,7 @@ from davis_ag.scene.organs import STRUCTURE
 #: ``none``: today's bare rows; ``default``: each row crop's structure (``row`` scenes only).
 StructureSetting = Literal["none", "default"]
 STRUCTURE_SETTINGS: tuple[str, ...] = get_args(StructureSetting)
-DEFAULT_STRUCTURES = "default"
+DEFAULT_STRUCTURES: Final = "default"
 
 Point = tuple[float, float, float]
 
