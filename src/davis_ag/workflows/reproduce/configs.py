@@ -33,6 +33,9 @@ class ReproduceConfig:
             and, beside it, ``ppo`` with RL Baselines3 Zoo's Atari settings.
         pairs: The run's ``(scenario, crop)`` groups, in the order it takes them.
         page: The page the run writes: ``table4`` (docs/results.md) or ``crops`` (docs/crops.md).
+        structures: The rows' structures (:mod:`davis_ag.scene.structures`): ``none``, the bare
+            rows every published run was made of, so a run made before the option resumes and
+            its pages stay reproducible.
     """
 
     name: str
@@ -49,6 +52,7 @@ class ReproduceConfig:
     learners: tuple[str, ...] = ("a2c", "ppo")
     pairs: tuple[tuple[str, str], ...] = SCENARIO_CROPS
     page: str = "table4"
+    structures: str = "none"
 
     def scenes(self, scenario_name: str) -> int:
         """How many scenes the run makes of a scenario (``sp``; ``mp`` or ``row``)."""
