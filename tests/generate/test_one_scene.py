@@ -445,13 +445,14 @@ def test_depth_and_renderer_settings_flow_from_flags_and_configs() -> None:
 
 
 def test_organ_classes_come_from_the_same_pass_as_the_masks(generated: tuple[Path, Path, dict], tmp_path: Path) -> None:
-    from davis_ag.scene.organs import FRUIT, LEAF, ORGAN_NAMES, SKY, SOIL, STEM
+    from davis_ag.scene.organs import BARE_ORGAN_NAMES, FRUIT, LEAF, ORGAN_NAMES, SKY, SOIL, STEM
 
     root, scene_dir, _ = generated
     from davis_ag.generate.dataset_files import dataset_settings
 
     assert [c["name"] for c in dataset_settings([REQUEST])["classes"]] == list(ORGAN_NAMES)
-    assert json.loads((scene_dir / "scene.json").read_text())["classes"]["table"] == list(ORGAN_NAMES)
+    # A scene without a structure records the table of before (no class ``structure``).
+    assert json.loads((scene_dir / "scene.json").read_text())["classes"]["table"] == list(BARE_ORGAN_NAMES)
     (scene,) = open_dataset(root).scenes
     seen: set[int] = set()
     for view in scene:

@@ -300,3 +300,31 @@ def test_ray_missing_is_refused_before_anything_is_written(
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--executor ray needs Ray" in err
     assert not out.exists()
+
+
+def test_structures_are_a_config_key_recorded_per_group_and_a_changed_one_is_refused(tmp_path: Path) -> None:
+    import json
+
+    from davis_ag.generate.dataset_files import dataset_settings, reconcile_settings
+
+    groups = "groups:\n  - {scenario: row, crop: vsp-vine, scenes: 1}\n  - {scenario: sp, crop: vsp-vine, scenes: 1}\n"
+    default = parse_dataset_config(groups, "test")
+    bare = parse_dataset_config("structures: none\n" + groups, "test")
+    assert (default.structures, bare.structures) == ("default", "none")
+    # A scene gets what it can have: single-plant scenes have nothing to build, and say none.
+    assert [r.structures for r in default.requests()] == ["default", "none"]
+    assert {r.structures for r in bare.requests()} == {"none"}
+    structured, unstructured = (dataset_settings(c.requests())["groups"] for c in (default, bare))
+    assert structured["Row-VSPVine"]["structures"] == "default"
+    assert "structures" not in structured["Single-VSPVine"]  # as every group recorded before
+    assert "structures" not in unstructured["Row-VSPVine"]
+    with pytest.raises(UserError, match="structures"):
+        parse_dataset_config("structures: trellis\n" + groups, "test")
+    # A folder holding bare rows refuses structured ones (and says how to go on).
+    root = tmp_path / "data"
+    (root / "Row-VSPVine" / "000").mkdir(parents=True)
+    (root / "Row-VSPVine" / "000" / "annotations.json").write_text("{}")
+    (root / "dataset.json").write_text(json.dumps(dataset_settings(bare.requests())))
+    with pytest.raises(UserError, match="made with structures none, not default: use --structures none"):
+        reconcile_settings(root, dataset_settings(default.requests()))
+    assert reconcile_settings(root, dataset_settings(bare.requests()))["groups"] == unstructured

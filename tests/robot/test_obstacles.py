@@ -11,7 +11,7 @@ from davis_ag.robot.definitions import load_robot
 from davis_ag.robot.ik import random_seeds, reach_pose
 from davis_ag.robot.model import build_robot, view_placement
 from davis_ag.robot.obstacles import trunk_points
-from davis_ag.scene.organs import LEAF, TRUNK
+from davis_ag.scene.organs import LEAF, STRUCTURE, TRUNK
 
 #: A camera 0.6 m out from the north base line at 0.9 m, facing the row: a UR5 on its trolley reaches it.
 POSE = [0.0, 1.15, 0.9, -90.0, 0.0]
@@ -55,6 +55,12 @@ def test_a_trunk_in_the_way_is_refused_and_leaves_are_brushed() -> None:
     leaves = trunk_points(_wall(LEAF))
     assert len(leaves) == 0  # leaves are never obstacles
     assert _reached(leaves) == (True, None)
+
+
+def test_a_trellis_in_the_way_is_an_obstacle_as_a_trunk_is() -> None:
+    structure, trunks = trunk_points(_wall(STRUCTURE)), trunk_points(_wall(TRUNK))
+    assert np.array_equal(structure, trunks)  # the same wall of posts and wires, the same points
+    assert _reached(structure) == (False, "obstacle")
 
 
 def test_the_ground_refuses_a_camera_below_it() -> None:

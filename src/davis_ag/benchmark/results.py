@@ -136,7 +136,7 @@ class SceneIdentity(_Model):
     """A scene of the dataset as generated: its id, seed, the code version that made it and how
     it was grown and drawn (None for scenes without our scene.json, e.g. the original download).
     The seed follows from the dataset seed alone: two datasets of one seed drawn at other sizes,
-    by another renderer, with other plants or another appearance differ only in ``drawn``."""
+    by another renderer, with other plants, another appearance or structures differ only in ``drawn``."""
 
     id: str
     seed: int | None = None
@@ -297,6 +297,8 @@ def scene_identity(scene_id: str, metadata: SceneFile | None) -> SceneIdentity:
         "appearance": metadata.appearance,
         "grid": metadata.grid.as_written() if metadata.grid else None,
         "min_fruit_pixels": metadata.min_fruit_pixels,
+        # Only where built: a scene without a structure hashes as it did before the option.
+        **({"structures": metadata.structures} if metadata.structures is not None else {}),
     }
     digest = hashlib.sha256(json.dumps(drawn, sort_keys=True).encode()).hexdigest()[:16]
     return SceneIdentity(id=str(scene_id), seed=metadata.seed, code=code, drawn=digest)

@@ -152,7 +152,7 @@ def antialiasing_mode(text: str) -> str:
 
 def add_renderer_flags(parser: argparse.ArgumentParser) -> None:
     """How a scene is grown and drawn, shared by generate and preview: ``--renderer``, ``--look``,
-    ``--antialiasing``, ``--plants``, ``--appearance`` and ``--strawberry-altitudes``."""
+    ``--antialiasing``, ``--plants``, ``--appearance``, ``--structures`` and ``--strawberry-altitudes``."""
     from davis_ag.render.backends import LOOKS, RENDERERS
     from davis_ag.scene.specs import PLANT_GENERATORS
 
@@ -185,6 +185,12 @@ def add_renderer_flags(parser: argparse.ArgumentParser) -> None:
         choices=("paper", "random"),
         help="paper: the paper's sky, soil and exposure (default); random: per scene, from its "
         "seed, the sun, sky, soil, exposure, white balance and sensor noise (labels unchanged)",
+    )
+    parser.add_argument(
+        "--structures",
+        choices=("none", "default"),
+        help="default: a row scene gets its crop's trellis posts and wires, stakes and twine, or "
+        "greenhouse strings and heating pipes (organ class structure); none: the bare rows of before",
     )
     parser.add_argument(
         "--strawberry-altitudes",

@@ -18,6 +18,7 @@ from davis_ag.generate.runner import run_dataset
 from davis_ag.render.backends import DEFAULT_ANTIALIASING, DEFAULT_RENDERER, resolve_look
 from davis_ag.scene.camera import Camera
 from davis_ag.scene.specs import DEFAULT_PLANTS
+from davis_ag.scene.structures import DEFAULT_STRUCTURES
 
 HELP = "render DAVIS-Ag scenes (Helios plants, our OpenGL renderer)"
 DESCRIPTION = __doc__
@@ -105,6 +106,8 @@ def run(args: argparse.Namespace) -> int:
             config = dataclasses.replace(config, appearance=args.appearance)
         if args.plants is not None:
             config = dataclasses.replace(config, plants=args.plants)
+        if args.structures is not None:
+            config = dataclasses.replace(config, structures=args.structures)
         if args.renderer is not None or args.look is not None or args.no_depth:
             renderer = args.renderer or config.renderer
             look = args.look if args.look is not None else (config.look if args.renderer is None else None)
@@ -124,6 +127,7 @@ def run(args: argparse.Namespace) -> int:
             args.antialiasing or DEFAULT_ANTIALIASING,
             args.plants or DEFAULT_PLANTS,
             args.appearance or "paper",
+            args.structures or DEFAULT_STRUCTURES,
         )
     if args.strawberry_altitudes:
         config = use_strawberry_altitudes(config, args.strawberry_altitudes)

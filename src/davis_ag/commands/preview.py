@@ -32,6 +32,7 @@ from davis_ag.scene.specs import (
     scenario_spec,
     with_strawberry_altitudes,
 )
+from davis_ag.scene.structures import DEFAULT_STRUCTURES
 
 HELP = "render a few views of one scene with boxes drawn"
 DESCRIPTION = __doc__
@@ -101,6 +102,7 @@ def _draw(
         look=look,
         plants=args.plants or DEFAULT_PLANTS,
         appearance=args.appearance or DEFAULT_APPEARANCE,
+        structures=args.structures or DEFAULT_STRUCTURES,
     )
     model, grid = grow_scene(request)  # generate's own growth: the same plants, light and slip
     _check_views(numbers, len(grid.viewpoints))

@@ -32,6 +32,7 @@ from davis_ag.data.reader import Scene, View, open_dataset
 from davis_ag.errors import UserError
 from davis_ag.formats.layout import view_number
 from davis_ag.formats.masks import NO_FRUIT_8, NO_FRUIT_16, no_fruit_value
+from davis_ag.scene.organs import ORGAN_NAMES
 
 #: Organ value of points whose scene has no class images.
 NO_CLASS = 255
@@ -211,7 +212,7 @@ def write_ply(points: np.ndarray, path: Path, comment: str = "") -> Path:
     none = NO_FRUIT_16 if dtype == POINT_DTYPE_16 else NO_FRUIT_8
     comments = [
         "davis-ag point cloud: world frame x east, y north, z up, metres",
-        f"organ: 0 sky 1 soil 2 fruit 3 leaf 4 stem 5 trunk, 255 unknown; fruit_id {none}: none",
+        f"organ: {' '.join(f'{v} {name}' for v, name in enumerate(ORGAN_NAMES))}, 255 unknown; fruit_id {none}: none",
     ]
     if comment:
         comments.append(comment)

@@ -130,7 +130,8 @@ class View:
 
     def classes(self) -> np.ndarray | None:
         """Decode the organ class image: ``H x W`` uint8, one value per class of
-        :data:`davis_ag.scene.organs.ORGAN_NAMES` (0 sky, 1 soil, 2 fruit, 3 leaf, 4 stem, 5 trunk);
+        :data:`davis_ag.scene.organs.ORGAN_NAMES` (0 sky, 1 soil, 2 fruit, 3 leaf, 4 stem, 5 trunk,
+        6-8 petiole, peduncle, flower, 9 structure);
         ``None`` where the dataset has none (the original download, datasets made before it).
 
         Raises:

@@ -45,6 +45,7 @@ from davis_ag.formats.layout import IMAGES, view_file, view_of_file
 from davis_ag.formats.masks import MAX_FRUIT_ID, mask_dtype, max_fruit_id
 from davis_ag.formats.models import AnnotationEntry, one_line
 from davis_ag.formats.scene_file import SceneFile, scene_file_from
+from davis_ag.scene.organs import ORGAN_NAMES
 
 
 def validate_scene(
@@ -199,7 +200,7 @@ def _check_pixels(
                     flag(mask_path, problem)
     for kind, check in (
         ("depth", lambda path: depth_problems(record, path, mask, metadata)),
-        ("classes", lambda path: class_problems(path, mask)),
+        ("classes", lambda path: class_problems(path, mask, _class_table(metadata))),
     ):
         path = view_file(scene.path, record.name, kind)
         if not path.is_file():
@@ -207,6 +208,15 @@ def _check_pixels(
         outside = outside_reason(path, scene.root)  # a link out of the dataset is never decoded
         for problem in [outside] if outside else check(path):
             flag(path, problem)
+
+
+def _class_table(metadata: SceneFile | None) -> tuple[str, ...]:
+    """The class table a scene records (a scene without a structure has none of class 9), or the
+    whole table where it records none."""
+    table = (metadata.classes or {}).get("table") if metadata is not None else None
+    if isinstance(table, list) and table and all(isinstance(name, str) for name in table):
+        return tuple(table)
+    return ORGAN_NAMES
 
 
 def _name_or_key(key: str) -> str:

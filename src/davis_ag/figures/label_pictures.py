@@ -15,8 +15,8 @@ from davis_ag.data.reader import View, open_dataset
 from davis_ag.figures.canvas import new_figure, save_figure
 from davis_ag.scene.organs import ORGAN_NAMES
 
-#: One colour per organ class (sky, soil, fruit, leaf, stem, trunk, petiole, peduncle, flower), for
-#: class images and clouds.
+#: One colour per organ class (sky, soil, fruit, leaf, stem, trunk, petiole, peduncle, flower,
+#: structure), for class images and clouds.
 ORGAN_COLOURS = np.array(
     [
         [135, 190, 235],
@@ -28,6 +28,7 @@ ORGAN_COLOURS = np.array(
         [40, 200, 190],
         [250, 130, 30],
         [250, 250, 250],
+        [235, 70, 200],
     ],
     dtype=np.uint8,
 )

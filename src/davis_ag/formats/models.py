@@ -37,6 +37,7 @@ from davis_ag.errors import UserError
 from davis_ag.formats.masks import MAX_FRUIT_ID as _MAX_MASK_FRUIT_ID
 from davis_ag.scene.appearance import DEFAULT_APPEARANCE, AppearanceMode
 from davis_ag.scene.specs import ALL_ACTIONS, DEFAULT_PLANTS, PlantGenerator, crop_spec, group_name, scenario_spec
+from davis_ag.scene.structures import DEFAULT_STRUCTURES, StructureSetting
 
 #: Largest seed: NumPy's legacy seeding, Gymnasium and Stable-Baselines3 take 32-bit seeds.
 MAX_SEED = 2**32 - 1
@@ -259,6 +260,7 @@ class DatasetConfigFile(_Model):
     antialiasing: Annotated[Literal["fxaa", "msaa", "none"], BeforeValidator(_antialiasing)] = "fxaa"
     plants: PlantGenerator = DEFAULT_PLANTS
     appearance: AppearanceMode = DEFAULT_APPEARANCE
+    structures: StructureSetting = DEFAULT_STRUCTURES
     strawberry_altitudes: Literal["table1", "readme"] = "table1"
     grid: GridOverride | None = None
     groups: list[GroupEntry]

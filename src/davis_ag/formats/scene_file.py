@@ -129,6 +129,8 @@ class SceneFile(_Record):
         scenario, crop, scene: Which scene (``scene`` is ``Group/NNN``).
         plant_generator: ``canopy`` or ``architecture``, ``library`` for a plant-library crop;
             scenes from before the choice lack it.
+        structures: The structures setting that built the scene's trellis, stakes or strings
+            (``default``); absent where the scene has none (read as ``none``).
         depth, classes: What the depth and class images hold; ``None`` where not written.
         min_fruit_pixels: The box threshold the scene's labels were made with, at its own size.
         visible_fraction: Per view name, per fruit id (text), the fruit's visible fraction.
@@ -143,6 +145,7 @@ class SceneFile(_Record):
     crop: str | None = None
     scene: str | None = None
     plant_generator: str | None = None
+    structures: str | None = None
     #: Units, frames and encodings in words.
     conventions: dict[str, Any] | None = None
     #: How the views were drawn.

@@ -51,7 +51,10 @@ def dataset_settings(requests: Sequence[SceneRequest]) -> dict[str, Any]:
             )
     groups: dict[str, Any] = {}
     for request in requests:
-        groups[request.folder.split("/")[0]] = {"grid": grid_settings(request.scenario, request.crop)}
+        group: dict[str, Any] = {"grid": grid_settings(request.scenario, request.crop)}
+        if request.structures != "none":  # a group without a structure records what it always did
+            group["structures"] = request.structures
+        groups[request.folder.split("/")[0]] = group
     return DatasetFile.model_validate(
         {
             "format": DATASET_FORMAT,
@@ -125,6 +128,12 @@ def reconcile_settings(root: Path, wanted: dict[str, Any]) -> dict[str, Any]:
     groups = dict(old["groups"])
     for name, settings in wanted["groups"].items():
         if name in groups and groups[name] != settings and any(s.startswith(name + "/") for s in present):
+            made, asked = groups[name].get("structures", "none"), settings.get("structures", "none")
+            if made != asked:
+                raise UserError(
+                    f"{root}: {name} scenes were made with structures {made}, not {asked}: use "
+                    f"--structures {made} (or structures: {made} in the config) or another --out"
+                )
             raise UserError(
                 f"{root}: {name} scenes were made with grid {groups[name]['grid']}, not "
                 f"{settings['grid']}: use the same grid or another --out"

@@ -38,7 +38,7 @@ from davis_ag.render.egl_context import renderer_name
 from davis_ag.scene.appearance import draw_appearance, resolve_appearance
 from davis_ag.scene.build import build_scene
 from davis_ag.scene.camera import Camera
-from davis_ag.scene.organs import ORGAN_NAMES, SKY
+from davis_ag.scene.organs import SKY, scene_organ_names
 from davis_ag.scene.specs import (
     CROPS,
     DEFAULT_PLANTS,
@@ -49,6 +49,7 @@ from davis_ag.scene.specs import (
     plant_centres,
     scene_folder,
 )
+from davis_ag.scene.structures import DEFAULT_STRUCTURES, check_structures, structure_parts
 from davis_ag.scene.view_grid import build_view_grid
 from davis_ag.seeds import derived_seed
 
@@ -72,10 +73,16 @@ CONVENTIONS = {
     "visible_fraction": "visible pixels of a fruit over the pixels it would cover with nothing in front",
     "depth": "images/NNNN_depth.png: uint16 millimetres from the camera plane along the optical axis "
     "(camera-space z), 0 where nothing is hit, 65535 for 65.535 m or more; row 0 at the top",
-    "classes": "images/NNNN_class.png: uint8 organ class per pixel ("
-    + ", ".join(f"{value} {name}" for value, name in enumerate(ORGAN_NAMES))
-    + "), from the same pass as the ids",
 }
+
+
+def conventions(organ_names: tuple[str, ...]) -> dict[str, Any]:
+    """The conventions a scene.json records, its class table among them."""
+    table = ", ".join(f"{value} {name}" for value, name in enumerate(organ_names))
+    return {
+        **CONVENTIONS,
+        "classes": f"images/NNNN_class.png: uint8 organ class per pixel ({table}), from the same pass as the ids",
+    }
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -92,6 +99,8 @@ class SceneSettings:
         antialiasing: Our renderer's antialiasing: ``fxaa``, ``msaa`` or ``none``.
         plants: The plant generator: ``canopy`` (default) or ``architecture``.
         appearance: ``paper`` or ``random`` (:mod:`davis_ag.scene.appearance`).
+        structures: ``default`` (a ``row`` scene's trellis, stakes or strings) or ``none``
+            (:mod:`davis_ag.scene.structures`).
     """
 
     renderer: str = DEFAULT_RENDERER
@@ -100,6 +109,7 @@ class SceneSettings:
     antialiasing: str = "fxaa"
     plants: str = DEFAULT_PLANTS
     appearance: str = "paper"
+    structures: str = DEFAULT_STRUCTURES
 
     def scene_settings(self) -> dict[str, Any]:
         """These settings alone, as keyword arguments of :class:`SceneRequest`."""
@@ -127,6 +137,11 @@ class SceneRequest(SceneSettings):
 
     def __post_init__(self) -> None:
         resolve_appearance(self.appearance)
+        check_structures(self.structures)
+        if not structure_parts(self.scenario.name, self.crop, self.structures):
+            # What the scene gets, not what was asked: a scene with nothing to build is a bare
+            # one, and reads back from its scene.json as such.
+            object.__setattr__(self, "structures", "none")
         if self.appearance != "paper" and self.renderer != "opengl":
             raise UserError(
                 f"appearance {self.appearance} needs our renderer: drop --renderer {self.renderer} "
@@ -184,7 +199,14 @@ def grow_scene(request: SceneRequest):
     """
     rng = np.random.default_rng(request.seed)
     appearance = draw_appearance(request.appearance, request.seed)
-    model = build_scene(request.scenario, request.crop, rng, request.plants, soil_texture=appearance.soil)
+    model = build_scene(
+        request.scenario,
+        request.crop,
+        rng,
+        request.plants,
+        soil_texture=appearance.soil,
+        structures=request.structures,
+    )
     model.lighting = appearance.lighting(model.lighting)
     grid = build_view_grid(
         request.scenario, request.crop, plant_centres(request.scenario, request.crop), model.aim_height, rng
@@ -319,7 +341,8 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict, timing: di
     import pyhelios
 
     lighting = model.lighting
-    return SceneFile(
+    organ_names = scene_organ_names(model.structures is not None)
+    record = SceneFile(
         format=SCENE_FORMAT,
         generator=GeneratorRecord(
             name="davis-ag",
@@ -336,7 +359,7 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict, timing: di
         crop=request.crop.name,
         scene=request.folder,
         plant_generator=model.plant_generator,
-        conventions={**CONVENTIONS, "segmentation": segmentation_convention(len(model.fruits))},
+        conventions={**conventions(organ_names), "segmentation": segmentation_convention(len(model.fruits))},
         camera=CameraRecord.model_validate(request.camera.intrinsics()),
         renderer=RendererRecord(
             name=request.renderer,
@@ -354,7 +377,7 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict, timing: di
         }
         if request.depth
         else None,
-        classes={"file": "images/NNNN_class.png", "dtype": "uint8", "table": list(ORGAN_NAMES)}
+        classes={"file": "images/NNNN_class.png", "dtype": "uint8", "table": list(organ_names)}
         if request.classes
         else None,
         appearance=draw_appearance(request.appearance, request.seed).summary(),
@@ -385,5 +408,10 @@ def scene_metadata(request: SceneRequest, model, grid, visible: dict, timing: di
             for v in grid.viewpoints
         },
         visible_fraction=visible,
-        **({"timing_s": timing} if timing is not None else {}),
     )
+    # Set only when known, so that a record without them dumps without the keys (``as_written``).
+    if timing is not None:
+        record.timing_s = timing
+    if model.structures is not None:  # only where one was built: a scene without records what it always did
+        record.structures = model.structures
+    return record

@@ -29,6 +29,7 @@ from davis_ag.scene.specs import (
     scenario_spec,
     with_strawberry_altitudes,
 )
+from davis_ag.scene.structures import check_structures
 
 T = TypeVar("T")
 
@@ -46,6 +47,8 @@ class RecordedSettings:
         renderer, look, antialiasing: How its views were drawn.
         plants: The plant generator (scenes from before the choice grew ``architecture`` plants).
         appearance: ``paper`` or ``random`` (soil, sun, sky, exposure and noise drawn from the seed).
+        structures: ``default`` where scene.json records a structure, else ``none`` (scenes from
+            before structures, and scenes without one).
     """
 
     folder: Path
@@ -61,6 +64,7 @@ class RecordedSettings:
     antialiasing: str
     plants: str = DEFAULT_PLANTS
     appearance: str = DEFAULT_APPEARANCE
+    structures: str = "none"
 
     def request(self, **drawing: Any) -> SceneRequest:
         """The generate request these settings describe; ``drawing`` adds what only drawing and
@@ -75,6 +79,7 @@ class RecordedSettings:
             look=self.look,
             plants=self.plants,
             appearance=self.appearance,
+            structures=self.structures,
             **drawing,
         )
 
@@ -151,6 +156,7 @@ def read_settings(scene_dir: str | Path) -> RecordedSettings:
             antialiasing_of(renderer),
             regrowing_plants(metadata.plant_generator),
             resolve_appearance((metadata.appearance or {}).get("mode", "paper")),
+            check_structures(metadata.structures or "none"),
         )
     except (ValueError, TypeError, UserError, AttributeError) as error:
         raise UserError(

@@ -11,6 +11,7 @@ Format (every key but ``groups`` is optional)::
     antialiasing: fxaa           # our renderer's: fxaa (default), msaa (4x samples, slower) or none
     plants: canopy               # canopy (Helios's Canopy Generator, default) or architecture
     appearance: paper            # paper (default) or random: sun, sky, soil, exposure, noise per scene
+    structures: default          # default: row scenes get their crop's trellis, stakes or strings; none: bare rows
     strawberry_altitudes: table1 # table1 (25/40/55 cm, default) or readme (0.50/0.75/1.00 m)
     grid:                        # overrides the scenario's Table 2 grid for every group
       extent: [3.0, 3.0]         #   grid size along x and y, m
@@ -66,6 +67,7 @@ from davis_ag.scene.specs import (
     scenario_spec,
     with_strawberry_altitudes,
 )
+from davis_ag.scene.structures import DEFAULT_STRUCTURES, check_structures
 from davis_ag.scene.view_grid import lattice_shape
 
 
@@ -169,6 +171,7 @@ def single_group_config(
     antialiasing: str = "fxaa",
     plants: str = DEFAULT_PLANTS,
     appearance: str = "paper",
+    structures: str = DEFAULT_STRUCTURES,
 ) -> DatasetConfig:
     """The dataset the classic flags (--scenario --crop --scenes --first) describe.
 
@@ -197,6 +200,7 @@ def single_group_config(
         antialiasing=antialiasing,
         plants=check_plants(plants),
         appearance=resolve_appearance(appearance),
+        structures=check_structures(structures),
     )
 
 
@@ -294,6 +298,7 @@ def parse_dataset_config(text: str, source: str, default_name: str = "dataset") 
         antialiasing=model.antialiasing,
         plants=model.plants,
         appearance=model.appearance,
+        structures=model.structures,
     )
 
 

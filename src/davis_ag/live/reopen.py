@@ -58,6 +58,8 @@ def cache_key(settings: RecordedSettings) -> str:
         "generator": meta.generator.as_written() if meta.generator else None,
         "plants": settings.plants,
         "appearance": settings.appearance,
+        # Keyed only where built, so the caches of scenes without structures keep their keys.
+        **({"structures": settings.structures} if settings.structures != "none" else {}),
     }
     return hashlib.sha256(json.dumps(keyed, sort_keys=True).encode()).hexdigest()[:20]
 

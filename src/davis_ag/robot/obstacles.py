@@ -1,7 +1,9 @@
-"""What a robot must not touch in a generated scene: its woody organs, seen by its own views.
+"""What a robot must not touch in a generated scene: its woody organs and the growers' structures,
+seen by its own views.
 
 The obstacles are the scene's points of organ class ``trunk`` (trunks, scaffolds, cordons and
-canes; docs/labels.md), unprojected from the views' depth and class images and thinned to one
+canes; docs/labels.md) and ``structure`` (trellis posts and wires, stakes, twine, strings and
+heating pipes: :mod:`davis_ag.scene.structures`), unprojected from the views' depth and class images and thinned to one
 point per 3 cm voxel: the surfaces the grid's cameras saw, which are the surfaces an arm coming
 from the same alleys meets. Leaves, flowers, fruit and green stems are left out on purpose: the
 arm may brush them, as foliage is treated as permeable in the lime-picking work (arXiv
@@ -20,7 +22,10 @@ import numpy as np
 
 from davis_ag.data.point_cloud import DEPTH_SATURATED_M, Pinhole, unproject
 from davis_ag.errors import UserError
-from davis_ag.scene.organs import TRUNK
+from davis_ag.scene.organs import STRUCTURE, TRUNK
+
+#: The organ classes a robot must not touch.
+OBSTACLE_CLASSES = (TRUNK, STRUCTURE)
 
 if TYPE_CHECKING:
     from davis_ag.data.reader import Scene
@@ -32,7 +37,8 @@ MAX_DEPTH = 6.0
 
 
 def trunk_points(scene: Scene) -> np.ndarray:
-    """The scene's woody surfaces as ``(n, 3)`` world points, one per 3 cm voxel.
+    """The scene's woody surfaces and structures (:data:`OBSTACLE_CLASSES`) as ``(n, 3)`` world
+    points, one per 3 cm voxel.
 
     Args:
         scene: A generated scene with depth and class images.
@@ -56,7 +62,7 @@ def trunk_points(scene: Scene) -> np.ndarray:
                 f"{scene.path}: {view.name} has no depth or class image, so its trunks cannot be found; "
                 "the robot needs a scene generated with depth (without --no-depth)"
             )
-        keep = (classes == TRUNK) & (depth > 0) & (depth < min(DEPTH_SATURATED_M, MAX_DEPTH))
+        keep = np.isin(classes, OBSTACLE_CLASSES) & (depth > 0) & (depth < min(DEPTH_SATURATED_M, MAX_DEPTH))
         if keep.any():
             parts.append(unproject(depth, pinhole, view.pose)[keep])
     if not parts:

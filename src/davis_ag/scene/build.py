@@ -33,6 +33,7 @@ from davis_ag.scene.specs import (
     check_plants,
     plant_positions,
 )
+from davis_ag.scene.structures import add_structures, structure_parts
 
 if TYPE_CHECKING:  # pyhelios loads its native library: imported only where a scene is built
     from pyhelios import Context
@@ -83,6 +84,8 @@ class SceneModel:
         aim_height: Height single-plant cameras aim at, m.
         plant_generator: Which generator grew the plants (``canopy``, ``architecture`` or, for a
             plant-library crop, ``library``).
+        structures: The structures setting that built the scene's trellis, stakes or strings
+            (:mod:`davis_ag.scene.structures`); None where the scene has none.
     """
 
     context: Context
@@ -91,6 +94,7 @@ class SceneModel:
     lighting: Lighting
     aim_height: float
     plant_generator: str = DEFAULT_PLANTS
+    structures: str | None = None
 
     @property
     def uuid_count(self) -> int:
@@ -238,6 +242,7 @@ def build_scene(
     rng: np.random.Generator,
     plants: str = DEFAULT_PLANTS,
     soil_texture: str = "dirt.jpg",
+    structures: str = "none",
 ) -> SceneModel:
     """Grow a scene's plants on soil, choose the sun and number the fruit.
 
@@ -249,6 +254,9 @@ def build_scene(
             (:data:`~davis_ag.scene.specs.PLANT_GENERATORS`); a plant-library crop grows from
             the library whatever it says, recorded as ``library``.
         soil_texture: The soil's image (:func:`add_ground`).
+        structures: ``none`` or ``default``: a ``row`` scene's trellis, stakes or strings
+            (:mod:`davis_ag.scene.structures`), added after the plants and the soil and drawing
+            nothing from ``rng``, so a scene without them is the scene as it always was.
 
     Returns:
         The :class:`SceneModel`.
@@ -266,6 +274,9 @@ def build_scene(
         grow = _grow_canopy_plants if plants == "canopy" else _grow_architecture_plants
     grown = grow(context, scenario, crop, rng)
     add_ground(context, soil_texture)
+    parts = structure_parts(scenario.name, crop, structures)
+    if parts:
+        add_structures(context, parts)
 
     fruits: list[Fruit] = []
     for plant in grown:
@@ -278,4 +289,12 @@ def build_scene(
                 )
             fruits.append(_fruit(context, len(fruits), plant.index, body))
     lighting = Lighting(sun_elevation=float(rng.uniform(35.0, 75.0)), sun_azimuth=float(rng.uniform(0.0, 360.0)))
-    return SceneModel(context, grown, fruits, lighting, aim_height=crop.centre_height, plant_generator=plants)
+    return SceneModel(
+        context,
+        grown,
+        fruits,
+        lighting,
+        aim_height=crop.centre_height,
+        plant_generator=plants,
+        structures=structures if parts else None,
+    )

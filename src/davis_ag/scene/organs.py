@@ -8,7 +8,8 @@ renderer reads everything else: in bulk, by UUID. :meth:`SceneModel.organ_of_uui
 Value 0 is the sky: a pixel where nothing was hit. It is never stored on a primitive. Values 6-8
 (petiole, peduncle, flower) are given to the crops of Helios's plant library
 (:mod:`davis_ag.scene.library_crops`), whose organs come as separate lists; the paper's three crops
-keep petioles and peduncles in ``stem``, as their labels have always had them.
+keep petioles and peduncles in ``stem``, as their labels have always had them. Value 9
+(structure) is what growers build around a row (:mod:`davis_ag.scene.structures`).
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from __future__ import annotations
 #: Name of the Context's per-primitive organ data (uint).
 ORGAN_DATA = "organ"
 
-SKY, SOIL, FRUIT, LEAF, STEM, TRUNK, PETIOLE, PEDUNCLE, FLOWER = 0, 1, 2, 3, 4, 5, 6, 7, 8
+SKY, SOIL, FRUIT, LEAF, STEM, TRUNK, PETIOLE, PEDUNCLE, FLOWER, STRUCTURE = 0, 1, 2, 3, 4, 5, 6, 7, 8, 9
 
 #: Class value -> (name, what it covers). The order is the value: ``ORGAN_CLASSES[v]``.
 ORGAN_CLASSES: tuple[tuple[str, str], ...] = (
@@ -29,9 +30,18 @@ ORGAN_CLASSES: tuple[tuple[str, str], ...] = (
     ("petiole", "leaf stalks of the plant-library crops"),
     ("peduncle", "fruit and flower stalks of the plant-library crops"),
     ("flower", "flowers and flower buds of the plant-library crops"),
+    ("structure", "what growers build: trellis posts, wires and arms, stakes, twine, strings, heating pipes"),
 )
 
 ORGAN_NAMES: tuple[str, ...] = tuple(name for name, _ in ORGAN_CLASSES)
+#: The table of a scene without structures (``--structures none``): what every scene recorded
+#: before class ``structure`` existed, so such a scene's scene.json comes out as it always did.
+BARE_ORGAN_NAMES: tuple[str, ...] = ORGAN_NAMES[:STRUCTURE]
+
+
+def scene_organ_names(structured: bool) -> tuple[str, ...]:
+    """The class table a scene records: with ``structure`` only where the scene has one."""
+    return ORGAN_NAMES if structured else BARE_ORGAN_NAMES
 
 
 def organ_table() -> list[dict]:

@@ -37,6 +37,9 @@ class ReproduceConfig:
         robots: The robots each row is played with beside none (the ``robot`` run).
         split_rule: How train and test split (:mod:`davis_ag.formats.splits`): ``scenes``
             (default) or ``starts``; the learners train and everything is scored under it.
+        structures: The rows' structures (:mod:`davis_ag.scene.structures`): ``none``, the bare
+            rows every published run was made of, so a run made before the option resumes and
+            its pages stay reproducible.
     """
 
     name: str
@@ -55,6 +58,7 @@ class ReproduceConfig:
     page: str = "table4"
     robots: tuple[str, ...] = ()
     split_rule: str = "scenes"
+    structures: str = "none"
 
     def scenes(self, scenario_name: str) -> int:
         """How many scenes the run makes of a scenario (``sp``; ``mp`` or ``row``)."""

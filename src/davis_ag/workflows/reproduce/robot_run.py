@@ -162,7 +162,10 @@ def reproduce_robot(
     for scenario_name, crop_name in pairs:
         scenario, crop = config.specs(scenario_name, crop_name)
         key = group_key(scenario_name, crop_name)
-        requests = [SceneRequest(scenario, crop, i, config.seed, camera) for i in range(config.scenes(scenario_name))]
+        requests = [
+            SceneRequest(scenario, crop, i, config.seed, camera, structures=config.structures)
+            for i in range(config.scenes(scenario_name))
+        ]
         state.scene_folders[key] = [r.folder for r in requests]
         print(f"== {key}: {len(requests)} scene(s) at {config.size[0]}x{config.size[1]}", flush=True)
         began = time.perf_counter()

@@ -96,7 +96,9 @@ def reproduce(
         scenario, crop = config.specs(scenario_name, crop_name)
         n = config.scenes(scenario_name)
         key = group_key(scenario_name, crop_name)
-        requests = [SceneRequest(scenario, crop, i, config.seed, camera) for i in range(n)]
+        requests = [
+            SceneRequest(scenario, crop, i, config.seed, camera, structures=config.structures) for i in range(n)
+        ]
         state.scene_folders[key] = [r.folder for r in requests]
         print(f"== {key}: {n} scene(s) at {config.size[0]}x{config.size[1]}", flush=True)
         with clock.timing(f"{key}: generate") as sitting:
