@@ -21,7 +21,7 @@ from davis_ag.workflows.reproduce.state import RunState, run_config
 from davis_ag.workflows.reproduce.status import format_status
 
 HELP = (
-    "reproduce Table 4, the crops ladder, row mapping or the robot run: generate, train A2C and PPO, "
+    "reproduce Table 4, the crops ladder, row mapping, the robot or the structures run: generate, train A2C and PPO, "
     "benchmark, write the page"
 )
 DESCRIPTION = __doc__
@@ -48,8 +48,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "medium (the paper's grids and 300K A2C steps, hours), paper-scale (Table 3's 130 scenes "
         "at 1280x720, over many sittings: --status says where a run stands), crops (every "
         "plant-library crop's SP and row scenes, its page docs/crops.md), mapping (row mapping on "
-        "five crops' rows with every baseline, its page docs/mapping.md) or robot (three rows without "
-        "a robot and with each robot, A2C and PPO trained under each, its page docs/robot.md)",
+        "five crops' rows with every baseline, its page docs/mapping.md), robot (three rows without "
+        "a robot and with each robot, A2C and PPO trained under each, its page docs/robot.md) or "
+        "structures (four rows bare and with their trellises, stakes and strings, its section in docs/crops.md)",
     )
     parser.add_argument(
         "--sp-scenes", type=arguments.bounded(1, 1000), default=None, help="override the SP scene count"
@@ -124,6 +125,10 @@ def run(args: argparse.Namespace) -> int:
             from davis_ag.workflows.reproduce.pages.robot import write_robot_page
 
             write_robot_page(args.results, recorded, state, args.out, recorded.pairs)
+        elif recorded.page == "structures":
+            from davis_ag.workflows.reproduce.pages.structures import write_structures_page
+
+            write_structures_page(args.results, recorded, state, args.out, recorded.pairs)
         else:
             write_page(args.results, recorded, state, args.out)
         print(f"wrote {args.results}")
@@ -140,4 +145,8 @@ def run(args: argparse.Namespace) -> int:
         from davis_ag.workflows.reproduce.robot_run import reproduce_robot
 
         return reproduce_robot(config, args.out, args.results, pairs)
+    if config.page == "structures":
+        from davis_ag.workflows.reproduce.structures_run import reproduce_structures
+
+        return reproduce_structures(config, args.out, args.results, pairs)
     return reproduce(config, args.out, args.results, pairs)

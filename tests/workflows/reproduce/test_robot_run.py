@@ -10,10 +10,10 @@ from pathlib import Path
 
 import pytest
 
+from davis_ag.workflows.reproduce.cells import evaluate_cell, results_path
 from davis_ag.workflows.reproduce.configs import CONFIGS
 from davis_ag.workflows.reproduce.pages.robot import write_robot_page
-from davis_ag.workflows.reproduce.robot_cells import cell_results_path
-from davis_ag.workflows.reproduce.robot_run import evaluate_cell
+from davis_ag.workflows.reproduce.robot_cells import robot_cell
 from davis_ag.workflows.reproduce.run import stage_recorder
 from davis_ag.workflows.reproduce.state import RunState
 from real_scenes import ROBOT_VINE, generate_config
@@ -40,7 +40,10 @@ def run(tmp_path_factory: pytest.TempPathFactory):
     )
     state = RunState()
     record = stage_recorder(state, out / "state.json")
-    cells = {robot: evaluate_cell(config, out, "sp", "vine", robot, state, record) for robot in (None, *config.robots)}
+    cells = {
+        robot: evaluate_cell(config, out, robot_cell(out, "sp", "vine", robot), state, record)
+        for robot in (None, *config.robots)
+    }
     return out, config, state, record, cells
 
 
@@ -59,14 +62,14 @@ def test_every_cell_is_evaluated_under_its_robot_and_an_unreached_one_is_recorde
     assert lift is not None and lift.protocol.robot["name"] == "ur10-lift"
     assert lift.policies["Oracle"].seconds.mean > 0 and bare.policies["Oracle"].seconds is None
     assert tall is None and "reaches no eligible start" in state.stages["sp-vine-tall: unreached"].note
-    assert not cell_results_path(out, "sp", "vine", config.robots[1]).exists()
+    assert not results_path(out, robot_cell(out, "sp", "vine", config.robots[1])).exists()
 
 
 def test_a_cell_of_the_same_protocol_is_reused(run) -> None:
     out, config, state, record, _ = run
-    path = cell_results_path(out, "sp", "vine", "ur10-lift")
+    path = results_path(out, robot_cell(out, "sp", "vine", "ur10-lift"))
     before = os.stat(path).st_mtime_ns
-    again = evaluate_cell(config, out, "sp", "vine", "ur10-lift", state, record)
+    again = evaluate_cell(config, out, robot_cell(out, "sp", "vine", "ur10-lift"), state, record)
     assert again is not None and os.stat(path).st_mtime_ns == before
 
 
@@ -93,7 +96,7 @@ def test_a_learner_trained_under_the_robot_joins_its_cell(run) -> None:
     model = model_path(out, "sp-vine-ur10-lift", "a2c")
     short = replace(config, n_envs=2)
     train_learner("a2c", out / "dataset", "sp", "vine", model, 32, short, robot="ur10-lift", arch="pooled")
-    results = evaluate_cell(short, out, "sp", "vine", "ur10-lift", state, record)
+    results = evaluate_cell(short, out, robot_cell(out, "sp", "vine", "ur10-lift"), state, record)
     assert results is not None and "A2C" in results.policies and results.policies["A2C"].seconds.mean >= 0
 
 

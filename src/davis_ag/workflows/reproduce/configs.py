@@ -11,7 +11,14 @@ from pathlib import Path
 
 from davis_ag.benchmark.cache import OBS_SIZE
 from davis_ag.scene.specs import PAPER_IMAGE_SIZE, PAPER_TABLE3, CropSpec, ScenarioSpec, crop_spec, scenario_spec
-from davis_ag.workflows.reproduce.groups import CROPS_PAIRS, MAPPING_PAIRS, ROBOT_PAIRS, SCENARIO_CROPS, group_key
+from davis_ag.workflows.reproduce.groups import (
+    CROPS_PAIRS,
+    MAPPING_PAIRS,
+    ROBOT_PAIRS,
+    SCENARIO_CROPS,
+    STRUCTURE_PAIRS,
+    group_key,
+)
 
 
 @dataclass(frozen=True)
@@ -73,7 +80,7 @@ class ReproduceConfig:
         crop for the crops run."""
         if self.page == "table4":
             return f"{self.sp_scenes} SP strawberry and {self.mp_scenes} MP vine scenes"
-        if self.page in ("mapping", "robot"):
+        if self.page in ("mapping", "robot", "structures"):
             return f"{self.mp_scenes} row scene(s) of each of {len(self.pairs)} crops"
         crops = len({crop for _, crop in self.pairs})
         return f"{self.sp_scenes} SP and {self.mp_scenes} row scenes of each of {crops} crops"
@@ -111,6 +118,9 @@ class ReproduceConfig:
 #: dataset seed 5), two scenes each (one trains, one tests), played without a robot and with each
 #: named robot; every baseline, and A2C and PPO trained under each robot for 10K steps (half the
 #: crops run's; the table sets them beside Rand and the Best fixed action).
+#: ``structures``: the fruiting wall, VSP vine, capsicum and Wye vine rows of the robot run's size
+#: (320x180, dataset seed 5, two scenes each), made bare and with their structures from the same
+#: seeds; every baseline, and A2C and PPO for 10K steps on each (docs/crops.md's section).
 #: Scene counts of Table 3 (SP strawberry, MP vine), what a configuration is measured against.
 PAPER_SCENES = (PAPER_TABLE3["sp", "strawberry"][0], PAPER_TABLE3["mp", "vine"][0])
 CONFIGS: dict[str, ReproduceConfig] = {
@@ -165,6 +175,19 @@ CONFIGS: dict[str, ReproduceConfig] = {
         pairs=ROBOT_PAIRS,
         page="robot",
         robots=("ur10-lift", "ur5-trolley", "panda-trolley"),
+    ),
+    "structures": ReproduceConfig(
+        "structures",
+        (320, 180),
+        sp_scenes=0,
+        mp_scenes=2,
+        mp_extent=None,
+        sp_timesteps=0,
+        mp_timesteps=10_000,
+        seed=5,
+        pairs=STRUCTURE_PAIRS,
+        page="structures",
+        structures="default",
     ),
 }
 

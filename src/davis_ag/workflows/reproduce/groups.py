@@ -30,3 +30,9 @@ MAPPING_PAIRS: tuple[tuple[str, str], ...] = tuple(
 
 #: The ``robot`` run's rows (docs/robot.md): a trellised wall, a vineyard and a greenhouse crop.
 ROBOT_PAIRS: tuple[tuple[str, str], ...] = tuple(("row", crop) for crop in ("apple-wall", "vsp-vine", "capsicum"))
+
+#: The ``structures`` run's rows (docs/crops.md): a fruiting wall, a VSP vineyard, a greenhouse crop
+#: and, last (its row takes the most memory), a Wye vineyard.
+STRUCTURE_PAIRS: tuple[tuple[str, str], ...] = tuple(
+    ("row", crop) for crop in ("apple-wall", "vsp-vine", "capsicum", "wye-vine")
+)

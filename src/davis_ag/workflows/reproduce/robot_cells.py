@@ -1,11 +1,13 @@
-"""The ``robot`` run's cells: a row played without a robot or with one, and the names each cell's
-results file, models and records go by (:mod:`davis_ag.workflows.reproduce.robot_run` makes them,
-its page and ``--status`` read them)."""
+"""The ``robot`` run's cells: a row played without a robot or with each robot, and the names each
+cell's results file, models and records go by (:mod:`davis_ag.workflows.reproduce.robot_run`
+makes them, its page and ``--status`` read them)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
+from davis_ag.workflows.reproduce.cells import Cell
+from davis_ag.workflows.reproduce.configs import ReproduceConfig
 from davis_ag.workflows.reproduce.groups import group_key
 
 #: The column of the rows played without a robot (the camera floats, as in the paper).
@@ -19,16 +21,11 @@ def robot_label(robot: str | None) -> str:
     return Path(robot).stem if robot.endswith((".yaml", ".yml")) else robot
 
 
-def cell_key(scenario: str, crop: str, robot: str | None) -> str:
-    """The name of one row and robot: its results file and models (``row-apple-wall-ur10-lift``)."""
-    return f"{group_key(scenario, crop)}-{robot_label(robot)}"
+def robot_cell(out: Path, scenario: str, crop: str, robot: str | None) -> Cell:
+    """One row with one robot (or none), on the run's dataset (``row-apple-wall-ur10-lift``)."""
+    return Cell(f"{group_key(scenario, crop)}-{robot_label(robot)}", out / "dataset", scenario, crop, robot)
 
 
-def cell_results_path(out: Path, scenario: str, crop: str, robot: str | None) -> Path:
-    """Where a run keeps one cell's evaluation."""
-    return out / "results" / f"{cell_key(scenario, crop, robot)}.json"
-
-
-def skipped_stage(scenario: str, crop: str, robot: str) -> str:
-    """The state record of a robot that reaches none of a row's test starts."""
-    return f"{cell_key(scenario, crop, robot)}: unreached"
+def robot_cells(out: Path, config: ReproduceConfig, pairs) -> list[Cell]:
+    """The run's cells in its order: every row without a robot, then every row with each robot."""
+    return [robot_cell(out, scenario, crop, robot) for robot in (None, *config.robots) for scenario, crop in pairs]

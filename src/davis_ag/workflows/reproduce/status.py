@@ -16,11 +16,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from davis_ag.workflows.reproduce.configs import ReproduceConfig
 from davis_ag.workflows.reproduce.groups import group_key
 from davis_ag.workflows.reproduce.state import RunState, StageRecord, run_config
+
+if TYPE_CHECKING:
+    from davis_ag.workflows.reproduce.cells import Cell
 
 
 @dataclass(frozen=True)
@@ -89,7 +92,7 @@ def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
             stages[-1] = replace(stages[-1], progress="started, not finished")
         elif not note:
             stages[-1] = _validation_from_elsewhere(config, clock, recorded, scenario, crop, stages[-1])
-        if config.page == "robot":
+        if config.page in ("robot", "structures"):
             continue  # its learners and evaluations are per robot: after every row's data
         timesteps = config.timesteps(scenario)
         for algo in config.learners:
@@ -104,44 +107,42 @@ def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
         if not written and seconds(stage) is None:
             stages[-1] = _evaluation_from_elsewhere(config, clock, out, scenario, crop, stages[-1])
     if config.page == "robot":
-        stages += _robot_cells(out, config, state, seconds)
+        from davis_ag.workflows.reproduce.robot_cells import robot_cells
+
+        stages += _cells_status(out, config, state, seconds, robot_cells(out, config, config.pairs))
+    elif config.page == "structures":
+        from davis_ag.workflows.reproduce.structure_cells import structure_cells
+
+        cells = [cell for _, cell in structure_cells(out, config, config.pairs)]
+        stages += _cells_status(out, config, state, seconds, cells)
     return config, stages
 
 
-def _robot_cells(out: Path, config: ReproduceConfig, state: RunState, seconds: Any) -> list[StageStatus]:
-    """The ``robot`` run's cells (a row without a robot and with each robot), in its order: every
-    cell's baselines, then cell by cell its learners and its evaluation with them."""
-    from davis_ag.benchmark.results import load_results
-    from davis_ag.errors import UserError
-    from davis_ag.workflows.reproduce.robot_cells import cell_key, cell_results_path, skipped_stage
+def _cells_status(
+    out: Path, config: ReproduceConfig, state: RunState, seconds: Any, cells: list[Cell]
+) -> list[StageStatus]:
+    """A run of cells (:mod:`davis_ag.workflows.reproduce.cells`), in its order: every cell's
+    baselines, then cell by cell its learners and its evaluation with them."""
+    from davis_ag.workflows.reproduce.cells import load_cell, unreached_stage
 
-    cells = [(pair, robot) for robot in (None, *config.robots) for pair in config.pairs]
-    rows: dict[str, set[str] | None] = {}  # each evaluated cell's learner rows
-    baselines = []
-    for (scenario, crop), robot in cells:
-        key = cell_key(scenario, crop, robot)
-        unreached = state.stages.get(skipped_stage(scenario, crop, robot)) if robot else None
-        try:
-            rows[key] = set(load_results(cell_results_path(out, scenario, crop, robot), check=False).policies)
-        except UserError:
-            rows[key] = None
+    rows = {cell.key: (set(r.policies) if (r := load_cell(out, cell)) else None) for cell in cells}
+    baselines, learners = [], []
+    for cell in cells:
+        unreached = state.stages.get(unreached_stage(cell))
         if unreached is not None:
-            baselines.append(StageStatus(f"{key}: baselines", True, unreached.note))
-        else:
-            done = rows[key] is not None
-            baselines.append(StageStatus(f"{key}: baselines", done, "written" if done else "not started"))
-    learners = []
-    for (scenario, crop), robot in cells:
-        key = cell_key(scenario, crop, robot)
-        if robot and skipped_stage(scenario, crop, robot) in state.stages:
+            baselines.append(StageStatus(f"{cell.key}: baselines", True, unreached.note))
             continue
+        done = rows[cell.key] is not None
+        baselines.append(StageStatus(f"{cell.key}: baselines", done, "written" if done else "not started"))
         for algo in config.learners:
-            stage = f"{key}: train {algo.upper()}"
-            learners.append(_training_status(out, key, algo, config.timesteps(scenario), stage, seconds(stage)))
+            stage = f"{cell.key}: train {algo.upper()}"
+            learners.append(
+                _training_status(out, cell.key, algo, config.timesteps(cell.scenario), stage, seconds(stage))
+            )
         wanted = {a.upper() for a in config.learners}
-        done = rows[key] is not None and wanted <= (rows[key] or set())
+        done = wanted <= (rows[cell.key] or set()) and rows[cell.key] is not None
         progress = "written with " + ", ".join(sorted(wanted)) if done else "not started"
-        learners.append(StageStatus(f"{key}: evaluate", done, progress, seconds(f"{key}: evaluate")))
+        learners.append(StageStatus(f"{cell.key}: evaluate", done, progress, seconds(f"{cell.key}: evaluate")))
     return baselines + learners
 
 
