@@ -48,8 +48,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "medium (the paper's grids and 300K A2C steps, hours), paper-scale (Table 3's 130 scenes "
         "at 1280x720, over many sittings: --status says where a run stands), crops (every "
         "plant-library crop's SP and row scenes, its page docs/crops.md), mapping (row mapping on "
-        "five crops' rows with every baseline, its page docs/mapping.md) or robot (three rows without "
-        "a robot and with each robot, A2C and PPO trained under each, its page docs/robot.md)",
+        "five crops' rows with every baseline, its page docs/mapping.md), robot (three rows without "
+        "a robot and with each robot, A2C and PPO trained under each, its page docs/robot.md) or "
+        "a2c-search (A2C settings searched on SP strawberry's train split beside PPO, never its test "
+        "split; its page docs/a2c-search.md)",
     )
     parser.add_argument(
         "--sp-scenes", type=arguments.bounded(1, 1000), default=None, help="override the SP scene count"
@@ -124,6 +126,12 @@ def run(args: argparse.Namespace) -> int:
             from davis_ag.workflows.reproduce.pages.robot import write_robot_page
 
             write_robot_page(args.results, recorded, state, args.out, recorded.pairs)
+        elif recorded.page == "a2c-search":
+            from davis_ag.workflows.reproduce.a2c_search import check_page
+            from davis_ag.workflows.reproduce.pages.a2c_search import write_search_page
+
+            check_page(args.results)
+            write_search_page(args.results, recorded, state, args.out)
         else:
             write_page(args.results, recorded, state, args.out)
         print(f"wrote {args.results}")
@@ -140,4 +148,8 @@ def run(args: argparse.Namespace) -> int:
         from davis_ag.workflows.reproduce.robot_run import reproduce_robot
 
         return reproduce_robot(config, args.out, args.results, pairs)
+    if config.page == "a2c-search":
+        from davis_ag.workflows.reproduce.a2c_search import reproduce_a2c_search
+
+        return reproduce_a2c_search(config, args.out, args.results)
     return reproduce(config, args.out, args.results, pairs)

@@ -89,8 +89,8 @@ def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
             stages[-1] = replace(stages[-1], progress="started, not finished")
         elif not note:
             stages[-1] = _validation_from_elsewhere(config, clock, recorded, scenario, crop, stages[-1])
-        if config.page == "robot":
-            continue  # its learners and evaluations are per robot: after every row's data
+        if config.page in ("robot", "a2c-search"):
+            continue  # their learners and evaluations are per robot, or per candidate: after the data
         timesteps = config.timesteps(scenario)
         for algo in config.learners:
             stage = f"{key}: train {algo.upper()}"
@@ -105,6 +105,10 @@ def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
             stages[-1] = _evaluation_from_elsewhere(config, clock, out, scenario, crop, stages[-1])
     if config.page == "robot":
         stages += _robot_cells(out, config, state, seconds)
+    if config.page == "a2c-search":
+        from davis_ag.workflows.reproduce.a2c_search import search_stages
+
+        stages += search_stages(out, config, seconds)
     return config, stages
 
 
