@@ -16,14 +16,13 @@ from typing import Any
 from davis_ag.atomic_files import read_page, write_marked_section, write_text_atomic
 from davis_ag.benchmark.results import EvaluationResults, load_results, signed_number, table_number
 from davis_ag.errors import UserError
-from davis_ag.workflows.reproduce.a2c_search import (
+from davis_ag.workflows.reproduce.a2c_candidates import (
     CANDIDATES,
     MARKER,
     SPLIT,
     Candidate,
     group_of,
     results_path,
-    steps_text,
 )
 from davis_ag.workflows.reproduce.configs import CONFIGS, ReproduceConfig
 from davis_ag.workflows.reproduce.state import RunState
@@ -95,7 +94,7 @@ def search_section(
     except UserError:
         results = None
     p = results.protocol if results else None
-    scenes = f"{len(p.scenes)} train scenes, {p.starts or 0:,} eligible starts" if p else "not yet evaluated"
+    scenes = f"{len(p.scenes)} train scene(s), {p.starts or 0:,} eligible starts" if p else "not yet evaluated"
     target = next((c.row(config) for c in candidates if c.algo != "a2c"), None)
     lines = [
         f"Written by `davis-ag reproduce --config {config.name}`: {config.scenes_in_words()} at "
@@ -103,7 +102,7 @@ def search_section(
         f"`{config.split_rule}`). Each candidate trained on the {SPLIT} split only (seed {config.seed}, the "
         "paper's network, the snapshot best on train kept), then scored with Rand and the Best fixed action "
         f"on fresh {SPLIT}-split episodes ({config.sessions} x {config.episodes}, seed {config.seed}); the "
-        "test split is never read by this run. OER_tau: mean ± std over episodes; gaps: paired on the same "
+        "test split is never read by this run. OER_tau: mean ± std over sessions (Table 4's ±); gaps: paired on the same "
         "episodes, 95 % bootstrap interval. Rand and the Best fixed action: exact expectations over the "
         "split's starts (sampled on the same episodes in brackets).",
         "",
@@ -134,7 +133,7 @@ def search_section(
             if result and exact is not None
             else "-"
         )
-        what = f"always `{result.action}`" if result and result.action else "uniform over the moves and done"
+        what = f"always `{result.action}`" if result and result.action else "uniform over every action, done included"
         lines.append(f"| {name} | {what} | - | - | {shown} | - | - | - |")
     lines += ["", choice_line(config, candidates, results)]
     lines += ["", "Where each candidate's settings come from:", ""]
@@ -231,7 +230,7 @@ def plan_table(rates: dict[str, float], config: ReproduceConfig | None = None) -
     lines += [
         "",
         f"About {total:.1f} hours of training at those rates ({BENCH_ROWS['a2c']} "
-        f"{rates['a2c']} steps/s, {BENCH_ROWS['ppo']} {rates['ppo']}), {steps_text(sum(c.timesteps(config) for c in CANDIDATES))} "
+        f"{rates['a2c']} steps/s, {BENCH_ROWS['ppo']} {rates['ppo']}), {sum(c.timesteps(config) for c in CANDIDATES):,} "
         "steps in all, before the scenes, their validation and the snapshot scores.",
     ]
     return "\n".join(lines)
