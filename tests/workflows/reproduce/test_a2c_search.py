@@ -143,6 +143,11 @@ def test_a_page_without_the_runs_markers_is_refused(tmp_path: Path) -> None:
     with pytest.raises(UserError, match="has no <!-- a2c-search:start --> section"):
         check_page(page)
     check_page(tmp_path / "new.md")  # a page not there yet is written whole
+    from davis_ag import cli
+
+    out = tmp_path / "run"
+    assert cli.main(["reproduce", "--config", "a2c-search", "--out", str(out), "--results", str(page)]) == 2
+    assert page.read_text() == "# Table 4\n" and not (out / "state.json").exists()
 
 
 def test_the_status_and_the_rewritten_page_of_a_search_run(run, tmp_path: Path, capsys) -> None:
@@ -171,3 +176,28 @@ def test_the_plan_in_the_docs_is_the_codes() -> None:
         "import write_marked_section as w; import davis_ag.workflows.reproduce.pages.a2c_search as s; "
         "w('docs/a2c-search.md', s.PLAN_MARKER, s.plan_table(s.bench_rates(Path('docs/performance.md'))))\""
     )
+
+
+@pytest.mark.slow
+def test_a_whole_search_run_and_a_rerun_that_reuses_everything(
+    tmp_path: Path, one_thread: None, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``reproduce --config a2c-search`` end to end at the smallest size (two real scenes at 160x90):
+    data, validation, every candidate and the page; a second sitting trains and scores nothing."""
+    from davis_ag.workflows.reproduce.a2c_search import reproduce_a2c_search
+    from davis_ag.workflows.reproduce.clock import CLOCK_FILE, read_clock
+
+    config = replace(
+        CONFIGS["a2c-search"], size=(160, 90), sp_scenes=2, sp_timesteps=48, n_envs=2, episodes=8, sessions=1
+    )
+    out, page = tmp_path / "run", tmp_path / "a2c-search.md"
+    assert reproduce_a2c_search(config, out, page, TINY, **TRAIN) == 0
+    text = page.read_text()
+    assert all(f"| {c.row(config)} |" in text for c in TINY) and "not trained yet" not in text
+    clock = read_clock(out / CLOCK_FILE)
+    assert {f"sp-strawberry: train {c.key}" for c in TINY} <= set(clock)
+    evaluated = os.stat(results_path(out, config)).st_mtime_ns
+    capsys.readouterr()
+    assert reproduce_a2c_search(config, out, page, TINY, **TRAIN) == 0
+    assert read_clock(out / CLOCK_FILE) == clock and os.stat(results_path(out, config)).st_mtime_ns == evaluated
+    assert "training" not in capsys.readouterr().out

@@ -188,10 +188,10 @@ def reproduce_a2c_search(
     from davis_ag.workflows.stages import generate_scenes
 
     scenario, crop, key = group_of(config)
+    check_page(Path(results_md))  # before anything is made: another run's page is never replaced
     check_disk(config, Path(out).expanduser().absolute(), config.pairs[:1])
     out = prove_writable_folder(out)  # absolute at once: Helios moves the working directory
     results_md = prove_writable_file(results_md, "--results")
-    check_page(results_md)
     state_path = out / "state.json"
     state = RunState.load(state_path)
     state.config = json.loads(json.dumps(asdict(config)))
