@@ -96,6 +96,8 @@ def search_section(
     p = results.protocol if results else None
     scenes = f"{len(p.scenes)} train scene(s), {p.starts or 0:,} eligible starts" if p else "not yet evaluated"
     target = next((c.row(config) for c in candidates if c.algo != "a2c"), None)
+    played = {r.play for r in (results.policies.values() if results else ()) if r.play}
+    play = f" The models play {', '.join(sorted(played))} actions." if played else ""
     lines = [
         f"Written by `davis-ag reproduce --config {config.name}`: {config.scenes_in_words()} at "
         f"{config.size[0]}x{config.size[1]} (dataset seed {config.seed}; {scenes}, split rule "
@@ -104,7 +106,7 @@ def search_section(
         f"on fresh {SPLIT}-split episodes ({config.sessions} x {config.episodes}, seed {config.seed}); the "
         "test split is never read by this run. OER_tau: mean ± std over sessions (Table 4's ±); gaps: paired on the same "
         "episodes, 95 % bootstrap interval. Rand and the Best fixed action: exact expectations over the "
-        "split's starts (sampled on the same episodes in brackets).",
+        f"split's starts (sampled on the same episodes in brackets).{play}",
         "",
         f"| candidate | settings over SB3's defaults | steps | environments | {SPLIT} OER_tau ± std "
         f"| against {target or 'PPO'} | against {BEST_FIXED} | hours on this machine |",
