@@ -74,3 +74,52 @@ def test_every_preset_and_sound_values_pass() -> None:
     for chosen in SETTINGS_PRESETS.values():
         check_setting_values("a2c", chosen)
     check_setting_values("ppo", {"n_steps": 64, "batch_size": 64, "gamma": 1, "learning_rate": "lin_3e-4"})
+
+
+def test_the_zoos_atari_a2c_resolves_to_sb3s_tf_like_rmsprop_and_16_environments() -> None:
+    """RL Baselines3 Zoo's ``atari`` entry of hyperparams/a2c.yml, kept as JSON in the preset and
+    built into SB3's own optimiser class only when the model is made."""
+    import json
+
+    from stable_baselines3.common.sb2_compat.rmsprop_tf_like import RMSpropTFLike
+
+    from davis_ag.benchmark.algorithms import SETTINGS_PRESETS, environments_of, resolve_settings
+
+    preset = resolve_settings("zoo-atari")
+    assert json.loads(json.dumps(preset)) == preset  # a record's settings stay JSON
+    assert preset["ent_coef"] == 0.01 and preset["vf_coef"] == 0.25 and preset["n_envs"] == 16
+    arguments = sb3_arguments(preset)
+    assert "n_envs" not in arguments  # the run's, never an argument of A2C
+    assert arguments["policy_kwargs"] == {"optimizer_class": RMSpropTFLike, "optimizer_kwargs": {"eps": 1e-5}}
+    assert SETTINGS_PRESETS["zoo-atari"]["policy_kwargs"]["optimizer_class"] == "RMSpropTFLike"
+    # The set's own environments unless the run names others; the record says which ran.
+    assert environments_of(dict(preset), None) == 16
+    given = dict(preset)
+    assert environments_of(given, 4) == 4 and given["n_envs"] == 4
+    assert environments_of(resolve_settings("ours"), None) == 8
+
+
+@pytest.mark.parametrize(
+    "values, message",
+    [
+        ({"policy_kwargs": {"optimizer_class": "SGD"}}, "optimizer_class must be one of RMSpropTFLike"),
+        ({"policy_kwargs": {"net_arch": [64]}}, "the network is --arch's"),
+        ({"policy_kwargs": {"optimizer_kwargs": 3}}, "optimizer_kwargs must be a dict"),
+        ({"n_envs": 0}, "n_envs=0: must be a whole number, at least 1"),
+        ({"n_envs": 2.5}, "n_envs=2.5: must be a whole number"),
+    ],
+)
+def test_an_optimiser_or_environments_sb3_cannot_take_are_refused_in_one_line(values: dict, message: str) -> None:
+    from davis_ag.benchmark.algorithms import resolve_settings
+
+    with pytest.raises(UserError, match=re.escape(message)):
+        resolve_settings(values)
+
+
+def test_train_offers_every_a2c_preset() -> None:
+    from davis_ag.benchmark.algorithms import SETTINGS_PRESETS
+    from davis_ag.cli import build_parser
+
+    parser = build_parser()
+    train = next(a for a in parser._subparsers._group_actions[0].choices["train"]._actions if a.dest == "a2c_settings")
+    assert list(train.choices) == list(SETTINGS_PRESETS)

@@ -595,3 +595,31 @@ def test_a_checkpoint_whose_record_lags_its_model_keeps_the_budget(tmp_path: Pat
     record = json.loads(training_record_path(path).read_text())
     assert A2C.load(path, device="cpu").num_timesteps == 240 and record["timesteps"] == 240
     assert [(s["from_step"], s["to_step"]) for s in record["sittings"]] == [(0, done), (done, 240)]  # no gap
+
+
+def test_the_zoos_atari_preset_trains_16_environments_with_tf_like_rmsprop(
+    tmp_path: Path, one_thread: None, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``davis-ag train --a2c-settings zoo-atari``: the preset's 16 environments and optimiser are
+    the model's, and the record names both; ``--n-envs`` given over it is what trains and is recorded."""
+    from stable_baselines3.common.sb2_compat.rmsprop_tf_like import RMSpropTFLike
+
+    from davis_ag import cli
+
+    root = write_tiny_dataset(tmp_path / "sp", "sp", "strawberry", scenes=2)
+    out = tmp_path / "zoo.zip"
+    argv = ["train", "--dataset", str(root), "--scenario", "sp", "--timesteps", "80", "--arch", "pooled"]
+    argv += ["--device", "cpu", "--checkpoint-every", "0", "--keep", "last", "--verbose", "0"]
+    assert cli.main([*argv, "--a2c-settings", "zoo-atari", "--out", str(out)]) == 0
+    model = A2C.load(out, device="cpu")
+    assert model.n_envs == 16 and model.vf_coef == 0.25 and model.ent_coef == 0.01
+    assert isinstance(model.policy.optimizer, RMSpropTFLike)
+    assert model.policy.optimizer.defaults["eps"] == 1e-5
+    record = json.loads(training_record_path(out).read_text())
+    assert record["n_envs"] == 16 and record["a2c_settings"]["n_envs"] == 16
+    assert record["a2c_settings"]["policy_kwargs"]["optimizer_class"] == "RMSpropTFLike"
+    fewer = tmp_path / "fewer.zip"
+    assert cli.main([*argv, "--a2c-settings", "zoo-atari", "--n-envs", "2", "--out", str(fewer)]) == 0
+    record = json.loads(training_record_path(fewer).read_text())
+    assert A2C.load(fewer, device="cpu").n_envs == 2 and record["n_envs"] == 2 and record["a2c_settings"]["n_envs"] == 2
+    assert isinstance(A2C.load(fewer, device="cpu").policy.optimizer, RMSpropTFLike)

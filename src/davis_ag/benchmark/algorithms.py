@@ -69,14 +69,20 @@ SCHEDULES = ("learning_rate", "clip_range", "clip_range_vf")
 def sb3_arguments(settings: dict[str, Any]) -> dict[str, Any]:
     """The keyword arguments SB3 takes for a setting set: each ``lin_X`` (RL Baselines3 Zoo's
     notation, kept as text so settings stay JSON in records and checkpoints) as SB3's own
-    schedule from X at the start to 0 at the end.
+    schedule from X at the start to 0 at the end, an optimiser named in ``policy_kwargs`` as its
+    class (:data:`OPTIMIZERS`), and without ``n_envs`` (the run's, :func:`environments_of`).
 
     Raises:
         UserError: for a ``lin_`` value that is not a number or is given to another setting.
     """
+    import importlib
+
     from stable_baselines3.common.utils import LinearSchedule
 
-    arguments = dict(settings)
+    arguments = {key: value for key, value in settings.items() if key != "n_envs"}  # the run's, not SB3's
+    if isinstance(chosen := settings.get("policy_kwargs"), dict) and "optimizer_class" in chosen:
+        module, name = OPTIMIZERS[chosen["optimizer_class"]]
+        arguments["policy_kwargs"] = {**chosen, "optimizer_class": getattr(importlib.import_module(module), name)}
     for key, value in settings.items():
         if not (isinstance(value, str) and value.startswith("lin_")):
             continue
@@ -103,9 +109,26 @@ def sb3_arguments(settings: dict[str, Any]) -> dict[str, Any]:
 A2C_SETTINGS: dict[str, Any] = {"ent_coef": 0.01, "normalize_advantage": True}
 #: Stable-Baselines3's own A2C defaults for the settings above (what ``--a2c-settings sb3`` trains).
 SB3_DEFAULT_SETTINGS: dict[str, Any] = {"ent_coef": 0.0, "normalize_advantage": False}
+#: RL Baselines3 Zoo's A2C for Atari (``hyperparams/a2c.yml``, its ``atari`` entry, the zoo's set
+#: for a ``CnnPolicy`` on images): 16 environments, ``ent_coef=0.01``, ``vf_coef=0.25`` and SB3's
+#: ``RMSpropTFLike`` optimiser (TensorFlow's RMSprop, as Stable Baselines 2 and OpenAI's baselines
+#: trained A2C) with ``eps=1e-5``; everything else SB3's defaults. The optimiser is named by text
+#: and the environments are a setting of the run, so the set stays JSON in records and checkpoints
+#: (:func:`sb3_arguments` builds the class; :func:`environments_of` takes ``n_envs``).
+ZOO_ATARI_SETTINGS: dict[str, Any] = {
+    **SB3_DEFAULT_SETTINGS,
+    "ent_coef": 0.01,
+    "vf_coef": 0.25,
+    "policy_kwargs": {"optimizer_class": "RMSpropTFLike", "optimizer_kwargs": {"eps": 1e-5}},
+    "n_envs": 16,
+}
 #: Named setting sets of :func:`davis_ag.benchmark.training.train_a2c`.
-SETTINGS_PRESETS: dict[str, dict[str, Any]] = {"ours": A2C_SETTINGS, "sb3": SB3_DEFAULT_SETTINGS}
-#: SB3 A2C keyword arguments a setting set may change.
+SETTINGS_PRESETS: dict[str, dict[str, Any]] = {
+    "ours": A2C_SETTINGS,
+    "sb3": SB3_DEFAULT_SETTINGS,
+    "zoo-atari": ZOO_ATARI_SETTINGS,
+}
+#: SB3 A2C keyword arguments a setting set may change, and ``n_envs``, the run's environments.
 TUNABLE = (
     "ent_coef",
     "normalize_advantage",
@@ -115,7 +138,54 @@ TUNABLE = (
     "vf_coef",
     "max_grad_norm",
     "gae_lambda",
+    "policy_kwargs",
+    "n_envs",
 )
+#: Environments a run trains with when neither it nor its setting set says.
+DEFAULT_N_ENVS = 8
+#: The optimisers a setting set may name in ``policy_kwargs`` (``optimizer_class``), by the
+#: module and class :func:`sb3_arguments` imports: SB3's TensorFlow-like RMSprop and torch's own.
+OPTIMIZERS: dict[str, tuple[str, str]] = {
+    "RMSpropTFLike": ("stable_baselines3.common.sb2_compat.rmsprop_tf_like", "RMSpropTFLike"),
+    "RMSprop": ("torch.optim", "RMSprop"),
+    "Adam": ("torch.optim", "Adam"),
+}
+#: What ``policy_kwargs`` may hold in a setting set: the optimiser (the network is ``--arch``'s).
+POLICY_SETTINGS = ("optimizer_class", "optimizer_kwargs")
+
+
+def environments_of(settings: dict[str, Any], n_envs: int | None) -> int:
+    """The environments a run trains with: ``n_envs`` where given, else its setting set's
+    ``n_envs`` (``zoo-atari``: 16), else :data:`DEFAULT_N_ENVS`. A set that carries ``n_envs`` is
+    given the number that runs, so its record says what trained.
+
+    Args:
+        settings: The resolved setting set (changed in place where it carries ``n_envs``).
+        n_envs: The run's number (``--n-envs``), None where not given.
+
+    Returns:
+        The number of environments.
+    """
+    carried = settings.get("n_envs")
+    chosen = n_envs if n_envs is not None else (carried or DEFAULT_N_ENVS)
+    if carried is not None:
+        settings["n_envs"] = chosen
+    return int(chosen)
+
+
+def check_policy_settings(algo: str, value: Any) -> None:
+    """Refuse a ``policy_kwargs`` setting other than a known optimiser and its keyword arguments.
+
+    Raises:
+        UserError: naming what is wrong and what may be given.
+    """
+    shown = f"{algo.upper()} setting policy_kwargs={value!r}"
+    if not isinstance(value, dict) or any(key not in POLICY_SETTINGS for key in value):
+        raise UserError(f"{shown}: give a dict of {', '.join(POLICY_SETTINGS)} (the network is --arch's)")
+    if value.get("optimizer_class", "RMSprop") not in OPTIMIZERS:
+        raise UserError(f"{shown}: optimizer_class must be one of {', '.join(OPTIMIZERS)}")
+    if not isinstance(value.get("optimizer_kwargs", {}), dict):
+        raise UserError(f'{shown}: optimizer_kwargs must be a dict, e.g. {{"eps": 1e-5}}')
 
 
 #: Settings that count something: whole numbers, at least 1. Every other number must not be
@@ -141,6 +211,11 @@ def check_setting_values(algo: str, settings: dict[str, Any]) -> None:
     defaults = {k: v.default for k, v in inspect.signature(algorithm_of(algo)).parameters.items()}
     for key, value in settings.items():
         default = defaults.get(key)
+        if key == "policy_kwargs":
+            check_policy_settings(algo, value)
+            continue
+        if key == "n_envs" and (isinstance(value, bool) or not isinstance(value, int) or value < 1):
+            raise UserError(f"{algo.upper()} setting n_envs={value!r}: must be a whole number, at least 1")
         if (isinstance(value, str) and value.startswith("lin_")) or default is None or isinstance(value, dict):
             continue  # schedules are checked by sb3_arguments; None defaults take many kinds
         shown = f"{algo.upper()} setting {key}={value!r}"
@@ -162,10 +237,12 @@ def resolve_settings(settings: str | dict[str, Any]) -> dict[str, Any]:
     Raises:
         UserError: for an unknown preset or an argument outside :data:`TUNABLE`.
     """
+    import copy
+
     if isinstance(settings, str):
         if settings not in SETTINGS_PRESETS:
             raise UserError(f"unknown A2C settings {settings!r}: choose one of {', '.join(SETTINGS_PRESETS)}")
-        return dict(SETTINGS_PRESETS[settings])
+        return copy.deepcopy(SETTINGS_PRESETS[settings])  # a run's record never shares the preset's dicts
     wrong = [k for k in settings if k not in TUNABLE]
     if wrong:
         raise UserError(f"A2C setting {wrong[0]!r} cannot be changed here: use {', '.join(TUNABLE)}")

@@ -31,6 +31,7 @@ from davis_ag.benchmark.algorithms import (
     POLICY_NAMES,
     algorithm_of,
     console_logger,
+    environments_of,
     resolve_sb3_settings,
     resolve_settings,
     sb3_arguments,
@@ -162,7 +163,7 @@ def train_agent(
     total_timesteps: int = 300_000,
     seed: int = 0,
     out_path: str | os.PathLike[str] = "a2c.zip",
-    n_envs: int = 8,
+    n_envs: int | None = None,
     crop: str | None = None,
     cache_dir: str | os.PathLike[str] | None = None,
     arch: str = "paper",
@@ -192,7 +193,7 @@ def train_agent(
     ``vf_coef=0.5``, ``max_grad_norm=0.5``, RMSprop (alpha 0.99, eps 1e-5), changed by
     ``settings``: by default :data:`~davis_ag.benchmark.algorithms.A2C_SETTINGS` (``ent_coef=0.01``, normalised advantages);
     ``"sb3"`` keeps SB3's ``ent_coef=0`` and raw advantages. CnnPolicy scales the uint8
-    observation by 1/255. ``n_envs`` (8) is ours; the paper's 300K timesteps count
+    observation by 1/255. ``n_envs`` (8, or a setting set's own: ``zoo-atari``'s 16) is ours; the paper's 300K timesteps count
     environment steps over all environments. By default the saved model is the snapshot that
     scored best on the train split (``keep``, :mod:`davis_ag.benchmark.selection`), not the
     last. The training record (:func:`training_record_path`) keeps the settings, the learning
@@ -204,7 +205,8 @@ def train_agent(
         total_timesteps: Environment steps to train for (300K in section VI).
         seed: Seeds SB3 (network init, action sampling) and the environments.
         out_path: Where to save the model (``.zip`` is added if missing).
-        n_envs: Parallel environments per update.
+        n_envs: Parallel environments per update; None: the setting set's ``n_envs`` where it
+            carries one (``zoo-atari``: 16), else 8 (:func:`~davis_ag.benchmark.algorithms.environments_of`).
         crop: Train on one crop only (the paper: strawberry for SP, vine for MP).
         cache_dir: Observation cache folder (default under the dataset root).
         arch: ``paper`` (section V-C's network, default), ``nature`` (SB3's NatureCNN) or
@@ -215,8 +217,10 @@ def train_agent(
         checkpoint_every: Environment steps between checkpoints (0: none). A checkpoint of a run
             with the same settings beside ``out_path`` is resumed; it is removed once the final
             model is saved.
-        settings: A name of :data:`~davis_ag.benchmark.algorithms.SETTINGS_PRESETS` (``ours``, ``sb3``) or a dict of SB3 A2C
-            arguments among :data:`~davis_ag.benchmark.algorithms.TUNABLE`, applied over SB3's defaults.
+        settings: A name of :data:`~davis_ag.benchmark.algorithms.SETTINGS_PRESETS` (``ours``, ``sb3``,
+            ``zoo-atari``) or a dict of SB3 A2C arguments among
+            :data:`~davis_ag.benchmark.algorithms.TUNABLE`, applied over SB3's defaults; an optimiser
+            in its ``policy_kwargs`` is added to the network's.
         keep: ``best-train`` (default): save the snapshot with the best train-split OER_tau,
             scored every ``select_every`` steps and at the end; ``last``: the last one.
         select_every: Environment steps between train-split scores (``best-train`` only).
@@ -248,7 +252,7 @@ def train_agent(
     algorithm = algorithm_of(algo)
     if arch not in ARCHITECTURES:
         raise UserError(f"unknown network {arch!r}: choose one of {', '.join(ARCHITECTURES)}")
-    if total_timesteps < 1 or n_envs < 1 or checkpoint_every < 0 or select_every < 0:
+    if total_timesteps < 1 or (n_envs is not None and n_envs < 1) or checkpoint_every < 0 or select_every < 0:
         raise UserError("--timesteps and --n-envs must be positive, --checkpoint-every from 0")
     check_keep(keep)
     check_seed(seed, "--seed")
@@ -257,7 +261,10 @@ def train_agent(
     if split_rule != "scenes" and task.name != TVM_TASK.name:
         raise UserError(f"--split-rule {split_rule} splits TVM-v0's starts; {task.name} splits by scenes: leave it out")
     chosen = resolve_settings(settings) if algo == "a2c" else resolve_sb3_settings(algo, settings)
+    n_envs = environments_of(chosen, n_envs)
     arguments = sb3_arguments(chosen)  # a bad lin_X refused here, before the data is opened
+    # The set's optimiser over the network's keyword arguments (SB3 takes one policy_kwargs).
+    policy_kwargs = {**ARCHITECTURES[arch], **arguments.pop("policy_kwargs", {})}
     final = model_path(Path(out_path).expanduser().absolute())
     prove_writable_file(final)  # before hours of training, not after
     model_file, settings_file = checkpoint_paths(final)
@@ -315,7 +322,7 @@ def train_agent(
             seed=seed,
             device=device,
             verbose=verbose,
-            policy_kwargs=dict(ARCHITECTURES[arch]),
+            policy_kwargs=policy_kwargs,
             **arguments,
         )
         done, earlier, points = 0, [], []

@@ -49,8 +49,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "at 1280x720, over many sittings: --status says where a run stands), crops (every "
         "plant-library crop's SP and row scenes, its page docs/crops.md), mapping (row mapping on "
         "five crops' rows with every baseline, its page docs/mapping.md), robot (three rows without "
-        "a robot and with each robot, A2C and PPO trained under each, its page docs/robot.md) or "
-        "structures (four rows bare and with their trellises, stakes and strings, its section in docs/crops.md)",
+        "a robot and with each robot, A2C and PPO trained under each, its page docs/robot.md), "
+        "structures (four rows bare and with their trellises, stakes and strings, its section in "
+        "docs/crops.md) or "
+        "a2c-search (A2C settings searched on SP strawberry's train split beside PPO, never its test "
+        "split; its page docs/a2c-search.md)",
     )
     parser.add_argument(
         "--sp-scenes", type=arguments.bounded(1, 1000), default=None, help="override the SP scene count"
@@ -129,6 +132,12 @@ def run(args: argparse.Namespace) -> int:
             from davis_ag.workflows.reproduce.pages.structures import write_structures_page
 
             write_structures_page(args.results, recorded, state, args.out, recorded.pairs)
+        elif recorded.page == "a2c-search":
+            from davis_ag.workflows.reproduce.a2c_search import check_page
+            from davis_ag.workflows.reproduce.pages.a2c_search import write_search_page
+
+            check_page(args.results)
+            write_search_page(args.results, recorded, state, args.out)
         else:
             write_page(args.results, recorded, state, args.out)
         print(f"wrote {args.results}")
@@ -149,4 +158,8 @@ def run(args: argparse.Namespace) -> int:
         from davis_ag.workflows.reproduce.structures_run import reproduce_structures
 
         return reproduce_structures(config, args.out, args.results, pairs)
+    if config.page == "a2c-search":
+        from davis_ag.workflows.reproduce.a2c_search import reproduce_a2c_search
+
+        return reproduce_a2c_search(config, args.out, args.results)
     return reproduce(config, args.out, args.results, pairs)

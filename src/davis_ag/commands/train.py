@@ -50,7 +50,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--seed", type=arguments.seed, default=0, help="seed of SB3 and the environments")
     parser.add_argument(
-        "--n-envs", type=arguments.bounded(1, 256), default=8, help="parallel environments (default: 8)"
+        "--n-envs",
+        type=arguments.bounded(1, 256),
+        default=None,
+        help="parallel environments (default: 8, or the --a2c-settings set's own: zoo-atari's 16)",
     )
     parser.add_argument(
         "--arch",
@@ -60,10 +63,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--a2c-settings",
-        choices=["ours", "sb3"],
+        choices=["ours", "sb3", "zoo-atari"],
         default="ours",
         help="A2C only; ours (default): SB3's A2C defaults with ent_coef=0.01 and normalised advantages, "
-        "which keep the policy from collapsing to one move; sb3: SB3's defaults alone",
+        "which keep the policy from collapsing to one move; sb3: SB3's defaults alone; zoo-atari: RL "
+        "Baselines3 Zoo's Atari A2C (16 environments, ent_coef=0.01, vf_coef=0.25, RMSpropTFLike eps 1e-5)",
     )
     parser.add_argument(
         "--set",

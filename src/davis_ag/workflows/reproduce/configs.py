@@ -40,7 +40,9 @@ class ReproduceConfig:
             and, beside it, ``ppo`` with RL Baselines3 Zoo's Atari settings.
         pairs: The run's ``(scenario, crop)`` groups, in the order it takes them.
         page: The page the run writes: ``table4`` (docs/results.md), ``crops`` (docs/crops.md),
-            ``mapping`` (docs/mapping.md) or ``robot`` (docs/robot.md).
+            ``mapping`` (docs/mapping.md), ``robot`` (docs/robot.md), ``structures`` (a section
+            of docs/crops.md) or ``a2c-search``
+            (docs/a2c-search.md; its candidates: :mod:`davis_ag.workflows.reproduce.a2c_search`).
         robots: The robots each row is played with beside none (the ``robot`` run).
         split_rule: How train and test split (:mod:`davis_ag.formats.splits`): ``scenes``
             (default) or ``starts``; the learners train and everything is scored under it.
@@ -80,6 +82,8 @@ class ReproduceConfig:
         crop for the crops run."""
         if self.page == "table4":
             return f"{self.sp_scenes} SP strawberry and {self.mp_scenes} MP vine scenes"
+        if self.page == "a2c-search":
+            return f"{self.sp_scenes} SP strawberry scenes"
         if self.page in ("mapping", "robot", "structures"):
             return f"{self.mp_scenes} row scene(s) of each of {len(self.pairs)} crops"
         crops = len({crop for _, crop in self.pairs})
@@ -121,6 +125,10 @@ class ReproduceConfig:
 #: ``structures``: the fruiting wall, VSP vine, capsicum and Wye vine rows of the robot run's size
 #: (320x180, dataset seed 5, two scenes each), made bare and with their structures from the same
 #: seeds; every baseline, and A2C and PPO for 10K steps on each (docs/crops.md's section).
+#: ``a2c-search``: the ``medium`` run's SP strawberry group (10 scenes at 640x360, dataset seed 0),
+#: on whose train split A2C is trained under each candidate setting set and budget beside PPO with
+#: the zoo's Atari settings, every model scored on fresh train-split episodes; the test split is
+#: never read (docs/a2c-search.md is its page; the candidates: ``a2c_search.CANDIDATES``).
 #: Scene counts of Table 3 (SP strawberry, MP vine), what a configuration is measured against.
 PAPER_SCENES = (PAPER_TABLE3["sp", "strawberry"][0], PAPER_TABLE3["mp", "vine"][0])
 CONFIGS: dict[str, ReproduceConfig] = {
@@ -188,6 +196,17 @@ CONFIGS: dict[str, ReproduceConfig] = {
         pairs=STRUCTURE_PAIRS,
         page="structures",
         structures="default",
+    ),
+    "a2c-search": ReproduceConfig(
+        "a2c-search",
+        (640, 360),
+        sp_scenes=10,
+        mp_scenes=0,
+        mp_extent=None,
+        sp_timesteps=300_000,
+        mp_timesteps=0,
+        pairs=(("sp", "strawberry"),),
+        page="a2c-search",
     ),
 }
 

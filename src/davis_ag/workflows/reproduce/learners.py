@@ -75,7 +75,8 @@ def train_learner(
         model: The model's ``.zip`` (:func:`model_path`).
         timesteps: Environment steps.
         config: The run's :class:`~davis_ag.workflows.reproduce.configs.ReproduceConfig` (seed, environments).
-        settings: The algorithm's settings over ours (tests: a short PPO rollout); None: ours.
+        settings: The algorithm's settings over ours (tests: a short PPO rollout); None: ours. One
+            that carries ``n_envs`` (``zoo-atari``) trains with that many environments.
         **train_kwargs: Passed on to ``train_agent`` (tests: a small network, a callback).
 
     Returns:
@@ -86,11 +87,13 @@ def train_learner(
     stamp = model.with_suffix(".json")
     made = {"keep": "last", **load_json_object(stamp)}
     wanted = learner_stamp(algo, timesteps, settings)
+    # A setting set that carries its environments (zoo-atari's 16) trains with them, not the run's.
+    n_envs = (settings or {}).get("n_envs", config.n_envs)
     if (
         model.is_file()
         and all(made.get(k) == v for k, v in wanted.items())
         and _split_unchanged(model, root, scenario, crop, config.split_rule)
-        and _made_as_configured(model, config, train_kwargs.get("arch", "paper"))
+        and _made_as_configured(model, config, train_kwargs.get("arch", "paper"), n_envs)
     ):
         return None
     network = "the paper's network" + (" as features extractor" if algo != "a2c" else "")
@@ -102,7 +105,7 @@ def train_learner(
         total_timesteps=timesteps,
         seed=config.seed,
         out_path=model,
-        n_envs=config.n_envs,
+        n_envs=n_envs,
         crop=crop,
         device="cpu",
         keep=KEEP,
@@ -117,13 +120,14 @@ def train_learner(
     return seconds
 
 
-def _made_as_configured(model: Path, config: Any, arch: str) -> bool:
+def _made_as_configured(model: Path, config: Any, arch: str, n_envs: int) -> bool:
     """Whether a finished model's training record names the run's seed, number of environments
-    and network, which the page states for it; a model without a record is taken as it is."""
+    (``n_envs``: the run's, or its setting set's) and network, which the page states for it; a
+    model without a record is taken as it is."""
     from davis_ag.benchmark.training_record import training_record_path
 
     record = load_json_object(training_record_path(model))
-    wanted = {"seed": config.seed, "n_envs": config.n_envs, "arch": arch}
+    wanted = {"seed": config.seed, "n_envs": n_envs, "arch": arch}
     return all(record.get(key, value) == value for key, value in wanted.items())
 
 

@@ -92,8 +92,8 @@ def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
             stages[-1] = replace(stages[-1], progress="started, not finished")
         elif not note:
             stages[-1] = _validation_from_elsewhere(config, clock, recorded, scenario, crop, stages[-1])
-        if config.page in ("robot", "structures"):
-            continue  # its learners and evaluations are per robot: after every row's data
+        if config.page in ("robot", "structures", "a2c-search"):
+            continue  # their learners and evaluations are per cell, or per candidate: after the data
         timesteps = config.timesteps(scenario)
         for algo in config.learners:
             stage = f"{key}: train {algo.upper()}"
@@ -115,6 +115,8 @@ def run_status(out: Path) -> tuple[ReproduceConfig, list[StageStatus]]:
 
         cells = [cell for _, cell in structure_cells(out, config, config.pairs)]
         stages += _cells_status(out, config, state, seconds, cells)
+    if config.page == "a2c-search":
+        stages += _search_stages(out, config, seconds)
     return config, stages
 
 
@@ -144,6 +146,48 @@ def _cells_status(
         progress = "written with " + ", ".join(sorted(wanted)) if done else "not started"
         learners.append(StageStatus(f"{cell.key}: evaluate", done, progress, seconds(f"{cell.key}: evaluate")))
     return baselines + learners
+
+
+def _search_stages(out: Path, config: ReproduceConfig, seconds: Any) -> list[StageStatus]:
+    """The run's stages after its data for ``--status``: each candidate's training (one not started
+    timed at the rate a finished candidate of the same algorithm trained at) and the scoring.
+
+    Args:
+        out: The run folder.
+        config: The run.
+        seconds: ``stage -> seconds on the clock or None`` (the status's).
+
+    Returns:
+        One :class:`StageStatus` per stage.
+    """
+    from davis_ag.benchmark.results import load_results
+    from davis_ag.errors import UserError
+    from davis_ag.workflows.reproduce.a2c_candidates import CANDIDATES as candidates
+    from davis_ag.workflows.reproduce.a2c_candidates import EVALUATE, group_of, results_path
+    from davis_ag.workflows.reproduce.learners import training_record
+
+    key = group_of(config)[2]
+    stages = []
+    for candidate in candidates:
+        stage, steps = f"{key}: train {candidate.key}", candidate.timesteps(config)
+        status = _training_status(out, key, candidate.key, steps, stage, seconds(stage))
+        if status.progress in ("not started", UNDER_WAY):
+            rates = [
+                training_record(out, key, c.key).get("steps_per_second") for c in candidates if c.algo == candidate.algo
+            ]
+            if rate := next((r for r in rates if r), None):
+                left = max(steps / rate - (status.seconds or 0.0), 0.0)
+                status = replace(status, progress=f"{status.progress}; timed at {rate:.1f} steps/s", left_s=left)
+        stages.append(status)
+    try:
+        scored = set(load_results(results_path(out, config), check=False).policies)
+    except UserError:
+        scored = set()
+    wanted = {c.row(config) for c in candidates}
+    done = wanted <= scored
+    progress = f"{len(wanted & scored)} of {len(wanted)} candidates scored" if scored else "not started"
+    stages.append(StageStatus(f"{key}: {EVALUATE}", done, progress, seconds(f"{key}: {EVALUATE}")))
+    return stages
 
 
 def _generation_status(
