@@ -21,6 +21,14 @@ METHODS = ("Oracle", "Best fixed action", "A2C", "PPO", "Rand", "LRD", "UDD")
 ExtraLine = tuple[str, Callable[[EvaluationResults], str]]
 
 
+def _start_oer(results: EvaluationResults) -> str:
+    return table_number(results.policies["Oracle"].oer_0.mean) if "Oracle" in results.policies else "-"
+
+
+#: The line every run of cells shows first under the methods: where its episodes start.
+START_OER: ExtraLine = ("start OER_0 (Oracle)", _start_oer)
+
+
 def change(value: float, base: float | None) -> str:
     """A number with, in brackets, its change from ``base`` (``.612 (-.041)``)."""
     from davis_ag.benchmark.results import signed_number

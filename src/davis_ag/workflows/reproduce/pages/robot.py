@@ -10,10 +10,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from davis_ag.benchmark.results import EvaluationResults, table_number
+from davis_ag.benchmark.results import EvaluationResults
 from davis_ag.workflows.reproduce.configs import ReproduceConfig
 from davis_ag.workflows.reproduce.groups import group_key
-from davis_ag.workflows.reproduce.pages.cells import row_table, run_head, write_run_section
+from davis_ag.workflows.reproduce.pages.cells import START_OER, row_table, run_head, write_run_section
 from davis_ag.workflows.reproduce.robot_cells import robot_cell, robot_label
 from davis_ag.workflows.reproduce.state import RunState
 
@@ -27,10 +27,6 @@ def _seconds(results: EvaluationResults) -> str:
     if row is None or not row.seconds or row.seconds.mean <= 0:
         return "-"
     return f"{row.seconds.mean:.1f} s ({(row.oer_tau.mean - row.oer_0.mean) / row.seconds.mean:.3f}/s)"
-
-
-def _oer_0(results: EvaluationResults) -> str:
-    return table_number(results.policies["Oracle"].oer_0.mean) if "Oracle" in results.policies else "-"
 
 
 def robot_section(config: ReproduceConfig, state: RunState, out: Path, pairs) -> str:
@@ -56,7 +52,7 @@ def robot_section(config: ReproduceConfig, state: RunState, out: Path, pairs) ->
             (robot_label(robot) if robot else "no robot", robot_cell(out, scenario, crop, robot))
             for robot in (None, *config.robots)
         ]
-        extra = (("start OER_0 (Oracle)", _oer_0), ("robot s / episode (Oracle)", _seconds))
+        extra = (START_OER, ("robot s / episode (Oracle)", _seconds))
         lines += row_table(group_key(scenario, crop), out, config, state, columns, extra)
     return "\n".join(lines).rstrip() + "\n"
 

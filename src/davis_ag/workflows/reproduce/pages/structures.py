@@ -10,18 +10,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from davis_ag.benchmark.results import EvaluationResults, table_number
+from davis_ag.benchmark.results import EvaluationResults
 from davis_ag.workflows.reproduce.configs import ReproduceConfig
 from davis_ag.workflows.reproduce.groups import group_key
-from davis_ag.workflows.reproduce.pages.cells import row_table, run_head, write_run_section
+from davis_ag.workflows.reproduce.pages.cells import START_OER, row_table, run_head, write_run_section
 from davis_ag.workflows.reproduce.state import RunState
 
 #: The markers of docs/crops.md's section.
 MARKER = "structures-run"
-
-
-def _oer_0(results: EvaluationResults) -> str:
-    return table_number(results.policies["Oracle"].oer_0.mean) if "Oracle" in results.policies else "-"
 
 
 def _starts(results: EvaluationResults) -> str:
@@ -52,7 +48,7 @@ def structures_section(config: ReproduceConfig, state: RunState, out: Path, pair
     for scenario, crop in pairs:
         key = group_key(scenario, crop)
         columns = [(heading, cell) for heading, cell in cells if cell.key.startswith(f"{key}-")]
-        extra = (("start OER_0 (Oracle)", _oer_0), ("eligible test starts", _starts))
+        extra = (START_OER, ("eligible test starts", _starts))
         lines += row_table(key, out, config, state, columns, extra)
     return "\n".join(lines).rstrip() + "\n"
 
