@@ -97,7 +97,10 @@ def row_table(
                 trained.append(f"{label} {algo.upper()} {record.seconds / 60:.0f} min")
     lines.append("")
     if trained:
-        lines.append(f"Training time on this machine: {'; '.join(trained)}.")
+        lines.append(
+            f"Training wall time on this machine (longer while other work shared its 2 cores, or the run was "
+            f"paused): {'; '.join(trained)}."
+        )
     if missing:
         lines.append(f"Not in the table yet: {'; '.join(missing)}.")
     lines.append("")
