@@ -26,6 +26,8 @@ Streams are NumPy ``SeedSequence`` keys, so two streams never share draws howeve
   (:data:`davis_ag.benchmark.selection.SELECT_SEED`) under a forked torch state;
 - a robot's reach of a scene (:mod:`davis_ag.robot.reach`): the IK's random restarts on the
   base line of side ``s`` (0 south, 1 north) draw from ``[scene seed, REACH_STREAM, s]``;
+- a row scene's cover crop (:mod:`davis_ag.scene.cover`): ``[scene seed, COVER_STREAM]``, apart
+  from the scene's own generator, so its plants, sun and cameras are those of a scene without;
 - the paired bootstrap: ``default_rng(seed)`` of the evaluation (:mod:`davis_ag.benchmark.paired`);
   the transfer experiment's split ``k``: ``seed + k``, its appearance shift: ``[seed, image]``.
 
@@ -67,6 +69,8 @@ REACH_STREAM = 2**32 - 4
 START_SPLIT_STREAM = 2**32 - 5
 #: A group's split of its target fruits, after the group's keys (as :data:`START_SPLIT_STREAM`).
 FRUIT_SPLIT_STREAM = 2**32 - 6
+#: A row scene's cover crop (spots, turns, its prototypes' Helios seeds), after the scene seed.
+COVER_STREAM = 2**32 - 7
 
 
 def derived_seed(*keys: int) -> int:

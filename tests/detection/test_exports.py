@@ -242,6 +242,7 @@ def test_coco_organs_are_semantic_rle_masks(dataset: Path, tmp_path: Path) -> No
         107: "peduncle",
         108: "flower",
         109: "structure",
+        110: "cover",
     }
     checked = 0
     for image in coco.loadImgs(coco.getImgIds()):
@@ -280,6 +281,7 @@ def test_yolo_organs_are_polygons_after_the_crops(dataset: Path, tmp_path: Path)
         crops + 6: "organ_peduncle",
         crops + 7: "organ_flower",
         crops + 8: "organ_structure",
+        crops + 9: "organ_cover",
     }
     assert list(names.values())[:3] == ["strawberry", "tomato", "vine"]  # the paper's crops keep 0-2
     import cv2

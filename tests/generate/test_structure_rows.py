@@ -1,6 +1,7 @@
 """A greenhouse row with and without its structure, end to end at a reduced size: the strings and
 pipe rails are drawn and labelled, recorded in scene.json and made again from it; without them the
-scene is the bare row of before (no new field, the old class table, the same plants and views)."""
+scene is the bare row of before (no new field, the old class table, the same plants and views).
+The greenhouse's floor cover is drawn white where the bare row's soil is brown."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from davis_ag.scene.organs import BARE_ORGAN_NAMES, ORGAN_NAMES, STRUCTURE
+from davis_ag.scene.organs import BARE_ORGAN_NAMES, ORGAN_NAMES, SOIL, STRUCTURE
 from real_scenes import generate_config
 
 pytestmark = pytest.mark.slow
@@ -51,6 +52,16 @@ def test_the_structure_is_drawn_labelled_and_recorded(rows: dict[str, Path]) -> 
     assert scene["classes"]["table"] == list(ORGAN_NAMES)
     assert json.loads((root / "dataset.json").read_text())["groups"]["Row-Capsicum"]["structures"] == "default"
     assert np.count_nonzero(_classes(root) == STRUCTURE) > 0
+    # the greenhouse's white floor cover where the bare row shows brown soil
+    assert _soil_brightness(root) > _soil_brightness(rows["none"]) + 60
+
+
+def _soil_brightness(root: Path) -> float:
+    from davis_ag.data.reader import open_dataset
+
+    scene = open_dataset(root).scene(SCENE)
+    pixels = [view.image()[view.classes() == SOIL] for view in scene]
+    return float(np.concatenate(pixels).mean())
 
 
 def test_without_structures_the_scene_is_the_bare_row_of_before(rows: dict[str, Path]) -> None:

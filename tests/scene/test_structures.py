@@ -108,7 +108,8 @@ def test_an_unknown_setting_is_one_clear_line() -> None:
 
 def test_a_scene_without_structures_records_the_class_table_of_before() -> None:
     assert scene_organ_names(False) == BARE_ORGAN_NAMES == ORGAN_NAMES[:STRUCTURE]
-    assert scene_organ_names(True)[STRUCTURE] == "structure" == ORGAN_NAMES[-1]
+    assert scene_organ_names(True)[STRUCTURE] == "structure" == ORGAN_NAMES[STRUCTURE]
+    assert scene_organ_names(True)[-1] == "cover"
 
 
 @given(

@@ -1,7 +1,7 @@
 #!/bin/sh
 # Remake the pictures of docs/crops.md's structures section: for each crop one view of its row
 # (the inner camera line, facing the row, the higher of its two heights, as docs/images/crops),
-# beside its organ classes (structure in magenta), 640x360 each.
+# beside its organ classes (structure in magenta, cover pale green), 640x360 each.
 # Run from the repository root: sh docs/images/structures/make.sh [CROP ...] (minutes per crop).
 set -eu
 HERE=docs/images/structures

@@ -16,7 +16,7 @@ from davis_ag.figures.canvas import new_figure, save_figure
 from davis_ag.scene.organs import ORGAN_NAMES
 
 #: One colour per organ class (sky, soil, fruit, leaf, stem, trunk, petiole, peduncle, flower,
-#: structure), for class images and clouds.
+#: structure, cover), for class images and clouds.
 ORGAN_COLOURS = np.array(
     [
         [135, 190, 235],
@@ -29,6 +29,7 @@ ORGAN_COLOURS = np.array(
         [250, 130, 30],
         [250, 250, 250],
         [235, 70, 200],
+        [175, 205, 105],
     ],
     dtype=np.uint8,
 )

@@ -5,9 +5,8 @@ The task is TVM-v0's (section V-A): start on a view of a target fruit with OER <
 is the camera: instead of stepping between the dataset's grid views, the agent moves anywhere,
 and every observation is drawn live from the regrown scene (:mod:`davis_ag.live.scene`).
 
-Why a separate environment: TVM-v0 reads any dataset in the published layout, the original
-download included, and knows nothing of Helios or renderers. This one must render every pose,
-so it needs a scene of ours (one with a scene.json to regrow from) and an OpenGL context.
+Why a separate environment: TVM-v0 reads any published dataset and knows nothing of renderers;
+this one renders every pose, so it needs a scene of ours (a scene.json to regrow) and OpenGL.
 
 - Action: a Box in [-1, 1]: ``(dx, dy, dz)`` in the world frame, scaled by ``max_move`` (default
   the scene's grid step) and ``max_climb`` (default half the span of the scene's altitudes); with
@@ -16,7 +15,7 @@ so it needs a scene of ours (one with a scene.json to regrow from) and an OpenGL
   scene's own grid as scene.json records it (reduced grids, crops of other altitudes). With
   ``aim="plant"`` (SP default) the camera always looks at the plant, as the SP grid's views do.
 - Slip (section III-B): a move with a horizontal part lands off by Gaussian noise of 2.5 cm on x
-  and y; turning and climbing in place do not slip. Slip draws from ``self.np_random`` only.
+  and y (turning and climbing in place do not slip), drawn from ``self.np_random`` only.
 - Refused moves (the agent stays, the step still counts), as section V-D refuses grid moves: the
   new position leaves the scenario's grid area or altitude range; the straight path comes within
   the crop's exclusion distance of a stem (section III-C: 0.75 m strawberry, 1 m others), the
@@ -256,9 +255,11 @@ class TVMContinuousEnv(gym.Env[np.ndarray, np.ndarray]):
             yaw = math.degrees(math.atan2(dy, dx)) + float(rng.uniform(-1, 1)) * self.max_turn
             pitch = math.degrees(math.atan2(aim_z - position[2], math.hypot(dx, dy)))
             view = self._pose(position, yaw, pitch)
+            if self.robot is not None and not self.robot.start(self._scene, view.pose, rng):
+                continue  # the arm first: a pose it cannot reach costs an IK, not a draw
             labels = self._draw(view)
             eligible = [f for f, oer in labels.oer.items() if can_start(oer, self.max_start_oer)]
-            if eligible and (self.robot is None or self.robot.start(self._scene, view.pose, rng)):
+            if eligible:
                 self._view, self._labels = view, labels
                 self._target = int(eligible[int(rng.integers(len(eligible)))])
                 return

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from davis_ag.errors import UserError
+from davis_ag.scene.cover import add_cover, floor_system
 from davis_ag.scene.helios_threads import one_helios_thread
 from davis_ag.scene.lighting import Lighting
 from davis_ag.scene.organs import ORGAN_DATA
@@ -33,7 +34,7 @@ from davis_ag.scene.specs import (
     check_plants,
     plant_positions,
 )
-from davis_ag.scene.structures import add_structures, structure_parts
+from davis_ag.scene.structures import add_greenhouse_floor, add_structures, greenhouse_floor, structure_parts
 
 if TYPE_CHECKING:  # pyhelios loads its native library: imported only where a scene is built
     from pyhelios import Context
@@ -243,6 +244,7 @@ def build_scene(
     plants: str = DEFAULT_PLANTS,
     soil_texture: str = "dirt.jpg",
     structures: str = "none",
+    cover_rng: np.random.Generator | None = None,
 ) -> SceneModel:
     """Grow a scene's plants on soil, choose the sun and number the fruit.
 
@@ -256,7 +258,10 @@ def build_scene(
         soil_texture: The soil's image (:func:`add_ground`).
         structures: ``none`` or ``default``: a ``row`` scene's trellis, stakes or strings
             (:mod:`davis_ag.scene.structures`), added after the plants and the soil and drawing
-            nothing from ``rng``, so a scene without them is the scene as it always was.
+            nothing from ``rng``, so a scene without them is the scene as it always was; with
+            them, an orchard's or vineyard's alleys grow their cover crop (:mod:`davis_ag.scene.cover`).
+        cover_rng: The cover's own stream (``[scene seed, COVER_STREAM]``); needed only where a
+            cover grows.
 
     Returns:
         The :class:`SceneModel`.
@@ -277,6 +282,14 @@ def build_scene(
     parts = structure_parts(scenario.name, crop, structures)
     if parts:
         add_structures(context, parts)
+        floor_sides = greenhouse_floor(crop)
+        if floor_sides is not None:
+            add_greenhouse_floor(context, floor_sides)
+    floor = floor_system(scenario.name, crop, structures)
+    if floor is not None and crop.row is not None:
+        if cover_rng is None:
+            raise ValueError("a scene with a cover crop needs its cover_rng")
+        add_cover(context, crop.row, floor, cover_rng)
 
     fruits: list[Fruit] = []
     for plant in grown:
@@ -296,5 +309,5 @@ def build_scene(
         lighting,
         aim_height=crop.centre_height,
         plant_generator=plants,
-        structures=structures if parts else None,
+        structures=structures if parts or floor is not None else None,
     )

@@ -9,7 +9,8 @@ Value 0 is the sky: a pixel where nothing was hit. It is never stored on a primi
 (petiole, peduncle, flower) are given to the crops of Helios's plant library
 (:mod:`davis_ag.scene.library_crops`), whose organs come as separate lists; the paper's three crops
 keep petioles and peduncles in ``stem``, as their labels have always had them. Value 9
-(structure) is what growers build around a row (:mod:`davis_ag.scene.structures`).
+(structure) is what growers build around a row (:mod:`davis_ag.scene.structures`), value 10
+(cover) the grass and weeds in a row scene's alleys (:mod:`davis_ag.scene.cover`).
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ from __future__ import annotations
 #: Name of the Context's per-primitive organ data (uint).
 ORGAN_DATA = "organ"
 
-SKY, SOIL, FRUIT, LEAF, STEM, TRUNK, PETIOLE, PEDUNCLE, FLOWER, STRUCTURE = 0, 1, 2, 3, 4, 5, 6, 7, 8, 9
+SKY, SOIL, FRUIT, LEAF, STEM, TRUNK, PETIOLE, PEDUNCLE, FLOWER, STRUCTURE, COVER = 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10
 
 #: Class value -> (name, what it covers). The order is the value: ``ORGAN_CLASSES[v]``.
 ORGAN_CLASSES: tuple[tuple[str, str], ...] = (
@@ -31,11 +32,12 @@ ORGAN_CLASSES: tuple[tuple[str, str], ...] = (
     ("peduncle", "fruit and flower stalks of the plant-library crops"),
     ("flower", "flowers and flower buds of the plant-library crops"),
     ("structure", "what growers build: trellis posts, wires and arms, stakes, twine, strings, heating pipes"),
+    ("cover", "the cover crop and weeds in the alleys between orchard and vineyard rows"),
 )
 
 ORGAN_NAMES: tuple[str, ...] = tuple(name for name, _ in ORGAN_CLASSES)
 #: The table of a scene without structures (``--structures none``): what every scene recorded
-#: before class ``structure`` existed, so such a scene's scene.json comes out as it always did.
+#: before classes ``structure`` and ``cover`` existed, so such a scene's scene.json comes out as it always did.
 BARE_ORGAN_NAMES: tuple[str, ...] = ORGAN_NAMES[:STRUCTURE]
 
 

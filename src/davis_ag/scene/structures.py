@@ -245,6 +245,50 @@ SYSTEMS: dict[str, Callable[[RowSpec, float], list[Part]]] = {
 }
 #: Crops grown in greenhouses, whose alleys carry heating-pipe rails: by crop name, the alley's parts.
 ALLEY_SYSTEMS: dict[str, Callable[[RowSpec, float], list[Part]]] = {"capsicum": heating_pipes}
+#: White woven polypropylene ground cover, the floor of a greenhouse, RGB in 0..1.
+GROUND_COVER = (0.86, 0.86, 0.83)
+#: How far the floor cover reaches past the planted stretch and the outer alleys' rails, m.
+FLOOR_MARGIN = 1.0
+
+
+def greenhouse_floor(crop: CropSpec) -> tuple[float, float] | None:
+    """The half-sides (x, y) of a greenhouse crop's floor cover, centred on the scene: the planted
+    stretch and the three rows with their four alleys, :data:`FLOOR_MARGIN` beyond; ``None``
+    for a crop grown outdoors.
+
+    Greenhouses lay white woven ground cover over the whole floor, under the rows and the pipe
+    rails, against weeds and to throw light back into the crop (the same heating-pipe house the
+    rails' source describes).
+    """
+    if crop.name not in ALLEY_SYSTEMS or crop.row is None:
+        return None
+    return _half_length(crop.row) + FLOOR_MARGIN, 2 * crop.row.row_spacing + FLOOR_MARGIN
+
+
+def add_greenhouse_floor(context, half_sides: tuple[float, float]) -> list[int]:
+    """Lay the floor cover 2 mm above the soil, labelled ``soil``: it is the ground the cameras
+    see and the robots drive on (the robots' ground is their own half-space), not an obstacle.
+
+    Args:
+        context: The scene's Context.
+        half_sides: :func:`greenhouse_floor`.
+
+    Returns:
+        The primitives added.
+    """
+    from pyhelios.types import RGBcolor, int2, vec2, vec3
+
+    from davis_ag.scene.organ_labels import label_soil, object_primitives
+
+    hx, hy = half_sides
+    tile = context.addTileObject(
+        center=vec3(0.0, 0.0, 0.002),
+        size=vec2(2 * hx, 2 * hy),
+        subdiv=int2(max(1, round(2 * hx)), max(1, round(2 * hy))),  # metre patches
+        color=RGBcolor(*GROUND_COVER),
+    )
+    label_soil(context, [tile])
+    return object_primitives(context, [tile])
 
 
 def structure_parts(scenario_name: str, crop: CropSpec, setting: str) -> list[Part]:
