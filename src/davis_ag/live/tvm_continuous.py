@@ -26,8 +26,7 @@ this one renders every pose, so it needs a scene of ours (a scene.json to regrow
   The OER is the target's at this size; the box threshold is the crop's scaled to the area.
 - Start (``reset``): a scene, then random poses inside the grid area (outside the exclusion
   distance), aimed at a plant (``aim="free"``: at a random plant, yaw jittered up to
-  ``max_turn``), until one shows a boxed fruit with OER < ``max_start_oer``; one such fruit is
-  the target.
+  ``max_turn``), until one shows a boxed fruit with OER < ``max_start_oer``: the target.
 - Episodes end after ``tau`` steps with ``terminated=True`` (no ``done`` action: standing still is
   a zero action); ``info`` has ``oer_0``, ``oer_t``, ``path`` (poses), ``refused`` (why the last
   move was refused, or ""), ``target_fruit``, ``scene`` and ``steps``.
