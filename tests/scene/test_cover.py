@@ -157,8 +157,37 @@ def test_a_greenhouse_row_stands_on_white_floor_cover_labelled_soil() -> None:
     context = Context()
     uuids = add_greenhouse_floor(context, sides)
     points = np.concatenate(primitive_vertices(context, uuids))
-    assert np.allclose(points[:, 2], 0.002, atol=1e-4)
+    assert np.allclose(points[:, 2], 0.0008, atol=1e-5)
     assert points[:, 0].max() == pytest.approx(hx, abs=1e-3) and points[:, 1].min() == pytest.approx(-hy, abs=1e-3)
     assert set(np.asarray(context.getPrimitiveDataArray(uuids, ORGAN_DATA)).tolist()) == {SOIL}
     colour = context.getPrimitiveColor(uuids[0])
     assert min(colour.r, colour.g, colour.b) > 0.8
+
+
+def test_the_sward_covers_each_alleys_strip_with_grass_labelled_cover_at_ground_level() -> None:
+    from pyhelios import Context
+
+    from davis_ag.render.scene_geometry import GROUND_TOLERANCE
+    from davis_ag.scene.build import helios_texture
+    from davis_ag.scene.cover import SWARD_TEXTURE, add_sward
+    from davis_ag.scene.organs import ORGAN_DATA
+    from davis_ag.scene.plants import primitive_vertices
+
+    crop = CROPS["vsp-vine"]
+    assert crop.row is not None
+    system = FLOOR_SYSTEMS["vsp-vine"]
+    context = Context()
+    uuids = add_sward(context, crop.row, system, helios_texture(SWARD_TEXTURE))
+    assert set(np.asarray(context.getPrimitiveDataArray(uuids, ORGAN_DATA)).tolist()) == {COVER}
+    points = np.concatenate(primitive_vertices(context, uuids))
+    assert np.all((points[:, 2] > 0) & (points[:, 2] < GROUND_TOLERANCE)), "the sward must lie on the ground"
+    strips = covered_strips(crop.row, system)
+    inside = np.zeros(len(points), bool)
+    for low, high in strips:
+        inside |= (points[:, 1] >= low - 1e-4) & (points[:, 1] <= high + 1e-4)
+    assert inside.all(), "sward on the bare strip under a row"
+    area = sum(high - low for low, high in strips) * 2 * cover_length(crop.row)
+    covered = sum(
+        np.ptp(p[:, 0]) * np.ptp(p[:, 1]) for p in primitive_vertices(context, uuids)
+    )  # each patch a rectangle
+    assert covered == pytest.approx(area, rel=1e-3)

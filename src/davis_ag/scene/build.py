@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from davis_ag.errors import UserError
-from davis_ag.scene.cover import add_cover, floor_system
+from davis_ag.scene.cover import SWARD_TEXTURE, add_cover, floor_system
 from davis_ag.scene.helios_threads import one_helios_thread
 from davis_ag.scene.lighting import Lighting
 from davis_ag.scene.organs import ORGAN_DATA
@@ -289,7 +289,7 @@ def build_scene(
     if floor is not None and crop.row is not None:
         if cover_rng is None:
             raise ValueError("a scene with a cover crop needs its cover_rng")
-        add_cover(context, crop.row, floor, cover_rng)
+        add_cover(context, crop.row, floor, cover_rng, helios_texture(SWARD_TEXTURE))
 
     fruits: list[Fruit] = []
     for plant in grown:

@@ -7,7 +7,8 @@ University's Intermountain Fruit, "Orchard floor management systems": a vegetati
 strip is narrower (a 7 ft row spacing with 3 ft tilled rows and 4 ft grass lanes; Virginia Tech
 SPES-209, "Floor management strategies for Virginia vineyards", cover in the row middles).
 
-The cover is grown from Helios's plant library: the cereal ``wheat`` a week or so after
+The alley's sward is a tile of Helios's grass photograph over each covered strip; on it stand
+tufts grown from Helios's plant library: the cereal ``wheat`` a week or so after
 emergence (0.15-0.23 m: a grass alley between mowings, and the cereal cover crops that
 vineyards sow), with one spot in twenty a weed of the library (``cheeseweed``, a mallow, or
 ``bindweed``). A handful of prototypes are grown, then copied to spots on a jittered grid across
@@ -71,6 +72,10 @@ WEEDS: Final = (("cheeseweed", 40.0), ("bindweed", 10.0))
 WEED_SHARE: Final = 0.05
 #: Distance between the spots' grid points; each spot moves up to half of it either way.
 SPACING: Final = 0.35
+#: The sward's photograph, shipped with Helios's visualizer (a mixed grass sward seen from above).
+SWARD_TEXTURE: Final = "grass2.jpg"
+#: Height of the sward above the soil, m: under the renderer's ground tolerance (1 mm).
+SWARD_HEIGHT: Final = 0.0008
 
 
 @dataclass(frozen=True)
@@ -141,17 +146,58 @@ def floor_system(scenario_name: str, crop: CropSpec, setting: str) -> FloorSyste
     return FLOOR_SYSTEMS.get(crop.name)
 
 
-def add_cover(context, row: RowSpec, system: FloorSystem, rng: np.random.Generator) -> list[int]:
-    """Grow the prototypes and copy them to every spot of the cover, labelled ``cover``.
+def add_sward(context, row: RowSpec, system: FloorSystem, texture: str) -> list[int]:
+    """Lay the sward under the tufts: each alley's covered strip a tile of Helios's grass
+    photograph, one texture per metre patch (as the near soil keeps its grain), labelled ``cover``.
+
+    It lies :data:`SWARD_HEIGHT` above the soil, within the renderer's ground tolerance, so it
+    receives shadows and casts none, as the soil does.
+
+    Args:
+        context: The scene's Context.
+        row: The crop's row.
+        system: Its floor system.
+        texture: Path of the grass image.
+
+    Returns:
+        The primitives added.
+    """
+    from pyhelios.types import int2, vec2, vec3
+
+    from davis_ag.scene.organ_labels import object_primitives, set_organ
+
+    half = cover_length(row)
+    tiles = [
+        context.addTileObject(
+            center=vec3(0.0, (low + high) / 2, SWARD_HEIGHT),
+            size=vec2(2 * half, high - low),
+            subdiv=int2(max(1, round(2 * half)), max(1, round(high - low))),
+            texturefile=texture,
+        )
+        for low, high in covered_strips(row, system)
+        if high > low
+    ]
+    uuids = object_primitives(context, tiles)
+    set_organ(context, uuids, COVER)
+    return uuids
+
+
+def add_cover(
+    context, row: RowSpec, system: FloorSystem, rng: np.random.Generator, sward_texture: str | None = None
+) -> list[int]:
+    """Lay the sward (:func:`add_sward`), grow the prototypes and copy them to every spot of the
+    cover, labelled ``cover``.
 
     Args:
         context: The scene's Context (its plants already grown: the Helios generator is reseeded).
         row: The crop's row.
         system: Its floor system.
         rng: The cover's stream.
+        sward_texture: The sward's grass image (:data:`SWARD_TEXTURE`, found by the caller); no
+            sward where ``None``.
 
     Returns:
-        The primitives added (the prototypes, grown at the origin, are deleted).
+        The primitives added, the sward's first (the prototypes, grown at the origin, are deleted).
     """
     from pyhelios import PlantArchitecture
     from pyhelios.types import vec3
@@ -159,6 +205,7 @@ def add_cover(context, row: RowSpec, system: FloorSystem, rng: np.random.Generat
     from davis_ag.scene.organ_labels import set_organ
     from davis_ag.scene.plants import helios_seed, quiet_stdout
 
+    swards = add_sward(context, row, system, sward_texture) if sward_texture is not None else []
     spots = cover_spots(row, system, rng)
     architecture = PlantArchitecture(context)
     architecture.disableMessages()
@@ -178,4 +225,4 @@ def add_cover(context, row: RowSpec, system: FloorSystem, rng: np.random.Generat
         uuids += tuft
     context.deletePrimitive([u for proto in prototypes for u in proto])
     set_organ(context, uuids, COVER)
-    return uuids
+    return swards + uuids
