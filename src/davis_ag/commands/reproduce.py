@@ -15,6 +15,7 @@ from pathlib import Path
 
 from davis_ag.commands import arguments
 from davis_ag.errors import UserError
+from davis_ag.formats.splits import SPLIT_RULES
 from davis_ag.workflows.reproduce.configs import CONFIGS
 from davis_ag.workflows.reproduce.run import reproduce, write_page
 from davis_ag.workflows.reproduce.state import RunState, run_config
@@ -65,6 +66,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--mp-timesteps", type=arguments.bounded(1, 10**9), default=None, help="override MP A2C steps")
     parser.add_argument("--only", choices=["sp", "mp", "row"], default=None, help="run one scenario only")
     parser.add_argument(
+        "--split-rule",
+        choices=SPLIT_RULES,
+        default=None,
+        help="how train and test split (default: the configuration's, scenes): starts or fruits train the "
+        "learners and score everything under that rule (issue 59: Table 4 read both ways); its Table 4 "
+        "page is its own, never a page of another rule's run (docs/benchmark.md#split-rules)",
+    )
+    parser.add_argument(
         "--rewrite-results", action="store_true", help="only rewrite --results from DIR/state.json; run nothing"
     )
     parser.add_argument(
@@ -98,6 +107,25 @@ def check_results_path(results: Path, out: Path) -> None:
         )
 
 
+def check_page_rule(results: Path, rule: str) -> None:
+    """Refuse a Table 4 page of another split rule's run: each rule's run has its own page, so a
+    ``starts`` run never replaces the ``scenes`` run's docs/results.md (or the other way round).
+
+    Raises:
+        UserError: naming the page's rule and where to write instead.
+    """
+    from davis_ag.workflows.reproduce.pages.results import page_split_rule
+
+    if not results.is_file():
+        return
+    written = page_split_rule(results.read_text(errors="replace"))
+    if written is not None and written != rule:
+        raise UserError(
+            f"--results {results} is the Table 4 page of a split rule {written} run; this run splits by "
+            f"{rule}: write its page elsewhere (e.g. --results {results.with_name(f'results-{rule}.md')})"
+        )
+
+
 def run(args: argparse.Namespace) -> int:
     """Run every stage of the chosen configuration and write the results file."""
     config = CONFIGS[args.config]
@@ -106,6 +134,8 @@ def run(args: argparse.Namespace) -> int:
         for k in ("sp_scenes", "mp_scenes", "sp_timesteps", "mp_timesteps")
         if getattr(args, k) is not None
     }
+    if args.split_rule is not None:
+        overrides["split_rule"] = args.split_rule
     config = replace(config, **overrides)
     if args.status:
         print(format_status(args.out))
@@ -139,10 +169,14 @@ def run(args: argparse.Namespace) -> int:
             check_page(args.results)
             write_search_page(args.results, recorded, state, args.out)
         else:
+            if recorded.page == "table4":
+                check_page_rule(args.results, recorded.split_rule)
             write_page(args.results, recorded, state, args.out)
         print(f"wrote {args.results}")
         return 0
     arguments.prove_writable_folder(args.out)
+    if config.page == "table4":
+        check_page_rule(args.results, config.split_rule)
     pairs = [p for p in config.pairs if args.only in (None, p[0])]
     if not pairs:
         raise UserError(f"--only {args.only}: the {config.name} run has no {args.only} groups")

@@ -212,8 +212,8 @@ def write_blocks_beside(
 ) -> None:
     """Rewrite the README's and docs/benchmark.md's blocks of a results page in a project's ``docs/``.
 
-    A page written elsewhere (a work folder) leaves both alone, as does a page whose README or
-    benchmark.md has no such block.
+    A page written elsewhere (a work folder) leaves both alone, as do a page whose README or
+    benchmark.md has no such block and a page of a run under another split rule than ``scenes``.
 
     Args:
         page: The results page just written.
@@ -225,7 +225,9 @@ def write_blocks_beside(
     from davis_ag.atomic_files import write_marked_section
 
     folder = Path(page).absolute().parent
-    if folder.name != "docs":
+    # The blocks are the headline run's, under the paper's reading (scenes): a page of another
+    # rule's run stands beside docs/results.md and leaves them alone.
+    if folder.name != "docs" or config.split_rule != "scenes":
         return
     for target, marker, text in (
         (folder.parent / "README.md", README_MARKER, lambda: readme_block(config, state, out)),

@@ -142,6 +142,26 @@ def _comparison(scenario: str, policies: Mapping[str, PolicyResult]) -> str:
     )
 
 
+#: The page's first line; a run under a rule other than ``scenes`` names it after a comma.
+PAGE_TITLE = "# Table 4 reproduction"
+
+
+def page_title(rule: str) -> str:
+    """The first line of a Table 4 page of a run under ``rule``."""
+    return PAGE_TITLE if rule == "scenes" else f"{PAGE_TITLE}, split rule `{rule}`"
+
+
+def page_split_rule(text: str) -> str | None:
+    """The split rule of a Table 4 page's run, read from its title; ``None`` for another page."""
+    first = text.split("\n", 1)[0].strip()
+    if first == PAGE_TITLE:
+        return "scenes"
+    prefix = f"{PAGE_TITLE}, split rule `"
+    if first.startswith(prefix) and first.endswith("`"):
+        return first[len(prefix) : -1]
+    return None
+
+
 def write_results_md(path: Path, config: ReproduceConfig, state: RunState, out: Path | None = None) -> Path:
     """Write the Markdown results: our Table 4 beside the paper's, how the run was made, the timings.
 
@@ -171,7 +191,7 @@ def write_results_md(path: Path, config: ReproduceConfig, state: RunState, out: 
         else f"section III-B's 7 x 3 m, {mp_views} views each"
     )
     lines = [
-        "# Table 4 reproduction",
+        page_title(config.split_rule),
         "",
         "Written by `davis-ag reproduce` from the run's own records; do not edit by hand. Every number in "
         "the *ours* columns was measured by the run described here; the *paper* columns are Table 4 of "
