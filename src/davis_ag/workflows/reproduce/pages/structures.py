@@ -42,7 +42,7 @@ def structures_section(config: ReproduceConfig, state: RunState, out: Path, pair
     lines = [
         run_head(config, pairs, "of its own variant")
         + " Under the methods: the start's OER_0 and the eligible (view, fruit) starts of the test "
-        "split (a fruit a wire hides below the visibility limit is no start).",
+        "split (a fruit a wire, a post or the cover hides below the visibility limit is no start).",
         "",
     ]
     for scenario, crop in pairs:
