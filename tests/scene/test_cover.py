@@ -115,15 +115,17 @@ def test_helios_grows_the_cover_labelled_cover_at_its_spots() -> None:
     assert np.all(np.min(np.abs(points[:, 1:2] - ys[None, :]), axis=1) < 0.45)
 
 
-@pytest.mark.slow
-def test_the_cover_draws_nothing_from_the_scenes_seed() -> None:
-    """A small olive row both ways (the quickest orchard to grow): the same plants, fruit and sun."""
+def test_the_cover_draws_nothing_from_the_scenes_seed(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A strawberry row (the quickest row to grow) given a covered floor, both ways: the same
+    plants, fruit and sun."""
+    from davis_ag.scene import cover
     from davis_ag.scene.build import build_scene
     from davis_ag.seeds import COVER_STREAM, stream_rng
 
-    base = CROPS["olive"]
+    monkeypatch.setitem(cover.FLOOR_SYSTEMS, "strawberry", FloorSystem("test", 0.5, "test"))
+    base = CROPS["strawberry"]
     assert base.row is not None
-    crop = dataclasses.replace(base, row=dataclasses.replace(base.row, plants=1))
+    crop = dataclasses.replace(base, row=dataclasses.replace(base.row, plants=1))  # nine plants
     scenario = scenario_spec("row", crop)
     models = {
         setting: build_scene(
