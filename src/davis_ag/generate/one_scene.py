@@ -38,7 +38,6 @@ from davis_ag.render.egl_context import renderer_name
 from davis_ag.scene.appearance import draw_appearance, resolve_appearance
 from davis_ag.scene.build import build_scene
 from davis_ag.scene.camera import Camera
-from davis_ag.scene.cover import floor_system
 from davis_ag.scene.organs import SKY, scene_organ_names
 from davis_ag.scene.specs import (
     CROPS,
@@ -50,7 +49,7 @@ from davis_ag.scene.specs import (
     plant_centres,
     scene_folder,
 )
-from davis_ag.scene.structures import DEFAULT_STRUCTURES, check_structures, structure_parts
+from davis_ag.scene.structures import DEFAULT_STRUCTURES, builds_something, check_structures
 from davis_ag.scene.view_grid import build_view_grid
 from davis_ag.seeds import COVER_STREAM, derived_seed, stream_rng
 
@@ -139,9 +138,7 @@ class SceneRequest(SceneSettings):
     def __post_init__(self) -> None:
         resolve_appearance(self.appearance)
         check_structures(self.structures)
-        if not structure_parts(self.scenario.name, self.crop, self.structures) and not floor_system(
-            self.scenario.name, self.crop, self.structures
-        ):
+        if not builds_something(self.scenario.name, self.crop, self.structures):
             # What the scene gets, not what was asked: a scene with nothing to build is a bare
             # one, and reads back from its scene.json as such.
             object.__setattr__(self, "structures", "none")

@@ -34,7 +34,13 @@ from davis_ag.scene.specs import (
     check_plants,
     plant_positions,
 )
-from davis_ag.scene.structures import add_greenhouse_floor, add_structures, greenhouse_floor, structure_parts
+from davis_ag.scene.structures import (
+    add_greenhouse_floor,
+    add_structures,
+    builds_something,
+    greenhouse_floor,
+    structure_parts,
+)
 
 if TYPE_CHECKING:  # pyhelios loads its native library: imported only where a scene is built
     from pyhelios import Context
@@ -309,5 +315,5 @@ def build_scene(
         lighting,
         aim_height=crop.centre_height,
         plant_generator=plants,
-        structures=structures if parts or floor is not None else None,
+        structures=structures if builds_something(scenario.name, crop, structures) else None,
     )

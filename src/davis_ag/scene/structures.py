@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from typing import Final, Literal, get_args
 
 from davis_ag.errors import UserError
+from davis_ag.scene.cover import floor_system
 from davis_ag.scene.crop_spec import CropSpec, RowSpec
 from davis_ag.scene.organs import STRUCTURE
 
@@ -313,6 +314,13 @@ def structure_parts(scenario_name: str, crop: CropSpec, setting: str) -> list[Pa
     if alley is not None:  # the alleys between the three rows and outside them
         parts += [part for k in (-1.5, -0.5, 0.5, 1.5) for part in alley(row, k * row.row_spacing)]
     return parts
+
+
+def builds_something(scenario_name: str, crop: CropSpec, setting: str) -> bool:
+    """Whether a scene of this setting gets a structure or a covered floor
+    (:func:`davis_ag.scene.cover.floor_system`): where neither, the scene is a bare one and
+    records itself as such."""
+    return bool(structure_parts(scenario_name, crop, setting)) or floor_system(scenario_name, crop, setting) is not None
 
 
 def add_structures(context, parts: list[Part]) -> list[int]:
