@@ -31,9 +31,10 @@ def a_run_part_way(out: Path) -> Path:
     (out / "dataset" / "Single-Strawberry" / ".002.partial").mkdir()  # under way: not a scene
     timings = [
         {"grow": 10.0, "draw_and_label": 590.0},
-        {"grow": 1.0, "draw_and_label": 20.0, "views_from_an_earlier_run": 9},
+        # Resumed after 95 of its 285 views: it drew 190 in 380 s, 2 s a view, as the first did.
+        {"grow": 30.0, "draw_and_label": 380.0, "views_from_an_earlier_run": 95},
     ]
-    for folder, timing in zip(folders, timings):  # the second was resumed: its time is partial
+    for folder, timing in zip(folders, timings):
         (out / "dataset" / folder / "scene.json").write_text(json.dumps({"timing_s": timing}))
     state = {
         "config": asdict(CONFIG),
@@ -70,7 +71,8 @@ def test_each_stage_says_what_its_files_show(tmp_path: Path) -> None:
     ]
     made = by_name["sp-strawberry: generate"]
     assert (made.done, made.progress, made.seconds) == (False, "2 of 3 scenes", 7200.0)
-    assert made.left_s == pytest.approx(600.0 / default_workers())  # one scene left, at the whole scene's time
+    # One scene left, at the mean whole scene's time: the resumed one's drawing scaled to all its views.
+    assert made.left_s == pytest.approx((600.0 + 30.0 + 570.0) / 2)
     a2c = by_name["sp-strawberry: train A2C"]
     assert not a2c.done and a2c.seconds == 900.0  # both sittings on the clock
     assert a2c.progress.startswith("20,000 of 30,000 steps at its last checkpoint (67 %)")
@@ -222,3 +224,21 @@ def test_an_evaluation_not_started_is_timed_at_another_groups_same_scenario_firs
     (out / "clock.json").write_text(json.dumps(clock))
     stage = {s.stage: s for s in run_status(out)[1]}["sp-tomato: evaluate"]
     assert (stage.done, stage.progress, stage.left_s) == (False, "not started; timed at sp-strawberry's 30 s", 30.0)
+
+
+def test_scenes_left_go_in_rounds_of_the_scene_processes_and_a_scene_wholly_resumed_gives_no_rate(
+    tmp_path: Path,
+) -> None:
+    """Five scenes left on a machine running two scene processes at once take three rounds of a scene's time."""
+    from davis_ag.workflows.reproduce.status import _generation_left
+
+    for folder, timing in (
+        ("a", {"grow": 10.0, "draw_and_label": 90.0}),
+        ("b", {"grow": 5.0, "draw_and_label": 0.1, "views_from_an_earlier_run": 20}),  # nothing drawn here
+    ):
+        (tmp_path / folder).mkdir()
+        (tmp_path / folder / "scene.json").write_text(json.dumps({"timing_s": timing}))
+    rounds = -(-5 // default_workers())
+    assert _generation_left(tmp_path, ["a", "b"], 5, views=20) == pytest.approx(rounds * 100.0)
+    assert _generation_left(tmp_path, ["b"], 5, views=20) is None
+    assert _generation_left(tmp_path, ["a"], 0, views=20) is None

@@ -228,16 +228,22 @@ def _generation_status(
     progress = f"{count} of {wanted} scenes" if started else "not started"
     if under_way:
         progress += f"; {under_way} more under way ({drawn:,} views drawn)"
-    left = _generation_left(root, [f for f in folders if f in made], wanted - count)
+    views = views_per_scene(scenario_spec, crop_spec)
+    left = _generation_left(root, [f for f in folders if f in made], wanted - count, views)
     if left is None and seconds and drawn and not count:
         # No scene finished yet: the views drawn on this stage's clock give the rate.
-        left = (wanted * views_per_scene(scenario_spec, crop_spec) - drawn) * seconds / drawn
+        left = (wanted * views - drawn) * seconds / drawn
     return StageStatus(f"{key}: generate", bool(recorded) and count == wanted, progress, seconds, left)
 
 
-def _generation_left(root: Path, made: list[str], remaining: int) -> float | None:
+def _generation_left(root: Path, made: list[str], remaining: int, views: int) -> float | None:
     """About how long the ``remaining`` scenes of a group take: the mean time of its scenes made
-    in one go (``scene.json``'s ``timing_s``) over the scene processes this machine runs at once."""
+    (``scene.json``'s ``timing_s``), in rounds of as many scene processes as this machine runs at once.
+
+    A scene resumed from an earlier run's views recorded only the time of the views it drew
+    itself; its drawing time is scaled up to all ``views`` of the scene (a stopped run's scenes
+    are often all resumed ones, and they are the only rate there is).
+    """
     import json
 
     from davis_ag.formats.layout import SCENE_METADATA
@@ -252,9 +258,14 @@ def _generation_left(root: Path, made: list[str], remaining: int) -> float | Non
             timing = json.loads((root / folder / SCENE_METADATA).read_text()).get("timing_s", {})
         except (OSError, ValueError):
             continue
-        if timing and not timing.get("views_from_an_earlier_run"):  # a resumed scene's time is partial
-            times.append(scene_seconds(timing))
-    return remaining * sum(times) / len(times) / default_workers() if times else None
+        earlier = int(timing.get("views_from_an_earlier_run", 0))
+        if not timing or earlier >= views:
+            continue
+        if earlier:
+            timing = {**timing, "draw_and_label": float(timing.get("draw_and_label", 0.0)) * views / (views - earlier)}
+        times.append(scene_seconds(timing))
+    # Each scene is one process's: the remaining ones go in rounds of as many as run at once.
+    return -(-remaining // default_workers()) * sum(times) / len(times) if times else None
 
 
 def _training_status(out: Path, key: str, algo: str, timesteps: int, stage: str, seconds: float | None) -> StageStatus:
