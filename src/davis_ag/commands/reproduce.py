@@ -12,14 +12,18 @@ from __future__ import annotations
 import argparse
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from davis_ag.commands import arguments
 from davis_ag.errors import UserError
 from davis_ag.formats.splits import SPLIT_RULES
-from davis_ag.workflows.reproduce.configs import CONFIGS
+from davis_ag.workflows.reproduce.configs import CONFIGS, ReproduceConfig
 from davis_ag.workflows.reproduce.run import reproduce, write_page
 from davis_ag.workflows.reproduce.state import RunState, run_config
 from davis_ag.workflows.reproduce.status import format_status
+
+if TYPE_CHECKING:
+    from davis_ag.workflows.reproduce.pages.split_rules import RuleRun
 
 HELP = (
     "reproduce Table 4, the crops ladder, row mapping, the robot or the structures run: generate, train A2C and PPO, "
@@ -77,6 +81,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--rewrite-results", action="store_true", help="only rewrite --results from DIR/state.json; run nothing"
     )
     parser.add_argument(
+        "--beside",
+        type=arguments.path,
+        action="append",
+        default=[],
+        metavar="DIR",
+        help="with --rewrite-results of a Table 4 run: the folder of the same configuration's run under "
+        "another split rule; the page gains a section on both readings of the paper's 70/30 split "
+        "(docs/benchmark.md#split-rules)",
+    )
+    parser.add_argument(
         "--status",
         action="store_true",
         help="only print where the run in DIR stands, stage by stage (safe while it runs); run nothing",
@@ -105,6 +119,42 @@ def check_results_path(results: Path, out: Path) -> None:
             f"--results {page} would replace the run's own records in {work}: "
             "choose another path (e.g. docs/results.md)"
         )
+
+
+def beside_runs(own: ReproduceConfig, folders: list[Path]) -> list[RuleRun]:
+    """The runs ``--beside`` names, each checked to be ``own``'s configuration under another rule.
+
+    Args:
+        own: The configuration of the run whose page is written.
+        folders: The other runs' folders.
+
+    Returns:
+        One :class:`~davis_ag.workflows.reproduce.pages.split_rules.RuleRun` per folder.
+
+    Raises:
+        UserError: for a folder with no finished run, a run of another page or configuration, or a
+            rule already on the page.
+    """
+    from davis_ag.workflows.reproduce.pages.split_rules import RuleRun
+
+    if own.page != "table4":
+        raise UserError(f"--beside: the {own.name} run has no Table 4 page to set another split rule's run beside")
+    runs, rules = [], {own.split_rule}
+    for folder in folders:
+        state = RunState.load(folder / "state.json")
+        if not state.config:
+            raise UserError(f"--beside {folder}: no reproduce run there (no state.json with a configuration)")
+        other = run_config(state, folder / "state.json")
+        if replace(other, split_rule=own.split_rule) != own:
+            raise UserError(
+                f"--beside {folder}: its run is the {other.name} configuration with other settings than this "
+                f"{own.name} run; both readings must be the same run but for --split-rule"
+            )
+        if other.split_rule in rules:
+            raise UserError(f"--beside {folder}: its split rule {other.split_rule} is already on the page")
+        rules.add(other.split_rule)
+        runs.append(RuleRun(other, state, folder))
+    return runs
 
 
 def check_page_rule(results: Path, rule: str) -> None:
@@ -150,7 +200,13 @@ def run(args: argparse.Namespace) -> int:
         if not state.config:
             raise UserError(f"{args.out / 'state.json'}: no finished run to write results from")
         recorded = run_config(state, args.out / "state.json")
-        if recorded.page == "mapping":
+        if args.beside:
+            from davis_ag.workflows.reproduce.pages.results import write_results_md
+
+            beside = beside_runs(recorded, args.beside)
+            check_page_rule(args.results, recorded.split_rule)
+            write_results_md(args.results, recorded, state, args.out, beside)
+        elif recorded.page == "mapping":
             from davis_ag.workflows.reproduce.mapping_run import write_run_page
 
             write_run_page(args.results, recorded, args.out, recorded.pairs)
@@ -174,6 +230,8 @@ def run(args: argparse.Namespace) -> int:
             write_page(args.results, recorded, state, args.out)
         print(f"wrote {args.results}")
         return 0
+    if args.beside:
+        raise UserError("--beside goes with --rewrite-results, once both runs have their records")
     arguments.prove_writable_folder(args.out)
     if config.page == "table4":
         check_page_rule(args.results, config.split_rule)

@@ -10,7 +10,7 @@ across code changes says so itself.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from davis_ag.benchmark.results import PolicyResult
@@ -37,6 +37,7 @@ from davis_ag.workflows.reproduce.pages.policies import (
     policy_sections,
 )
 from davis_ag.workflows.reproduce.pages.provenance import how_made, stage_rows
+from davis_ag.workflows.reproduce.pages.split_rules import RuleRun, split_rules_section
 from davis_ag.workflows.reproduce.state import RunState
 
 
@@ -162,7 +163,13 @@ def page_split_rule(text: str) -> str | None:
     return None
 
 
-def write_results_md(path: Path, config: ReproduceConfig, state: RunState, out: Path | None = None) -> Path:
+def write_results_md(
+    path: Path,
+    config: ReproduceConfig,
+    state: RunState,
+    out: Path | None = None,
+    beside: Sequence[RuleRun] = (),
+) -> Path:
     """Write the Markdown results: our Table 4 beside the paper's, how the run was made, the timings.
 
     Args:
@@ -171,6 +178,8 @@ def write_results_md(path: Path, config: ReproduceConfig, state: RunState, out: 
         state: The run's records: ``results`` (per scenario), ``stages`` (seconds, notes,
             code) and ``scene_folders`` (per group).
         out: The work folder, for the scene and training records.
+        beside: Runs of the same configuration under other split rules: the page gains the
+            section on both readings of the split (:mod:`~davis_ag.workflows.reproduce.pages.split_rules`).
 
     Returns:
         ``path``.
@@ -263,6 +272,8 @@ def write_results_md(path: Path, config: ReproduceConfig, state: RunState, out: 
         lines.append("")
         lines += policy_sections(scenario, result, out, Path(path))
     lines += learning_curve_section(out, Path(path), state.results)
+    if beside:
+        lines += split_rules_section([RuleRun(config, state, out), *beside])
     lines += ["## Notes", ""] + [f"- {note}" for note in _notes(config, state, out)] + [""]
     lines += how_made(state, out)
     lines += [
