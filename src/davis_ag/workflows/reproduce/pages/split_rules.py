@@ -75,8 +75,9 @@ def split_rules_section(runs: Sequence[RuleRun]) -> list[str]:
         "starts come from the scenes it trained on. The same configuration "
         f"(`{runs[0].config.name}`, dataset seed {runs[0].config.seed}) was run under each rule; their "
         f"wall times: {hours} (each run's own page has its stage table). A baseline learns nothing, so "
-        "its change between the readings is the test starts' own difficulty; a learner's change beyond "
-        "Rand's is what training on the test scenes is worth to it.",
+        "its change between the readings is the test starts' own (Rand's: how hard they are to improve "
+        "by chance; the Oracle's: how much there is to gain); a learner's change beyond Rand's is what "
+        "training on the test scenes is worth to it.",
         "",
     ]
     for scenario in ("sp", "mp"):
@@ -125,7 +126,7 @@ def _what_it_says(
     rules: list[str], results: list[EvaluationResults], paper: Mapping[str, float], learners: list[str]
 ) -> list[str]:
     """The sentences the numbers support: which reading's A2C is nearer the paper's, and how far
-    each learner moves between the first two readings beside Rand's move."""
+    each learner moves between the first two readings beside the moves of Rand and the Oracle."""
     sentences = []
     if "A2C" in learners and "A2C" in paper:
         a2c = [r.policies["A2C"].oer_tau.mean for r in results]
@@ -136,11 +137,18 @@ def _what_it_says(
             f"reading comes nearer it, {signed(a2c[nearest] - paper['A2C'])} from it."
         )
     first, second = results[0].policies, results[1].policies
-    rand_move = second["Rand"].oer_tau.mean - first["Rand"].oer_tau.mean
-    moves = ", ".join(f"{name} {signed(second[name].oer_tau.mean - first[name].oer_tau.mean)}" for name in learners)
+
+    def move(name: str) -> str:
+        return signed(second[name].oer_tau.mean - first[name].oer_tau.mean)
+
+    moves = " and ".join(f"{name} {move(name)}" for name in learners)
+    owners = {"Rand": "Rand's", "Oracle": "the Oracle's"}
+    fixed = " and ".join(
+        f"{owner} by {move(name)}" for name, owner in owners.items() if name in first and name in second
+    )
     sentences.append(
-        f"From `{rules[0]}` to `{rules[1]}`, OER_tau moves by {moves}, and Rand's by {signed(rand_move)} "
-        "(the starts' difficulty alone); a score on this benchmark is comparable only with scores "
+        f"From `{rules[0]}` to `{rules[1]}`, OER_tau moves by {moves}; {fixed} (neither learns: their "
+        "moves are the test starts' own). A score on this benchmark is comparable only with scores "
         "under the same split rule."
     )
     return sentences
