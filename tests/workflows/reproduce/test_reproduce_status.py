@@ -242,3 +242,22 @@ def test_scenes_left_go_in_rounds_of_the_scene_processes_and_a_scene_wholly_resu
     assert _generation_left(tmp_path, ["a", "b"], 5, views=20) == pytest.approx(rounds * 100.0)
     assert _generation_left(tmp_path, ["b"], 5, views=20) is None
     assert _generation_left(tmp_path, ["a"], 0, views=20) is None
+
+
+def test_a_cell_s_learner_not_started_is_timed_at_the_median_rate_of_the_cells_trained(tmp_path: Path) -> None:
+    """A cells run (robot, structures): a learner is timed once some cell has trained the same one."""
+    from davis_ag.workflows.reproduce.cells import Cell
+    from davis_ag.workflows.reproduce.status import StageStatus, _timed_from_other_cells
+
+    cells = [Cell(f"row-vsp-vine-{k}", tmp_path / "dataset", "row", "vsp-vine") for k in ("a", "b", "c", "d")]
+    (tmp_path / "models").mkdir()
+    for cell, rate in zip(cells[:3], (20.0, 40.0, 100.0)):
+        record = {"timesteps": 10_000, "steps_per_second": rate}
+        (tmp_path / "models" / f"a2c_{cell.key}.training.json").write_text(json.dumps(record))
+    waiting = StageStatus("row-vsp-vine-d: train A2C", False, "not started")
+    timed = _timed_from_other_cells(tmp_path, cells, "a2c", 10_000, waiting)
+    assert timed.left_s == pytest.approx(10_000 / 40.0)
+    assert timed.progress == "not started; timed at the median 40.0 steps/s of 3 cell(s) trained"
+    running = replace(waiting, progress="under way, no checkpoint yet", seconds=100.0)
+    assert _timed_from_other_cells(tmp_path, cells, "a2c", 10_000, running).left_s == pytest.approx(150.0)
+    assert _timed_from_other_cells(tmp_path, cells, "ppo", 10_000, waiting) == waiting  # no PPO trained yet

@@ -5,7 +5,8 @@ each stage of the whole run has done (scenes made, steps trained, evaluations wr
 has worked on the stage's clock, and about how long is left: for a stage under way (a learner at the
 rate of its last sitting, a generate stage at the mean time of its scenes so far, or at the rate of
 the views drawn before its first scene ends), for a learner not started, at the rate the same
-learner trained at on the run's other group, and for a validation not started, at the views per
+learner trained at on the run's other group (in a run of cells, the median rate of the cells that
+trained it), and for a validation not started, at the views per
 second of the other group's last whole check; the stages with no rate yet are named, not guessed.
 Reading it while the run goes on is safe: it writes nothing, every file it reads but one is written
 atomically, and the one that grows (a scene's journal of views) may vanish as its scene ends, which
@@ -137,15 +138,33 @@ def _cells_status(
         done = rows[cell.key] is not None
         baselines.append(StageStatus(f"{cell.key}: baselines", done, "written" if done else "not started"))
         for algo in config.learners:
-            stage = f"{cell.key}: train {algo.upper()}"
-            learners.append(
-                _training_status(out, cell.key, algo, config.timesteps(cell.scenario), stage, seconds(stage))
-            )
+            stage, steps = f"{cell.key}: train {algo.upper()}", config.timesteps(cell.scenario)
+            status = _training_status(out, cell.key, algo, steps, stage, seconds(stage))
+            if status.progress in ("not started", UNDER_WAY):
+                status = _timed_from_other_cells(out, cells, algo, steps, status)
+            learners.append(status)
         wanted = {a.upper() for a in config.learners}
         done = wanted <= (rows[cell.key] or set()) and rows[cell.key] is not None
         progress = "written with " + ", ".join(sorted(wanted)) if done else "not started"
         learners.append(StageStatus(f"{cell.key}: evaluate", done, progress, seconds(f"{cell.key}: evaluate")))
     return baselines + learners
+
+
+def _timed_from_other_cells(out: Path, cells: list[Cell], algo: str, steps: int, status: StageStatus) -> StageStatus:
+    """A cell's learner not started (or with no checkpoint yet), timed at the median rate the same
+    learner trained at in the run's cells that have finished it (their scenes and robots differ,
+    so it is a rough time), less the time it has run."""
+    import statistics
+
+    from davis_ag.workflows.reproduce.learners import training_record
+
+    rates = [r for cell in cells if (r := training_record(out, cell.key, algo).get("steps_per_second"))]
+    if not rates:
+        return status
+    rate = statistics.median(rates)
+    left = max(steps / rate - (status.seconds or 0.0), 0.0)
+    progress = f"{status.progress}; timed at the median {rate:.1f} steps/s of {len(rates)} cell(s) trained"
+    return replace(status, progress=progress, left_s=left)
 
 
 def _search_stages(out: Path, config: ReproduceConfig, seconds: Any) -> list[StageStatus]:
