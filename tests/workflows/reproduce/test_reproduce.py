@@ -95,8 +95,8 @@ def test_the_status_of_a_run_stopped_in_its_first_stage_says_where_it_stands(
     """A crops run's first stage (ten apple trees grown and drawn) takes half an hour: ``--status``
     answered "no reproduce run started there" all that while, as after a kill in it."""
     from davis_ag.workflows import stages
-    from davis_ag.workflows.reproduce.configs import CONFIGS
     from davis_ag.workflows.reproduce import run as reproduce_run
+    from davis_ag.workflows.reproduce.configs import CONFIGS
     from davis_ag.workflows.reproduce.run import reproduce
     from davis_ag.workflows.reproduce.status import run_status
 

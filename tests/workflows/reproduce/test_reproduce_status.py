@@ -146,7 +146,7 @@ def test_a_learner_under_way_before_its_first_checkpoint_is_timed_at_the_other_g
     mp_a2c = {s.stage: s for s in run_status(out)[1]}["mp-vine: train A2C"]
     whole = CONFIG.mp_timesteps / 50.0 / 3600
     assert (mp_a2c.progress, mp_a2c.left_s) == (
-        f"under way, no checkpoint yet; past the {whole:.2f} h sp-strawberry's rate gives",
+        f"under way, no checkpoint yet; past the {whole:.2f} h that sp-strawberry's 50.0 steps/s gives",
         None,
     )
 

@@ -162,9 +162,17 @@ def _timed_from_other_cells(out: Path, cells: list[Cell], algo: str, steps: int,
     if not rates:
         return status
     rate = statistics.median(rates)
-    left = max(steps / rate - (status.seconds or 0.0), 0.0)
-    progress = f"{status.progress}; timed at the median {rate:.1f} steps/s of {len(rates)} cell(s) trained"
-    return replace(status, progress=progress, left_s=left)
+    return _timed_at(status, steps, rate, f"the median {rate:.1f} steps/s of {len(rates)} cell(s) trained")
+
+
+def _timed_at(status: StageStatus, steps: int, rate: float, source: str) -> StageStatus:
+    """``status`` (a learner not started, or with no checkpoint yet) timed at ``rate`` steps/s, less
+    the time it has run; ``source`` says where the rate comes from. A learner already past the time
+    the rate gives (a busier machine, a paused run) gets no guess."""
+    whole, spent = steps / rate, status.seconds or 0.0
+    if spent >= whole:
+        return replace(status, progress=f"{status.progress}; past the {whole / 3600:.2f} h that {source} gives")
+    return replace(status, progress=f"{status.progress}; timed at {source}", left_s=whole - spent)
 
 
 def _search_stages(out: Path, config: ReproduceConfig, seconds: Any) -> list[StageStatus]:
@@ -195,8 +203,7 @@ def _search_stages(out: Path, config: ReproduceConfig, seconds: Any) -> list[Sta
                 training_record(out, key, c.key).get("steps_per_second") for c in candidates if c.algo == candidate.algo
             ]
             if rate := next((r for r in rates if r), None):
-                left = max(steps / rate - (status.seconds or 0.0), 0.0)
-                status = replace(status, progress=f"{status.progress}; timed at {rate:.1f} steps/s", left_s=left)
+                status = _timed_at(status, steps, rate, f"{rate:.1f} steps/s")
         stages.append(status)
     try:
         scored = set(load_results(results_path(out, config), check=False).policies)
@@ -321,14 +328,8 @@ def _estimated_from_elsewhere(
 
     for other in (group_key(s, c) for s, c in config.pairs):
         rate = training_record(out, other, algo).get("steps_per_second") if other != key else None
-        if not rate:
-            continue
-        whole, spent = timesteps / rate, status.seconds or 0.0
-        if spent >= whole:  # slower than there (a busier machine, a paused run): no guess
-            return replace(status, progress=f"{status.progress}; past the {whole / 3600:.2f} h {other}'s rate gives")
-        return replace(
-            status, progress=f"{status.progress}; timed at {other}'s {rate:.1f} steps/s", left_s=whole - spent
-        )
+        if rate:
+            return _timed_at(status, timesteps, rate, f"{other}'s {rate:.1f} steps/s")
     return status
 
 
