@@ -121,7 +121,7 @@ def test_a_learner_not_started_is_timed_at_its_rate_on_the_other_group(tmp_path:
     assert mp_a2c.progress == "not started; timed at sp-strawberry's 50.0 steps/s"
     assert mp_a2c.left_s == pytest.approx(CONFIG.mp_timesteps / 50.0)
     assert by_name["mp-vine: train PPO"].left_s is None  # SP's PPO has no record yet
-    last = format_status(out).splitlines()[-1]
+    last = format_status(out).splitlines()[-3]  # the disk's line last
     timed = by_name["sp-strawberry: generate"].left_s + 400.0 + CONFIG.mp_timesteps / 50.0
     assert last.startswith(f"About {timed / 3600:.1f} hours left in the stages timed above, and ")
     assert last.endswith(
@@ -261,3 +261,32 @@ def test_a_cell_s_learner_not_started_is_timed_at_the_median_rate_of_the_cells_t
     running = replace(waiting, progress="under way, no checkpoint yet", seconds=100.0)
     assert _timed_from_other_cells(tmp_path, cells, "a2c", 10_000, running).left_s == pytest.approx(150.0)
     assert _timed_from_other_cells(tmp_path, cells, "ppo", 10_000, waiting) == waiting  # no PPO trained yet
+
+
+@pytest.mark.parametrize(
+    ("free", "ending"),
+    [
+        ("both", "GB free there."),
+        ("the larger", "GB free there: not all at once; run a group at a time (`--only`), or free space."),
+        ("the smaller", "GB free there: {larger} cannot fit; free space, or move the run to a larger disk."),
+    ],
+)
+def test_the_status_says_what_each_group_still_writes_to_disk_and_what_does_not_fit(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, free: str, ending: str
+) -> None:
+    """A paper-scale run's MP vine writes about 52 GB: the status says so before the next sitting is
+    refused for it, and whether ``--only`` one group at a time would fit."""
+    from davis_ag.workflows.reproduce import configs
+    from davis_ag.workflows.reproduce.status import format_status
+
+    out = a_run_part_way(tmp_path / "run")
+    sp, mp = (configs.disk_needed(CONFIG, out / "dataset", [pair]) * configs.DISK_MARGIN for pair in CONFIG.pairs)
+    # The made scenes are not counted again: SP with 2 of its 3 scenes made writes less than with none.
+    assert 0 < sp < configs.disk_needed(CONFIG, tmp_path / "empty", [CONFIG.pairs[0]]) * configs.DISK_MARGIN
+    (_, small), (larger, large) = sorted([("sp-strawberry", sp), ("mp-vine", mp)], key=lambda kv: kv[1])
+    room = {"both": sp + mp, "the larger": large, "the smaller": small}[free]
+    monkeypatch.setattr(configs, "free_bytes", lambda out: room)
+    line = format_status(out).splitlines()[-1]
+    assert line.startswith("Disk, still to write under the dataset")
+    assert f"sp-strawberry {sp / 1e9:.1f} GB, mp-vine {mp / 1e9:.1f} GB; {room / 1e9:.1f} GB free there" in line
+    assert line.endswith(ending.format(larger=larger))

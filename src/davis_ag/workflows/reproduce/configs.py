@@ -331,10 +331,34 @@ def check_disk(
     from davis_ag.errors import UserError
 
     needed = disk_needed(config, out / "dataset", pairs) * DISK_MARGIN
-    probe = out if out.exists() else next(p for p in out.parents if p.exists())
-    free = shutil.disk_usage(probe).free
+    free = free_bytes(out)
     if free < needed:
         raise UserError(
             f"reproduce --config {config.name} needs about {needed / 1e9:.1f} GB more under {out} "
             f"and the disk has {free / 1e9:.1f} GB free: free space, or pass --out on a larger disk"
         )
+
+
+def free_bytes(out: Path) -> int:
+    """Free bytes on the disk that holds ``out``'s dataset (a linked dataset: the link's disk), or
+    ``out``'s nearest existing parent for a run not started."""
+    probe = next(p for p in (out / "dataset", out, *out.parents) if p.exists())
+    return shutil.disk_usage(probe).free
+
+
+def disk_line(config: ReproduceConfig, out: Path) -> str:
+    """For ``--status``: what each group still has to write under ``out/dataset`` (with the margin
+    :func:`check_disk` asks) beside the free space, and which groups do not fit, so a long run's
+    next sitting (or its ``--only`` half) is planned before it is refused."""
+    root = out / "dataset"
+    needs = {group_key(s, c): disk_needed(config, root, [(s, c)]) * DISK_MARGIN for s, c in config.pairs}
+    free = free_bytes(out)
+    line = "Disk, still to write under the dataset (scenes and observation caches not yet made, 10 % margin): "
+    line += ", ".join(f"{key} {need / 1e9:.1f} GB" for key, need in needs.items())
+    line += f"; {free / 1e9:.1f} GB free there"
+    if sum(needs.values()) <= free:
+        return line + "."
+    over = [key for key, need in needs.items() if need > free]
+    if over:
+        return line + f": {', '.join(over)} cannot fit; free space, or move the run to a larger disk."
+    return line + ": not all at once; run a group at a time (`--only`), or free space."

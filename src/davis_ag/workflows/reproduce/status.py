@@ -19,7 +19,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from davis_ag.workflows.reproduce.configs import ReproduceConfig
+from davis_ag.workflows.reproduce.configs import ReproduceConfig, disk_line
 from davis_ag.workflows.reproduce.groups import group_key
 from davis_ag.workflows.reproduce.state import RunState, StageRecord, run_config
 
@@ -420,4 +420,6 @@ def format_status(out: Path) -> str:
             named = "; ".join(f"{step} of {', '.join(keys)}" for step, keys in by_step.items() if keys)
             lines[-1] += f", and {len(untimed)} not timed yet (no rate measured for them): {named}"
         lines[-1] += "."
+    if config.page not in ("robot", "structures"):  # a cells run's variants make datasets of their own
+        lines += ["", disk_line(config, out)]
     return "\n".join(lines)
