@@ -47,7 +47,8 @@ def results(
     **fields: Any,
 ) -> EvaluationResults:
     """An evaluation of the policies in ``oer`` (name: mean OER_tau), each learner in ``gaps`` with its
-    gap to the Best fixed action; ``fields``: ``starts`` (the protocol's), or the results' own fields."""
+    gap to the Best fixed action; ``fields``: ``starts`` and ``split_rule`` (the protocol's), or the
+    results' own fields."""
     protocol = Protocol(
         scenario=scenario,
         split=split,
@@ -60,6 +61,7 @@ def results(
         actions=SP_ACTIONS,
         starts=fields.pop("starts", None),
         start_rule="pairs",
+        split_rule=fields.pop("split_rule", None),
     )
     rows = {name: policy(mean) for name, mean in oer.items()}
     for learner, paired in (gaps or {}).items():

@@ -27,7 +27,7 @@ OER = {
 
 
 def state_of(rule: str, scenarios: tuple[str, ...] = ("sp",)) -> RunState:
-    return RunState(results={s: made_results(OER[rule], scenario=s) for s in scenarios})
+    return RunState(results={s: made_results(OER[rule], scenario=s, split_rule=rule) for s in scenarios})
 
 
 def test_the_paper_s_gain_over_rand_is_section_vi_s_over_18_percent() -> None:
@@ -83,3 +83,31 @@ def test_rewrite_results_beside_writes_the_section_and_refuses_what_is_not_the_s
         assert says in err and len(err.strip().splitlines()) == 1
     assert cli.main(["reproduce", "--out", str(tmp_path / "new"), "--beside", str(starts)]) == 2
     assert "--beside goes with --rewrite-results" in capsys.readouterr().err
+
+
+def test_the_readme_block_names_each_row_s_split_rule_and_gains_the_other_reading_s_rows(tmp_path: Path) -> None:
+    """Issue 59: the README's Table 4 says which rule each row used; with ``--beside`` the other
+    reading's rows stand under ours, and a page of the ``starts`` run alone leaves the README be."""
+    scenes = save_run(tmp_path / "scenes", SCENES, state_of("scenes", ("sp", "mp")))
+    starts = save_run(tmp_path / "starts", STARTS, state_of("starts", ("sp",)))
+    (tmp_path / "docs").mkdir()
+    readme = tmp_path / "README.md"
+    readme.write_text("<!-- results-table4:start -->\n<!-- results-table4:end -->\n")
+    page = tmp_path / "docs" / "results.md"
+    args = ["reproduce", "--out", str(scenes), "--results", str(page), "--rewrite-results"]
+    assert cli.main([*args, "--beside", str(starts)]) == 0
+    block = readme.read_text()
+    rows = [line for line in block.splitlines() if ", ours (" in line]
+    assert [row.split(" | ")[0] for row in rows] == [
+        "| SP strawberry, ours (2 test scenes, split rule `scenes`)",
+        "| SP strawberry, ours (2 test scenes, split rule `starts`)",
+        "| MP vine, ours (2 test scenes, split rule `scenes`)",  # the starts run has no MP yet: no row
+    ]
+    assert rows[0].split(" | ")[1] == ".457 ± .010" and rows[1].split(" | ")[1] == ".512 ± .010"
+    assert "Rows under split rule `starts` are the same configuration's run under that reading" in block
+    assert cli.main(args) == 0  # without --beside: the scenes rows alone
+    assert [line for line in readme.read_text().splitlines() if ", ours (" in line] == [rows[0], rows[2]]
+    before = readme.read_text()
+    starts_page = tmp_path / "docs" / "results-starts.md"
+    assert cli.main(["reproduce", "--out", str(starts), "--results", str(starts_page), "--rewrite-results"]) == 0
+    assert readme.read_text() == before

@@ -7,8 +7,9 @@ no number of a run is ever copied into the README or the docs by hand.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from davis_ag.benchmark.exact import BEST_FIXED
 from davis_ag.benchmark.paired import CONFIDENCE, FEW_SCENES
@@ -31,13 +32,18 @@ from davis_ag.workflows.reproduce.pages.policies import learners_run, train_spli
 from davis_ag.workflows.reproduce.pages.provenance import one_whole_hours
 from davis_ag.workflows.reproduce.state import RunState, StageRecord
 
+if TYPE_CHECKING:
+    from davis_ag.workflows.reproduce.pages.split_rules import RuleRun
+
 #: The README's block that holds the run's OER_tau beside Table 4's (see :func:`readme_block`).
 README_MARKER = "results-table4"
 #: docs/benchmark.md's block that names the run results.md shows and its hours (:func:`run_block`).
 RUN_MARKER = "results-run"
 
 
-def readme_block(config: ReproduceConfig, state: RunState, out: Path | None = None) -> str:
+def readme_block(
+    config: ReproduceConfig, state: RunState, out: Path | None = None, beside: Sequence[RuleRun] = ()
+) -> str:
     """The README's short Table 4: OER_tau, ours beside the paper's, whether the orderings hold,
     and each learner against the best fixed action on test and on train.
 
@@ -45,6 +51,8 @@ def readme_block(config: ReproduceConfig, state: RunState, out: Path | None = No
         config: The run's :class:`~davis_ag.workflows.reproduce.configs.ReproduceConfig`.
         state: The run's records (its ``results``).
         out: The run's folder, for the learners' training records (the train-split gap).
+        beside: The same configuration's runs under other split rules: each adds its row under
+            ours, named by its rule (the orderings and gaps stay the run's own).
 
     Returns:
         Markdown: a line on the run, a table, a line per ordering, a line per learner.
@@ -58,6 +66,11 @@ def readme_block(config: ReproduceConfig, state: RunState, out: Path | None = No
         f"{config.mp_timesteps:,} (MP) steps; OER_tau, mean ± std over {config.sessions} sessions of "
         f"{config.episodes} episodes on the split each row names. Table 4's rows are the paper's."
     )
+    for run in beside:
+        head += (
+            f" Rows under split rule `{run.config.split_rule}` are the same configuration's run under that reading "
+            "of the paper's 70/30 split (docs/results.md, \"Both readings of the paper's 70/30 split\")."
+        )
     extra = [n for n in learners if n != "A2C"]  # learners the paper did not train: ours only
     columns = ["A2C", *extra, "LRD", "UDD", "Rand", "Oracle", BEST_FIXED]
     lines = [
@@ -73,16 +86,8 @@ def readme_block(config: ReproduceConfig, state: RunState, out: Path | None = No
         result = results.get(scenario)
         if result is not None:
             policies = result.policies
-            scenes, split = len(result.protocol.scenes), result.protocol.split
-            rule = result.protocol.split_rule or "scenes"
-            cells = [
-                f"{cell(policies[n].oer_tau.mean)} ± {cell(policies[n].oer_tau.std)}" if n in policies else "–"
-                for n in columns
-            ]
-            lines.append(
-                f"| {TITLES[scenario]}, ours ({scenes} {split} scene{'s' if scenes != 1 else ''}, "
-                f"split rule `{rule}`) | " + " | ".join(cells) + " |"
-            )
+            lines.append(_our_row(scenario, result, columns))
+            lines += [_our_row(scenario, r, columns) for run in beside if (r := run.state.results.get(scenario))]
             failures = ordering_failures(PAPER_ORDERINGS[scenario], {n: p.oer_tau for n, p in policies.items()})
             verdict = (
                 "not checked"
@@ -127,6 +132,20 @@ def readme_block(config: ReproduceConfig, state: RunState, out: Path | None = No
         ]
         lines += [f"- {learner}: " + "; ".join(found) + "." for learner, found in gaps.items()]
     return "\n".join(lines)
+
+
+def _our_row(scenario: str, result: EvaluationResults, columns: list[str]) -> str:
+    """``| SP strawberry, ours (26 test scenes, split rule `scenes`) | .457 ± .008 | ... |``."""
+    policies = result.policies
+    scenes, split = len(result.protocol.scenes), result.protocol.split
+    rule = result.protocol.split_rule or "scenes"
+    cells = [
+        f"{cell(policies[n].oer_tau.mean)} ± {cell(policies[n].oer_tau.std)}" if n in policies else "–" for n in columns
+    ]
+    return (
+        f"| {TITLES[scenario]}, ours ({scenes} {split} scene{'s' if scenes != 1 else ''}, "
+        f"split rule `{rule}`) | " + " | ".join(cells) + " |"
+    )
 
 
 def _learner_gaps(scenario: str, result: EvaluationResults | None, out: Path | None, learner: str) -> str | None:
@@ -209,6 +228,7 @@ def write_blocks_beside(
     state: RunState,
     out: Path | None,
     stages: list[tuple[str, float, list[dict[str, Any]]]],
+    beside: Sequence[RuleRun] = (),
 ) -> None:
     """Rewrite the README's and docs/benchmark.md's blocks of a results page in a project's ``docs/``.
 
@@ -221,6 +241,7 @@ def write_blocks_beside(
         state: The run's records.
         out: The run's folder.
         stages: ``(stage, seconds, sittings)`` per stage (:func:`run_block`).
+        beside: The same configuration's runs under other split rules (their rows in the README's).
     """
     from davis_ag.atomic_files import write_marked_section
 
@@ -230,7 +251,7 @@ def write_blocks_beside(
     if folder.name != "docs" or config.split_rule != "scenes":
         return
     for target, marker, text in (
-        (folder.parent / "README.md", README_MARKER, lambda: readme_block(config, state, out)),
+        (folder.parent / "README.md", README_MARKER, lambda: readme_block(config, state, out, beside)),
         (folder / "benchmark.md", RUN_MARKER, lambda: run_block(config, state, stages)),
     ):
         if target.is_file() and f"<!-- {marker}:start -->" in target.read_text():

@@ -293,5 +293,5 @@ def write_results_md(
     written = write_text_atomic(path, "\n".join(lines) + "\n")
     # A page in a project's docs/ also rewrites its blocks in the README and docs/benchmark.md,
     # so their numbers are the run's, never copied by hand.
-    write_blocks_beside(Path(path), config, state, out, stages)
+    write_blocks_beside(Path(path), config, state, out, stages, beside)
     return written
