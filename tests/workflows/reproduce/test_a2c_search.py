@@ -26,7 +26,7 @@ from layout_factory import write_tiny_dataset
 TINY = (
     CANDIDATES[0],
     Candidate("ppo-zoo-atari", "PPO zoo-atari", "ppo", "ours", "the target", over={"n_steps": 16, "batch_size": 32}),
-    CANDIDATES[2],
+    next(c for c in CANDIDATES if c.key == "a2c-zoo-atari"),
 )
 TRAIN = {"arch": "pooled", "progress": False, "checkpoint_every": 0, "select_every": 0}
 
