@@ -55,6 +55,7 @@ bench: $(STAMP)
 	$(BIN)/davis-ag bench --only play --out $(OUT)/bench-play.json --doc docs/performance.md
 	$(BIN)/davis-ag bench --only robot --out $(OUT)/bench-robot.json --doc docs/performance.md
 	$(BIN)/davis-ag bench --only mapping --out $(OUT)/bench-mapping.json --doc docs/performance.md
+	$(BIN)/davis-ag bench --only sharing --out $(OUT)/bench-sharing.json --doc docs/performance.md
 
 reproduce: $(STAMP)
 	$(BIN)/davis-ag reproduce --out $(OUT)/reproduce

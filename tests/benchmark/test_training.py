@@ -52,7 +52,7 @@ def test_a_killed_run_resumes_from_its_checkpoint(
     assert path == tmp_path / "models" / "a2c.zip"
     assert A2C.load(path, device="cpu").num_timesteps == 240  # no step trained twice or skipped
     assert not model_file.exists() and not settings_file.exists()
-    # The record says it was made in two sittings, which steps each made, and with what code.
+    # The record says it was made in two sittings, which steps each made, with what code and threads.
     record = json.loads(training_record_path(out).read_text())
     sittings = record["sittings"]
     assert [(s["from_step"], s["to_step"]) for s in sittings] == [
@@ -60,6 +60,7 @@ def test_a_killed_run_resumes_from_its_checkpoint(
         (saved["timesteps_done"], 240),
     ]
     assert all(s["code"] == code_version() and s["seconds"] > 0 for s in sittings)
+    assert all(s["torch_threads"] == 1 for s in sittings)  # one_thread's: the same weights need the same count
     assert record["timesteps"] == 240 and record["seconds"] == pytest.approx(
         sum(s["seconds"] for s in sittings), abs=0.2
     )

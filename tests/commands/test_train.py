@@ -36,8 +36,10 @@ def disk_full(monkeypatch: pytest.MonkeyPatch, full: Callable[[Path], bool]) -> 
     monkeypatch.setattr(checkpoints, "atomic_output", atomic_output)
 
 
-def train(capsys: pytest.CaptureFixture[str], dataset: Path, out: Path, keep: str) -> tuple[int, list[str]]:
-    """A short run without checkpoints: exit status and the lines on stderr."""
+def train(
+    capsys: pytest.CaptureFixture[str], dataset: Path, out: Path, keep: str, extra: tuple[str, ...] = ()
+) -> tuple[int, list[str]]:
+    """A short run without checkpoints (``extra``: more flags): exit status and the lines on stderr."""
     code = cli.main(
         [
             "train",
@@ -61,6 +63,7 @@ def train(capsys: pytest.CaptureFixture[str], dataset: Path, out: Path, keep: st
             "0",
             "--out",
             str(out),
+            *extra,
         ]
     )
     out_text, err = capsys.readouterr()
@@ -115,3 +118,28 @@ def test_when_the_model_can_be_kept_nowhere_the_line_names_both_failures(
     assert "nor could the trained model (60 steps) be kept in" in line and "is lost" in line
     assert not list((tmp_path / "cache").rglob("*.zip"))  # no empty rescue folder claims to hold it
     assert not list((tmp_path / "cache").rglob("davis-ag-*"))
+
+
+def test_the_torch_threads_asked_for_train_the_model_and_its_record_keeps_them(
+    sp_root: Path, tmp_path: Path, one_thread: None, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--torch-threads``: two runs sharing a machine each take their share of its cores; the
+    record's sitting says how many threads made it (the same weights come only from the same count)."""
+    import torch
+
+    out = tmp_path / "m.zip"
+    torch.set_num_threads(2)  # not what is asked for
+    try:
+        code, lines = train(capsys, sp_root, out, "last", ("--torch-threads", "1"))
+        assert code == 0 and torch.get_num_threads() == 1, lines
+    finally:
+        torch.set_num_threads(1)
+    (sitting,) = json.loads(out.with_suffix(".training.json").read_text())["sittings"]
+    assert sitting["torch_threads"] == 1
+    for bad in ("0", str((os.cpu_count() or 1) + 1), "two"):
+        with pytest.raises(SystemExit) as stopped:
+            train(capsys, sp_root, tmp_path / f"bad-{bad}.zip", "last", ("--torch-threads", bad))
+        assert stopped.value.code == 2
+        err = capsys.readouterr().err.strip().splitlines()[-1]
+        assert f"--torch-threads: {bad!r}: give torch from 1 to {os.cpu_count()} threads" in err
+        assert not (tmp_path / f"bad-{bad}.zip").exists()

@@ -145,17 +145,22 @@ def save_model(model: Any, path: Path) -> None:
 
 
 class Sittings:
-    """The sittings of one training run: for each, the code that ran, the steps and the seconds.
-    A run resumed from a checkpoint keeps the sittings before it, so its record says how it was
-    made (and whether the code changed between sittings)."""
+    """The sittings of one training run: for each, the code that ran, torch's thread count (a run
+    trains the same weights bit for bit only on the same count), the steps and the seconds. A run
+    resumed from a checkpoint keeps the sittings before it, so its record says how it was made
+    (and whether the code or the threads changed between sittings)."""
 
     def __init__(self, earlier: list[dict[str, Any]], first_step: int) -> None:
+        import torch
+
         self.earlier, self.first_step, self.start = earlier, first_step, time.perf_counter()
+        self.threads = torch.get_num_threads()
 
     def upto(self, step: int) -> list[dict[str, Any]]:
         """Every sitting, this one up to ``step``."""
         now = {
             "code": code_version(),
+            "torch_threads": self.threads,
             "from_step": self.first_step,
             "to_step": step,
             "seconds": round(time.perf_counter() - self.start, 1),

@@ -9,6 +9,7 @@ those create a temporary file where the output will go, the only test that holds
 from __future__ import annotations
 
 import argparse
+import os
 from collections.abc import Callable
 from pathlib import Path
 
@@ -83,6 +84,35 @@ def bounded(low: int, high: int) -> Callable[[str], int]:
 
     parse.__name__ = f"whole number from {low} to {high}"  # argparse names the type in errors
     return parse
+
+
+def torch_threads(text: str) -> int:
+    """Parse a torch thread count: from 1 to this machine's CPUs (more only queue for the cores)."""
+    value, cpus = _digits(text), os.cpu_count() or 1
+    if value is None or not 1 <= value <= cpus:
+        raise argparse.ArgumentTypeError(f"{text!r}: give torch from 1 to {cpus} threads (this machine's CPUs)")
+    return value
+
+
+def add_torch_threads_flag(parser: argparse.ArgumentParser, verb: str) -> None:
+    """Add ``--torch-threads`` (:func:`use_torch_threads`), shared by train and reproduce."""
+    parser.add_argument(
+        "--torch-threads",
+        type=torch_threads,
+        default=None,
+        metavar="N",
+        help=f"torch's threads to {verb} with (default: torch's own, one per core); two runs sharing a "
+        'machine each train faster on their share of its cores (docs/performance.md, "Two trainings on '
+        "one machine\"); each sitting's training record keeps the count",
+    )
+
+
+def use_torch_threads(args: argparse.Namespace) -> None:
+    """Give torch the ``--torch-threads`` asked for (none asked: torch's own count stays)."""
+    if args.torch_threads is not None:
+        import torch
+
+        torch.set_num_threads(args.torch_threads)
 
 
 def seed(text: str) -> int:

@@ -17,7 +17,7 @@ CROP_NAMES = ("strawberry", "tomato", "vine")
 #: The plant-library crops ``--only crops`` measures.
 LIBRARY_NAMES = tuple(name for name, crop in CROPS.items() if crop.source == "library")
 #: The measurements ``--only`` runs alone, each written between its ``bench-NAME`` markers.
-MEASUREMENTS = ("continuous", "training", "crops", "verify", "play", "robot", "mapping")
+MEASUREMENTS = ("continuous", "training", "crops", "verify", "play", "robot", "mapping", "sharing")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -60,7 +60,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "file's summaries and episodes are checked (about a minute); play: only a trained model's "
         "episodes one at a time against in step (about a minute); robot: the robots' reach of a row "
         "scene and a grid step with a robot (about five minutes); mapping: a row-mapping step beside "
-        "TVM-v0's, the segment's ceiling and the budget's bound (about five minutes)",
+        "TVM-v0's, the segment's ceiling and the budget's bound (about five minutes); sharing: two "
+        "trainings at once with torch's threads each and with half the cores each, beside one alone "
+        "(about five minutes)",
     )
     parser.add_argument(
         "--device",

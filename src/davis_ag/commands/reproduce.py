@@ -95,6 +95,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         action="store_true",
         help="only print where the run in DIR stands, stage by stage (safe while it runs); run nothing",
     )
+    arguments.add_torch_threads_flag(parser, "train and score")
 
 
 def check_results_path(results: Path, out: Path) -> None:
@@ -233,6 +234,7 @@ def run(args: argparse.Namespace) -> int:
     if args.beside:
         raise UserError("--beside goes with --rewrite-results, once both runs have their records")
     arguments.prove_writable_folder(args.out)
+    arguments.use_torch_threads(args)
     if config.page == "table4":
         check_page_rule(args.results, config.split_rule)
     pairs = [p for p in config.pairs if args.only in (None, p[0])]

@@ -114,6 +114,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "views it reaches (docs/robot.md)",
     )
     arguments.add_task_flags(parser, "train on")
+    arguments.add_torch_threads_flag(parser, "train")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -133,6 +134,7 @@ def run(args: argparse.Namespace) -> int:
         raise UserError("--budget and --seen-fraction are for --task mapping: add it or leave them out")
     arguments.check_task_split_rule(args)
     check_device(args.device)
+    arguments.use_torch_threads(args)
     arguments.prove_writable_file(args.out)
     if args.cache_dir is not None:
         arguments.prove_writable_folder(args.cache_dir, "--cache-dir")

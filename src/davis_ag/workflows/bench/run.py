@@ -336,7 +336,9 @@ def run_only(
     :mod:`davis_ag.workflows.bench.play`, about a minute; ``--only robot``: the robots' reach of a row
     and the grid step with a robot, :mod:`davis_ag.workflows.bench.robot`, about five minutes;
     ``--only mapping``: a row-mapping step beside TVM-v0's and the segment's ceiling and bound,
-    :mod:`davis_ag.workflows.bench.mapping`, about five minutes):
+    :mod:`davis_ag.workflows.bench.mapping`, about five minutes; ``--only sharing``: two trainings on
+    one machine with torch's threads and with half the cores each, :mod:`davis_ag.workflows.bench.sharing`,
+    about five minutes):
     JSON, the doc's section (its GPU section on a ``gpu_machine``) and the line another page shows
     of it."""
     from davis_ag.scene.library_crops import LIBRARY_CROPS
@@ -344,6 +346,7 @@ def run_only(
     from davis_ag.workflows.bench.mapping import mapping_speed, mapping_table, write_mapping
     from davis_ag.workflows.bench.play import play_speed, play_table, write_play
     from davis_ag.workflows.bench.robot import robot_speed, robot_table, write_robot
+    from davis_ag.workflows.bench.sharing import sharing_speed, sharing_table, write_sharing
     from davis_ag.workflows.bench.verify import verify_speed, verify_table, write_verify
 
     measurements: dict[str, tuple[str, Any, Any, Any]] = {
@@ -359,6 +362,7 @@ def run_only(
         "play": ("play", play_speed, play_table, write_play),
         "robot": ("robot", robot_speed, robot_table, write_robot),
         "mapping": ("mapping", mapping_speed, mapping_table, write_mapping),
+        "sharing": ("sharing", sharing_speed, sharing_table, write_sharing),
     }
     key, measure, table_of, write = measurements[what]
     start = os.getloadavg()[0]
