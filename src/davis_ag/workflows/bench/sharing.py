@@ -71,7 +71,9 @@ def _row(
             except queue.Empty:
                 # A process that died (its error is on stderr) would leave the others at the barrier.
                 if any(w.exitcode not in (None, 0) for w in workers) or time.monotonic() > deadline:
-                    raise MachineError(f"bench --only sharing: a training of the row {name!r} failed") from None
+                    raise MachineError(
+                        f"bench --only sharing: a training of the row {name!r} failed (its process printed why above)"
+                    ) from None
     finally:
         for worker in workers:
             if len(results) < processes:
