@@ -8,7 +8,7 @@ from typing import Any
 
 from davis_ag.benchmark.exact import BEST_FIXED
 from davis_ag.benchmark.paired import FEW_SCENES
-from davis_ag.benchmark.results import EvaluationResults, Protocol, as_results, split_text, table_number
+from davis_ag.benchmark.results import EvaluationResults, PolicyResult, Protocol, as_results, split_text, table_number
 from davis_ag.benchmark.summaries import PAIRED_BASELINES
 
 #: Table 4's metrics: key in the results, row label.
@@ -98,17 +98,21 @@ def replays_few_starts(protocol: Protocol) -> bool:
     return protocol.starts is not None and 2 * protocol.starts < protocol.episodes * protocol.sessions
 
 
+def only_action(policy: PolicyResult) -> str | None:
+    """The one action a policy played in every step of its episodes (a learner that collapsed to a
+    fixed action), or None when it played several or its counts are not recorded."""
+    played = [action for action, n in (policy.action_counts or {}).items() if n]
+    return played[0] if len(played) == 1 else None
+
+
 def _warnings(results: EvaluationResults) -> list[str]:
     """What a reader could mistake in the table: a policy that plays one action only (a collapsed
     learner looks like a method), and episodes that replay a few starts (the interval over
     episodes is then sure of those starts, not of the method)."""
     notes = []
     for name, policy in results.policies.items():
-        played = {action: n for action, n in (policy.action_counts or {}).items() if n}
-        if name != BEST_FIXED and len(played) == 1:
-            notes.append(
-                f"note: {name} played {next(iter(played))} only: a fixed action, not a method; see {BEST_FIXED}"
-            )
+        if name != BEST_FIXED and (action := only_action(policy)):
+            notes.append(f"note: {name} played {action} only: a fixed action, not a method; see {BEST_FIXED}")
     protocol = results.protocol
     if protocol.sessions == 1:
         notes.append("note: one session, so every ± (the spread of session means) is 0; section V-D plays 3")

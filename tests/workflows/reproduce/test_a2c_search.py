@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pytest
 
+from davis_ag.benchmark.results import load_results
 from davis_ag.benchmark.tvm import TVMEnv
 from davis_ag.errors import UserError
 from davis_ag.workflows.reproduce.a2c_candidates import CANDIDATES, Candidate, candidate_model, results_path
@@ -135,6 +136,33 @@ def test_the_page_sets_every_candidate_beside_the_trivial_policies_between_its_m
     assert "exact" in next(x for x in text.splitlines() if x.startswith("| Best fixed action |"))
     assert 'Chosen by the rule "highest train-split OER_tau" among the 2 of 2 A2C candidates' in text
     assert "the test split is never read by this run" in text
+
+
+def test_a_candidate_that_played_one_action_only_is_named_a_fixed_action(run, tmp_path: Path) -> None:
+    """A collapsed learner (the zoo's A2C on the paper's network plays one move from 10K steps) must
+    not read as a method: the page says which candidate played one action only, and no other."""
+    import shutil
+
+    from davis_ag.benchmark.results_table import only_action
+
+    out, config, state, *_ = run
+    copy = shutil.copytree(out, tmp_path / "run", ignore=shutil.ignore_patterns("dataset", "*.zip"))
+    path = results_path(copy, config)
+    data = json.loads(path.read_text())
+    ours, up = TINY[0].row(config), data["protocol"]["actions"].index("up")
+    for episode in data["policies"][ours]["episodes"]:  # every step "up", as the file's checks recount it
+        episode["actions"] = [up] * len(episode["actions"])
+    counts = data["policies"][ours]["action_counts"]
+    data["policies"][ours]["action_counts"] = {action: 0 for action in counts} | {"up": sum(counts.values())}
+    path.write_text(json.dumps(data))
+    page = tmp_path / "a2c-search.md"
+    write_search_page(page, config, state, copy, TINY)
+    text = page.read_text()
+    assert f"{ours} played `up` only on these episodes: a fixed action, not a method" in text
+    results = load_results(path)
+    for candidate in TINY[1:]:
+        named = f"{candidate.row(config)} played `" in text
+        assert named == (only_action(results.policies[candidate.row(config)]) is not None)
 
 
 def test_a_page_without_the_runs_markers_is_refused(tmp_path: Path) -> None:

@@ -87,6 +87,7 @@ def search_section(
         Markdown.
     """
     from davis_ag.benchmark.exact import BEST_FIXED
+    from davis_ag.benchmark.results_table import only_action
 
     _, _, key = group_of(config)
     try:
@@ -137,6 +138,12 @@ def search_section(
         )
         what = f"always `{result.action}`" if result and result.action else "uniform over every action, done included"
         lines.append(f"| {name} | {what} | - | - | {shown} | - | - | - |")
+    collapsed = [(c.row(config), a) for c in candidates if (r := scored.get(c.row(config))) and (a := only_action(r))]
+    lines += [
+        f"\n{row} played `{action}` only on these episodes: a fixed action, not a method ({BEST_FIXED}'s row "
+        "is what always playing the best one scores)."
+        for row, action in collapsed
+    ]
     lines += ["", choice_line(config, candidates, results)]
     lines += ["", "Where each candidate's settings come from:", ""]
     lines += [f"- {c.row(config)}: {c.source}." for c in candidates]
