@@ -28,17 +28,23 @@ from davis_ag.workflows.bench.training import SEED, STEPS, training_scenes
 ROW_TIMEOUT_S = 3600
 
 
+def _trainer(arch: str) -> Any:
+    """``train_agent`` as every training of this bench runs it: A2C (ours), 8 environments, no
+    checkpoints or snapshot scores, quiet."""
+    from davis_ag.benchmark.training import train_agent
+
+    return partial(train_agent, seed=SEED, n_envs=8, arch=arch, checkpoint_every=0, keep="last", progress=False)
+
+
 def _timed_training(
     root: Path, out: Path, threads: int | None, steps: int, arch: str, barrier: Any, rates: Any
 ) -> None:
     """One process of a row: warm up, wait for the others, train ``steps`` steps, report the rate."""
     import torch
 
-    from davis_ag.benchmark.training import train_agent
-
     if threads is not None:
         torch.set_num_threads(threads)
-    train = partial(train_agent, seed=SEED, n_envs=8, arch=arch, checkpoint_every=0, keep="last", progress=False)
+    train = _trainer(arch)
     train(root, "sp", total_timesteps=8, out_path=out.with_suffix(".warm.zip"))
     barrier.wait()
     started = time.perf_counter()
@@ -103,21 +109,9 @@ def sharing_speed(scratch: Path, steps: int = STEPS, arch: str = "paper", root: 
         "steps_per_second_each", "steps_per_second", "over_alone"}}}``; ``steps_per_second`` is the
         rows' processes together.
     """
-    from davis_ag.benchmark.training import train_agent
-
     root = root or training_scenes(scratch / "training")
     # Builds the observation cache once, before any row (the rows' processes then only read it).
-    train_agent(
-        root,
-        "sp",
-        total_timesteps=8,
-        out_path=scratch / "cache.zip",
-        seed=SEED,
-        checkpoint_every=0,
-        keep="last",
-        progress=False,
-        arch=arch,
-    )
+    _trainer(arch)(root, "sp", total_timesteps=8, out_path=scratch / "cache.zip")
     share = max(1, (os.cpu_count() or 1) // 2)
     rows = {
         "one training alone, torch's threads": _row(root, scratch, "alone", 1, None, steps, arch),

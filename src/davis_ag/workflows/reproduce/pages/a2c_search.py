@@ -138,12 +138,13 @@ def search_section(
         )
         what = f"always `{result.action}`" if result and result.action else "uniform over every action, done included"
         lines.append(f"| {name} | {what} | - | - | {shown} | - | - | - |")
-    collapsed = [(c.row(config), a) for c in candidates if (r := scored.get(c.row(config))) and (a := only_action(r))]
-    lines += [
-        f"\n{row} played `{action}` only on these episodes: a fixed action, not a method ({BEST_FIXED}'s row "
-        "is what always playing the best one scores)."
-        for row, action in collapsed
-    ]
+    for c in candidates:
+        if (result := scored.get(c.row(config))) and (action := only_action(result)):
+            lines += [
+                "",
+                f"{c.row(config)} played `{action}` only on these episodes: a fixed action, not a method "
+                f"({BEST_FIXED}'s row is what always playing the best one scores).",
+            ]
     lines += ["", choice_line(config, candidates, results)]
     lines += ["", "Where each candidate's settings come from:", ""]
     lines += [f"- {c.row(config)}: {c.source}." for c in candidates]
