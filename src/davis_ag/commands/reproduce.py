@@ -56,9 +56,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "five crops' rows with every baseline, its page docs/mapping.md), robot (three rows without "
         "a robot and with each robot, A2C and PPO trained under each, its page docs/robot.md), "
         "structures (four rows bare and with their trellises, stakes and strings, its section in "
-        "docs/crops.md) or "
+        "docs/crops.md), "
         "a2c-search (A2C settings searched on SP strawberry's train split beside PPO, never its test "
-        "split; its page docs/a2c-search.md)",
+        "split; its page docs/a2c-search.md) or a2c-search-paper-scale (the same on the paper-scale "
+        "SP strawberry dataset under the starts rule, the longer budget first; its page "
+        "docs/a2c-search-paper-scale.md)",
     )
     parser.add_argument(
         "--sp-scenes", type=arguments.bounded(1, 1000), default=None, help="override the SP scene count"

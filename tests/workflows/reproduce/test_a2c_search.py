@@ -14,7 +14,13 @@ import pytest
 from davis_ag.benchmark.results import load_results
 from davis_ag.benchmark.tvm import TVMEnv
 from davis_ag.errors import UserError
-from davis_ag.workflows.reproduce.a2c_candidates import CANDIDATES, Candidate, candidate_model, results_path
+from davis_ag.workflows.reproduce.a2c_candidates import (
+    CANDIDATES,
+    Candidate,
+    candidate_model,
+    candidates_of,
+    results_path,
+)
 from davis_ag.workflows.reproduce.a2c_search import check_page, evaluate_on_train, train_candidate
 from davis_ag.workflows.reproduce.configs import CONFIGS
 from davis_ag.workflows.reproduce.pages.a2c_search import write_search_page
@@ -73,13 +79,35 @@ def run(tmp_path_factory: pytest.TempPathFactory):
 def test_the_configuration_searches_sp_strawberrys_train_split_beside_ppo() -> None:
     config = CONFIGS["a2c-search"]
     assert config.page == "a2c-search" and config.pairs == (("sp", "strawberry"),) and config.sp_scenes == 10
-    presets = {(c.algo, c.preset) for c in CANDIDATES}
-    assert {("a2c", "ours"), ("a2c", "sb3"), ("a2c", "zoo-atari"), ("ppo", "ours")} <= presets
-    assert sorted(c.timesteps(config) for c in CANDIDATES if c.preset == "ours" and c.algo == "a2c") == [
-        300_000,
-        1_000_000,
-    ]
+    presets = {(c.algo, c.preset) for c in candidates_of(config)}
+    assert presets == {("a2c", "ours"), ("a2c", "sb3"), ("a2c", "zoo-atari"), ("ppo", "ours")}
+    assert {c.timesteps(config) for c in candidates_of(config)} == {300_000}  # the longer budget is paper-scale's
     assert len({c.key for c in CANDIDATES}) == len({c.row(config) for c in CANDIDATES}) == len(CANDIDATES)
+
+
+def test_the_paper_scale_search_reads_the_table4_dataset_and_tries_the_longer_budget_first() -> None:
+    """Its group is the paper-scale run's (so a link shares the dataset), its rule the starts run's,
+    and its 300K rows are trained exactly as that run trains A2C and PPO (so their models reuse)."""
+    from davis_ag.workflows.reproduce.learners import learner_stamp
+
+    config, table4 = CONFIGS["a2c-search-paper-scale"], CONFIGS["paper-scale"]
+    assert config.page == "a2c-search" and config.split_rule == "starts"
+    assert (config.size, config.sp_scenes, config.seed, config.pairs[0]) == (
+        table4.size,
+        table4.sp_scenes,
+        table4.seed,
+        table4.pairs[0],
+    )
+    candidates = candidates_of(config)
+    assert [(c.algo, c.timesteps(config)) for c in candidates] == [
+        ("a2c", 1_000_000),
+        ("a2c", 300_000),
+        ("ppo", 300_000),
+    ]
+    for candidate in candidates[1:]:
+        ours = learner_stamp(candidate.algo, candidate.timesteps(config), candidate.settings())
+        assert ours == learner_stamp(candidate.algo, table4.sp_timesteps)
+    assert len({c.key for c in candidates}) == len({c.row(config) for c in candidates}) == len(candidates)
 
 
 def test_the_search_never_reads_the_test_split(run) -> None:
@@ -193,16 +221,19 @@ def test_the_status_and_the_rewritten_page_of_a_search_run(run, tmp_path: Path, 
     assert "<!-- a2c-search:start -->" in page.read_text() and "| A2C ours 48 |" in page.read_text()
 
 
-def test_the_plan_in_the_docs_is_the_codes() -> None:
+@pytest.mark.parametrize("name", ["a2c-search", "a2c-search-paper-scale"])
+def test_the_plan_in_the_docs_is_the_codes(name: str) -> None:
     from davis_ag.workflows.reproduce.pages.a2c_search import PLAN_MARKER, bench_rates, plan_table
 
     docs = Path(__file__).parents[3] / "docs"
-    page = (docs / "a2c-search.md").read_text()
+    page = (docs / f"{name}.md").read_text()
     section = page.split(f"<!-- {PLAN_MARKER}:start -->\n", 1)[1].split(f"\n<!-- {PLAN_MARKER}:end -->", 1)[0]
-    assert section == plan_table(bench_rates(docs / "performance.md")), (
-        "docs/a2c-search.md's plan is stale: python -c \"from pathlib import Path; from davis_ag.atomic_files "
+    assert section == plan_table(bench_rates(docs / "performance.md"), CONFIGS[name]), (
+        f"docs/{name}.md's plan is stale: python -c \"from pathlib import Path; from davis_ag.atomic_files "
         "import write_marked_section as w; import davis_ag.workflows.reproduce.pages.a2c_search as s; "
-        "w('docs/a2c-search.md', s.PLAN_MARKER, s.plan_table(s.bench_rates(Path('docs/performance.md'))))\""
+        "from davis_ag.workflows.reproduce.configs import CONFIGS; "
+        f"w('docs/{name}.md', s.PLAN_MARKER, s.plan_table(s.bench_rates(Path('docs/performance.md')), "
+        f"CONFIGS['{name}']))\""
     )
 
 

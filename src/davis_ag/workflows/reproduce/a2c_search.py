@@ -6,8 +6,8 @@ configuration's own dataset under ``OUT/dataset``), each stage resumable:
 
 1. the group's scenes (finished ones skipped) and their validation;
 2. Rand and the Best fixed action on the train split, so the page has its yardsticks at once;
-3. each of :data:`~davis_ag.workflows.reproduce.a2c_candidates.CANDIDATES` in turn (the paper's
-   budget first, the longer one last) trained on the train split (:func:`~davis_ag.workflows.reproduce.learners.train_learner`: reused when
+3. each of its candidates in turn (:func:`~davis_ag.workflows.reproduce.a2c_candidates.candidates_of`:
+   the 10-scene search's at the paper's budget; the paper-scale search's longer budget first) trained on the train split (:func:`~davis_ag.workflows.reproduce.learners.train_learner`: reused when
    finished with the same settings, resumed from its checkpoint when killed), then every finished
    candidate scored with Rand and the Best fixed action on fresh train-split episodes (the test's
    protocol, another draw than the snapshot scores that kept the model), and the page rewritten.
@@ -27,12 +27,12 @@ from typing import TYPE_CHECKING, Any
 
 from davis_ag.errors import UserError
 from davis_ag.workflows.reproduce.a2c_candidates import (
-    CANDIDATES,
     EVALUATE,
     MARKER,
     SPLIT,
     Candidate,
     candidate_model,
+    candidates_of,
     group_of,
     results_path,
 )
@@ -162,7 +162,7 @@ def reproduce_a2c_search(
     config: ReproduceConfig,
     out: Path,
     results_md: Path,
-    candidates: tuple[Candidate, ...] = CANDIDATES,
+    candidates: tuple[Candidate, ...] | None = None,
     **train_kwargs: Any,
 ) -> int:
     """Generate and validate the group, then train and score each candidate on the train split;
@@ -172,7 +172,8 @@ def reproduce_a2c_search(
         config: The run (``page="a2c-search"``; its first pair is the group).
         out: Work folder (``dataset``, ``models``, ``results``, ``state.json``).
         results_md: The page (docs/a2c-search.md's section, or a page of its own).
-        candidates: What to train (tests: tiny budgets).
+        candidates: What to train (None: :func:`~davis_ag.workflows.reproduce.a2c_candidates.candidates_of`
+            the configuration's; tests: tiny budgets).
         **train_kwargs: Passed on to ``train_agent`` (tests: a small network).
 
     Returns:
@@ -188,6 +189,7 @@ def reproduce_a2c_search(
     from davis_ag.workflows.stages import generate_scenes
 
     scenario, crop, key = group_of(config)
+    candidates = candidates or candidates_of(config)
     check_page(Path(results_md))  # before anything is made: another run's page is never replaced
     check_disk(config, Path(out).expanduser().absolute(), config.pairs[:1])
     out = prove_writable_folder(out)  # absolute at once: Helios moves the working directory

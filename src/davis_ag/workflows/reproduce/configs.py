@@ -41,8 +41,9 @@ class ReproduceConfig:
         pairs: The run's ``(scenario, crop)`` groups, in the order it takes them.
         page: The page the run writes: ``table4`` (docs/results.md), ``crops`` (docs/crops.md),
             ``mapping`` (docs/mapping.md), ``robot`` (docs/robot.md), ``structures`` (a section
-            of docs/crops.md) or ``a2c-search``
-            (docs/a2c-search.md; its candidates: :mod:`davis_ag.workflows.reproduce.a2c_search`).
+            of docs/crops.md) or ``a2c-search`` (docs/a2c-search.md and
+            docs/a2c-search-paper-scale.md; their candidates:
+            :func:`davis_ag.workflows.reproduce.a2c_candidates.candidates_of`).
         robots: The robots each row is played with beside none (the ``robot`` run).
         split_rule: How train and test split (:mod:`davis_ag.formats.splits`): ``scenes``
             (default) or ``starts``; the learners train and everything is scored under it.
@@ -128,7 +129,11 @@ class ReproduceConfig:
 #: ``a2c-search``: the ``medium`` run's SP strawberry group (10 scenes at 640x360, dataset seed 0),
 #: on whose train split A2C is trained under each candidate setting set and budget beside PPO with
 #: the zoo's Atari settings, every model scored on fresh train-split episodes; the test split is
-#: never read (docs/a2c-search.md is its page; the candidates: ``a2c_search.CANDIDATES``).
+#: never read (docs/a2c-search.md is its page; the candidates: ``a2c_candidates.CANDIDATES``).
+#: ``a2c-search-paper-scale``: the same on the ``paper-scale`` run's SP strawberry group (86 scenes
+#: at 1280x720, dataset seed 0: the Table 4 dataset, which a link at ``OUT/dataset`` shares) under
+#: the ``starts`` rule, the longer budget first (docs/a2c-search-paper-scale.md; its candidates:
+#: ``a2c_candidates.PAPER_SCALE_CANDIDATES``).
 #: Scene counts of Table 3 (SP strawberry, MP vine), what a configuration is measured against.
 PAPER_SCENES = (PAPER_TABLE3["sp", "strawberry"][0], PAPER_TABLE3["mp", "vine"][0])
 CONFIGS: dict[str, ReproduceConfig] = {
@@ -207,6 +212,18 @@ CONFIGS: dict[str, ReproduceConfig] = {
         mp_timesteps=0,
         pairs=(("sp", "strawberry"),),
         page="a2c-search",
+    ),
+    "a2c-search-paper-scale": ReproduceConfig(
+        "a2c-search-paper-scale",
+        PAPER_IMAGE_SIZE,
+        sp_scenes=PAPER_SCENES[0],
+        mp_scenes=0,
+        mp_extent=None,
+        sp_timesteps=300_000,
+        mp_timesteps=0,
+        pairs=(("sp", "strawberry"),),
+        page="a2c-search",
+        split_rule="starts",
     ),
 }
 

@@ -189,11 +189,10 @@ def _search_stages(out: Path, config: ReproduceConfig, seconds: Any) -> list[Sta
     """
     from davis_ag.benchmark.results import load_results
     from davis_ag.errors import UserError
-    from davis_ag.workflows.reproduce.a2c_candidates import CANDIDATES as candidates
-    from davis_ag.workflows.reproduce.a2c_candidates import EVALUATE, group_of, results_path
+    from davis_ag.workflows.reproduce.a2c_candidates import EVALUATE, candidates_of, group_of, results_path
     from davis_ag.workflows.reproduce.learners import training_record
 
-    key = group_of(config)[2]
+    key, candidates = group_of(config)[2], candidates_of(config)
     stages = []
     for candidate in candidates:
         stage, steps = f"{key}: train {candidate.key}", candidate.timesteps(config)

@@ -17,10 +17,10 @@ from davis_ag.atomic_files import read_page, write_marked_section, write_text_at
 from davis_ag.benchmark.results import EvaluationResults, load_results, signed_number, table_number
 from davis_ag.errors import UserError
 from davis_ag.workflows.reproduce.a2c_candidates import (
-    CANDIDATES,
     MARKER,
     SPLIT,
     Candidate,
+    candidates_of,
     group_of,
     results_path,
 )
@@ -73,7 +73,7 @@ def _hours(state: RunState, key: str, candidate: Candidate) -> str:
 
 
 def search_section(
-    config: ReproduceConfig, state: RunState, out: Path, candidates: tuple[Candidate, ...] = CANDIDATES
+    config: ReproduceConfig, state: RunState, out: Path, candidates: tuple[Candidate, ...] | None = None
 ) -> str:
     """The run's section: one line per candidate, then Rand and the Best fixed action, then the choice.
 
@@ -81,7 +81,7 @@ def search_section(
         config: The run.
         state: Its records (training hours).
         out: The run folder (its train-split evaluation).
-        candidates: The search's candidates.
+        candidates: The search's candidates (None: :func:`candidates_of` the run's).
 
     Returns:
         Markdown.
@@ -89,6 +89,7 @@ def search_section(
     from davis_ag.benchmark.exact import BEST_FIXED
     from davis_ag.benchmark.results_table import only_action
 
+    candidates = candidates or candidates_of(config)
     _, _, key = group_of(config)
     try:
         results: EvaluationResults | None = load_results(results_path(out, config))
@@ -136,7 +137,15 @@ def search_section(
             if result and exact is not None
             else "-"
         )
-        what = f"always `{result.action}`" if result and result.action else "uniform over every action, done included"
+        what = (
+            f"always `{result.action}`"
+            if result and result.action
+            else (
+                "always the split's best single action"
+                if name == BEST_FIXED
+                else "uniform over every action, done included"
+            )
+        )
         lines.append(f"| {name} | {what} | - | - | {shown} | - | - | - |")
     for c in candidates:
         if (result := scored.get(c.row(config))) and (action := only_action(result)):
@@ -173,7 +182,7 @@ def choice_line(config: ReproduceConfig, candidates: tuple[Candidate, ...], resu
 
 
 def write_search_page(
-    path: Path, config: ReproduceConfig, state: RunState, out: Path, candidates: tuple[Candidate, ...] = CANDIDATES
+    path: Path, config: ReproduceConfig, state: RunState, out: Path, candidates: tuple[Candidate, ...] | None = None
 ) -> None:
     """Write the run's section into ``path`` (between its markers), or the whole page when it has none.
 
@@ -182,7 +191,7 @@ def write_search_page(
         config: The run.
         state: Its records.
         out: The run folder.
-        candidates: The search's candidates.
+        candidates: The search's candidates (None: :func:`candidates_of` the run's).
     """
     text = search_section(config, state, out, candidates)
     start = f"<!-- {MARKER}:start -->"
@@ -219,18 +228,19 @@ def plan_table(rates: dict[str, float], config: ReproduceConfig | None = None) -
 
     Args:
         rates: Steps per second by algorithm (:func:`bench_rates`).
-        config: The run (default: ``a2c-search``).
+        config: The search (default: ``a2c-search``); its candidates are :func:`candidates_of`'s.
 
     Returns:
         A Markdown table and a line with the total.
     """
     config = config or CONFIGS["a2c-search"]
+    candidates = candidates_of(config)
     lines = [
         "| candidate | settings over SB3's defaults | steps | environments | hours at performance.md's rate |",
         "|---|---|---|---|---|",
     ]
     total = 0.0
-    for c in CANDIDATES:
+    for c in candidates:
         hours = c.timesteps(config) / rates[c.algo] / 3600
         total += hours
         lines.append(
@@ -240,7 +250,7 @@ def plan_table(rates: dict[str, float], config: ReproduceConfig | None = None) -
     lines += [
         "",
         f"About {total:.1f} hours of training at those rates ({BENCH_ROWS['a2c']} "
-        f"{rates['a2c']} steps/s, {BENCH_ROWS['ppo']} {rates['ppo']}), {sum(c.timesteps(config) for c in CANDIDATES):,} "
+        f"{rates['a2c']} steps/s, {BENCH_ROWS['ppo']} {rates['ppo']}), {sum(c.timesteps(config) for c in candidates):,} "
         "steps in all, before the scenes, their validation and the snapshot scores.",
     ]
     return "\n".join(lines)
