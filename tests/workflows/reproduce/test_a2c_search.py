@@ -166,6 +166,23 @@ def test_the_page_sets_every_candidate_beside_the_trivial_policies_between_its_m
     assert "the test split is never read by this run" in text
 
 
+def test_the_page_draws_each_trained_candidates_curves_against_the_trivial_policies(run, tmp_path: Path) -> None:
+    from PIL import Image
+
+    out, config, state, *_ = run
+    page = tmp_path / "docs" / "search.md"
+    page.parent.mkdir()
+    write_search_page(page, config, state, out, TINY[:1])  # before any other candidate finished: its curve alone
+    picture = page.parent / "images" / "search-curves.png"
+    assert "![learning curves of the candidates](images/search-curves.png)" in page.read_text()
+    with Image.open(picture) as drawn:
+        assert drawn.size[0] > 300
+    untrained = (Candidate("a2c-never", "A2C never", "a2c", "sb3", "not trained"),)
+    picture.unlink()
+    write_search_page(page, config, state, out, untrained)  # nothing trained: no figure, no link
+    assert not picture.exists() and "search-curves.png" not in page.read_text()
+
+
 def test_a_candidate_that_played_one_action_only_is_named_a_fixed_action(run, tmp_path: Path) -> None:
     """A collapsed learner (the zoo's A2C on the paper's network plays one move from 10K steps) must
     not read as a method: the page says which candidate played one action only, and no other."""

@@ -73,7 +73,11 @@ def _hours(state: RunState, key: str, candidate: Candidate) -> str:
 
 
 def search_section(
-    config: ReproduceConfig, state: RunState, out: Path, candidates: tuple[Candidate, ...] | None = None
+    config: ReproduceConfig,
+    state: RunState,
+    out: Path,
+    candidates: tuple[Candidate, ...] | None = None,
+    page: Path | None = None,
 ) -> str:
     """The run's section: one line per candidate, then Rand and the Best fixed action, then the choice.
 
@@ -82,6 +86,8 @@ def search_section(
         state: Its records (training hours).
         out: The run folder (its train-split evaluation).
         candidates: The search's candidates (None: :func:`candidates_of` the run's).
+        page: The page's path, to draw the candidates' curves beside it (:func:`curves_lines`);
+            None: no figure.
 
     Returns:
         Markdown.
@@ -129,9 +135,7 @@ def search_section(
         )
     for name in ("Rand", BEST_FIXED):
         result = scored.get(name)
-        exact = (result.exact or {}).get("oer_tau") if result else None
-        if name == BEST_FIXED and results and results.fixed_actions and result and result.action:
-            exact = results.fixed_actions[result.action]["oer_tau"]
+        exact = _exact(results, name)
         shown = (
             f"{table_number(exact)} exact ({table_number(result.oer_tau.mean)} sampled)"
             if result and exact is not None
@@ -155,9 +159,71 @@ def search_section(
                 f"({BEST_FIXED}'s row is what always playing the best one scores).",
             ]
     lines += ["", choice_line(config, candidates, results)]
+    if page is not None:
+        lines += curves_lines(config, out, page, candidates, results)
     lines += ["", "Where each candidate's settings come from:", ""]
     lines += [f"- {c.row(config)}: {c.source}." for c in candidates]
     return "\n".join(lines) + "\n"
+
+
+def _exact(results: EvaluationResults | None, name: str) -> float | None:
+    """Rand's or the Best fixed action's exact expectation over the split's starts, where scored."""
+    from davis_ag.benchmark.exact import BEST_FIXED
+
+    result = results.policies.get(name) if results else None
+    if result is None:
+        return None
+    if name == BEST_FIXED and results and results.fixed_actions and result.action:
+        return float(results.fixed_actions[result.action]["oer_tau"])
+    return (result.exact or {}).get("oer_tau")
+
+
+def curves_lines(
+    config: ReproduceConfig,
+    out: Path,
+    page: Path,
+    candidates: tuple[Candidate, ...],
+    results: EvaluationResults | None,
+) -> list[str]:
+    """Every trained candidate's learning curve and train-split snapshots, drawn into
+    ``images/<page>-curves.png`` beside the page, against Rand's and the Best fixed action's
+    exact train-split scores, so a candidate that never left their level reads as one that did
+    not learn; no lines before a candidate has finished.
+
+    Args:
+        config: The run.
+        out: The run folder (each candidate's training record beside its model).
+        page: The page the figure goes beside.
+        candidates: The search's candidates.
+        results: The train-split evaluation (the references), None before it.
+
+    Returns:
+        Markdown lines.
+    """
+    from davis_ag.benchmark.exact import BEST_FIXED
+    from davis_ag.figures.training_curve import plot_learning_curve
+    from davis_ag.workflows.reproduce.learners import training_record
+
+    _, _, key = group_of(config)
+    records = {c.row(config): r for c in candidates if (r := training_record(out, key, c.key))}
+    references = {}
+    for name in ("Rand", BEST_FIXED):
+        if results is not None and (value := _exact(results, name)) is not None:
+            action = results.policies[name].action
+            references[f"{name} (always {action}), exact" if action else f"{name}, exact"] = value
+    target = page.parent / "images" / f"{page.stem}-curves"
+    try:
+        plot_learning_curve(records, target, formats=("png",), references=references)
+    except UserError:  # none finished yet, or records from before curves were kept
+        return []
+    return [
+        "",
+        "Each trained candidate's mean episodic reward per 1,000 training steps (top) and the "
+        f"{SPLIT}-split OER_tau of its snapshots (below; ringed: the one kept), against Rand's and the "
+        f"Best fixed action's exact {SPLIT}-split scores (dashed, dotted):",
+        "",
+        f"![learning curves of the candidates](images/{target.name}.png)",
+    ]
 
 
 def choice_line(config: ReproduceConfig, candidates: tuple[Candidate, ...], results: EvaluationResults | None) -> str:
@@ -193,7 +259,7 @@ def write_search_page(
         out: The run folder.
         candidates: The search's candidates (None: :func:`candidates_of` the run's).
     """
-    text = search_section(config, state, out, candidates)
+    text = search_section(config, state, out, candidates, Path(path))
     start = f"<!-- {MARKER}:start -->"
     if path.is_file() and start in read_page(path, "--results"):
         write_marked_section(path, MARKER, text)
