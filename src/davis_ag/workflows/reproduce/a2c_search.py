@@ -6,9 +6,11 @@ configuration's own dataset under ``OUT/dataset``), each stage resumable:
 
 1. the group's scenes (finished ones skipped) and their validation;
 2. Rand and the Best fixed action on the train split, so the page has its yardsticks at once;
-3. each of its candidates in turn (:func:`~davis_ag.workflows.reproduce.a2c_candidates.candidates_of`:
-   the 10-scene search's at the paper's budget; the paper-scale search's longer budget first) trained on the train split (:func:`~davis_ag.workflows.reproduce.learners.train_learner`: reused when
-   finished with the same settings, resumed from its checkpoint when killed), then every finished
+3. each of its candidates in turn
+   (:func:`~davis_ag.workflows.reproduce.a2c_candidates.candidates_of`: the 10-scene search's at
+   the paper's budget; the paper-scale search's longer budget first) trained on the train split
+   (:func:`~davis_ag.workflows.reproduce.learners.train_learner`: reused when finished with the
+   same settings, resumed from its checkpoint when killed), then every finished
    candidate scored with Rand and the Best fixed action on fresh train-split episodes (the test's
    protocol, another draw than the snapshot scores that kept the model), and the page rewritten.
 
