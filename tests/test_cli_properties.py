@@ -163,6 +163,7 @@ def pools_for(command: str, out: str) -> tuple[list[str], dict[str, st.SearchStr
                 "--sp-timesteps": ANY,
                 "--mp-timesteps": ANY,
                 "--only": ANY,
+                "--learners": ANY,
             },
             ["--out"],
         )

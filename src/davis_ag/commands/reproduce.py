@@ -12,12 +12,12 @@ from __future__ import annotations
 import argparse
 from dataclasses import replace
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from davis_ag.commands import arguments
 from davis_ag.errors import UserError
 from davis_ag.formats.splits import SPLIT_RULES
-from davis_ag.workflows.reproduce.configs import CONFIGS, ReproduceConfig
+from davis_ag.workflows.reproduce.configs import CONFIGS, TABLE4_LEARNERS, ReproduceConfig
 from davis_ag.workflows.reproduce.run import reproduce, write_page
 from davis_ag.workflows.reproduce.state import RunState, run_config
 from davis_ag.workflows.reproduce.status import format_status
@@ -71,6 +71,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--sp-timesteps", type=arguments.bounded(1, 10**9), default=None, help="override SP A2C steps")
     parser.add_argument("--mp-timesteps", type=arguments.bounded(1, 10**9), default=None, help="override MP A2C steps")
     parser.add_argument("--only", choices=["sp", "mp", "row"], default=None, help="run one scenario only")
+    parser.add_argument(
+        "--learners",
+        type=arguments.name_list(TABLE4_LEARNERS),
+        default=None,
+        help="the learners a Table 4 run trains and scores, comma-separated (default: the configuration's, "
+        "a2c,ppo): a2c alone leaves out PPO's hours; the page names the learners the run had",
+    )
     parser.add_argument(
         "--split-rule",
         choices=SPLIT_RULES,
@@ -179,17 +186,33 @@ def check_page_rule(results: Path, rule: str) -> None:
         )
 
 
-def run(args: argparse.Namespace) -> int:
-    """Run every stage of the chosen configuration and write the results file."""
+def configured(args: argparse.Namespace) -> ReproduceConfig:
+    """The configuration ``--config`` names, with the size, split-rule and learner flags over it.
+
+    Raises:
+        UserError: for ``--learners`` on a run that is not a Table 4 run.
+    """
     config = CONFIGS[args.config]
-    overrides = {
+    overrides: dict[str, Any] = {
         k: getattr(args, k)
         for k in ("sp_scenes", "mp_scenes", "sp_timesteps", "mp_timesteps")
         if getattr(args, k) is not None
     }
     if args.split_rule is not None:
         overrides["split_rule"] = args.split_rule
-    config = replace(config, **overrides)
+    if args.learners is not None:
+        if config.page != "table4":
+            raise UserError(
+                f"--learners: the {config.name} run chooses its own learners; it goes with a Table 4 run "
+                "(small, medium, paper-scale)"
+            )
+        overrides["learners"] = tuple(args.learners)
+    return replace(config, **overrides)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run every stage of the chosen configuration and write the results file."""
+    config = configured(args)
     if args.status:
         print(format_status(args.out))
         return 0

@@ -20,6 +20,10 @@ from davis_ag.workflows.reproduce.groups import (
     group_key,
 )
 
+#: The learners a Table 4 run trains beside the baselines, in the order they train (``--learners``
+#: chooses among them).
+TABLE4_LEARNERS: tuple[str, ...] = ("a2c", "ppo")
+
 
 @dataclass(frozen=True)
 class ReproduceConfig:
@@ -63,7 +67,7 @@ class ReproduceConfig:
     episodes: int = 200
     sessions: int = 3
     seed: int = 0
-    learners: tuple[str, ...] = ("a2c", "ppo")
+    learners: tuple[str, ...] = TABLE4_LEARNERS
     pairs: tuple[tuple[str, str], ...] = SCENARIO_CROPS
     page: str = "table4"
     robots: tuple[str, ...] = ()
