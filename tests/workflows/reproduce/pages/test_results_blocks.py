@@ -45,6 +45,9 @@ def test_the_readme_block_beside_docs_is_rewritten_from_the_run(tmp_path: Path) 
     other.mkdir()
     write_results_md(other / "results.md", CONFIGS["medium"], RunState(), other)
     assert readme.read_text() == text
+    # So does another page in docs/ (a smaller run's, beside the headline's).
+    write_results_md(tmp_path / "docs" / "results-medium.md", CONFIGS["medium"], RunState(), tmp_path)
+    assert readme.read_text() == text
 
 
 def test_the_readme_block_names_each_rows_split_rule(tmp_path: Path) -> None:

@@ -222,6 +222,10 @@ def _stage_hours(step: str, seconds: float, entry: StageRecord | None, sittings:
     return f"{step} {one:.2f} h ({len(sittings)} sittings, each doing it whole: {seconds / 3600:.2f} h in all)"
 
 
+#: The page whose run the README's Table 4 block and docs/benchmark.md's run block show.
+HEADLINE_PAGE = "results.md"
+
+
 def write_blocks_beside(
     page: Path,
     config: ReproduceConfig,
@@ -232,8 +236,10 @@ def write_blocks_beside(
 ) -> None:
     """Rewrite the README's and docs/benchmark.md's blocks of a results page in a project's ``docs/``.
 
-    A page written elsewhere (a work folder) leaves both alone, as do a page whose README or
-    benchmark.md has no such block and a page of a run under another split rule than ``scenes``.
+    Only the headline page, ``docs/results.md``, writes them: a page written elsewhere (a work
+    folder), another page in ``docs/`` (a smaller run's beside it), a page whose README or
+    benchmark.md has no such block and a page of a run under another split rule than ``scenes``
+    leave both alone.
 
     Args:
         page: The results page just written.
@@ -247,8 +253,8 @@ def write_blocks_beside(
 
     folder = Path(page).absolute().parent
     # The blocks are the headline run's, under the paper's reading (scenes): a page of another
-    # rule's run stands beside docs/results.md and leaves them alone.
-    if folder.name != "docs" or config.split_rule != "scenes":
+    # rule's run, or of another run, stands beside docs/results.md and leaves them alone.
+    if folder.name != "docs" or Path(page).name != HEADLINE_PAGE or config.split_rule != "scenes":
         return
     for target, marker, text in (
         (folder.parent / "README.md", README_MARKER, lambda: readme_block(config, state, out, beside)),
