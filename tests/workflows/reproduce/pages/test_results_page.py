@@ -221,6 +221,14 @@ def test_the_page_shows_what_each_policy_does(tmp_path: Path, sp_root: Path, one
     ):
         assert f"(images/{picture})" in text and (tmp_path / "docs" / "images" / picture).is_file()
     assert "PPO" not in text  # this run trained A2C only
+    # Another run's page beside it (a smaller run's, a split rule's) draws its own pictures and
+    # leaves this page's alone.
+    drawn = {p.name: p.read_bytes() for p in (tmp_path / "docs" / "images").iterdir()}
+    other = write_results_md(tmp_path / "docs" / "results-medium.md", CONFIGS["medium"], state, tmp_path).read_text()
+    for picture in drawn:
+        own = picture.replace("results-", "results-medium-", 1)
+        assert f"(images/{own})" in other and (tmp_path / "docs" / "images" / own).is_file()
+        assert (tmp_path / "docs" / "images" / picture).read_bytes() == drawn[picture]
 
 
 def test_a_run_with_ppo_shows_its_row_gap_settings_and_stage(tmp_path: Path, sp_root: Path, one_thread: None) -> None:

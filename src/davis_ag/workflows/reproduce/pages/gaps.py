@@ -117,7 +117,7 @@ def scene_gap_figure(scenario: str, result: EvaluationResults, gaps: dict[str, P
 
     if not gaps:
         return None
-    target = page.parent / "images" / f"results-{GROUPS[scenario]}-scene-gaps.png"
+    target = page.parent / "images" / f"{page.stem}-{GROUPS[scenario]}-scene-gaps.png"
     split = result.protocol.split
     plot_scene_gaps(
         {learner: gap.model_dump() for learner, gap in gaps.items()}, target, f"{GROUPS[scenario]}, {split} split"

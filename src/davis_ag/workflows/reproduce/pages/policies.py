@@ -247,7 +247,7 @@ def action_figure(scenario: str, out: Path | None, page: Path) -> str | None:
     results = load_json_object(out / "results" / f"{GROUPS[scenario]}.json") if out else {}
     if not results.get("policies"):
         return None
-    target = page.parent / "images" / f"results-{GROUPS[scenario]}-actions"
+    target = page.parent / "images" / f"{page.stem}-{GROUPS[scenario]}-actions"
     try:
         plot_actions(results, target, formats=("png",), source=f"{GROUPS[scenario]}.json")
     except (UserError, KeyError, TypeError):
@@ -290,7 +290,7 @@ def learning_curve_section(
     title = "A2C learning curve" if alone else "Learning curves"
     if not records:
         return []
-    target = page.parent / "images" / "results-learning-curve"
+    target = page.parent / "images" / f"{page.stem}-learning-curve"
     try:
         plotted = plot_learning_curve(
             records, target, formats=("png",), references=train_split_references(results or {})
