@@ -202,9 +202,9 @@ def configured(args: argparse.Namespace) -> ReproduceConfig:
         overrides["split_rule"] = args.split_rule
     if args.learners is not None:
         if config.page != "table4":
+            table4 = ", ".join(name for name, c in CONFIGS.items() if c.page == "table4")
             raise UserError(
-                f"--learners: the {config.name} run chooses its own learners; it goes with a Table 4 run "
-                "(small, medium, paper-scale)"
+                f"--learners: the {config.name} run chooses its own learners; it goes with a Table 4 run ({table4})"
             )
         overrides["learners"] = tuple(args.learners)
     return replace(config, **overrides)
